@@ -1,0 +1,261 @@
+#include "mesh.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <unordered_map>
+
+namespace contact::mesh {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+
+double cross(const Point& a, const Point& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+// Node parameters in [0, 1] for n elements; grading `ratio` = largest / smallest element, smallest at t = 0
+// if `small_at_start`, else at t = 1. ratio == 1 (or n == 1) gives uniform spacing.
+std::vector<double> graded_parameters(int n, double ratio, bool small_at_start) {
+  std::vector<double> sizes(static_cast<size_t>(n), 1.0);
+  if (n > 1 && ratio != 1.0) {
+    const double q = std::pow(ratio, 1.0 / (n - 1));
+    for (int i = 0; i < n; ++i) sizes[static_cast<size_t>(i)] = std::pow(q, i);
+    if (!small_at_start) std::reverse(sizes.begin(), sizes.end());
+  }
+  std::vector<double> t(static_cast<size_t>(n) + 1, 0.0);
+  double total = 0.0;
+  for (double s : sizes) total += s;
+  for (int i = 0; i < n; ++i) t[static_cast<size_t>(i) + 1] = t[static_cast<size_t>(i)] + sizes[static_cast<size_t>(i)] / total;
+  t.back() = 1.0;
+  return t;
+}
+}  // namespace
+
+Point Curve::between(const Point& p, const Point& q, double t) const {
+  switch (kind) {
+    case Kind::line:
+      return p + t * (q - p);
+    case Kind::parabola: {
+      const double x = p.x() + t * (q.x() - p.x());
+      return {x, a * x * x + b * x + c};
+    }
+    case Kind::arc: {
+      const double tp = std::atan2(p.y() - center.y(), p.x() - center.x());
+      const double tq = std::atan2(q.y() - center.y(), q.x() - center.x());
+      double d = tq - tp;
+      while (d > kPi) d -= 2 * kPi;
+      while (d <= -kPi) d += 2 * kPi;
+      const double th = tp + t * d;
+      return center + radius * Point(std::cos(th), std::sin(th));
+    }
+  }
+  return p;
+}
+
+std::optional<std::string> fit_curve(Curve& curve, const Point& p, const Point& q) {
+  const double scale = std::max({1.0, p.norm(), q.norm()});
+  if (curve.kind == Curve::Kind::parabola) {
+    if (!std::isfinite(curve.a)) return "the parabola coefficient a must be finite";
+    if (std::abs(q.x() - p.x()) <= 1e-12 * scale)
+      return "a parabola edge y = a x^2 + b x + c needs its two end corners at different x";
+    curve.b = ((q.y() - curve.a * q.x() * q.x()) - (p.y() - curve.a * p.x() * p.x())) / (q.x() - p.x());
+    curve.c = p.y() - curve.a * p.x() * p.x() - curve.b * p.x();
+    return std::nullopt;
+  }
+  if (curve.kind == Curve::Kind::arc) {
+    if (!(curve.radius > 0)) return "the arc radius must be positive";
+    const double dp = (p - curve.center).norm(), dq = (q - curve.center).norm();
+    const double tol = 1e-6 * curve.radius;
+    if (std::abs(dp - curve.radius) > tol || std::abs(dq - curve.radius) > tol) {
+      std::ostringstream os;
+      os << "the edge's end corners are at distances " << dp << " and " << dq << " from the arc centre, not at the radius "
+         << curve.radius;
+      return os.str();
+    }
+    const Point a = p - curve.center, b = q - curve.center;
+    if (cross(a, b) == 0.0 && a.dot(b) < 0) return "the arc's end corners are diametrically opposite: the arc is ambiguous";
+    return std::nullopt;
+  }
+  return std::nullopt;
+}
+
+std::vector<int> Mesh::edge_set_nodes(const std::string& name) const {
+  auto it = edge_sets.find(name);
+  if (it == edge_sets.end() || it->second.empty()) return {};
+  std::vector<int> out;
+  for (const auto& e : it->second) out.push_back(edge_nodes(e)[0]);
+  out.push_back(edge_nodes(it->second.back())[1]);
+  return out;
+}
+
+double Mesh::cell_area(int cell) const {
+  const auto& c = cells[static_cast<size_t>(cell)];
+  double a = 0.0;
+  for (size_t k = 0; k < 4; ++k) a += cross(nodes[static_cast<size_t>(c[k])], nodes[static_cast<size_t>(c[(k + 1) % 4])]);
+  return 0.5 * a;
+}
+
+Eigen::Vector2d Mesh::bbox_min() const {
+  Eigen::Vector2d m = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+  for (const auto& p : nodes) m = m.cwiseMin(p);
+  return m;
+}
+
+Eigen::Vector2d Mesh::bbox_max() const {
+  Eigen::Vector2d m = Eigen::Vector2d::Constant(-std::numeric_limits<double>::infinity());
+  for (const auto& p : nodes) m = m.cwiseMax(p);
+  return m;
+}
+
+Mesh make_block(const BlockSpec& spec) {
+  const int nx = spec.nx, ny = spec.ny;
+  const auto& P = spec.corners;
+  auto curve_of = [&](const char* name) {
+    auto it = spec.curves.find(name);
+    return it == spec.curves.end() ? Curve{} : it->second;
+  };
+  auto grading_of = [&](const char* name) {
+    auto it = spec.grading.find(name);
+    return it == spec.grading.end() ? 1.0 : it->second;
+  };
+  const Curve bottom = curve_of("bottom"), right = curve_of("right"), top = curve_of("top"), left = curve_of("left");
+
+  // Parameters: a ratio towards "left" puts the small elements at xi = 0, towards "right" at xi = 1.
+  std::vector<double> xi = spec.grading.count("right") ? graded_parameters(nx, grading_of("right"), false)
+                                                       : graded_parameters(nx, grading_of("left"), true);
+  std::vector<double> eta = spec.grading.count("top") ? graded_parameters(ny, grading_of("top"), false)
+                                                      : graded_parameters(ny, grading_of("bottom"), true);
+
+  Mesh m;
+  m.nodes.resize(static_cast<size_t>((nx + 1) * (ny + 1)));
+  auto node = [nx](int i, int j) { return j * (nx + 1) + i; };
+  for (int j = 0; j <= ny; ++j) {
+    for (int i = 0; i <= nx; ++i) {
+      const double s = xi[static_cast<size_t>(i)], t = eta[static_cast<size_t>(j)];
+      // Transfinite (Coons) interpolation of the four edges.
+      const Point B = bottom.between(P[0], P[1], s), T = top.between(P[3], P[2], s);
+      const Point L = left.between(P[0], P[3], t), R = right.between(P[1], P[2], t);
+      const Point bilinear = (1 - s) * (1 - t) * P[0] + s * (1 - t) * P[1] + s * t * P[2] + (1 - s) * t * P[3];
+      Point x = (1 - t) * B + t * T + (1 - s) * L + s * R - bilinear;
+      // Boundary nodes exactly on their curves (the formula reproduces them up to round-off; make it exact).
+      if (j == 0) x = B;
+      if (j == ny) x = T;
+      if (i == 0) x = L;
+      if (i == nx) x = R;
+      m.nodes[static_cast<size_t>(node(i, j))] = x;
+    }
+  }
+  m.cells.reserve(static_cast<size_t>(nx * ny));
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) m.cells.push_back({node(i, j), node(i + 1, j), node(i + 1, j + 1), node(i, j + 1)});
+  m.level.assign(m.cells.size(), 0);
+  auto cell = [nx](int i, int j) { return j * nx + i; };
+  auto& b = m.edge_sets["bottom"];
+  for (int i = 0; i < nx; ++i) b.push_back({cell(i, 0), 0});
+  auto& r = m.edge_sets["right"];
+  for (int j = 0; j < ny; ++j) r.push_back({cell(nx - 1, j), 1});
+  auto& tp = m.edge_sets["top"];
+  for (int i = nx - 1; i >= 0; --i) tp.push_back({cell(i, ny - 1), 2});
+  auto& l = m.edge_sets["left"];
+  for (int j = ny - 1; j >= 0; --j) l.push_back({cell(0, j), 3});
+  for (const auto& [name, c] : spec.curves)
+    if (c.kind != Curve::Kind::line) m.edge_curves[name] = c;
+  return m;
+}
+
+std::optional<std::string> add_edge_set(Mesh& m, const std::string& name, const std::vector<std::array<int, 2>>& pairs) {
+  // Sides of all cells by their unordered node pair.
+  std::map<std::pair<int, int>, std::vector<EdgeRef>> sides;
+  for (int c = 0; c < m.num_cells(); ++c)
+    for (int s = 0; s < 4; ++s) {
+      auto n = m.edge_nodes({c, s});
+      sides[{std::min(n[0], n[1]), std::max(n[0], n[1])}].push_back({c, s});
+    }
+  std::vector<EdgeRef> refs;
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    const auto [i, j] = pairs[k];
+    auto it = sides.find({std::min(i, j), std::max(i, j)});
+    std::ostringstream os;
+    if (it == sides.end()) {
+      os << "pair " << k << " [" << i << ", " << j << "] is not a side of any quad";
+      return os.str();
+    }
+    if (it->second.size() != 1) {
+      os << "pair " << k << " [" << i << ", " << j << "] is an interior side shared by two quads, not a boundary edge";
+      return os.str();
+    }
+    refs.push_back(it->second.front());
+  }
+  // Order into a chain along the boundary direction when the set is one open chain.
+  std::unordered_map<int, size_t> by_first;
+  std::unordered_map<int, int> second_count;
+  for (size_t k = 0; k < refs.size(); ++k) {
+    auto n = m.edge_nodes(refs[k]);
+    by_first[n[0]] = k;
+    second_count[n[1]]++;
+  }
+  int start = -1, starts = 0;
+  for (const auto& [first, k] : by_first)
+    if (!second_count.count(first)) {
+      start = first;
+      ++starts;
+    }
+  if (starts == 1 && by_first.size() == refs.size()) {
+    std::vector<EdgeRef> chain;
+    int cur = start;
+    while (chain.size() < refs.size()) {
+      auto it = by_first.find(cur);
+      if (it == by_first.end()) break;
+      chain.push_back(refs[it->second]);
+      cur = m.edge_nodes(refs[it->second])[1];
+    }
+    if (chain.size() == refs.size()) refs = std::move(chain);
+  }
+  m.edge_sets[name] = std::move(refs);
+  return std::nullopt;
+}
+
+std::vector<std::string> check_cells(const Mesh& m) {
+  std::vector<std::string> problems;
+  for (int c = 0; c < m.num_cells(); ++c) {
+    const auto& q = m.cells[static_cast<size_t>(c)];
+    std::ostringstream os;
+    bool bad_index = false;
+    for (int k = 0; k < 4; ++k)
+      if (q[static_cast<size_t>(k)] < 0 || q[static_cast<size_t>(k)] >= m.num_nodes()) bad_index = true;
+    if (bad_index) {
+      os << "cell " << c << " refers to a node index outside 0.." << m.num_nodes() - 1;
+      problems.push_back(os.str());
+      continue;
+    }
+    const double area = m.cell_area(c);
+    double scale = 0.0;
+    for (int k = 0; k < 4; ++k)
+      scale = std::max(scale, (m.nodes[static_cast<size_t>(q[static_cast<size_t>((k + 1) % 4)])] -
+                               m.nodes[static_cast<size_t>(q[static_cast<size_t>(k)])]).squaredNorm());
+    if (!(scale > 0) || std::abs(area) <= 1e-12 * scale) {
+      os << "cell " << c << " is degenerate (zero area)";
+      problems.push_back(os.str());
+      continue;
+    }
+    if (area < 0) {
+      os << "cell " << c << " is inverted: its nodes run clockwise (they must be counter-clockwise)";
+      problems.push_back(os.str());
+      continue;
+    }
+    // The bilinear map's Jacobian is positive everywhere iff it is positive at the four corners.
+    for (int k = 0; k < 4; ++k) {
+      const Point& x = m.nodes[static_cast<size_t>(q[static_cast<size_t>(k)])];
+      const Point& next = m.nodes[static_cast<size_t>(q[static_cast<size_t>((k + 1) % 4)])];
+      const Point& prev = m.nodes[static_cast<size_t>(q[static_cast<size_t>((k + 3) % 4)])];
+      if (cross(next - x, prev - x) <= 1e-12 * scale) {
+        os << "cell " << c << " is degenerate or not convex at its local node " << k << " (node " << q[static_cast<size_t>(k)]
+           << ")";
+        problems.push_back(os.str());
+        break;
+      }
+    }
+  }
+  return problems;
+}
+
+}  // namespace contact::mesh

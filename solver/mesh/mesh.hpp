@@ -1,0 +1,98 @@
+// Quadrilateral meshes of one body: plain arrays plus named boundary edge sets.
+//
+// Layering: this module knows nothing of finite elements or contact. A Mesh is a value type; copies are
+// independent. Node coordinates are in the user's length unit.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <array>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace contact::mesh {
+
+using Point = Eigen::Vector2d;
+
+// One side of a cell: side s joins the cell's local nodes s and (s + 1) % 4, so with counter-clockwise cells
+// the body lies to the left of the side's direction and its outward normal points to the right.
+struct EdgeRef {
+  int cell = -1;
+  int side = -1;
+  bool operator==(const EdgeRef& o) const { return cell == o.cell && side == o.side; }
+};
+
+// The true geometry of a block edge, so that refinement can put new boundary nodes on the curve, not on the
+// chord. A straight edge needs no curve.
+struct Curve {
+  enum class Kind { line, parabola, arc };
+  Kind kind = Kind::line;
+  // parabola: the graph y(x) = a x^2 + b x + c through the edge's two end corners (b, c follow from them).
+  double a = 0.0, b = 0.0, c = 0.0;
+  // arc: circle of this centre and radius, the shorter arc between the end corners.
+  Point center = Point::Zero();
+  double radius = 0.0;
+
+  // The point of the curve between p and q (both on the curve) at parameter t in [0, 1]: for a parabola
+  // t runs linearly in x, for an arc linearly in angle, for a line along the chord.
+  Point between(const Point& p, const Point& q, double t) const;
+};
+
+struct Mesh {
+  std::vector<Point> nodes;
+  std::vector<std::array<int, 4>> cells;  // node indices, counter-clockwise
+  std::vector<int> level;                  // refinement level per cell (0 = initial mesh)
+  // Boundary edge sets by name, each ordered along the edge (consecutive entries share a node).
+  std::map<std::string, std::vector<EdgeRef>> edge_sets;
+  // True geometry of named edges that are curved (block edges); absent means straight.
+  std::map<std::string, Curve> edge_curves;
+
+  int num_nodes() const { return static_cast<int>(nodes.size()); }
+  int num_cells() const { return static_cast<int>(cells.size()); }
+  // The two node indices of a side, in the cell's counter-clockwise direction.
+  std::array<int, 2> edge_nodes(EdgeRef e) const {
+    const auto& c = cells[static_cast<size_t>(e.cell)];
+    return {c[static_cast<size_t>(e.side)], c[static_cast<size_t>((e.side + 1) % 4)]};
+  }
+  // Nodes of an edge set in order along the set (n_edges + 1 nodes for an open chain). Empty if unknown.
+  std::vector<int> edge_set_nodes(const std::string& name) const;
+  // Area of a cell (shoelace formula; positive for counter-clockwise cells).
+  double cell_area(int cell) const;
+  Eigen::Vector2d bbox_min() const;
+  Eigen::Vector2d bbox_max() const;
+};
+
+// ---------------------------------------------------------------------------------------------------------
+// Block generator: one quadrilateral patch mapped by transfinite interpolation from its four (possibly
+// curved) edges. Corners are counter-clockwise; edges are bottom (corner 0 -> 1), right (1 -> 2),
+// top (3 -> 2 in parameter direction, i.e. traversed 2 -> 3 along the boundary), left (0 -> 3 likewise).
+struct BlockSpec {
+  std::array<Point, 4> corners;
+  int nx = 1, ny = 1;
+  // Optional curves per edge name ("bottom", "right", "top", "left").
+  std::map<std::string, Curve> curves;
+  // Grading: ratio of the largest to the smallest element size across the block, smallest at the named edge.
+  // Keys "bottom" or "top" grade in y (the eta direction), "left" or "right" in x (xi); at most one per direction.
+  std::map<std::string, double> grading;
+};
+
+// Builds the block mesh with edge sets "bottom", "right", "top", "left" (each ordered counter-clockwise along
+// the boundary). Assumes the spec was validated (nx, ny >= 1, ratios > 0, corners on their curves).
+Mesh make_block(const BlockSpec& spec);
+
+// Completes a parabola or arc Curve for the edge from p to q: for a parabola, fills b and c from a; returns
+// an error message if the ends do not fit the curve (equal x for a parabola, not on the circle for an arc).
+std::optional<std::string> fit_curve(Curve& curve, const Point& p, const Point& q);
+
+// Adds a named edge set from node pairs (either orientation) of an explicit mesh: each pair must be a
+// boundary side of exactly one cell. The set is ordered into a chain when it is one. Returns an error message
+// naming the offending pair (by its index in `pairs`) if a pair is not a boundary side.
+std::optional<std::string> add_edge_set(Mesh& m, const std::string& name,
+                                        const std::vector<std::array<int, 2>>& pairs);
+
+// Mesh sanity checks used by validation. Each problem is a message naming the cell or edge.
+std::vector<std::string> check_cells(const Mesh& m);
+
+}  // namespace contact::mesh

@@ -1,0 +1,104 @@
+// A contact problem as plain data: what job::parse produces from a job JSON and what solve() consumes.
+//
+// Units are the user's (the examples use cm and MPa). Sign conventions, stated once here:
+//  * displacements and tractions are vectors in the global x-y frame;
+//  * a traction {"normal": p} is a pressure: p > 0 pushes into the body (t = -p n, n the outward normal);
+//  * contact pressure is reported positive in compression (the paper's sigma_n = -pressure <= 0).
+#pragma once
+
+#include "mesh/mesh.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace contact {
+
+enum class Plane { strain, stress };
+
+struct Model {
+  Plane plane = Plane::strain;
+  double thickness = 1.0;  // out-of-plane thickness; forces are per this thickness (plane stress only)
+};
+
+struct Material {
+  double E = 0.0;   // Young's modulus, > 0
+  double nu = 0.0;  // Poisson's ratio, in (-1, 0.5)
+};
+
+// One boundary condition on a named edge of a body. Edges without a condition are traction-free.
+struct BoundaryCondition {
+  enum class Kind { displacement, traction, free };
+  std::string edge;
+  Kind kind = Kind::free;
+  // displacement: only the given components are prescribed
+  std::optional<double> ux, uy;
+  // traction: either a vector (force per length) or a normal pressure (positive = pushing into the body)
+  bool normal_pressure = false;
+  Eigen::Vector2d traction = Eigen::Vector2d::Zero();
+  double pressure = 0.0;
+};
+
+struct Body {
+  std::string name;
+  Material material;
+  mesh::Mesh mesh;
+  std::vector<BoundaryCondition> boundary;
+  Eigen::Vector2d body_force = Eigen::Vector2d::Zero();  // force per volume (optional; zero in the paper)
+};
+
+// The initial gap d(x) at a slave point x: the geometric normal distance to the master edge (unless switched
+// off) plus optional analytic terms, e.g. the paper's d = r0 (x - x0)^2.
+struct GapSpec {
+  bool geometric = true;
+  double constant = 0.0;                       // added everywhere
+  std::optional<double> parabola_r0;           // adds r0 (x - x0)^2, x the slave point's x coordinate
+  double parabola_x0 = 0.0;
+};
+
+struct ContactPair {
+  std::string name;      // "slave_body.edge~master_body.edge" unless the job names it
+  int slave_body = -1;   // index into Problem::bodies
+  std::string slave_edge;
+  int master_body = -1;
+  std::string master_edge;
+  GapSpec gap;
+};
+
+// theta = c * length / E_pair unless theta is given. E_pair is the harmonic mean 2 E1 E2 / (E1 + E2) of the
+// pair's Young's moduli (E itself for equal bodies); length defaults to the smaller of the two bodies' extents
+// along the contact normal (the body height in the paper).
+struct PenaltySpec {
+  std::optional<double> theta;
+  double c = 0.05;
+  std::optional<double> length;
+};
+
+enum class Method { neumann, monolithic };
+enum class Criterion { paper, residual };
+enum class InitialGuess { zero, elastic_layer };
+
+struct SolverSettings {
+  Method method = Method::neumann;
+  PenaltySpec penalty;
+  double gamma = 0.02;        // relaxation of (17)
+  double tolerance = 0.0015;  // eps of the chosen criterion
+  Criterion criterion = Criterion::paper;
+  int max_iterations = 2000;
+  InitialGuess initial_guess = InitialGuess::elastic_layer;
+  int threads = 0;            // worker threads for the per-body solves; 0 = one per body up to the cores
+};
+
+struct Problem {
+  std::string name;
+  Model model;
+  std::vector<Body> bodies;
+  std::vector<ContactPair> contacts;
+  SolverSettings solver;
+  nlohmann::json submitted;   // the job JSON as submitted
+  nlohmann::json normalized;  // the same with every default filled in
+};
+
+}  // namespace contact
