@@ -1,0 +1,75 @@
+// One elastic body on a fixed mesh: assembly, constraints, one CHOLMOD factorisation, many solves.
+//
+// The DDM changes only the right-hand side between iterations (paper eq. (16)), so the reduced stiffness
+// T^T K T is factorised once per mesh and every iteration costs one forward/back substitution per body.
+// Owns copies of nothing but its matrices: the Body and Model passed in must outlive the solver.
+#pragma once
+
+#include "../problem.hpp"
+#include "constraints.hpp"
+#include "elasticity.hpp"
+
+#include <Eigen/CholmodSupport>
+#include <Eigen/SparseCore>
+
+#include <memory>
+#include <string>
+
+namespace contact::fem {
+
+struct StressFields {
+  Eigen::MatrixX4d cell;  // mean over the Gauss points: sxx, syy, sxy, szz
+  Eigen::MatrixX4d node;  // Gauss values extrapolated to the corners, averaged over the cells at a node
+  Eigen::VectorXd von_mises_cell;
+};
+
+class BodySolver {
+ public:
+  // Sets up constraints, assembles and factorises. Never throws for a singular or indefinite matrix: check
+  // ok() and error().
+  BodySolver(const Body& body, const Model& model);
+
+  bool ok() const { return error_.empty(); }
+  const std::string& error() const { return error_; }
+
+  int n_dofs() const { return constraints_.n_dofs(); }
+  int n_free() const { return constraints_.n_free(); }
+
+  // Displacements (all dofs) under the body's own loads plus `extra_load` (full dof vector, e.g. contact
+  // forces). One back-substitution; safe to call concurrently for different BodySolver objects.
+  Eigen::VectorXd solve(const Eigen::VectorXd& extra_load) const;
+  // The same for a load that is already reduced (T^T f) and without the body's own loads/prescribed values:
+  // the linear response x = K_red^{-1} b. Used by the interface methods.
+  Eigen::VectorXd solve_reduced(const Eigen::VectorXd& reduced_rhs) const;
+
+  // Support reactions: the force the supports exert on the body, K u - f_ext - extra_load, kept at the
+  // prescribed (Dirichlet) dofs and zero elsewhere.
+  Eigen::VectorXd reactions(const Eigen::VectorXd& u, const Eigen::VectorXd& extra_load) const;
+
+  StressFields stresses(const Eigen::VectorXd& u) const;
+
+  const Constraints& constraints() const { return constraints_; }
+  const Eigen::SparseMatrix<double>& stiffness() const { return K_; }           // all dofs
+  const Eigen::SparseMatrix<double>& reduced_stiffness() const { return K_red_; }
+  const Eigen::VectorXd& external_load() const { return f_ext_; }               // all dofs
+  const Eigen::VectorXd& reduced_rhs() const { return rhs_base_; }              // T^T (f_ext - K g)
+  const Elasticity& elasticity() const { return elasticity_; }
+  double factorization_seconds() const { return factorization_seconds_; }
+  double assembly_seconds() const { return assembly_seconds_; }
+
+ private:
+  void setup_constraints();
+  void assemble_system();
+  void factorize();
+
+  const Body& body_;
+  Elasticity elasticity_;
+  Constraints constraints_;
+  Eigen::SparseMatrix<double> K_, K_red_;
+  Eigen::VectorXd f_ext_, rhs_base_;
+  std::unique_ptr<Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower>> factor_;
+  std::string error_;
+  double factorization_seconds_ = 0.0, assembly_seconds_ = 0.0;
+};
+
+}  // namespace contact::fem
