@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <sstream>
+#include <stdexcept>
 
 namespace contact::fem {
 
@@ -13,14 +14,14 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }
 }  // namespace
 
-BodySolver::BodySolver(const Body& body, const Model& model)
+BodySolver::BodySolver(const Body& body, const Model& model, bool factorize_now)
     : body_(body), elasticity_(make_elasticity(body.material, model)), constraints_(2 * body.mesh.num_nodes()) {
   const auto t0 = std::chrono::steady_clock::now();
   setup_constraints();
   if (!ok()) return;
   assemble_system();
   assembly_seconds_ = seconds_since(t0);
-  factorize();
+  if (factorize_now) factorize();
 }
 
 void BodySolver::setup_constraints() {
@@ -115,11 +116,13 @@ void BodySolver::factorize() {
 
 Eigen::VectorXd BodySolver::solve_reduced(const Eigen::VectorXd& reduced_rhs) const {
   if (n_free() == 0) return Eigen::VectorXd::Zero(0);
+  if (!factor_) throw std::logic_error("BodySolver::solve_reduced called on a solver built without factorisation");
   return factor_->solve(reduced_rhs);
 }
 
 Eigen::VectorXd BodySolver::solve(const Eigen::VectorXd& extra_load) const {
   if (n_free() == 0) return constraints_.g();
+  if (!factor_) throw std::logic_error("BodySolver::solve called on a solver built without factorisation");
   Eigen::VectorXd rhs = rhs_base_;
   if (extra_load.size() > 0) rhs.noalias() += constraints_.T().transpose() * extra_load;
   return constraints_.expand(factor_->solve(rhs));

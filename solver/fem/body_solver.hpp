@@ -27,7 +27,8 @@ class BodySolver {
  public:
   // Sets up constraints, assembles and factorises. Never throws for a singular or indefinite matrix: check
   // ok() and error().
-  BodySolver(const Body& body, const Model& model);
+  // With factorize = false only assembly is done (for methods that factorise a coupled system instead).
+  BodySolver(const Body& body, const Model& model, bool factorize = true);
 
   bool ok() const { return error_.empty(); }
   const std::string& error() const { return error_; }
