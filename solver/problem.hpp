@@ -59,7 +59,7 @@ struct GapSpec {
 };
 
 struct ContactPair {
-  std::string name;      // "slave_body.edge~master_body.edge" unless the job names it
+  std::string name;      // "slave_body.edge-master_body.edge" unless the job names it
   int slave_body = -1;   // index into Problem::bodies
   std::string slave_edge;
   int master_body = -1;

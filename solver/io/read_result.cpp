@@ -1,0 +1,225 @@
+// read_result: HDF5 result file -> ResultFile (the inverse of write_result, for tests and tools).
+#include "result_file.hpp"
+
+#include "h5.hpp"
+
+#include <stdexcept>
+
+namespace contact::io {
+
+namespace {
+
+using h5::Handle;
+
+template <class T>
+using Matrix = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>;
+
+// A rows x cols dataset (cols checked unless expected_cols < 0) into a column-major Eigen matrix.
+template <class T>
+Matrix<T> read_matrix(hid_t loc, const std::string& name, Eigen::Index expected_cols = -1) {
+  std::vector<hsize_t> dims;
+  const std::vector<T> data = h5::read_dataset<T>(loc, name, 2, dims);
+  const auto rows = static_cast<Eigen::Index>(dims[0]);
+  const auto cols = static_cast<Eigen::Index>(dims[1]);
+  if (expected_cols >= 0 && cols != expected_cols)
+    throw std::runtime_error("dataset '" + h5::object_name(loc) + "/" + name + "' has " + std::to_string(cols) +
+                             " columns, expected " + std::to_string(expected_cols));
+  using RowMajor = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  return Eigen::Map<const RowMajor>(data.data(), rows, cols);
+}
+
+template <class T>
+Eigen::Matrix<T, Eigen::Dynamic, 1> read_column(hid_t loc, const std::string& name) {
+  const std::vector<T> data = h5::read_vector<T>(loc, name);
+  return Eigen::Map<const Eigen::Matrix<T, Eigen::Dynamic, 1>>(data.data(), static_cast<Eigen::Index>(data.size()));
+}
+
+// A dataset of any rank <= 2 as a matrix with one column per component.
+Eigen::MatrixXd read_components(hid_t loc, const std::string& name) {
+  const auto shape = h5::dataset_shape(loc, name);
+  if (shape.size() == 1) return read_column<double>(loc, name);
+  return read_matrix<double>(loc, name);
+}
+
+void read_root(hid_t file, ResultFile& r) {
+  if (!h5::has_attribute(file, "format"))
+    throw std::runtime_error(std::string("not a result file: the root has no 'format' attribute (expected '") +
+                             kFormatName + "')");
+  r.format = h5::read_string_attribute(file, "format");
+  if (r.format != kFormatName)
+    throw std::runtime_error("not a result file: format is '" + r.format + "', expected '" + kFormatName + "'");
+  r.format_version = h5::read_attribute<std::int32_t>(file, "format_version");
+  if (r.format_version > kFormatVersion)
+    throw std::runtime_error("format_version " + std::to_string(r.format_version) +
+                             " is newer than this reader's " + std::to_string(kFormatVersion));
+  r.solver_version = h5::read_string_attribute(file, "solver_version");
+  r.job_id = h5::read_string_attribute(file, "job_id");
+  r.job_name = h5::read_string_attribute(file, "name");
+  r.created = h5::read_string_attribute(file, "created");
+  r.wall_seconds = h5::read_attribute<double>(file, "wall_seconds");
+  r.converged = h5::read_attribute<std::int32_t>(file, "converged") != 0;
+  r.stop_reason = h5::read_string_attribute(file, "stop_reason");
+  r.message = h5::read_string_attribute(file, "message");
+  r.iterations = h5::read_attribute<std::int32_t>(file, "iterations");
+  r.method = h5::read_string_attribute(file, "method");
+}
+
+void read_input_and_provenance(hid_t file, ResultFile& r) {
+  Handle input = h5::open_group(file, "input");
+  r.job_json = h5::read_string_dataset(input, "job");
+  r.normalized_json = h5::read_string_dataset(input, "normalized");
+
+  Handle prov = h5::open_group(file, "provenance");
+  Provenance& p = r.provenance;
+  p.solver_version = h5::read_string_attribute(prov, "solver_version");
+  p.compiler = h5::read_string_attribute(prov, "compiler");
+  p.build_type = h5::read_string_attribute(prov, "build_type");
+  p.host = h5::read_string_attribute(prov, "host");
+  p.method = h5::read_string_attribute(prov, "method");
+  p.gamma = h5::read_attribute<double>(prov, "gamma");
+  p.setup_seconds = h5::read_attribute<double>(prov, "setup_seconds");
+  p.factorization_seconds = h5::read_attribute<double>(prov, "factorization_seconds");
+  p.wall_seconds = h5::read_attribute<double>(prov, "wall_seconds");
+  p.pair_names = h5::read_strings_dataset(prov, "pair_names");
+  p.theta = h5::read_vector<double>(prov, "theta");
+}
+
+void read_history(hid_t file, ResultFile& r) {
+  Handle history = h5::open_group(file, "history");
+  {
+    Handle g = h5::open_group(history, "iterations");
+    IterationHistory& h = r.history;
+    h.body_names = h5::read_strings_attribute(g, "body_names");
+    h.pair_names = h5::read_strings_attribute(g, "pair_names");
+    const auto nb = static_cast<Eigen::Index>(h.body_names.size());
+    const auto np = static_cast<Eigen::Index>(h.pair_names.size());
+    h.iteration = h5::read_vector<int>(g, "iteration");
+    h.paper_criterion = h5::read_vector<double>(g, "paper_criterion");
+    h.fixed_point_residual = h5::read_vector<double>(g, "fixed_point_residual");
+    h.elapsed_seconds = h5::read_vector<double>(g, "elapsed_seconds");
+    h.elements = read_matrix<int>(g, "elements", nb);
+    h.dofs = read_matrix<int>(g, "dofs", nb);
+    h.elements_refined = read_matrix<int>(g, "elements_refined", nb);
+    h.force = read_matrix<double>(g, "force", np);
+    h.max_pressure = read_matrix<double>(g, "max_pressure", np);
+    h.extent_begin = read_matrix<double>(g, "extent_begin", np);
+    h.extent_end = read_matrix<double>(g, "extent_end", np);
+    h.active_points = read_matrix<int>(g, "active_points", np);
+    h.changed_points = read_matrix<int>(g, "changed_points", np);
+    h.theta = read_matrix<double>(g, "theta", np);
+  }
+  {
+    Handle g = h5::open_group(history, "steps");
+    StepHistory& s = r.step_history;
+    s.body_names = h5::read_strings_attribute(g, "body_names");
+    const auto nb = static_cast<Eigen::Index>(s.body_names.size());
+    s.step = h5::read_vector<int>(g, "step");
+    s.iteration = h5::read_vector<int>(g, "iteration");
+    s.elements = read_matrix<int>(g, "elements", nb);
+    s.dofs = read_matrix<int>(g, "dofs", nb);
+  }
+}
+
+BodyField read_body(hid_t bodies, const std::string& name) {
+  Handle g = h5::open_group(bodies, name);
+  BodyField b;
+  b.name = name;
+  const Eigen::MatrixXd points = read_matrix<double>(g, "points", 2);
+  const Eigen::MatrixXi quads = read_matrix<int>(g, "quads", 4);
+  for (Eigen::Index i = 0; i < points.rows(); ++i) b.mesh.nodes.emplace_back(points(i, 0), points(i, 1));
+  for (Eigen::Index e = 0; e < quads.rows(); ++e)
+    b.mesh.cells.push_back({quads(e, 0), quads(e, 1), quads(e, 2), quads(e, 3)});
+  b.mesh.level = h5::read_vector<int>(g, "level");
+  b.displacement = read_matrix<double>(g, "displacement", 2);
+  b.stress_cell = read_matrix<double>(g, "stress_cell", 4);
+  b.stress_node = read_matrix<double>(g, "stress_node", 4);
+  b.von_mises_cell = read_column<double>(g, "von_mises");
+  if (h5::has_link(g, "indicator")) b.indicator_cell = read_column<double>(g, "indicator");
+  b.reaction = read_matrix<double>(g, "reaction", 2);
+  return b;
+}
+
+PairField read_pair(hid_t contacts, const std::string& name) {
+  Handle g = h5::open_group(contacts, name);
+  PairField p;
+  p.name = name;
+  p.slave_body = h5::read_string_attribute(g, "slave_body");
+  p.slave_edge = h5::read_string_attribute(g, "slave_edge");
+  p.master_body = h5::read_string_attribute(g, "master_body");
+  p.master_edge = h5::read_string_attribute(g, "master_edge");
+  p.theta = h5::read_attribute<double>(g, "theta");
+  p.force = h5::read_attribute<double>(g, "force");
+  p.position = read_matrix<double>(g, "position", 2);
+  p.arc_length = read_column<double>(g, "arc_length");
+  p.gap = read_column<double>(g, "gap");
+  p.normal_gap = read_column<double>(g, "normal_gap");
+  p.pressure = read_column<double>(g, "pressure");
+  p.penetration = read_column<double>(g, "penetration");
+  p.active = read_column<int>(g, "active");
+  return p;
+}
+
+void read_steps(hid_t file, ResultFile& r) {
+  Handle steps = h5::open_group(file, "steps");
+  const int count = h5::read_attribute<std::int32_t>(steps, "count");
+  for (int k = 0; k < count; ++k) {
+    Handle g = h5::open_group(steps, std::to_string(k));
+    Step s;
+    s.index = k;
+    s.iteration = h5::read_attribute<std::int32_t>(g, "iteration");
+    Handle bodies = h5::open_group(g, "bodies");
+    for (const auto& name : h5::read_strings_attribute(g, "body_names")) s.bodies.push_back(read_body(bodies, name));
+    Handle contacts = h5::open_group(g, "contacts");
+    for (const auto& name : h5::read_strings_attribute(g, "pair_names")) s.pairs.push_back(read_pair(contacts, name));
+    r.steps.push_back(std::move(s));
+  }
+}
+
+void read_vtkhdf(hid_t file, ResultFile& r) {
+  if (!h5::has_link(file, "VTKHDF")) return;
+  Handle v = h5::open_group(file, "VTKHDF");
+  VtkHdf& out = r.vtkhdf;
+  out.present = true;
+  out.version = h5::read_attribute_array<std::int64_t>(v, "Version");
+  out.type = h5::read_string_attribute(v, "Type");
+  const h5::StringTypeInfo info = h5::string_attribute_type(v, "Type");
+  out.type_storage.fixed_length = info.is_string && !info.variable_length;
+  out.type_storage.size = info.size;
+  out.type_storage.padding = info.padding == H5T_STR_NULLPAD    ? "nullpad"
+                             : info.padding == H5T_STR_NULLTERM ? "nullterm"
+                             : info.padding == H5T_STR_SPACEPAD ? "spacepad"
+                                                                : "";
+  out.number_of_points = h5::read_vector<std::int64_t>(v, "NumberOfPoints");
+  out.number_of_cells = h5::read_vector<std::int64_t>(v, "NumberOfCells");
+  out.number_of_connectivity_ids = h5::read_vector<std::int64_t>(v, "NumberOfConnectivityIds");
+  out.points = read_matrix<double>(v, "Points", 3);
+  out.connectivity = h5::read_vector<std::int64_t>(v, "Connectivity");
+  out.offsets = h5::read_vector<std::int64_t>(v, "Offsets");
+  out.types = h5::read_vector<std::uint8_t>(v, "Types");
+  for (const char* group : {"PointData", "CellData"}) {
+    if (!h5::has_link(v, group)) continue;
+    Handle g = h5::open_group(v, group);
+    auto& arrays = std::string(group) == "PointData" ? out.point_data : out.cell_data;
+    for (const auto& name : h5::link_names(g)) arrays[name] = read_components(g, name);
+  }
+}
+
+}  // namespace
+
+ResultFile read_result(const std::string& path) {
+  try {
+    h5::QuietErrors quiet;
+    Handle file = h5::open_file(path);
+    ResultFile r;
+    read_root(file, r);
+    read_input_and_provenance(file, r);
+    read_history(file, r);
+    read_steps(file, r);
+    read_vtkhdf(file, r);
+    return r;
+  } catch (const std::exception& e) {
+    throw std::runtime_error("cannot read result file '" + path + "': " + e.what());
+  }
+}
+
+}  // namespace contact::io

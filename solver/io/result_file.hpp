@@ -1,0 +1,121 @@
+// The HDF5 result file: writer, XDMF sidecar, and a reader for tests and tools.
+//
+// The layout (groups, dataset shapes, dtypes, units, sign conventions) is specified in docs/results-format.md;
+// change both together and bump kFormatVersion on any incompatible change.
+//
+// Thread safety: the functions may be called from several threads at once on different files (Debian's
+// libhdf5 is built thread-safe; HDF5 serialises the calls internally).
+#pragma once
+
+#include "../problem.hpp"
+#include "../result.hpp"
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace contact::io {
+
+inline constexpr const char* kFormatName = "contact-ddm-result";
+inline constexpr int kFormatVersion = 1;
+
+struct WriteInfo {
+  std::string job_id;   // "" for the CLI
+  std::string created;  // ISO 8601 UTC ("2024-05-01T12:00:00Z"); filled with the current time if empty
+  std::string host;     // filled with the machine's host name if empty
+};
+
+// Writes `result` of `problem` to `path` (name it *.hdf: ParaView 5.11 finds no reader for *.h5).
+// The file is written to "<path>.tmp", synced, then renamed over `path`, so a crash or an error never leaves a
+// partial file under the final name; on error the temporary file is removed.
+// Throws std::runtime_error naming the path and the failed step (HDF5's own message appended), and also when
+// `result` is inconsistent (a field whose row count is neither the mesh's nor 0, a history row with another
+// number of bodies or pairs, a body or pair name that cannot be an HDF5 link name).
+void write_result(const std::string& path, const Problem& problem, const Result& result, const WriteInfo& info = {});
+
+// Writes the XDMF 3 sidecar describing every step of `result` as a time series (Time = step index), each step a
+// spatial collection of one grid per body. Data items reference "<hdf_file_name>:/steps/<k>/bodies/<name>/...",
+// so `hdf_file_name` should be the result file's name relative to the sidecar's directory (normally the bare
+// file name: both are written side by side). Same temporary-file-then-rename discipline and errors as above.
+void write_xdmf(const std::string& xmf_path, const std::string& hdf_file_name, const Result& result);
+
+// The sidecar's conventional name next to a result file: "x.hdf" -> "x.xmf" (other names get ".xmf" appended).
+std::string xdmf_path_for(const std::string& hdf_path);
+
+// ---------------------------------------------------------------------------------------------------------
+// What read_result returns: the file's contents in the solver's own types where one exists.
+
+struct Provenance {
+  std::string solver_version, compiler, build_type, host, method;
+  double gamma = 0.0;
+  double setup_seconds = 0.0, factorization_seconds = 0.0, wall_seconds = 0.0;
+  std::vector<std::string> pair_names;  // of the final step
+  std::vector<double> theta;            // penalty parameter per pair, final step
+};
+
+// /history/iterations: one row per IterationReport. Matrices are n_iterations x n_bodies or x n_pairs.
+struct IterationHistory {
+  std::vector<std::string> body_names, pair_names;
+  std::vector<int> iteration;
+  std::vector<double> paper_criterion, fixed_point_residual, elapsed_seconds;
+  Eigen::MatrixXi elements, dofs, elements_refined;
+  Eigen::MatrixXd force, max_pressure, extent_begin, extent_end, theta;
+  Eigen::MatrixXi active_points, changed_points;
+};
+
+// /history/steps: one row per adaptive step. dofs = 2 x nodes (see the format document).
+struct StepHistory {
+  std::vector<std::string> body_names;
+  std::vector<int> step, iteration;
+  Eigen::MatrixXi elements, dofs;
+};
+
+// How a string attribute is stored (VTKHDF's Type must be fixed-length with size == its text length).
+struct StringStorage {
+  bool fixed_length = false;
+  std::size_t size = 0;  // bytes, fixed-length only
+  std::string padding;   // "nullpad", "nullterm" or "spacepad" (fixed-length only)
+};
+
+// /VTKHDF as stored (one partition per body of the final step). `present` is false when the file has no steps.
+struct VtkHdf {
+  bool present = false;
+  std::vector<std::int64_t> version;
+  std::string type;
+  StringStorage type_storage;
+  std::vector<std::int64_t> number_of_points, number_of_cells, number_of_connectivity_ids;
+  Eigen::MatrixXd points;  // sum(number_of_points) x 3
+  std::vector<std::int64_t> connectivity, offsets;
+  std::vector<std::uint8_t> types;
+  std::map<std::string, Eigen::MatrixXd> point_data, cell_data;  // rows = points / cells, columns = components
+};
+
+struct ResultFile {
+  // root attributes
+  std::string format;
+  int format_version = 0;
+  std::string solver_version, job_id, job_name, created;
+  double wall_seconds = 0.0;
+  bool converged = false;
+  std::string stop_reason, message;
+  int iterations = 0;
+  std::string method;
+  // /input
+  std::string job_json, normalized_json;
+  Provenance provenance;
+  IterationHistory history;
+  StepHistory step_history;
+  // /steps/<k>; Step::index = k. Meshes carry nodes, cells and level only (no edge sets).
+  std::vector<Step> steps;
+  VtkHdf vtkhdf;
+};
+
+// Reads a file written by write_result. Throws std::runtime_error naming the path and what is missing or
+// malformed (a file of another format or of a newer format version is refused).
+ResultFile read_result(const std::string& path);
+
+}  // namespace contact::io

@@ -1,0 +1,432 @@
+// write_result: Result -> HDF5 file in the layout of docs/results-format.md.
+#include "result_file.hpp"
+
+#include "../solve.hpp"
+#include "file_util.hpp"
+#include "h5.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace contact::io {
+
+namespace {
+
+using h5::Handle;
+
+const char* compiler_name() {
+#if defined(__clang__)
+  return "clang " __clang_version__;
+#elif defined(__GNUC__)
+  return "GCC " __VERSION__;
+#else
+  return "unknown compiler";
+#endif
+}
+
+const char* build_type() {
+#if defined(CONTACT_BUILD_TYPE)
+  return CONTACT_BUILD_TYPE;
+#elif defined(NDEBUG)
+  return "optimised (NDEBUG)";
+#else
+  return "debug (assertions on)";
+#endif
+}
+
+std::string rows_text(Eigen::Index n) { return std::to_string(static_cast<long long>(n)); }
+
+// Group names come from user-chosen body and pair names: they must be usable as one HDF5 link name.
+void check_link_name(const std::string& kind, const std::string& name) {
+  if (name.empty() || name == "." || name.find('/') != std::string::npos)
+    throw std::runtime_error(kind + " name '" + name + "' cannot name an HDF5 group (empty, '.' or contains '/')");
+}
+
+// A per-node or per-cell field has the mesh's row count, or 0 rows when the solver did not produce it.
+void check_rows(const std::string& what, Eigen::Index rows, Eigen::Index expected) {
+  if (rows != expected && rows != 0)
+    throw std::runtime_error(what + " has " + rows_text(rows) + " rows, expected " + rows_text(expected) + " (or 0)");
+}
+
+// Any Eigen matrix (either storage order) as a rows x cols dataset in HDF5's row-major order.
+template <class Derived>
+void write_matrix(hid_t loc, const std::string& name, const Eigen::MatrixBase<Derived>& m) {
+  using T = typename Derived::Scalar;
+  const auto rows = static_cast<size_t>(m.rows());
+  const auto cols = static_cast<size_t>(m.cols());
+  std::vector<T> data(rows * cols);
+  for (size_t r = 0; r < rows; ++r)
+    for (size_t c = 0; c < cols; ++c)
+      data[r * cols + c] = m(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c));
+  h5::write_dataset(loc, name, data, {static_cast<hsize_t>(rows), static_cast<hsize_t>(cols)});
+}
+
+template <class Derived>
+void write_column(hid_t loc, const std::string& name, const Eigen::MatrixBase<Derived>& v) {
+  using T = typename Derived::Scalar;
+  std::vector<T> data(static_cast<size_t>(v.size()));
+  for (Eigen::Index k = 0; k < v.size(); ++k) data[static_cast<size_t>(k)] = v(k);
+  h5::write_vector(loc, name, data);
+}
+
+// A row-major n x 3 copy of an n x 2 field with a zero third column (VTK's vectors are 3-D).
+Eigen::MatrixX3d with_zero_z(const Eigen::MatrixX2d& m) {
+  Eigen::MatrixX3d out = Eigen::MatrixX3d::Zero(m.rows(), 3);
+  out.leftCols<2>() = m;
+  return out;
+}
+
+// ---- root, input, provenance --------------------------------------------------------------------------
+
+void write_root_attributes(hid_t file, const Problem& problem, const Result& result, const WriteInfo& info) {
+  h5::write_attribute(file, "format", kFormatName);
+  h5::write_attribute<std::int32_t>(file, "format_version", kFormatVersion);
+  h5::write_attribute(file, "solver_version", solver_version());
+  h5::write_attribute(file, "job_id", info.job_id);
+  h5::write_attribute(file, "name", problem.name);
+  h5::write_attribute(file, "created", info.created);
+  h5::write_attribute<double>(file, "wall_seconds", result.wall_seconds);
+  h5::write_attribute<std::int32_t>(file, "converged", result.converged ? 1 : 0);
+  h5::write_attribute(file, "stop_reason", to_string(result.stop_reason));
+  h5::write_attribute(file, "message", result.message);
+  h5::write_attribute<std::int32_t>(file, "iterations", result.iterations);
+  h5::write_attribute(file, "method", result.method);
+}
+
+std::string dump_json(const nlohmann::json& j) {
+  // Replace invalid UTF-8 rather than throw: the document is a record, not an input.
+  return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+void write_input(hid_t file, const Problem& problem) {
+  Handle input = h5::create_group(file, "input");
+  h5::write_string_dataset(input, "job", dump_json(problem.submitted));
+  h5::write_string_dataset(input, "normalized", dump_json(problem.normalized));
+}
+
+void write_provenance(hid_t file, const Result& result, const WriteInfo& info) {
+  Handle prov = h5::create_group(file, "provenance");
+  h5::write_attribute(prov, "solver_version", solver_version());
+  h5::write_attribute(prov, "compiler", compiler_name());
+  h5::write_attribute(prov, "build_type", build_type());
+  h5::write_attribute(prov, "host", info.host);
+  h5::write_attribute(prov, "method", result.method);
+  h5::write_attribute<double>(prov, "gamma", result.gamma);
+  h5::write_attribute<double>(prov, "setup_seconds", result.setup_seconds);
+  h5::write_attribute<double>(prov, "factorization_seconds", result.factorization_seconds);
+  h5::write_attribute<double>(prov, "wall_seconds", result.wall_seconds);
+  std::vector<std::string> names;
+  std::vector<double> theta;
+  if (!result.steps.empty()) {
+    for (const auto& p : result.steps.back().pairs) {
+      names.push_back(p.name);
+      theta.push_back(p.theta);
+    }
+  }
+  h5::write_strings_dataset(prov, "pair_names", names);
+  h5::write_vector(prov, "theta", theta);
+}
+
+// ---- history ------------------------------------------------------------------------------------------
+
+void write_iteration_history(hid_t history, const Problem& problem, const Result& result) {
+  Handle g = h5::create_group(history, "iterations");
+  const auto& rows = result.history;
+  const auto n = static_cast<Eigen::Index>(rows.size());
+
+  // Columns are named by the first row (or by the problem when there is no row).
+  std::vector<std::string> body_names, pair_names;
+  if (!rows.empty()) {
+    for (const auto& b : rows.front().bodies) body_names.push_back(b.name);
+    for (const auto& p : rows.front().pairs) pair_names.push_back(p.name);
+  } else {
+    for (const auto& b : problem.bodies) body_names.push_back(b.name);
+    for (const auto& c : problem.contacts) pair_names.push_back(c.name);
+  }
+  const auto nb = static_cast<Eigen::Index>(body_names.size());
+  const auto np = static_cast<Eigen::Index>(pair_names.size());
+
+  std::vector<std::int32_t> iteration;
+  std::vector<double> paper, residual, elapsed;
+  Eigen::MatrixXi elements(n, nb), dofs(n, nb), refined(n, nb), active(n, np), changed(n, np);
+  Eigen::MatrixXd force(n, np), max_pressure(n, np), extent_begin(n, np), extent_end(n, np), theta(n, np);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const IterationReport& r = rows[static_cast<size_t>(i)];
+    if (static_cast<Eigen::Index>(r.bodies.size()) != nb || static_cast<Eigen::Index>(r.pairs.size()) != np)
+      throw std::runtime_error("history row " + rows_text(i) + " (iteration " + std::to_string(r.iteration) +
+                               ") has " + std::to_string(r.bodies.size()) + " bodies and " +
+                               std::to_string(r.pairs.size()) + " pairs; the first row has " + rows_text(nb) +
+                               " and " + rows_text(np));
+    iteration.push_back(r.iteration);
+    paper.push_back(r.paper_criterion);
+    residual.push_back(r.fixed_point_residual);
+    elapsed.push_back(r.elapsed_seconds);
+    for (Eigen::Index b = 0; b < nb; ++b) {
+      const BodyReport& body = r.bodies[static_cast<size_t>(b)];
+      elements(i, b) = body.elements;
+      dofs(i, b) = body.dofs;
+      refined(i, b) = body.elements_refined;
+    }
+    for (Eigen::Index p = 0; p < np; ++p) {
+      const PairReport& pair = r.pairs[static_cast<size_t>(p)];
+      force(i, p) = pair.force;
+      max_pressure(i, p) = pair.max_pressure;
+      extent_begin(i, p) = pair.extent_begin;
+      extent_end(i, p) = pair.extent_end;
+      active(i, p) = pair.active_points;
+      changed(i, p) = pair.changed_points;
+      theta(i, p) = pair.theta;
+    }
+  }
+  h5::write_attribute(g, "body_names", body_names);
+  h5::write_attribute(g, "pair_names", pair_names);
+  h5::write_vector(g, "iteration", iteration);
+  h5::write_vector(g, "paper_criterion", paper);
+  h5::write_vector(g, "fixed_point_residual", residual);
+  h5::write_vector(g, "elapsed_seconds", elapsed);
+  write_matrix(g, "elements", elements);
+  write_matrix(g, "dofs", dofs);
+  write_matrix(g, "elements_refined", refined);
+  write_matrix(g, "force", force);
+  write_matrix(g, "max_pressure", max_pressure);
+  write_matrix(g, "extent_begin", extent_begin);
+  write_matrix(g, "extent_end", extent_end);
+  write_matrix(g, "active_points", active);
+  write_matrix(g, "changed_points", changed);
+  write_matrix(g, "theta", theta);
+}
+
+std::vector<std::string> body_names_of(const Step& s) {
+  std::vector<std::string> names;
+  for (const auto& b : s.bodies) names.push_back(b.name);
+  return names;
+}
+
+std::vector<std::string> pair_names_of(const Step& s) {
+  std::vector<std::string> names;
+  for (const auto& p : s.pairs) names.push_back(p.name);
+  return names;
+}
+
+void write_step_history(hid_t history, const Result& result) {
+  Handle g = h5::create_group(history, "steps");
+  const auto n = static_cast<Eigen::Index>(result.steps.size());
+  const std::vector<std::string> names =
+      result.steps.empty() ? std::vector<std::string>{} : body_names_of(result.steps.front());
+  const auto nb = static_cast<Eigen::Index>(names.size());
+  std::vector<std::int32_t> step, iteration;
+  Eigen::MatrixXi elements(n, nb), dofs(n, nb);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const Step& s = result.steps[static_cast<size_t>(k)];
+    if (body_names_of(s) != names)
+      throw std::runtime_error("step " + rows_text(k) + " does not have the bodies of step 0 in the same order");
+    step.push_back(static_cast<std::int32_t>(k));
+    iteration.push_back(s.iteration);
+    for (Eigen::Index b = 0; b < nb; ++b) {
+      const mesh::Mesh& m = s.bodies[static_cast<size_t>(b)].mesh;
+      elements(k, b) = m.num_cells();
+      dofs(k, b) = 2 * m.num_nodes();
+    }
+  }
+  h5::write_attribute(g, "body_names", names);
+  h5::write_vector(g, "step", step);
+  h5::write_vector(g, "iteration", iteration);
+  write_matrix(g, "elements", elements);
+  write_matrix(g, "dofs", dofs);
+}
+
+// ---- steps --------------------------------------------------------------------------------------------
+
+void write_body(hid_t bodies, const BodyField& b, const std::string& where) {
+  check_link_name("body", b.name);
+  const mesh::Mesh& m = b.mesh;
+  const Eigen::Index n = m.num_nodes();
+  const Eigen::Index c = m.num_cells();
+  const std::string at = where + " body '" + b.name + "': ";
+  check_rows(at + "displacement", b.displacement.rows(), n);
+  check_rows(at + "stress_node", b.stress_node.rows(), n);
+  check_rows(at + "reaction", b.reaction.rows(), n);
+  check_rows(at + "stress_cell", b.stress_cell.rows(), c);
+  check_rows(at + "von_mises_cell", b.von_mises_cell.rows(), c);
+  check_rows(at + "indicator_cell", b.indicator_cell.rows(), c);
+  check_rows(at + "mesh level", static_cast<Eigen::Index>(m.level.size()), c);
+
+  Handle g = h5::create_group(bodies, b.name);
+  Eigen::MatrixX2d points(n, 2);
+  for (Eigen::Index i = 0; i < n; ++i) points.row(i) = m.nodes[static_cast<size_t>(i)].transpose();
+  Eigen::Matrix<std::int64_t, Eigen::Dynamic, 4> quads(c, 4);
+  std::vector<std::int32_t> level(static_cast<size_t>(c), 0);
+  for (Eigen::Index e = 0; e < c; ++e) {
+    for (int j = 0; j < 4; ++j) quads(e, j) = m.cells[static_cast<size_t>(e)][static_cast<size_t>(j)];
+    if (!m.level.empty()) level[static_cast<size_t>(e)] = m.level[static_cast<size_t>(e)];
+  }
+  write_matrix(g, "points", points);
+  write_matrix(g, "quads", quads);
+  h5::write_vector(g, "level", level);
+  write_matrix(g, "displacement", b.displacement);
+  write_matrix(g, "stress_cell", b.stress_cell);
+  write_matrix(g, "stress_node", b.stress_node);
+  write_column(g, "von_mises", b.von_mises_cell);
+  if (b.indicator_cell.size() > 0) write_column(g, "indicator", b.indicator_cell);
+  write_matrix(g, "reaction", b.reaction);
+}
+
+void write_pair(hid_t contacts, const PairField& p, const std::string& where) {
+  check_link_name("contact pair", p.name);
+  const Eigen::Index n = p.position.rows();
+  const std::string at = where + " pair '" + p.name + "': ";
+  auto same = [&](const std::string& what, Eigen::Index rows) {
+    if (rows != n)
+      throw std::runtime_error(at + what + " has " + rows_text(rows) + " rows, position has " + rows_text(n));
+  };
+  same("arc_length", p.arc_length.rows());
+  same("gap", p.gap.rows());
+  same("normal_gap", p.normal_gap.rows());
+  same("pressure", p.pressure.rows());
+  same("penetration", p.penetration.rows());
+  same("active", p.active.rows());
+
+  Handle g = h5::create_group(contacts, p.name);
+  h5::write_attribute(g, "slave_body", p.slave_body);
+  h5::write_attribute(g, "slave_edge", p.slave_edge);
+  h5::write_attribute(g, "master_body", p.master_body);
+  h5::write_attribute(g, "master_edge", p.master_edge);
+  h5::write_attribute<double>(g, "theta", p.theta);
+  h5::write_attribute<double>(g, "force", p.force);
+  write_matrix(g, "position", p.position);
+  write_column(g, "arc_length", p.arc_length);
+  write_column(g, "gap", p.gap);
+  write_column(g, "normal_gap", p.normal_gap);
+  write_column(g, "pressure", p.pressure);
+  write_column(g, "penetration", p.penetration);
+  write_column(g, "active", p.active.cast<std::int8_t>().eval());
+}
+
+void write_steps(hid_t file, const Result& result) {
+  Handle steps = h5::create_group(file, "steps");
+  h5::write_attribute<std::int32_t>(steps, "count", static_cast<std::int32_t>(result.steps.size()));
+  for (size_t k = 0; k < result.steps.size(); ++k) {
+    const Step& s = result.steps[k];
+    const std::string where = "step " + std::to_string(k);
+    Handle g = h5::create_group(steps, std::to_string(k));
+    h5::write_attribute<std::int32_t>(g, "iteration", s.iteration);
+    h5::write_attribute(g, "body_names", body_names_of(s));
+    h5::write_attribute(g, "pair_names", pair_names_of(s));
+    Handle bodies = h5::create_group(g, "bodies");
+    for (const auto& b : s.bodies) write_body(bodies, b, where);
+    Handle contacts = h5::create_group(g, "contacts");
+    for (const auto& p : s.pairs) write_pair(contacts, p, where);
+  }
+}
+
+// ---- VTKHDF -------------------------------------------------------------------------------------------
+
+// The final step as a VTKHDF 1.0 UnstructuredGrid with one partition per body: the per-partition counts are
+// NumberOf*, and Points, Connectivity, Offsets, Types and the data arrays are the partitions' arrays one after
+// the other, with Connectivity holding partition-local point ids and each partition's Offsets starting at 0.
+void write_vtkhdf(hid_t file, const Step& last) {
+  Handle v = h5::create_group(file, "VTKHDF");
+  h5::write_attribute_array<std::int64_t>(v, "Version", {1, 0});
+  // ParaView 5.11 compares the whole stored string: 16 bytes, no terminator counted.
+  h5::write_fixed_string_attribute(v, "Type", "UnstructuredGrid");
+
+  std::vector<std::int64_t> n_points, n_cells, n_ids, connectivity, offsets;
+  std::vector<std::uint8_t> types;
+  std::vector<std::int32_t> body_id, level;
+  Eigen::Index total_points = 0, total_cells = 0;
+  bool all_displacement = true, all_stress_node = true, all_reaction = true, all_stress_cell = true,
+       all_von_mises = true, any_indicator = false;
+  for (const auto& b : last.bodies) {
+    total_points += b.mesh.num_nodes();
+    total_cells += b.mesh.num_cells();
+    all_displacement = all_displacement && b.displacement.rows() > 0;
+    all_stress_node = all_stress_node && b.stress_node.rows() > 0;
+    all_reaction = all_reaction && b.reaction.rows() > 0;
+    all_stress_cell = all_stress_cell && b.stress_cell.rows() > 0;
+    all_von_mises = all_von_mises && b.von_mises_cell.rows() > 0;
+    any_indicator = any_indicator || b.indicator_cell.rows() > 0;
+  }
+  Eigen::MatrixX3d points(total_points, 3), displacement(total_points, 3), reaction(total_points, 3);
+  Eigen::MatrixX4d stress_node(total_points, 4), stress_cell(total_cells, 4);
+  Eigen::VectorXd von_mises(total_cells), indicator(total_cells);
+  Eigen::Index p0 = 0, c0 = 0;
+  for (size_t id = 0; id < last.bodies.size(); ++id) {
+    const BodyField& b = last.bodies[id];
+    const mesh::Mesh& m = b.mesh;
+    const Eigen::Index n = m.num_nodes(), c = m.num_cells();
+    n_points.push_back(n);
+    n_cells.push_back(c);
+    n_ids.push_back(4 * c);
+    for (Eigen::Index i = 0; i < n; ++i)
+      points.row(p0 + i) << m.nodes[static_cast<size_t>(i)].x(), m.nodes[static_cast<size_t>(i)].y(), 0.0;
+    offsets.push_back(0);
+    for (Eigen::Index e = 0; e < c; ++e) {
+      for (int node : m.cells[static_cast<size_t>(e)]) connectivity.push_back(node);
+      offsets.push_back(4 * (e + 1));
+      types.push_back(9);  // VTK_QUAD
+      body_id.push_back(static_cast<std::int32_t>(id));
+      level.push_back(m.level.empty() ? 0 : m.level[static_cast<size_t>(e)]);
+    }
+    if (all_displacement) displacement.middleRows(p0, n) = with_zero_z(b.displacement);
+    if (all_reaction) reaction.middleRows(p0, n) = with_zero_z(b.reaction);
+    if (all_stress_node) stress_node.middleRows(p0, n) = b.stress_node;
+    if (all_stress_cell) stress_cell.middleRows(c0, c) = b.stress_cell;
+    if (all_von_mises) von_mises.segment(c0, c) = b.von_mises_cell;
+    if (any_indicator) {
+      if (b.indicator_cell.rows() > 0)
+        indicator.segment(c0, c) = b.indicator_cell;
+      else
+        indicator.segment(c0, c).setConstant(std::numeric_limits<double>::quiet_NaN());
+    }
+    p0 += n;
+    c0 += c;
+  }
+  h5::write_vector(v, "NumberOfPoints", n_points);
+  h5::write_vector(v, "NumberOfCells", n_cells);
+  h5::write_vector(v, "NumberOfConnectivityIds", n_ids);
+  write_matrix(v, "Points", points);
+  h5::write_vector(v, "Connectivity", connectivity);
+  h5::write_vector(v, "Offsets", offsets);
+  h5::write_vector(v, "Types", types);
+
+  Handle pd = h5::create_group(v, "PointData");
+  if (all_displacement) write_matrix(pd, "displacement", displacement);
+  if (all_stress_node) write_matrix(pd, "stress", stress_node);
+  if (all_reaction) write_matrix(pd, "reaction", reaction);
+  Handle cd = h5::create_group(v, "CellData");
+  if (all_stress_cell) write_matrix(cd, "stress", stress_cell);
+  if (all_von_mises) write_column(cd, "von_mises", von_mises);
+  if (any_indicator) write_column(cd, "indicator", indicator);
+  h5::write_vector(cd, "body_id", body_id);
+  h5::write_vector(cd, "level", level);
+}
+
+void write_contents(hid_t file, const Problem& problem, const Result& result, const WriteInfo& info) {
+  write_root_attributes(file, problem, result, info);
+  write_input(file, problem);
+  write_provenance(file, result, info);
+  {
+    Handle history = h5::create_group(file, "history");
+    write_iteration_history(history, problem, result);
+    write_step_history(history, result);
+  }
+  write_steps(file, result);
+  if (!result.steps.empty()) write_vtkhdf(file, result.steps.back());
+}
+
+}  // namespace
+
+void write_result(const std::string& path, const Problem& problem, const Result& result, const WriteInfo& info) {
+  WriteInfo filled = info;
+  if (filled.created.empty()) filled.created = detail::utc_now_iso8601();
+  if (filled.host.empty()) filled.host = detail::host_name();
+  detail::write_atomically(path, "result file", [&](const std::string& tmp) {
+    h5::QuietErrors quiet;
+    Handle file = h5::create_file(tmp);
+    write_contents(file, problem, result, filled);
+    file.close("close the file");
+  });
+}
+
+}  // namespace contact::io

@@ -1,0 +1,120 @@
+// write_xdmf: the XDMF 3 sidecar that lets ParaView step through /steps/<k> of a result file.
+//
+// Every attribute references a stored dataset whole: XDMF has no 2-component "Vector" (it means 3), so the
+// multi-component arrays are declared "Matrix" (rows x components), which both of ParaView 5.11's XDMF readers
+// (the default Xdmf3ReaderS and the XDMF 2 "XDMFReader") load with the right shape. HyperSlab items, which
+// could cut ux and uy out as scalars, are dropped by the Xdmf3 reader ("unrecognized array type").
+#include "result_file.hpp"
+
+#include "file_util.hpp"
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace contact::io {
+
+namespace {
+
+std::string xml_escape(const std::string& s) {
+  std::string out;
+  out.reserve(s.size());
+  for (char ch : s) {
+    switch (ch) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&apos;"; break;
+      default: out += ch;
+    }
+  }
+  return out;
+}
+
+struct Writer {
+  std::ostringstream out;
+  std::string hdf;  // file name, escaped
+
+  // <DataItem> reading the whole dataset `path` of `rows` x `cols` (cols 0 = 1-D).
+  void data_item(const std::string& indent, const std::string& path, Eigen::Index rows, Eigen::Index cols,
+                 const char* number_type, int precision) {
+    out << indent << "<DataItem Dimensions=\"" << rows;
+    if (cols > 0) out << ' ' << cols;
+    out << "\" NumberType=\"" << number_type << "\" Precision=\"" << precision << "\" Format=\"HDF\">" << hdf << ':'
+        << xml_escape(path) << "</DataItem>\n";
+  }
+
+  // An attribute read whole from the dataset `path` (cols 0 = 1-D). Multi-component arrays are "Matrix":
+  // "Vector" means 3 components to ParaView's XDMF 2 reader, which garbles 2-component data.
+  void attribute(const std::string& indent, const std::string& name, const char* center, const std::string& path,
+                 Eigen::Index rows, Eigen::Index cols, const char* number_type = "Float", int precision = 8) {
+    out << indent << "<Attribute Name=\"" << name << "\" AttributeType=\"" << (cols > 0 ? "Matrix" : "Scalar")
+        << "\" Center=\"" << center << "\">\n";
+    data_item(indent + "  ", path, rows, cols, number_type, precision);
+    out << indent << "</Attribute>\n";
+  }
+
+  void body(const std::string& step_path, const BodyField& b) {
+    const Eigen::Index n = b.mesh.num_nodes(), c = b.mesh.num_cells();
+    if (c == 0) return;  // an empty grid would only confuse readers
+    const std::string base = step_path + "/bodies/" + b.name;
+    const std::string in = "        ";
+    out << "      <Grid Name=\"" << xml_escape(b.name) << "\" GridType=\"Uniform\">\n";
+    out << in << "<Topology TopologyType=\"Quadrilateral\" NumberOfElements=\"" << c << "\">\n";
+    data_item(in + "  ", base + "/quads", c, 4, "Int", 8);
+    out << in << "</Topology>\n";
+    out << in << "<Geometry GeometryType=\"XY\">\n";
+    data_item(in + "  ", base + "/points", n, 2, "Float", 8);
+    out << in << "</Geometry>\n";
+    if (b.displacement.rows() == n) attribute(in, "displacement", "Node", base + "/displacement", n, 2);
+    if (b.stress_node.rows() == n) attribute(in, "stress_node", "Node", base + "/stress_node", n, 4);
+    if (b.reaction.rows() == n) attribute(in, "reaction", "Node", base + "/reaction", n, 2);
+    if (b.stress_cell.rows() == c) attribute(in, "stress_cell", "Cell", base + "/stress_cell", c, 4);
+    if (b.von_mises_cell.rows() == c) attribute(in, "von_mises", "Cell", base + "/von_mises", c, 0);
+    attribute(in, "level", "Cell", base + "/level", c, 0, "Int", 4);
+    if (b.indicator_cell.rows() == c) attribute(in, "indicator", "Cell", base + "/indicator", c, 0);
+    out << "      </Grid>\n";
+  }
+};
+
+}  // namespace
+
+std::string xdmf_path_for(const std::string& hdf_path) {
+  const std::string ext = ".hdf";
+  if (hdf_path.size() > ext.size() && hdf_path.compare(hdf_path.size() - ext.size(), ext.size(), ext) == 0)
+    return hdf_path.substr(0, hdf_path.size() - ext.size()) + ".xmf";
+  return hdf_path + ".xmf";
+}
+
+void write_xdmf(const std::string& xmf_path, const std::string& hdf_file_name, const Result& result) {
+  Writer w;
+  w.hdf = xml_escape(hdf_file_name);
+  auto& out = w.out;
+  out << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+      << "<Xdmf Version=\"3.0\">\n"
+      << "  <Domain>\n"
+      << "    <Grid Name=\"steps\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  for (size_t k = 0; k < result.steps.size(); ++k) {
+    const Step& s = result.steps[k];
+    out << "    <Grid Name=\"step " << k << "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n"
+        << "      <Time Value=\"" << k << "\"/>\n";
+    for (const auto& b : s.bodies) w.body("/steps/" + std::to_string(k), b);
+    out << "    </Grid>\n";
+  }
+  out << "    </Grid>\n"
+      << "  </Domain>\n"
+      << "</Xdmf>\n";
+  const std::string text = out.str();
+  detail::write_atomically(xmf_path, "XDMF file", [&](const std::string& tmp) {
+    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+    if (!f) throw std::runtime_error("cannot create '" + tmp + "': " + std::strerror(errno));
+    f << text;
+    f.close();
+    if (!f) throw std::runtime_error("cannot write '" + tmp + "': " + std::strerror(errno));
+  });
+}
+
+}  // namespace contact::io

@@ -1,0 +1,310 @@
+#!/usr/bin/python3
+"""The result file layout of docs/results-format.md, checked with h5py the way a user would read it.
+
+Runs the CLI on api/examples/seed_layers.json (CONTACT_BINARY_DIR and CONTACT_SOURCE_DIR come from ctest) and
+checks the file it writes and the XDMF sidecar next to it. With a path argument, checks that file instead:
+    python3 tests/py/test_result_layout.py some/result.hdf
+Prints one line per check and "N passed, M failed"; exits non-zero on any failure.
+"""
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import traceback
+import xml.etree.ElementTree as ET
+
+import h5py
+import numpy as np
+
+STOP_REASONS = {"converged", "max_iterations", "stagnation", "cancelled", "error"}
+CHECKS = []
+
+
+def check(fn):
+    CHECKS.append(fn)
+    return fn
+
+
+def text(value):
+    """An h5py attribute or scalar string dataset as str (variable-length strings may come back as bytes)."""
+    if isinstance(value, bytes):
+        return value.decode("utf-8")
+    if isinstance(value, np.ndarray) and value.shape == ():
+        return text(value[()])
+    return str(value)
+
+
+def names(value):
+    return [text(v) for v in np.asarray(value).ravel()]
+
+
+def expect(condition, message):
+    if not condition:
+        raise AssertionError(message)
+
+
+class Context:
+    def __init__(self, path, job_path=None, bodies=("upper", "lower")):
+        self.path = path
+        self.job_path = job_path
+        self.bodies = bodies
+        self.f = h5py.File(path, "r")
+
+
+@check
+def root_attributes(c):
+    a = c.f.attrs
+    expect(text(a["format"]) == "contact-ddm-result", f"format is {a['format']!r}")
+    expect(int(a["format_version"]) == 1 and np.issubdtype(np.asarray(a["format_version"]).dtype, np.integer),
+           f"format_version is {a['format_version']!r}")
+    expect(text(a["solver_version"]) != "", "solver_version is empty")
+    text(a["job_id"])  # may be empty for the CLI
+    expect(re.fullmatch(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d(\.\d+)?Z", text(a["created"])),
+           f"created {a['created']!r} is not ISO 8601 UTC")
+    expect(float(a["wall_seconds"]) >= 0, "wall_seconds < 0")
+    expect(int(a["converged"]) in (0, 1), "converged is not 0/1")
+    expect(text(a["stop_reason"]) in STOP_REASONS, f"stop_reason {a['stop_reason']!r}")
+    expect((int(a["converged"]) == 1) == (text(a["stop_reason"]) == "converged"),
+           "converged and stop_reason disagree")
+    expect(int(a["iterations"]) >= 0, "iterations < 0")
+    expect(text(a["method"]) in ("neumann", "monolithic"), f"method {a['method']!r}")
+    text(a["message"])
+    text(a["name"])
+
+
+@check
+def input_documents(c):
+    job = json.loads(c.f["input/job"].asstr()[()])
+    normalized = json.loads(c.f["input/normalized"].asstr()[()])
+    if c.job_path:
+        with open(c.job_path, encoding="utf-8") as fh:
+            submitted = json.load(fh)
+        expect(job == submitted, "/input/job differs from the submitted job")
+        expect(isinstance(normalized, dict) and "solver" in normalized, "/input/normalized has no 'solver'")
+        expect(normalized.get("name", submitted.get("name")) == submitted.get("name"), "normalized renames the job")
+
+
+@check
+def provenance(c):
+    p = c.f["provenance"]
+    for key in ("solver_version", "compiler", "build_type", "host", "method"):
+        expect(isinstance(text(p.attrs[key]), str), f"provenance {key}")
+    for key in ("gamma", "setup_seconds", "factorization_seconds", "wall_seconds"):
+        expect(np.isfinite(float(p.attrs[key])), f"provenance {key} not finite")
+    expect(text(p.attrs["solver_version"]) == text(c.f.attrs["solver_version"]), "two solver versions")
+    theta = p["theta"][()]
+    expect(len(names(p["pair_names"][()])) == len(theta), "theta and pair_names lengths differ")
+    expect(np.all(theta > 0), "theta must be positive")
+
+
+@check
+def iteration_history(c):
+    g = c.f["history/iterations"]
+    n = g["iteration"].shape[0]
+    nb, npair = len(names(g.attrs["body_names"])), len(names(g.attrs["pair_names"]))
+    for col in ("iteration", "paper_criterion", "fixed_point_residual", "elapsed_seconds"):
+        expect(g[col].shape == (n,), f"{col} has shape {g[col].shape}, expected ({n},)")
+    for col in ("elements", "dofs", "elements_refined"):
+        expect(g[col].shape == (n, nb), f"{col} has shape {g[col].shape}, expected ({n}, {nb})")
+    for col in ("force", "max_pressure", "extent_begin", "extent_end", "active_points", "changed_points", "theta"):
+        expect(g[col].shape == (n, npair), f"{col} has shape {g[col].shape}, expected ({n}, {npair})")
+    expect(np.issubdtype(g["iteration"].dtype, np.integer), "iteration is not an integer column")
+    it = g["iteration"][()]
+    expect(np.all(np.diff(it) > 0), "iteration numbers do not increase")
+    expect(np.all(g["max_pressure"][()] >= 0), "a max_pressure is negative")
+    expect(np.all(g["elapsed_seconds"][()] >= 0), "elapsed_seconds < 0")
+    if text(c.f.attrs["stop_reason"]) != "error":
+        expect(n >= 1, "no iteration recorded")
+        expect(int(c.f.attrs["iterations"]) == n, f"iterations = {c.f.attrs['iterations']} but {n} history rows")
+
+
+@check
+def step_history(c):
+    g = c.f["history/steps"]
+    n = g["step"].shape[0]
+    nb = len(names(g.attrs["body_names"]))
+    expect(n == int(c.f["steps"].attrs["count"]), "history/steps rows != steps count")
+    expect(g["iteration"].shape == (n,), "history/steps/iteration length")
+    expect(g["elements"].shape == (n, nb) and g["dofs"].shape == (n, nb), "history/steps matrix shapes")
+    expect(list(g["step"][()]) == list(range(n)), "step column is not 0..n-1")
+
+
+@check
+def steps_bodies(c):
+    steps = c.f["steps"]
+    count = int(steps.attrs["count"])
+    expect(count >= 1 or text(c.f.attrs["stop_reason"]) == "error", "no step")
+    expect(sorted(steps.keys(), key=int) == [str(k) for k in range(count)], f"step groups {list(steps.keys())}")
+    for k in range(count):
+        s = steps[str(k)]
+        body_names = names(s.attrs["body_names"])
+        expect(sorted(body_names) == sorted(s["bodies"].keys()), f"step {k} body_names vs groups")
+        for body in c.bodies:
+            expect(body in body_names, f"step {k} has no body {body!r}")
+        for body in body_names:
+            b = s["bodies"][body]
+            where = f"step {k} body {body}"
+            n, m = b["points"].shape[0], b["quads"].shape[0]
+            expect(n > 0 and m > 0, f"{where} is empty")
+            shapes = {"points": (n, 2), "quads": (m, 4), "displacement": (n, 2), "stress_cell": (m, 4),
+                      "stress_node": (n, 4), "von_mises": (m,), "level": (m,), "reaction": (n, 2)}
+            if "indicator" in b:
+                shapes["indicator"] = (m,)
+            for name, shape in shapes.items():
+                expect(b[name].shape == shape, f"{where} {name} has shape {b[name].shape}, expected {shape}")
+            expect(b["points"].dtype == np.float64, f"{where} points dtype {b['points'].dtype}")
+            expect(b["quads"].dtype == np.int64, f"{where} quads dtype {b['quads'].dtype}")
+            expect(np.issubdtype(b["level"].dtype, np.integer), f"{where} level dtype")
+            q = b["quads"][()]
+            expect(q.min() >= 0 and q.max() < n, f"{where} quads index outside 0..{n - 1}")
+            expect(np.all(np.isfinite(b["displacement"][()])), f"{where} displacement not finite")
+            expect(np.all(b["von_mises"][()] >= 0), f"{where} von Mises < 0")
+            # counter-clockwise cells (positive shoelace area), as mesh.hpp promises
+            p = b["points"][()][q]
+            area = 0.5 * np.sum(p[:, :, 0] * np.roll(p[:, :, 1], -1, axis=1)
+                                - np.roll(p[:, :, 0], -1, axis=1) * p[:, :, 1], axis=1)
+            expect(np.all(area > 0), f"{where} has cells that are not counter-clockwise")
+
+
+@check
+def steps_contacts(c):
+    steps = c.f["steps"]
+    for k in range(int(steps.attrs["count"])):
+        s = steps[str(k)]
+        pair_names = names(s.attrs["pair_names"])
+        expect(sorted(pair_names) == sorted(s["contacts"].keys()), f"step {k} pair_names vs groups")
+        if c.job_path:
+            expect(len(pair_names) >= 1, f"step {k} has no contact pair")
+        for pair in pair_names:
+            g = s["contacts"][pair]
+            where = f"step {k} pair {pair}"
+            n = g["position"].shape[0]
+            expect(g["position"].shape == (n, 2), f"{where} position shape")
+            for name in ("arc_length", "gap", "normal_gap", "pressure", "penetration", "active"):
+                expect(g[name].shape == (n,), f"{where} {name} has shape {g[name].shape}, expected ({n},)")
+            expect(g["active"].dtype == np.int8, f"{where} active dtype {g['active'].dtype}")
+            expect(set(np.unique(g["active"][()]).tolist()) <= {0, 1}, f"{where} active is not 0/1")
+            pressure = g["pressure"][()]
+            expect(np.all(np.isfinite(pressure)) and np.all(pressure >= 0),
+                   f"{where} pressure must be >= 0 (positive in compression)")
+            expect(np.all(g["penetration"][()] >= 0), f"{where} penetration < 0")
+            expect(np.all(np.diff(g["arc_length"][()]) > 0), f"{where} arc_length does not increase")
+            for key in ("slave_body", "slave_edge", "master_body", "master_edge"):
+                expect(text(g.attrs[key]) != "", f"{where} attribute {key} empty")
+            body_names = names(s.attrs["body_names"])
+            expect(text(g.attrs["slave_body"]) in body_names and text(g.attrs["master_body"]) in body_names,
+                   f"{where} names a body that is not in the step")
+            expect(float(g.attrs["theta"]) > 0, f"{where} theta <= 0")
+            expect(float(g.attrs["force"]) >= 0, f"{where} force < 0")
+
+
+@check
+def vtkhdf(c):
+    if int(c.f["steps"].attrs["count"]) == 0:
+        expect("VTKHDF" not in c.f, "VTKHDF without steps")
+        return
+    v = c.f["VTKHDF"]
+    expect(list(v.attrs["Version"]) == [1, 0], f"Version is {v.attrs['Version']!r}")
+    type_id = v.attrs.get_id("Type").get_type()
+    expect(type_id.get_class() == h5py.h5t.STRING and not type_id.is_variable_str(), "Type is not fixed-length")
+    expect(type_id.get_size() == 16, f"Type is {type_id.get_size()} bytes, expected 16")
+    expect(text(v.attrs["Type"]) == "UnstructuredGrid", f"Type is {v.attrs['Type']!r}")
+    npts, ncells, nids = (v[k][()] for k in ("NumberOfPoints", "NumberOfCells", "NumberOfConnectivityIds"))
+    last = c.f["steps"][str(int(c.f["steps"].attrs["count"]) - 1)]
+    expect(len(npts) == len(names(last.attrs["body_names"])), "one partition per body")
+    expect(v["Points"].shape == (npts.sum(), 3), f"Points shape {v['Points'].shape}")
+    expect(np.all(v["Points"][:, 2] == 0), "Points z != 0")
+    expect(v["Connectivity"].shape == (nids.sum(),), "Connectivity length")
+    expect(v["Offsets"].shape == (ncells.sum() + len(ncells),), "Offsets length (n_cells + 1 per partition)")
+    expect(v["Types"].shape == (ncells.sum(),) and v["Types"].dtype == np.uint8, "Types shape/dtype")
+    expect(np.all(v["Types"][()] == 9), "Types are not all VTK_QUAD (9)")
+    offsets, conn = v["Offsets"][()], v["Connectivity"][()]
+    o = i = 0
+    for p in range(len(npts)):
+        part = offsets[o:o + ncells[p] + 1]
+        expect(part[0] == 0 and part[-1] == nids[p], f"partition {p} offsets run {part[0]}..{part[-1]}")
+        ids = conn[i:i + nids[p]]
+        expect(ids.min() >= 0 and ids.max() < npts[p], f"partition {p} connectivity is not partition-local")
+        o += ncells[p] + 1
+        i += nids[p]
+    expect(v["PointData/displacement"].shape == (npts.sum(), 3), "PointData/displacement shape")
+    for name in v["CellData"]:
+        expect(v["CellData"][name].shape[0] == ncells.sum(), f"CellData/{name} rows")
+    for name in ("stress", "von_mises", "body_id", "level"):
+        expect(name in v["CellData"], f"CellData/{name} missing")
+
+
+@check
+def xdmf_sidecar(c):
+    base, _ = os.path.splitext(c.path)
+    xmf = base + ".xmf"
+    folder = os.path.dirname(c.path) or "."
+    expect(os.path.exists(xmf), f"no sidecar {xmf} (files there: {sorted(os.listdir(folder))})")
+    root = ET.parse(xmf).getroot()
+    expect(root.tag == "Xdmf", f"root element is {root.tag}")
+    temporal = root.find("Domain/Grid")
+    expect(temporal is not None and temporal.get("CollectionType") == "Temporal", "no temporal collection")
+    count = int(c.f["steps"].attrs["count"])
+    children = temporal.findall("Grid")
+    expect(len(children) == count, f"{len(children)} step grids for {count} steps")
+    hdf_name = os.path.basename(c.path)
+    for k, step in enumerate(children):
+        expect(step.find("Time").get("Value") == str(k), f"step {k} has Time {step.find('Time').get('Value')}")
+        grids = {g.get("Name"): g for g in step.findall("Grid")}
+        expect(sorted(grids) == sorted(names(c.f["steps"][str(k)].attrs["body_names"])), f"step {k} grids")
+        for item in step.iter("DataItem"):
+            if item.get("Format") != "HDF":
+                continue
+            file_name, _, dataset = item.text.strip().partition(":")
+            expect(file_name == hdf_name, f"data item names {file_name}, expected {hdf_name}")
+            expect(dataset in c.f, f"{dataset} referenced by the sidecar is not in the file")
+            dims = tuple(int(d) for d in item.get("Dimensions").split())
+            expect(c.f[dataset].shape == dims, f"{dataset} is {c.f[dataset].shape}, sidecar says {dims}")
+
+
+def run_cli(tmp):
+    binary = os.path.join(os.environ.get("CONTACT_BINARY_DIR", "build"), "contact-solve")
+    job = os.path.join(os.environ.get("CONTACT_SOURCE_DIR", "."), "api", "examples", "seed_layers.json")
+    out = os.path.join(tmp, "seed.hdf")
+    for needed in (binary, job):
+        if not os.path.exists(needed):
+            raise RuntimeError(f"{needed} does not exist")
+    proc = subprocess.run([binary, job, "-o", out], capture_output=True, text=True, timeout=540)
+    if proc.returncode != 0:
+        raise RuntimeError(f"contact-solve exited {proc.returncode}:\n{proc.stdout[-2000:]}\n{proc.stderr[-2000:]}")
+    if not os.path.exists(out):
+        raise RuntimeError(f"contact-solve exited 0 but wrote no {out} (files: {sorted(os.listdir(tmp))})")
+    return out, job
+
+
+def main():
+    passed = failed = 0
+    with tempfile.TemporaryDirectory() as tmp:
+        try:
+            if len(sys.argv) > 1:
+                context = Context(sys.argv[1])
+            else:
+                path, job = run_cli(tmp)
+                context = Context(path, job_path=job)
+        except Exception as e:  # the whole file is unavailable: one failure, nothing else to check
+            print(f"FAIL produce a result file: {e}")
+            print("0 passed, 1 failed")
+            return 1
+        for fn in CHECKS:
+            try:
+                fn(context)
+                passed += 1
+                print(f"ok   {fn.__name__}")
+            except Exception as e:
+                failed += 1
+                detail = str(e) if isinstance(e, AssertionError) else traceback.format_exc(limit=2)
+                print(f"FAIL {fn.__name__}: {detail}")
+        context.f.close()
+    print(f"{passed} passed, {failed} failed")
+    return 0 if failed == 0 else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
