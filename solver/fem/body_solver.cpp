@@ -38,9 +38,10 @@ void BodySolver::setup_constraints() {
     return;
   }
   // CHOLMOD factorises a singular stiffness without complaint (a tiny pivot), so check the supports.
-  std::vector<bool> prescribed(static_cast<size_t>(constraints_.n_dofs()), false);
-  for (int d = 0; d < constraints_.n_dofs(); ++d) prescribed[static_cast<size_t>(d)] = constraints_.is_dirichlet(d);
-  const auto modes = free_rigid_modes(body_.mesh, prescribed);
+  std::vector<PrescribedDof> prescribed;
+  for (int d = 0; d < constraints_.n_dofs(); ++d)
+    if (constraints_.is_dirichlet(d)) prescribed.push_back({d / 2, d % 2});
+  const auto modes = free_rigid_motions(body_.mesh, prescribed);
   if (!modes.empty()) {
     std::string list;
     for (const auto& m : modes) list += (list.empty() ? "" : ", ") + m;

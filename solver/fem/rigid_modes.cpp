@@ -1,61 +1,108 @@
 #include "rigid_modes.hpp"
 
 #include <Eigen/SVD>
-
+#include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 
 namespace contact::fem {
 
-std::vector<std::string> free_rigid_modes(const mesh::Mesh& mesh, const std::vector<bool>& prescribed) {
-  // Rigid modes about the centroid, scaled to unit size: t_x, t_y and the rotation (-(y - cy), x - cx) / L.
-  const Eigen::Vector2d lo = mesh.bbox_min(), hi = mesh.bbox_max();
-  const Eigen::Vector2d centre = 0.5 * (lo + hi);
-  const double size = std::max((hi - lo).norm(), 1e-300);
-  std::vector<Eigen::RowVector3d> rows;
-  for (size_t dof = 0; dof < prescribed.size(); ++dof) {
-    if (!prescribed[dof]) continue;
-    const Eigen::Vector2d p = mesh.nodes[dof / 2] - centre;
-    if (dof % 2 == 0)
-      rows.emplace_back(1.0, 0.0, -p.y() / size);
-    else
-      rows.emplace_back(0.0, 1.0, p.x() / size);
+namespace {
+
+constexpr double kNullTolerance = 1e-10;  // relative to the largest singular value
+constexpr double kNegligible = 1e-8;      // a component of a unit vector this small counts as zero
+
+// Four significant digits; values that are round-off next to `scale` print as 0.
+std::string format_coordinate(double v, double scale) {
+  std::ostringstream os;
+  os << std::setprecision(4) << (std::abs(v) < 1e-9 * scale ? 0.0 : v);
+  return os.str();
+}
+
+// A unit translation (a, b) in words, sign chosen so the first non-zero component is positive.
+std::string describe_translation(Eigen::Vector2d d) {
+  d.normalize();
+  if (std::abs(d.y()) < kNegligible) return "translation in x";
+  if (std::abs(d.x()) < kNegligible) return "translation in y";
+  if (d.x() < 0) d = -d;
+  return "translation along (" + format_coordinate(d.x(), 1.0) + ", " + format_coordinate(d.y(), 1.0) + ")";
+}
+
+}  // namespace
+
+std::vector<std::string> free_rigid_motions(const mesh::Mesh& mesh, const std::vector<PrescribedDof>& prescribed) {
+  // Centroid of the body (area-weighted cell centres) and the distance to its farthest node, which scales the
+  // rotation mode to unit size so that the three modes are comparable in the SVD.
+  Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
+  double area = 0.0;
+  for (int c = 0; c < mesh.num_cells(); ++c) {
+    Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+    for (int node : mesh.cells[static_cast<size_t>(c)]) centre += mesh.nodes[static_cast<size_t>(node)] / 4.0;
+    const double a = std::abs(mesh.cell_area(c));
+    centroid += a * centre;
+    area += a;
   }
-  Eigen::Matrix3d null_basis = Eigen::Matrix3d::Identity();
-  int n_null = 3;
-  if (!rows.empty()) {
-    Eigen::MatrixXd R(static_cast<Eigen::Index>(rows.size()), 3);
-    for (size_t i = 0; i < rows.size(); ++i) R.row(static_cast<Eigen::Index>(i)) = rows[i];
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd(R, Eigen::ComputeFullV);
-    const auto& sv = svd.singularValues();
-    const double tol = 1e-10 * std::max(sv[0], 1e-300);
-    int rank = 0;
-    for (int i = 0; i < sv.size(); ++i)
-      if (sv[i] > tol) ++rank;
-    n_null = 3 - rank;
-    null_basis = svd.matrixV();
-    // Null vectors are V's last columns.
-    Eigen::Matrix3d tmp = Eigen::Matrix3d::Zero();
-    for (int k = 0; k < n_null; ++k) tmp.col(k) = null_basis.col(rank + k);
-    null_basis = tmp;
+  if (area > 0) centroid /= area;
+  double radius = 0.0;
+  for (const auto& p : mesh.nodes) radius = std::max(radius, (p - centroid).norm());
+  if (!(radius > 0)) radius = 1.0;
+
+  // Rows: prescribed components; columns: the modes tx, ty, rot evaluated there.
+  Eigen::MatrixXd modes(static_cast<Eigen::Index>(prescribed.size()), 3);
+  for (size_t k = 0; k < prescribed.size(); ++k) {
+    const Eigen::Vector2d r = (mesh.nodes[static_cast<size_t>(prescribed[k][0])] - centroid) / radius;
+    const Eigen::Vector2d rotation(-r.y(), r.x());
+    const auto row = static_cast<Eigen::Index>(k);
+    const int component = prescribed[k][1];
+    modes(row, 0) = component == 0 ? 1.0 : 0.0;
+    modes(row, 1) = component == 1 ? 1.0 : 0.0;
+    modes(row, 2) = rotation(component);
   }
-  std::vector<std::string> modes;
-  if (n_null == 3) return {"translation in x", "translation in y", "rotation"};
-  for (int k = 0; k < n_null; ++k) {
-    const Eigen::Vector3d v = null_basis.col(k).normalized();
-    if (std::abs(v[2]) > 1e-6) {
-      modes.emplace_back("rotation");
-    } else if (std::abs(v[1]) < 1e-9) {
-      modes.emplace_back("translation in x");
-    } else if (std::abs(v[0]) < 1e-9) {
-      modes.emplace_back("translation in y");
+
+  Eigen::MatrixXd null_space;  // 3 x k, orthonormal columns
+  if (prescribed.empty()) {
+    null_space = Eigen::MatrixXd::Identity(3, 3);
+  } else {
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(modes, Eigen::ComputeFullV);
+    const auto& sigma = svd.singularValues();
+    Eigen::Index rank = 0;
+    while (rank < sigma.size() && sigma(rank) > kNullTolerance * sigma(0)) ++rank;
+    null_space = svd.matrixV().rightCols(3 - rank);
+  }
+  if (null_space.cols() == 0) return {};
+
+  // Describe the null space in a canonical basis (the SVD's own basis mixes modes arbitrarily): its part with
+  // no rotation is spanned by translations, and at most one further direction rotates.
+  std::vector<std::string> free;
+  const Eigen::RowVectorXd rotation_part = null_space.row(2);
+  Eigen::MatrixXd translations = null_space;  // columns spanning the rotation-free part (after projection)
+  std::string rotation_text;
+  if (rotation_part.norm() > kNegligible) {
+    const Eigen::Vector3d w = null_space * rotation_part.transpose() / rotation_part.norm();
+    translations = null_space - w * (w.transpose() * null_space);
+    if (null_space.cols() == 1) {
+      // The only free motion: a rotation about the point where its displacement vanishes.
+      const Eigen::Vector2d pivot = centroid + radius * Eigen::Vector2d(-w(1), w(0)) / w(2);
+      const double scale = radius + centroid.norm();
+      rotation_text =
+          "rotation about (" + format_coordinate(pivot.x(), scale) + ", " + format_coordinate(pivot.y(), scale) + ")";
     } else {
-      std::ostringstream os;
-      os << "translation along (" << v[0] << ", " << v[1] << ")";
-      modes.push_back(os.str());
+      rotation_text = "rotation";
     }
   }
-  return modes;
+  // The translation part has dimension 0, 1 or 2 (columns are dependent after the projection above).
+  Eigen::JacobiSVD<Eigen::MatrixXd> tsvd(translations.topRows(2), Eigen::ComputeFullU);
+  Eigen::Index tdim = 0;
+  while (tdim < tsvd.singularValues().size() && tsvd.singularValues()(tdim) > 1e-6) ++tdim;
+  if (tdim == 2) {
+    free.push_back("translation in x");
+    free.push_back("translation in y");
+  } else if (tdim == 1) {
+    free.push_back(describe_translation(tsvd.matrixU().col(0)));
+  }
+  if (!rotation_text.empty()) free.push_back(rotation_text);
+  return free;
 }
 
 }  // namespace contact::fem

@@ -1,18 +1,27 @@
-// Which rigid motions a body's prescribed displacement components leave free. Each body is solved alone in
-// the Neumann DDM (paper eq. (16)), so each must be restrained by its own supports: a free rigid mode makes
-// the body's stiffness singular.
+// Which rigid motions a body's prescribed displacement components leave free.
+//
+// Why it matters: the DDM solves each body on its own with contact forces as loads, so each body's stiffness
+// matrix must be non-singular by its own displacement conditions; contact never restrains a body. A body that
+// can still translate or rotate would only fail later, inside the factorisation, with a message no user can act
+// on; this check names the free motion instead.
 #pragma once
 
-#include "../mesh/mesh.hpp"
-
+#include <array>
 #include <string>
 #include <vector>
 
+#include "../mesh/mesh.hpp"
+
 namespace contact::fem {
 
-// prescribed[dof] is true where the displacement component dof = 2 node + c is prescribed. Returns one
-// description per free rigid mode ("translation in x", "translation in y", "translation along (a, b)",
-// "rotation"); empty if the body is restrained.
-std::vector<std::string> free_rigid_modes(const mesh::Mesh& mesh, const std::vector<bool>& prescribed);
+// One prescribed displacement component: node index and component (0 = x, 1 = y).
+using PrescribedDof = std::array<int, 2>;
+
+// The free rigid motions of `mesh` under the prescribed components, described in words: "translation in x",
+// "translation in y", "translation along (0.6, 0.8)", "rotation" or, when it is the only free motion,
+// "rotation about (x, y)". Empty when the body is restrained. Method: the three rigid modes about the
+// centroid (two unit translations and a rotation scaled to unit size at the farthest node) evaluated at the
+// prescribed components; their null space, by SVD with a relative tolerance of 1e-10, holds the free motions.
+std::vector<std::string> free_rigid_motions(const mesh::Mesh& mesh, const std::vector<PrescribedDof>& prescribed);
 
 }  // namespace contact::fem

@@ -1,0 +1,179 @@
+#include "read.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+
+namespace contact::job::read {
+
+std::string escape_token(const std::string& token) {
+  std::string out;
+  out.reserve(token.size());
+  for (char ch : token) {
+    if (ch == '~')
+      out += "~0";
+    else if (ch == '/')
+      out += "~1";
+    else
+      out += ch;
+  }
+  return out;
+}
+
+std::string child(const std::string& pointer, const std::string& key) { return pointer + "/" + escape_token(key); }
+
+std::string child(const std::string& pointer, size_t index) { return pointer + "/" + std::to_string(index); }
+
+std::string format_number(double value) {
+  std::ostringstream os;
+  if (std::isfinite(value) && value == std::floor(value) && std::abs(value) < 1e15)
+    os << std::fixed << std::setprecision(0) << value;
+  else
+    os << std::setprecision(10) << value;
+  return os.str();
+}
+
+std::string join_names(const std::vector<std::string>& names) {
+  if (names.empty()) return "(none)";
+  std::string out;
+  for (size_t k = 0; k < names.size(); ++k) {
+    if (k > 0) out += (k + 1 == names.size()) ? " and " : ", ";
+    out += names[k];
+  }
+  return out;
+}
+
+std::string type_name(const json& value) { return value.type_name(); }
+
+size_t Errors::count_under(const std::string& pointer) const {
+  return static_cast<size_t>(std::count_if(list_.begin(), list_.end(), [&](const ValidationError& e) {
+    return e.pointer == pointer || e.pointer.rfind(pointer + "/", 0) == 0;
+  }));
+}
+
+std::optional<double> number(const json& value, const std::string& pointer, const std::string& what, Errors& errors) {
+  if (!value.is_number()) {
+    errors.add(pointer, what + " must be a number, got " + type_name(value));
+    return std::nullopt;
+  }
+  const double x = value.get<double>();
+  if (!std::isfinite(x)) {
+    errors.add(pointer, what + " must be a finite number (this one overflows a double)");
+    return std::nullopt;
+  }
+  return x;
+}
+
+std::optional<long long> integer(const json& value, const std::string& pointer, const std::string& what,
+                                 Errors& errors) {
+  if (value.is_number_integer()) {
+    // An unsigned value above the signed range is still far beyond any count the solver could use.
+    if (value.is_number_unsigned() &&
+        value.get<unsigned long long>() > static_cast<unsigned long long>(std::numeric_limits<long long>::max())) {
+      errors.add(pointer, what + " = " + value.dump() + " is too large");
+      return std::nullopt;
+    }
+    return value.get<long long>();
+  }
+  const auto x = number(value, pointer, what, errors);
+  if (!x) return std::nullopt;
+  if (*x != std::floor(*x)) {
+    errors.add(pointer, what + " must be an integer, got " + format_number(*x));
+    return std::nullopt;
+  }
+  if (std::abs(*x) >= 9.2e18) {
+    errors.add(pointer, what + " = " + format_number(*x) + " is too large");
+    return std::nullopt;
+  }
+  return static_cast<long long>(*x);
+}
+
+std::optional<std::string> string(const json& value, const std::string& pointer, const std::string& what,
+                                  Errors& errors) {
+  if (!value.is_string()) {
+    errors.add(pointer, what + " must be a string, got " + type_name(value));
+    return std::nullopt;
+  }
+  return value.get<std::string>();
+}
+
+std::optional<bool> boolean(const json& value, const std::string& pointer, const std::string& what, Errors& errors) {
+  if (!value.is_boolean()) {
+    errors.add(pointer, what + " must be true or false, got " + type_name(value));
+    return std::nullopt;
+  }
+  return value.get<bool>();
+}
+
+std::optional<Eigen::Vector2d> pair(const json& value, const std::string& pointer, const std::string& what,
+                                    Errors& errors) {
+  if (!value.is_array() || value.size() != 2) {
+    errors.add(pointer, what + " must be an array of two numbers [x, y], got " +
+                            (value.is_array() ? "an array of " + std::to_string(value.size()) : type_name(value)));
+    return std::nullopt;
+  }
+  const auto x = number(value[0], child(pointer, 0), what + " x", errors);
+  const auto y = number(value[1], child(pointer, 1), what + " y", errors);
+  if (!x || !y) return std::nullopt;
+  return Eigen::Vector2d(*x, *y);
+}
+
+namespace {
+// Levenshtein distance, for "did you mean" suggestions on unknown fields.
+size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+}  // namespace
+
+Fields::Fields(const json& value, std::string pointer, std::string what, std::vector<std::string> allowed,
+               Errors& errors)
+    : pointer_(std::move(pointer)), errors_(errors) {
+  if (!value.is_object()) {
+    errors_.add(pointer_, what + " must be an object, got " + type_name(value));
+    return;
+  }
+  object_ = &value;
+  for (const auto& item : value.items()) {
+    if (std::find(allowed.begin(), allowed.end(), item.key()) != allowed.end()) continue;
+    std::string message = "unknown field '" + item.key() + "' in " + what;
+    std::string closest;
+    size_t best = 3;  // suggest only close misspellings
+    for (const auto& name : allowed) {
+      const size_t d = edit_distance(item.key(), name);
+      if (d < best) {
+        best = d;
+        closest = name;
+      }
+    }
+    if (!closest.empty()) message += " (did you mean '" + closest + "'?)";
+    message += "; allowed: " + join_names(allowed);
+    errors_.add(child(pointer_, item.key()), message);
+  }
+}
+
+const json* Fields::find(const std::string& key) const {
+  if (!object_) return nullptr;
+  auto it = object_->find(key);
+  return it == object_->end() ? nullptr : &*it;
+}
+
+const json* Fields::require(const std::string& key, const std::string& hint) const {
+  const json* value = find(key);
+  if (!value && object_) errors_.add(at(key), "required field '" + key + "' is missing: " + hint);
+  return value;
+}
+
+}  // namespace contact::job::read

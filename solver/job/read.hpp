@@ -1,0 +1,82 @@
+// Reading JSON values with validation: typed views of a value that report what is wrong with it at its
+// RFC 6901 pointer instead of throwing. Private to the job module; job.cpp holds the format itself.
+#pragma once
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "job.hpp"
+
+namespace contact::job::read {
+
+using nlohmann::json;
+
+// Documents nested deeper than this are rejected (a job needs 6 levels); it bounds the recursion of every
+// later walk over the document, nlohmann's own copy and comparison included.
+constexpr int kMaxDepth = 64;
+
+// RFC 6901: "~" is written "~0" and "/" is written "~1" inside a reference token.
+std::string escape_token(const std::string& token);
+std::string child(const std::string& pointer, const std::string& key);
+std::string child(const std::string& pointer, size_t index);
+
+// Numbers in messages: integers exactly, others with up to 10 significant digits.
+std::string format_number(double value);
+// "a, b and c" for messages; "(none)" when empty.
+std::string join_names(const std::vector<std::string>& names);
+// nlohmann's type name: "object", "array", "string", "boolean", "number", "null".
+std::string type_name(const json& value);
+
+// The errors found so far, in the order found.
+class Errors {
+ public:
+  void add(std::string pointer, std::string message) { list_.push_back({std::move(pointer), std::move(message)}); }
+  size_t size() const { return list_.size(); }
+  // How many errors point at `pointer` or inside it.
+  size_t count_under(const std::string& pointer) const;
+  const std::vector<ValidationError>& list() const { return list_; }
+  std::vector<ValidationError> take() { return std::move(list_); }
+
+ private:
+  std::vector<ValidationError> list_;
+};
+
+// Typed views of one value. `what` names the value in messages ("nu", "corner 2"). Each returns nullopt after
+// reporting the problem: wrong type ("nu must be a number, got string"), or a number that is not finite
+// (nlohmann reads 1e400 as infinity) or, for integers, has a fractional part. 2.0 counts as an integer, as in
+// JSON Schema.
+std::optional<double> number(const json& value, const std::string& pointer, const std::string& what, Errors& errors);
+std::optional<long long> integer(const json& value, const std::string& pointer, const std::string& what,
+                                 Errors& errors);
+std::optional<std::string> string(const json& value, const std::string& pointer, const std::string& what,
+                                  Errors& errors);
+std::optional<bool> boolean(const json& value, const std::string& pointer, const std::string& what, Errors& errors);
+// A point or vector written [x, y].
+std::optional<Eigen::Vector2d> pair(const json& value, const std::string& pointer, const std::string& what,
+                                    Errors& errors);
+
+// The fields of one JSON object. Construction reports a value that is not an object and every field not in
+// `allowed` (unknown fields are errors: a misspelt optional field must not be silently ignored).
+class Fields {
+ public:
+  Fields(const json& value, std::string pointer, std::string what, std::vector<std::string> allowed, Errors& errors);
+
+  bool ok() const { return object_ != nullptr; }
+  const std::string& pointer() const { return pointer_; }
+  std::string at(const std::string& key) const { return child(pointer_, key); }
+  bool has(const std::string& key) const { return find(key) != nullptr; }
+  // nullptr if absent (or if the value is not an object).
+  const json* find(const std::string& key) const;
+  // As find, and reports a missing field at the pointer where it belongs; `hint` says what it should hold.
+  const json* require(const std::string& key, const std::string& hint) const;
+
+ private:
+  const json* object_ = nullptr;
+  std::string pointer_;
+  Errors& errors_;
+};
+
+}  // namespace contact::job::read

@@ -1,0 +1,136 @@
+#!/usr/bin/env python3
+"""api/job.schema.json: it is a valid draft 2020-12 schema, every example job validates against it, it is
+closed (additionalProperties false on every fixed-key object), and bad jobs are rejected for the reason
+expected. Standard library plus Debian's python3-jsonschema; exits non-zero on any failure."""
+
+import copy
+import glob
+import json
+import os
+import sys
+
+from jsonschema import Draft202012Validator
+
+SOURCE = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
+SCHEMA_PATH = os.path.join(SOURCE, "api", "job.schema.json")
+EXAMPLES = sorted(glob.glob(os.path.join(SOURCE, "api", "examples", "*.json")))
+EXPECTED_EXAMPLES = {"seed_layers", "seed_layers_curved", "flat_patch", "flat_patch_nonmatching", "hertz", "stack3"}
+
+passed = 0
+failed = 0
+
+
+def check(name, condition, detail=""):
+    global passed, failed
+    if condition:
+        passed += 1
+        print(f"ok    {name}")
+    else:
+        failed += 1
+        print(f"FAIL  {name}" + (f": {detail}" if detail else ""))
+
+
+def load(path):
+    with open(path, encoding="utf-8") as f:
+        return json.load(f)
+
+
+schema = load(SCHEMA_PATH)
+try:
+    Draft202012Validator.check_schema(schema)
+    check("schema is a valid draft 2020-12 schema", True)
+except Exception as e:  # noqa: BLE001 - report any failure of the meta-schema check
+    check("schema is a valid draft 2020-12 schema", False, str(e))
+validator = Draft202012Validator(schema)
+
+
+def errors_of(document):
+    return sorted(validator.iter_errors(document), key=lambda e: list(e.absolute_path))
+
+
+# --- the schema is closed ---------------------------------------------------------------------------------
+def open_objects(node, path="#"):
+    """Schemas of objects with fixed keys ("properties") that do not forbid other keys."""
+    found = []
+    if isinstance(node, dict):
+        if "properties" in node and node.get("additionalProperties") is not False:
+            found.append(path)
+        for key, value in node.items():
+            found += open_objects(value, f"{path}/{key}")
+    elif isinstance(node, list):
+        for i, value in enumerate(node):
+            found += open_objects(value, f"{path}/{i}")
+    return found
+
+
+check("every object with fixed keys sets additionalProperties false", not open_objects(schema), str(open_objects(schema)))
+
+# --- examples -----------------------------------------------------------------------------------------------
+names = {os.path.splitext(os.path.basename(p))[0] for p in EXAMPLES}
+check("all six examples are present", EXPECTED_EXAMPLES <= names, f"missing {EXPECTED_EXAMPLES - names}")
+for path in EXAMPLES:
+    errs = errors_of(load(path))
+    check(f"example {os.path.basename(path)} validates", not errs,
+          "; ".join(f"{'/'.join(map(str, e.absolute_path))}: {e.message}" for e in errs))
+
+# --- bad documents --------------------------------------------------------------------------------------------
+base = load(os.path.join(SOURCE, "api", "examples", "seed_layers.json"))
+
+
+def mutated(change):
+    doc = copy.deepcopy(base)
+    change(doc)
+    return doc
+
+
+def rejected_at(name, change, path, keyword=None):
+    """The mutated example is invalid, with an error at `path` (a list of keys and indices)."""
+    errs = errors_of(mutated(change))
+    at = [e for e in errs if list(e.absolute_path) == path and (keyword is None or e.validator == keyword)]
+    check(f"rejects {name}", bool(at),
+          "errors were: " + ("; ".join(f"{list(e.absolute_path)} {e.validator}: {e.message}" for e in errs) or "none"))
+
+
+rejected_at("an unknown top-level field", lambda d: d.update(solvr={}), [], "additionalProperties")
+rejected_at("an unknown field inside a block",
+            lambda d: d["bodies"][0]["mesh"]["block"].update(nz=3), ["bodies", 0, "mesh"])
+rejected_at("nu given as a string", lambda d: d["bodies"][1]["material"].update(nu="0.3"),
+            ["bodies", 1, "material", "nu"], "type")
+rejected_at("a body without material", lambda d: d["bodies"][0].pop("material"), ["bodies", 0], "required")
+rejected_at("nx = 0", lambda d: d["bodies"][0]["mesh"]["block"].update(nx=0), ["bodies", 0, "mesh"])
+rejected_at("nx = 2.5", lambda d: d["bodies"][0]["mesh"]["block"].update(nx=2.5), ["bodies", 0, "mesh"])
+rejected_at("nu = 0.5", lambda d: d["bodies"][0]["material"].update(nu=0.5),
+            ["bodies", 0, "material", "nu"], "exclusiveMaximum")
+rejected_at("E = 0", lambda d: d["bodies"][0]["material"].update(E=0), ["bodies", 0, "material", "E"])
+rejected_at("a number that overflows a double",
+            lambda d: d["bodies"][0]["material"].update(E=float("inf")), ["bodies", 0, "material", "E"])
+rejected_at("a body name with a dot", lambda d: d["bodies"][0].update(name="up.per"),
+            ["bodies", 0, "name"], "pattern")
+rejected_at("a malformed contact reference", lambda d: d["contacts"][0].update(slave="upper"),
+            ["contacts", 0, "slave"], "pattern")
+rejected_at("adaptivity", lambda d: d.update(adaptivity={"indicator": "fem_bem"}), ["adaptivity"], "not")
+rejected_at("both theta and c", lambda d: d["solver"].update(penalty={"theta": 1e-7, "c": 0.05}),
+            ["solver", "penalty"], "oneOf")
+rejected_at("gamma = 2", lambda d: d["solver"].update(gamma=2), ["solver", "gamma"], "exclusiveMaximum")
+rejected_at("grading towards both bottom and top",
+            lambda d: d["bodies"][0]["mesh"]["block"].update(grading={"bottom": 4, "top": 4}), ["bodies", 0, "mesh"])
+rejected_at("a condition with both displacement and traction",
+            lambda d: d["bodies"][0]["boundary"][0].update(traction=[0, 0]), ["bodies", 0, "boundary", 0], "oneOf")
+rejected_at("an empty displacement", lambda d: d["bodies"][0]["boundary"][0].update(displacement={}),
+            ["bodies", 0, "boundary", 0, "displacement"], "minProperties")
+rejected_at("free = false", lambda d: d["bodies"][0]["boundary"].__setitem__(2, {"edge": "right", "free": False}),
+            ["bodies", 0, "boundary", 2, "free"], "const")
+rejected_at("version 2", lambda d: d.update(version=2), ["version"], "const")
+rejected_at("no bodies", lambda d: d.update(bodies=[]), ["bodies"], "minItems")
+rejected_at("a quad repeating a node",
+            lambda d: d["bodies"][0].update(mesh={"nodes": [[0, 0], [1, 0], [1, 1], [0, 1]], "quads": [[0, 1, 1, 3]]}),
+            ["bodies", 0, "mesh"])
+
+# The defaults the schema documents are the solver's (solver/problem.hpp): a spot check of the important ones.
+solver_props = schema["$defs"]["solver"]["properties"]
+check("documented defaults match the paper's parameters",
+      solver_props["gamma"]["default"] == 0.02 and solver_props["tolerance"]["default"] == 0.0015
+      and solver_props["max_iterations"]["default"] == 2000 and solver_props["penalty"]["default"] == {"c": 0.05})
+
+print(f"{passed} passed, {failed} failed")
+sys.exit(1 if failed else 0)

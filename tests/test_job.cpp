@@ -1,0 +1,619 @@
+// Job module: the examples parse, defaults are filled in, and every bad job is reported at the pointer of the
+// offending value with a message that says what is wrong.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <string>
+
+#include "job/job.hpp"
+
+using contact::BoundaryCondition;
+using contact::job::Limits;
+using contact::job::parse;
+using contact::job::parse_text;
+using contact::job::ParseResult;
+using nlohmann::json;
+
+namespace {
+
+std::string read_example(const std::string& name) {
+  std::ifstream in(std::string(CONTACT_SOURCE_DIR) + "/api/examples/" + name);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Two small blocks pressed together, restrained as in the flat patch test: a valid job that the tests below
+// break in one place each.
+json small_job() {
+  return json::parse(R"({
+    "name": "small",
+    "bodies": [
+      {"name": "upper", "material": {"E": 2.1e5, "nu": 0.3},
+       "mesh": {"block": {"corners": [[0, 0], [2, 0], [2, 1], [0, 1]], "nx": 2, "ny": 1}},
+       "boundary": [{"edge": "left", "displacement": {"x": 0}},
+                    {"edge": "top", "displacement": {"y": -0.001}}]},
+      {"name": "lower", "material": {"E": 2.1e5, "nu": 0.3},
+       "mesh": {"block": {"corners": [[0, -1], [2, -1], [2, 0], [0, 0]], "nx": 2, "ny": 1}},
+       "boundary": [{"edge": "left", "displacement": {"x": 0}},
+                    {"edge": "bottom", "displacement": {"y": 0}}]}
+    ],
+    "contacts": [{"slave": "upper.bottom", "master": "lower.top"}]
+  })");
+}
+
+// A unit square as an explicit mesh of two quads, with its four sides as edge sets.
+json explicit_mesh() {
+  return json::parse(R"({
+    "nodes": [[0, 0], [1, 0], [2, 0], [0, 1], [1, 1], [2, 1]],
+    "quads": [[0, 1, 4, 3], [1, 2, 5, 4]],
+    "edges": {"base": [[0, 1], [1, 2]], "side": [[2, 5]], "cap": [[5, 4], [4, 3]], "wall": [[3, 0]]}
+  })");
+}
+
+std::string listing(const ParseResult& r) { return contact::job::format_errors(r.errors); }
+
+// Exactly one error, at `pointer`, whose message contains `phrase`.
+void expect_only_error(const ParseResult& r, const std::string& pointer, const std::string& phrase) {
+  ASSERT_EQ(r.errors.size(), 1u) << listing(r);
+  EXPECT_FALSE(r.problem.has_value());
+  EXPECT_EQ(r.errors[0].pointer, pointer) << listing(r);
+  EXPECT_NE(r.errors[0].message.find(phrase), std::string::npos) << "missing phrase '" << phrase << "' in\n"
+                                                                 << listing(r);
+}
+
+}  // namespace
+
+// ---- valid jobs -------------------------------------------------------------------------------------------
+
+TEST(JobExamples, EveryExampleParsesWithoutErrors) {
+  for (const char* name : {"seed_layers.json", "seed_layers_curved.json", "flat_patch.json",
+                           "flat_patch_nonmatching.json", "hertz.json", "stack3.json"}) {
+    const std::string text = read_example(name);
+    ASSERT_FALSE(text.empty()) << name;
+    const ParseResult r = parse_text(text);
+    EXPECT_TRUE(r.ok()) << name << ":\n" << listing(r);
+    EXPECT_TRUE(r.problem.has_value()) << name;
+  }
+}
+
+TEST(JobExamples, SeedLayersGivesTheMeshesConditionsAndContactIndicesItDescribes) {
+  const ParseResult r = parse_text(read_example("seed_layers.json"));
+  ASSERT_TRUE(r.ok()) << listing(r);
+  const contact::Problem& p = *r.problem;
+  EXPECT_EQ(p.name, "seed_layers");
+  ASSERT_EQ(p.bodies.size(), 2u);
+  for (const auto& body : p.bodies) {
+    EXPECT_EQ(body.mesh.num_cells(), 32 * 8);
+    EXPECT_EQ(body.mesh.num_nodes(), 33 * 9);
+    EXPECT_EQ(body.mesh.edge_sets.at("bottom").size(), 32u);
+    EXPECT_EQ(body.mesh.level, std::vector<int>(256, 0));
+    EXPECT_DOUBLE_EQ(body.material.E, 2.1e5);
+    EXPECT_DOUBLE_EQ(body.material.nu, 0.3);
+    ASSERT_EQ(body.boundary.size(), 3u);
+  }
+  const auto& upper = p.bodies[0];
+  EXPECT_EQ(upper.name, "upper");
+  EXPECT_EQ(upper.boundary[0].edge, "left");
+  EXPECT_EQ(upper.boundary[0].kind, BoundaryCondition::Kind::displacement);
+  EXPECT_EQ(upper.boundary[0].ux, 0.0);
+  EXPECT_FALSE(upper.boundary[0].uy.has_value());
+  EXPECT_EQ(upper.boundary[1].uy, -0.001366);
+  EXPECT_EQ(upper.boundary[2].kind, BoundaryCondition::Kind::traction);
+  EXPECT_FALSE(upper.boundary[2].normal_pressure);
+  EXPECT_EQ(upper.boundary[2].traction, Eigen::Vector2d::Zero());
+  EXPECT_NEAR(upper.mesh.bbox_min().y(), 0.0, 1e-15);
+  EXPECT_NEAR(p.bodies[1].mesh.bbox_max().y(), 0.0, 1e-15);
+
+  ASSERT_EQ(p.contacts.size(), 1u);
+  const auto& pair = p.contacts[0];
+  EXPECT_EQ(pair.name, "upper.bottom-lower.top");
+  EXPECT_EQ(pair.slave_body, 0);
+  EXPECT_EQ(pair.slave_edge, "bottom");
+  EXPECT_EQ(pair.master_body, 1);
+  EXPECT_EQ(pair.master_edge, "top");
+  EXPECT_TRUE(pair.gap.geometric);
+  EXPECT_EQ(pair.gap.parabola_r0, 0.001);
+  EXPECT_EQ(pair.gap.parabola_x0, 0.0);
+
+  EXPECT_EQ(p.solver.method, contact::Method::neumann);
+  EXPECT_FALSE(p.solver.penalty.theta.has_value());
+  EXPECT_EQ(p.solver.penalty.c, 0.05);
+  EXPECT_EQ(p.solver.penalty.length, 1.0);
+  EXPECT_EQ(p.solver.criterion, contact::Criterion::paper);
+  EXPECT_EQ(p.solver.initial_guess, contact::InitialGuess::elastic_layer);
+  EXPECT_EQ(p.submitted, json::parse(read_example("seed_layers.json")));
+}
+
+TEST(JobExamples, CurvedEdgeKeepsItsCurveForRefinementAndItsNodesOnTheParabola) {
+  const ParseResult r = parse_text(read_example("seed_layers_curved.json"));
+  ASSERT_TRUE(r.ok()) << listing(r);
+  const auto& upper = r.problem->bodies[0].mesh;
+  ASSERT_EQ(upper.edge_curves.count("bottom"), 1u);
+  EXPECT_EQ(upper.edge_curves.at("bottom").kind, contact::mesh::Curve::Kind::parabola);
+  for (int n : upper.edge_set_nodes("bottom")) {
+    const auto& x = upper.nodes[static_cast<size_t>(n)];
+    EXPECT_NEAR(x.y(), 0.001 * x.x() * x.x(), 1e-14);
+  }
+  EXPECT_FALSE(r.problem->contacts[0].gap.parabola_r0.has_value());
+}
+
+TEST(JobDefaults, MissingFieldsGetTheirDefaultsInProblemAndNormalized) {
+  const json job = small_job();
+  const ParseResult r = parse(job);
+  ASSERT_TRUE(r.ok()) << listing(r);
+  const contact::Problem& p = *r.problem;
+  EXPECT_EQ(p.model.plane, contact::Plane::strain);
+  EXPECT_EQ(p.model.thickness, 1.0);
+  EXPECT_EQ(p.solver.method, contact::Method::neumann);
+  EXPECT_EQ(p.solver.gamma, 0.02);
+  EXPECT_EQ(p.solver.tolerance, 0.0015);
+  EXPECT_EQ(p.solver.max_iterations, 2000);
+  EXPECT_EQ(p.solver.threads, 0);
+  EXPECT_EQ(p.contacts[0].name, "upper.bottom-lower.top");
+  EXPECT_EQ(p.bodies[0].body_force, Eigen::Vector2d::Zero());
+
+  EXPECT_EQ(p.submitted, job);
+  const json& n = p.normalized;
+  EXPECT_EQ(n["version"], 1);
+  EXPECT_EQ(n["model"]["plane"], "strain");
+  EXPECT_EQ(n["model"]["thickness"], 1.0);
+  EXPECT_EQ(n["solver"]["method"], "neumann");
+  EXPECT_EQ(n["solver"]["penalty"], json({{"c", 0.05}}));
+  EXPECT_EQ(n["solver"]["gamma"], 0.02);
+  EXPECT_EQ(n["solver"]["tolerance"], 0.0015);
+  EXPECT_EQ(n["solver"]["criterion"], "paper");
+  EXPECT_EQ(n["solver"]["max_iterations"], 2000);
+  EXPECT_EQ(n["solver"]["initial_guess"], "elastic_layer");
+  EXPECT_EQ(n["solver"]["threads"], 0);
+  EXPECT_EQ(n["contacts"][0]["name"], "upper.bottom-lower.top");
+  EXPECT_EQ(n["contacts"][0]["gap"], json({{"geometric", true}, {"constant", 0.0}}));
+  EXPECT_EQ(n["bodies"][1]["body_force"], json::array({0.0, 0.0}));
+  // Normalising is idempotent: the normalized document reads back to itself.
+  const ParseResult again = parse(n);
+  ASSERT_TRUE(again.ok()) << listing(again);
+  EXPECT_EQ(again.problem->normalized, n);
+}
+
+TEST(JobDefaults, ThetaGivenDirectlyIsKeptAndNoCIsAdded) {
+  json job = small_job();
+  job["solver"] = {{"penalty", {{"theta", 1e-8}}}, {"method", "monolithic"}};
+  const ParseResult r = parse(job);
+  ASSERT_TRUE(r.ok()) << listing(r);
+  EXPECT_EQ(r.problem->solver.penalty.theta, 1e-8);
+  EXPECT_EQ(r.problem->solver.method, contact::Method::monolithic);
+  EXPECT_EQ(r.problem->normalized["solver"]["penalty"], json({{"theta", 1e-8}}));
+}
+
+TEST(JobExplicitMesh, ArraysBecomeAMeshWithOrderedEdgeSetsAndConditions) {
+  json job = small_job();
+  job["bodies"][0]["mesh"] = explicit_mesh();
+  job["bodies"][0]["boundary"] = json::parse(
+      R"([{"edge": "wall", "displacement": {"x": 0}}, {"edge": "cap", "traction": {"normal": 5}},
+          {"edge": "side", "free": true}, {"edge": "base", "displacement": {"y": 0}}])");
+  job["contacts"][0]["slave"] = "upper.base";
+  const ParseResult r = parse(job);
+  ASSERT_TRUE(r.ok()) << listing(r);
+  const auto& body = r.problem->bodies[0];
+  EXPECT_EQ(body.mesh.num_nodes(), 6);
+  EXPECT_EQ(body.mesh.num_cells(), 2);
+  EXPECT_EQ(body.mesh.level, (std::vector<int>{0, 0}));
+  EXPECT_EQ(body.mesh.edge_set_nodes("cap"), (std::vector<int>{5, 4, 3}));
+  EXPECT_TRUE(body.boundary[1].normal_pressure);
+  EXPECT_EQ(body.boundary[1].pressure, 5.0);
+  EXPECT_EQ(body.boundary[2].kind, BoundaryCondition::Kind::free);
+  EXPECT_EQ(r.problem->contacts[0].slave_edge, "base");
+}
+
+TEST(JobRobustness, NonObjectDocumentsAreErrorsNotExceptions) {
+  for (const json& doc : {json(nullptr), json(3), json("job"), json::array()}) {
+    const ParseResult r = parse(doc);
+    ASSERT_EQ(r.errors.size(), 1u) << doc.dump();
+    EXPECT_EQ(r.errors[0].pointer, "");
+    EXPECT_NE(r.errors[0].message.find("must be an object"), std::string::npos);
+  }
+}
+
+TEST(JobRobustness, AnyLeafReplacedByAnyValueGivesErrorsNeverAnInternalFailure) {
+  json with_arrays = small_job();
+  with_arrays["bodies"][0]["mesh"] = explicit_mesh();
+  with_arrays["bodies"][0]["boundary"] = {{{"edge", "wall"}, {"displacement", {{"x", 0}, {"y", 0}}}}};
+  with_arrays["bodies"][1]["mesh"]["block"]["edges"] = {
+      {"bottom", {{"arc", {{"center", {1, -5}}, {"radius", 4.123105625617661}}}}}};
+  with_arrays["contacts"][0]["slave"] = "upper.base";
+  with_arrays["contacts"][0]["gap"] = {{"parabola", {{"r0", 0.001}}}};
+  with_arrays["solver"] = {{"penalty", {{"c", 0.1}}}, {"gamma", 0.1}};
+  const json replacements[] = {
+      nullptr, "x", -1, 0, 2.5, 1e300, true, json::array(), json::object(), json::array({1, 2, 3, 4, 5})};
+  int tried = 0;
+  for (const json& job : {small_job(), with_arrays}) {
+    ASSERT_TRUE(parse(job).ok()) << listing(parse(job));
+    const json leaves = job.flatten();
+    for (const auto& leaf : leaves.items()) {
+      const json::json_pointer at(leaf.key());
+      for (const json& value : replacements) {
+        json bad = job;
+        bad[at] = value;
+        const ParseResult r = parse(bad);
+        EXPECT_EQ(r.ok(), r.problem.has_value());
+        for (const auto& e : r.errors) {
+          EXPECT_EQ(e.message.find("internal error"), std::string::npos)
+              << leaf.key() << " = " << value.dump() << ": " << e.message;
+          EXPECT_FALSE(e.message.empty());
+        }
+        ++tried;
+      }
+      // And the leaf removed altogether.
+      json without = job;
+      json& parent = without[at.parent_pointer()];
+      if (parent.is_object())
+        parent.erase(at.back());
+      else
+        parent.erase(static_cast<size_t>(std::stoul(at.back())));
+      for (const auto& e : parse(without).errors)
+        EXPECT_EQ(e.message.find("internal error"), std::string::npos) << e.message;
+    }
+  }
+  EXPECT_GT(tried, 500);
+}
+
+// ---- bad jobs: one fault each, reported at its pointer -----------------------------------------------------
+
+TEST(JobErrors, MissingMaterialIsReportedWhereItBelongs) {
+  json job = small_job();
+  job["bodies"][0].erase("material");
+  expect_only_error(parse(job), "/bodies/0/material", "required field 'material' is missing");
+}
+
+TEST(JobErrors, ZeroYoungsModulusIsRejectedAsNotPositive) {
+  json job = small_job();
+  job["bodies"][1]["material"]["E"] = 0;
+  expect_only_error(parse(job), "/bodies/1/material/E", "E = 0 must be positive");
+}
+
+TEST(JobErrors, NuOfOneHalfIsRejectedAtItsPointer) {
+  json job = small_job();
+  job["bodies"][1]["material"]["nu"] = 0.5;
+  expect_only_error(parse(job), "/bodies/1/material/nu", "nu = 0.5 is outside (-1, 0.5)");
+}
+
+TEST(JobErrors, NuOfMinusOneIsRejectedAtItsPointer) {
+  json job = small_job();
+  job["bodies"][0]["material"]["nu"] = -1;
+  expect_only_error(parse(job), "/bodies/0/material/nu", "nu = -1 is outside (-1, 0.5)");
+}
+
+TEST(JobErrors, ZeroElementsAcrossABlockAreRejected) {
+  json job = small_job();
+  job["bodies"][0]["mesh"]["block"]["nx"] = 0;
+  expect_only_error(parse(job), "/bodies/0/mesh/block/nx", "nx = 0 must be at least 1");
+}
+
+TEST(JobErrors, FractionalElementCountIsNotAnInteger) {
+  json job = small_job();
+  job["bodies"][0]["mesh"]["block"]["nx"] = 2.5;
+  expect_only_error(parse(job), "/bodies/0/mesh/block/nx", "nx must be an integer, got 2.5");
+}
+
+TEST(JobErrors, IntegralFloatElementCountIsAccepted) {
+  json job = small_job();
+  job["bodies"][0]["mesh"]["block"]["nx"] = 2.0;
+  EXPECT_TRUE(parse(job).ok());
+}
+
+TEST(JobErrors, UnknownTopLevelFieldIsRejectedWithASuggestion) {
+  json job = small_job();
+  job["solvr"] = json::object();
+  expect_only_error(parse(job), "/solvr", "unknown field 'solvr' in the job (did you mean 'solver'?)");
+}
+
+TEST(JobErrors, UnknownFieldInsideABlockIsRejected) {
+  json job = small_job();
+  job["bodies"][1]["mesh"]["block"]["nz"] = 3;
+  expect_only_error(parse(job), "/bodies/1/mesh/block/nz", "unknown field 'nz' in block");
+}
+
+TEST(JobErrors, UnknownFieldNamesAreEscapedInThePointer) {
+  json job = small_job();
+  job["a/b~c"] = 1;
+  expect_only_error(parse(job), "/a~1b~0c", "unknown field 'a/b~c'");
+}
+
+TEST(JobErrors, AdaptivityIsRefusedInThisVersion) {
+  json job = small_job();
+  job["adaptivity"] = {{"indicator", "fem_bem"}};
+  expect_only_error(parse(job), "/adaptivity", "adaptivity is not available in this version of the solver");
+}
+
+TEST(JobErrors, UnsupportedVersionIsRejected) {
+  json job = small_job();
+  job["version"] = 2;
+  expect_only_error(parse(job), "/version", "version 2 is not supported");
+}
+
+TEST(JobErrors, UnknownEdgeInBoundaryListsTheEdgesTheBodyHas) {
+  json job = small_job();
+  job["bodies"][1]["boundary"][1]["edge"] = "botom";
+  expect_only_error(parse(job), "/bodies/1/boundary/1/edge",
+                    "the body has no edge 'botom'; its edges are bottom, right, top and left");
+}
+
+TEST(JobErrors, ConditionWithTwoKindsIsRejected) {
+  json job = small_job();
+  job["bodies"][0]["boundary"][0]["traction"] = {0, 0};
+  expect_only_error(parse(job), "/bodies/0/boundary/0", "exactly one of displacement, traction or free");
+}
+
+TEST(JobErrors, DisplacementWithoutComponentsIsRejected) {
+  json job = small_job();
+  job["bodies"][0]["boundary"].push_back({{"edge", "right"}, {"displacement", json::object()}});
+  expect_only_error(parse(job), "/bodies/0/boundary/2/displacement", "at least one of the components x and y");
+}
+
+TEST(JobErrors, SecondConditionOnTheSameEdgeIsRejected) {
+  json job = small_job();
+  job["bodies"][0]["boundary"].push_back({{"edge", "left"}, {"displacement", {{"y", 0}}}});
+  expect_only_error(parse(job), "/bodies/0/boundary/2/edge", "already has a condition at /bodies/0/boundary/0");
+}
+
+TEST(JobErrors, UnknownBodyInContactListsTheBodies) {
+  json job = small_job();
+  job["contacts"][0]["slave"] = "uper.bottom";
+  expect_only_error(parse(job), "/contacts/0/slave", "there is no body named 'uper'; the bodies are upper and lower");
+}
+
+TEST(JobErrors, UnknownEdgeInContactIsRejected) {
+  json job = small_job();
+  job["contacts"][0]["master"] = "lower.tip";
+  expect_only_error(parse(job), "/contacts/0/master", "body 'lower' has no edge 'tip'");
+}
+
+TEST(JobErrors, ContactReferenceWithoutADotIsMalformed) {
+  json job = small_job();
+  job["contacts"][0]["slave"] = "upper";
+  expect_only_error(parse(job), "/contacts/0/slave", "must be \"body.edge\"");
+}
+
+TEST(JobErrors, BodyCannotBeInContactWithItself) {
+  json job = small_job();
+  job["contacts"][0]["master"] = "upper.top";
+  expect_only_error(parse(job), "/contacts/0", "a body cannot be in contact with itself");
+}
+
+TEST(JobErrors, SamePairTwiceIsRejectedEvenWithSlaveAndMasterSwapped) {
+  json job = small_job();
+  job["contacts"].push_back({{"slave", "upper.bottom"}, {"master", "lower.top"}, {"name", "again"}});
+  expect_only_error(parse(job), "/contacts/1", "already given at /contacts/0");
+  json swapped = small_job();
+  swapped["contacts"].push_back({{"slave", "lower.top"}, {"master", "upper.bottom"}});
+  expect_only_error(parse(swapped), "/contacts/1", "slave and master swapped");
+}
+
+TEST(JobErrors, BodyFreeToSlideInXIsNotRestrained) {
+  json job = small_job();
+  job["bodies"][1]["boundary"].erase(0);  // only {"y": 0} on the bottom remains
+  expect_only_error(parse(job), "/bodies/1/boundary",
+                    "body 'lower' is not restrained against rigid motion: translation in x is free");
+}
+
+TEST(JobErrors, BodyWithoutDisplacementConditionsHasAllThreeRigidMotionsFree) {
+  json job = small_job();
+  job["bodies"][0]["boundary"] = {{{"edge", "top"}, {"traction", {{"normal", 1.0}}}}};
+  expect_only_error(parse(job), "/bodies/0/boundary", "translation in x, translation in y and rotation are free");
+}
+
+TEST(JobErrors, BodyHeldOnlyAgainstTranslationsRotatesAboutTheCornerThatNamesIt) {
+  // u_x = 0 along the (horizontal) bottom and u_y = 0 along the (vertical) left edge leave the rotation about
+  // their common corner (0, -1) free.
+  json job = small_job();
+  job["bodies"][1]["boundary"] =
+      json::parse(R"([{"edge": "bottom", "displacement": {"x": 0}}, {"edge": "left", "displacement": {"y": 0}}])");
+  expect_only_error(parse(job), "/bodies/1/boundary", "rotation about (0, -1) is free");
+}
+
+TEST(JobErrors, RigidMotionIsNotCheckedForABodyWithOtherErrors) {
+  json job = small_job();
+  job["bodies"][1]["boundary"].erase(0);
+  job["bodies"][1]["material"]["E"] = -1;
+  expect_only_error(parse(job), "/bodies/1/material/E", "must be positive");
+}
+
+TEST(JobErrors, InvertedExplicitQuadIsReportedOnTheMesh) {
+  json job = small_job();
+  job["bodies"][0]["mesh"] = explicit_mesh();
+  job["bodies"][0]["mesh"]["quads"][1] = {1, 4, 5, 2};  // clockwise
+  job["bodies"][0]["boundary"] = {{{"edge", "wall"}, {"displacement", {{"x", 0}, {"y", 0}}}}};
+  job["contacts"][0]["slave"] = "upper.base";
+  const ParseResult r = parse(job);
+  ASSERT_FALSE(r.ok());
+  expect_only_error(r, "/bodies/0/mesh", "cell 1 is inverted");
+}
+
+TEST(JobErrors, DegenerateExplicitQuadIsReportedOnTheMesh) {
+  // Quad 1 has four distinct node indices, but nodes 5 and 2 coincide: it collapses to a triangle.
+  json job = small_job();
+  job["bodies"][0]["mesh"] = json::parse(R"({
+    "nodes": [[0, 0], [1, 0], [1, 1], [0, 1], [2, 0], [1, 1]],
+    "quads": [[0, 1, 2, 3], [1, 4, 5, 2]],
+    "edges": {"base": [[0, 1], [1, 4]], "wall": [[3, 0]]}})");
+  job["bodies"][0]["boundary"] = {{{"edge", "wall"}, {"displacement", {{"x", 0}, {"y", 0}}}}};
+  job["contacts"][0]["slave"] = "upper.base";
+  expect_only_error(parse(job), "/bodies/0/mesh", "cell 1 is degenerate");
+}
+
+TEST(JobErrors, NodeIndexOutOfRangeIsReportedAtTheIndex) {
+  json job = small_job();
+  job["bodies"][0]["mesh"] = explicit_mesh();
+  job["bodies"][0]["mesh"]["quads"][0][2] = 6;
+  job["contacts"][0]["slave"] = "upper.base";
+  const ParseResult r = parse(job);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.errors[0].pointer, "/bodies/0/mesh/quads/0/2") << listing(r);
+  EXPECT_NE(r.errors[0].message.find("node index = 6 is out of range: the mesh has 6 nodes"), std::string::npos)
+      << listing(r);
+}
+
+TEST(JobErrors, QuadRepeatingANodeIsRejected) {
+  json job = small_job();
+  job["bodies"][0]["mesh"] = explicit_mesh();
+  job["bodies"][0]["mesh"]["quads"][0] = {0, 1, 1, 3};
+  job["contacts"][0]["slave"] = "upper.base";
+  const ParseResult r = parse(job);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.errors[0].pointer, "/bodies/0/mesh/quads/0") << listing(r);
+  EXPECT_NE(r.errors[0].message.find("repeats a node"), std::string::npos) << listing(r);
+}
+
+TEST(JobErrors, EdgePairThatIsNotABoundarySideIsReportedAtTheEdgeSet) {
+  json job = small_job();
+  job["bodies"][0]["mesh"] = explicit_mesh();
+  job["bodies"][0]["mesh"]["edges"]["base"] = {{0, 1}, {1, 4}};  // 1-4 is shared by both quads
+  job["bodies"][0]["boundary"] = {{{"edge", "wall"}, {"displacement", {{"x", 0}, {"y", 0}}}}};
+  job["contacts"][0]["slave"] = "upper.cap";
+  expect_only_error(parse(job), "/bodies/0/mesh/edges/base", "interior side");
+}
+
+TEST(JobErrors, TooManyDegreesOfFreedomAreRefusedBeforeAnyMeshIsBuilt) {
+  json job = small_job();
+  job["bodies"][0]["mesh"]["block"]["nx"] = 1000000000;  // would need tens of gigabytes if generated
+  expect_only_error(parse(job), "/bodies", "more than the limit of 2000000");
+
+  // The limit is the caller's: the small job has 2 * (6 + 6) = 24 DOFs.
+  Limits tight;
+  tight.max_dofs = 20;
+  expect_only_error(
+      parse(small_job(), tight), "/bodies",
+      "the meshes would have 24 degrees of freedom ('upper' 12 and 'lower' 12), more than the limit of 20");
+}
+
+TEST(JobErrors, NumberThatOverflowsIsNotFinite) {
+  std::string text = small_job().dump();
+  const std::string from = "210000.0";
+  text.replace(text.find(from), from.size(), "1e400");
+  expect_only_error(parse_text(text), "/bodies/0/material/E", "E must be a finite number (1e400 overflows a double)");
+
+  const std::string in_array = R"({"bodies": [{"body_force": [0, -1e999]}]})";
+  expect_only_error(parse_text(in_array), "/bodies/0/body_force/1", "must be a finite number");
+
+  // A document built in memory can hold infinity itself.
+  json job = small_job();
+  job["bodies"][1]["material"]["E"] = std::numeric_limits<double>::infinity();
+  expect_only_error(parse(job), "/bodies/1/material/E", "E must be a finite number");
+}
+
+TEST(JobErrors, WrongTypeIsNamed) {
+  json job = small_job();
+  job["bodies"][0]["material"]["nu"] = "0.3";
+  expect_only_error(parse(job), "/bodies/0/material/nu", "nu must be a number, got string");
+}
+
+TEST(JobErrors, MalformedJsonNamesTheByteOffset) {
+  expect_only_error(parse_text(R"({"name": })"), "", "malformed JSON at byte 10");
+}
+
+TEST(JobErrors, NestingTooDeepIsRefusedBeforeParsing) {
+  // Deep enough to overflow the stack of a recursive reader: it must be refused by counting brackets alone.
+  const std::string text = std::string(200000, '[') + std::string(200000, ']');
+  expect_only_error(parse_text(text), "", "nested deeper than 64 levels (at byte 65)");
+
+  json deep = json::array();
+  for (int k = 0; k < 100; ++k) deep = json::array({std::move(deep)});
+  json job = small_job();
+  job["extra"] = std::move(deep);
+  expect_only_error(parse(job), "", "nested deeper than 64 levels");
+}
+
+TEST(JobErrors, BracketsInsideStringsDoNotCountAsNesting) {
+  json job = small_job();
+  job["name"] = std::string(100, '[') + "\\\"" + std::string(100, '{');  // also an escaped quote
+  const ParseResult r = parse_text(job.dump());
+  ASSERT_TRUE(r.ok()) << listing(r);
+  EXPECT_EQ(r.problem->name, job["name"].get<std::string>());
+}
+
+TEST(JobErrors, DuplicateKeyInTheTextIsReportedAtItsPointer) {
+  const std::string text = R"({"bodies": [{"name": "a", "name": "b"}]})";
+  const ParseResult r = parse_text(text);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.errors[0].pointer, "/bodies/0/name") << listing(r);
+  EXPECT_NE(r.errors[0].message.find("duplicate key 'name'"), std::string::npos) << listing(r);
+}
+
+TEST(JobErrors, DuplicateBodyNamesAreRejected) {
+  json job = small_job();
+  job["bodies"][1]["name"] = "upper";
+  const ParseResult r = parse(job);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.errors[0].pointer, "/bodies/1/name") << listing(r);
+  EXPECT_NE(r.errors[0].message.find("body name 'upper' is already used by /bodies/0"), std::string::npos)
+      << listing(r);
+}
+
+TEST(JobErrors, BodyNameWithADotIsRejectedSinceContactsReferToBodyDotEdge) {
+  json job = small_job();
+  job["bodies"][0]["name"] = "up.per";
+  const ParseResult r = parse(job);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.errors[0].pointer, "/bodies/0/name") << listing(r);
+  EXPECT_NE(r.errors[0].message.find("^[A-Za-z0-9_-]+$"), std::string::npos) << listing(r);
+}
+
+TEST(JobErrors, BothThetaAndCAreRejected) {
+  json job = small_job();
+  job["solver"] = {{"penalty", {{"theta", 1e-7}, {"c", 0.05}}}};
+  expect_only_error(parse(job), "/solver/penalty", "give either theta, or c");
+}
+
+TEST(JobErrors, GammaOfTwoIsOutsideTheOpenInterval) {
+  json job = small_job();
+  job["solver"] = {{"gamma", 2}};
+  expect_only_error(parse(job), "/solver/gamma", "gamma = 2 is outside (0, 2)");
+}
+
+TEST(JobErrors, UnknownMethodListsTheChoices) {
+  json job = small_job();
+  job["solver"] = {{"method", "robin"}};
+  expect_only_error(parse(job), "/solver/method", "method \"robin\" is not one of \"neumann\" and \"monolithic\"");
+}
+
+TEST(JobErrors, ArcRadiusInconsistentWithTheCornersIsReportedAtTheArc) {
+  json job = small_job();
+  job["bodies"][0]["mesh"]["block"]["edges"] = {{"bottom", {{"arc", {{"center", {1, 5}}, {"radius", 4}}}}}};
+  expect_only_error(parse(job), "/bodies/0/mesh/block/edges/bottom/arc", "not at the radius 4");
+}
+
+TEST(JobErrors, ParabolaWithEqualXEndsIsReportedAtTheParabola) {
+  json job = small_job();
+  job["bodies"][0]["mesh"]["block"]["edges"] = {{"left", {{"parabola", {{"a", 0.1}}}}}};
+  expect_only_error(parse(job), "/bodies/0/mesh/block/edges/left/parabola", "different x");
+}
+
+TEST(JobErrors, GradingTowardsBothTopAndBottomIsRejected) {
+  json job = small_job();
+  job["bodies"][0]["mesh"]["block"]["grading"] = {{"top", 4}, {"bottom", 4}};
+  expect_only_error(parse(job), "/bodies/0/mesh/block/grading", "grading towards both bottom and top");
+}
+
+TEST(JobErrors, ClockwiseCornersAreRejectedBeforeMeshing) {
+  json job = small_job();
+  job["bodies"][0]["mesh"]["block"]["corners"] = {{0, 0}, {0, 1}, {2, 1}, {2, 0}};
+  expect_only_error(parse(job), "/bodies/0/mesh/block/corners", "the corners run clockwise");
+}
+
+TEST(JobErrors, SeveralErrorsAreAllReportedInOneAnswer) {
+  json job = small_job();
+  job["bodies"][0]["material"]["nu"] = 0.5;
+  job["bodies"][1]["mesh"]["block"]["ny"] = 0;
+  job["contacts"][0]["master"] = "lower.tip";
+  job["solver"] = {{"gamma", 3}, {"tolerance", -1}};
+  job["colour"] = "red";
+  const ParseResult r = parse(job);
+  ASSERT_EQ(r.errors.size(), 6u) << listing(r);
+  std::vector<std::string> pointers;
+  for (const auto& e : r.errors) pointers.push_back(e.pointer);
+  std::sort(pointers.begin(), pointers.end());
+  EXPECT_EQ(pointers, (std::vector<std::string>{"/bodies/0/material/nu", "/bodies/1/mesh/block/ny", "/colour",
+                                                "/contacts/0/master", "/solver/gamma", "/solver/tolerance"}));
+}
