@@ -1,1 +1,133 @@
-int main() { return 0; }
+// contact-solve: the solver without the server.
+//   contact-solve JOB.json [-o RESULT.hdf]     solve, print one progress line per iteration, write the result
+//   contact-solve JOB.json --validate          only check the job
+// Exit codes: 0 converged; 1 solver or I/O error; 2 invalid job (errors printed with their JSON pointers);
+// 3 stopped without converging (max_iterations or cancelled; the result file is still written).
+#include "io/result_file.hpp"
+#include "job/job.hpp"
+#include "solve.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+namespace {
+
+contact::CancelToken* g_cancel = nullptr;
+extern "C" void on_interrupt(int) {
+  if (g_cancel) g_cancel->cancel();  // an atomic store: async-signal-safe
+}
+
+// One line per iteration: both stopping measures, then per pair force, max pressure and active points.
+class ProgressPrinter final : public contact::Observer {
+ public:
+  explicit ProgressPrinter(bool quiet) : quiet_(quiet) {}
+  void on_iteration(const contact::IterationReport& r) override {
+    if (quiet_) return;
+    std::printf("iter %5d  paper %.3e  residual %.3e", r.iteration, r.paper_criterion, r.fixed_point_residual);
+    for (const auto& p : r.pairs)
+      std::printf("  | %s: force %.6g  p_max %.6g  active %d (%+d)", p.name.c_str(), p.force, p.max_pressure,
+                  p.active_points, p.changed_points);
+    std::printf("  %.2fs\n", r.elapsed_seconds);
+    std::fflush(stdout);
+  }
+
+ private:
+  bool quiet_;
+};
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot open job file '" + path + "'");
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"contact-solve: frictionless contact of elastic bodies by the penalty Neumann DDM"};
+  std::string job_path, output;
+  bool validate_only = false, quiet = false;
+  long max_dofs = contact::job::Limits{}.max_dofs;
+  int threads = -1;
+  app.add_option("job", job_path, "contact job (JSON, see docs/job-format.md)")->required();
+  app.add_option("-o,--output", output, "result file (HDF5; default: the job file's name with .hdf)");
+  app.add_flag("--validate", validate_only, "only validate the job and exit");
+  app.add_flag("-q,--quiet", quiet, "no per-iteration lines");
+  app.add_option("--max-dofs", max_dofs, "reject jobs with more unknowns than this")->check(CLI::PositiveNumber);
+  app.add_option("--threads", threads, "threads for the per-body solves (overrides the job; 0 = automatic)")
+      ->check(CLI::NonNegativeNumber);
+  CLI11_PARSE(app, argc, argv);
+
+  std::string text;
+  try {
+    text = read_file(job_path);
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
+  }
+  contact::job::Limits limits;
+  limits.max_dofs = max_dofs;
+  auto parsed = contact::job::parse_text(text, limits);
+  if (!parsed.ok()) {
+    std::cerr << job_path << ": the job is invalid (" << parsed.errors.size() << " error"
+              << (parsed.errors.size() == 1 ? "" : "s") << "):\n"
+              << contact::job::format_errors(parsed.errors);
+    return 2;
+  }
+  contact::Problem& problem = *parsed.problem;
+  if (threads >= 0) problem.solver.threads = threads;
+  if (validate_only) {
+    long dofs = 0;
+    for (const auto& b : problem.bodies) dofs += 2L * b.mesh.num_nodes();
+    std::cout << job_path << ": valid (" << problem.bodies.size() << " bodies, " << problem.contacts.size()
+              << " contact pairs, " << dofs << " dofs before constraints)\n";
+    return 0;
+  }
+  if (output.empty()) output = std::filesystem::path(job_path).stem().string() + ".hdf";
+
+  contact::CancelToken cancel;
+  g_cancel = &cancel;
+  std::signal(SIGINT, on_interrupt);
+  std::signal(SIGTERM, on_interrupt);
+
+  std::printf("%s: %zu bodies, %zu contact pairs, method %s\n", problem.name.c_str(), problem.bodies.size(),
+              problem.contacts.size(), problem.solver.method == contact::Method::monolithic ? "monolithic" : "neumann");
+  ProgressPrinter printer(quiet);
+  const contact::Result result = contact::solve(problem, printer, cancel);
+  g_cancel = nullptr;
+
+  std::printf("stop: %s (%s) after %d iterations, %.3f s (setup %.3f s)\n", contact::to_string(result.stop_reason),
+              result.message.c_str(), result.iterations, result.wall_seconds, result.setup_seconds);
+  if (result.steps.empty()) {
+    std::cerr << "error: " << result.message << "\n";
+    return 1;
+  }
+  for (const auto& p : result.steps.back().pairs) {
+    double p_max = 0, penetration = 0;
+    for (Eigen::Index j = 0; j < p.pressure.size(); ++j) {
+      p_max = std::max(p_max, p.pressure[j]);
+      penetration = std::max(penetration, p.penetration[j]);
+    }
+    std::printf("pair %s: theta %.4g, force %.8g, max pressure %.8g, max penetration %.4g\n", p.name.c_str(), p.theta,
+                p.force, p_max, penetration);
+  }
+  try {
+    contact::io::write_result(output, problem, result);
+    const std::filesystem::path xmf = std::filesystem::path(output).replace_extension(".xmf");
+    contact::io::write_xdmf(xmf.string(), std::filesystem::path(output).filename().string(), result);
+    std::printf("wrote %s and %s\n", output.c_str(), xmf.string().c_str());
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 1;
+  }
+  if (result.stop_reason == contact::StopReason::error) return 1;
+  return result.converged ? 0 : 3;
+}
