@@ -38,6 +38,8 @@ MethodOutcome run_neumann(const ContactSystem& system, const SolverSettings& set
 
   const double gamma = settings.gamma;
   double smallest_residual = std::numeric_limits<double>::infinity();
+  int best_iteration = 0;  // where smallest_residual was reached (by a margin of 0.1 %)
+  const int stagnation_window = 100;
   for (int k = 1; k <= settings.max_iterations; ++k) {
     if (context.cancel.cancelled()) {
       out.reason = StopReason::cancelled;
@@ -79,7 +81,19 @@ MethodOutcome run_neumann(const ContactSystem& system, const SolverSettings& set
       out.message = os.str();
       break;
     }
+    if (residual < 0.999 * smallest_residual) best_iteration = k;
     smallest_residual = std::min(smallest_residual, residual);
+    if (k - best_iteration >= stagnation_window) {
+      // A relaxation above the stability bound does not always blow up: the penalty switching contact on and
+      // off can lock it into a cycle (seen with gamma = 1 on seed_layers).
+      std::ostringstream os;
+      os << "the iteration stagnates: the fixed-point residual has not fallen below " << smallest_residual
+         << " (reached at iteration " << best_iteration << ") in " << stagnation_window << " iterations";
+      if (smallest_residual > 1e-6) os << "; gamma = " << gamma << " is probably above the stability bound: reduce it";
+      out.reason = StopReason::stagnation;
+      out.message = os.str();
+      break;
+    }
     if (!std::isfinite(residual) || (k > 5 && residual > 1e3 * smallest_residual && residual > 1.0)) {
       std::ostringstream os;
       os << "the iteration diverges: the fixed-point residual grew from " << smallest_residual << " to " << residual

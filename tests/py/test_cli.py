@@ -1,0 +1,74 @@
+#!/usr/bin/env python3
+"""contact-solve as a user meets it: exit codes, validation messages, --validate, the output files."""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
+BIN = os.environ.get("CONTACT_BINARY_DIR", os.path.join(SRC, "build"))
+CLI = os.path.join(BIN, "contact-solve")
+EXAMPLE = os.path.join(SRC, "api", "examples", "flat_patch.json")
+
+passed, failed = 0, 0
+
+
+def check(name, condition, detail=""):
+    global passed, failed
+    if condition:
+        passed += 1
+    else:
+        failed += 1
+        print(f"FAIL {name}: {detail}")
+
+
+def run(*args):
+    return subprocess.run([CLI, *args], capture_output=True, text=True, timeout=120)
+
+
+with tempfile.TemporaryDirectory() as tmp:
+    # A valid job solves, prints one line per iteration and writes the result and its sidecar.
+    out = os.path.join(tmp, "patch.hdf")
+    r = run(EXAMPLE, "-o", out)
+    check("valid job exits 0", r.returncode == 0, r.stderr)
+    lines = [l for l in r.stdout.splitlines() if l.startswith("iter ")]
+    check("one progress line per iteration", len(lines) >= 2, r.stdout[:400])
+    check("summary names the stop", "stop: converged" in r.stdout, r.stdout[-400:])
+    check("result file written", os.path.getsize(out) > 0 if os.path.exists(out) else False)
+    check("sidecar written", os.path.exists(os.path.join(tmp, "patch.xmf")))
+
+    # --validate only checks.
+    r = run(EXAMPLE, "--validate")
+    check("--validate exits 0", r.returncode == 0 and "valid" in r.stdout, r.stdout + r.stderr)
+
+    # A bad job: exit code 2, every error with its JSON pointer, nothing written.
+    with open(EXAMPLE) as f:
+        job = json.load(f)
+    job["bodies"][1]["material"]["nu"] = 0.5
+    job["bodies"][0]["mesh"]["block"]["nx"] = 0
+    job["solver"]["gama"] = 0.1
+    bad = os.path.join(tmp, "bad.json")
+    with open(bad, "w") as f:
+        json.dump(job, f)
+    bad_out = os.path.join(tmp, "bad.hdf")
+    r = run(bad, "-o", bad_out)
+    check("bad job exits 2", r.returncode == 2, f"{r.returncode} {r.stderr}")
+    for pointer in ("/bodies/1/material/nu", "/bodies/0/mesh/block/nx", "/solver/gama"):
+        check(f"error names {pointer}", pointer in r.stderr, r.stderr)
+    check("bad job writes nothing", not os.path.exists(bad_out))
+
+    # Malformed JSON and a missing file: exit 2 with a message, never a crash.
+    with open(bad, "w") as f:
+        f.write('{"bodies": [')
+    r = run(bad)
+    check("malformed JSON exits 2", r.returncode == 2 and "JSON" in r.stderr, r.stderr)
+    r = run(os.path.join(tmp, "missing.json"))
+    check("missing file exits 2", r.returncode == 2 and "cannot open" in r.stderr, r.stderr)
+
+    # The DOF limit is enforced from the command line.
+    r = run(EXAMPLE, "--validate", "--max-dofs", "10")
+    check("--max-dofs rejects", r.returncode == 2 and "/bodies" in r.stderr, r.stderr)
+
+print(f"{passed} passed, {failed} failed")
+sys.exit(1 if failed else 0)

@@ -1,0 +1,114 @@
+// The interfaces the server plugs into: one report per iteration, in order, with the documented fields; and
+// cancellation within one iteration.
+#include "job/job.hpp"
+#include "solve.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+using namespace contact;
+
+namespace {
+
+Problem seed(const std::string& method) {
+  std::ifstream in(std::string(CONTACT_SOURCE_DIR) + "/api/examples/seed_layers.json");
+  nlohmann::json job = nlohmann::json::parse(in);
+  job["solver"]["method"] = method;
+  job["solver"]["criterion"] = "residual";
+  job["solver"]["tolerance"] = 1e-9;
+  job["solver"]["gamma"] = 0.05;
+  auto r = job::parse(job);
+  EXPECT_TRUE(r.ok()) << job::format_errors(r.errors);
+  return std::move(*r.problem);
+}
+
+struct Recorder : Observer {
+  std::vector<IterationReport> reports;
+  CancelToken* cancel_at_three = nullptr;
+  void on_iteration(const IterationReport& r) override {
+    reports.push_back(r);
+    if (cancel_at_three && r.iteration == 3) cancel_at_three->cancel();
+  }
+};
+
+}  // namespace
+
+TEST(Observer, ReceivesEveryIterationInOrderWithTheDocumentedFields) {
+  for (const char* method : {"neumann", "monolithic"}) {
+    const Problem p = seed(method);
+    Recorder rec;
+    CancelToken cancel;
+    const Result r = solve(p, rec, cancel);
+    ASSERT_TRUE(r.converged) << method << ": " << r.message;
+    ASSERT_EQ(static_cast<int>(rec.reports.size()), r.iterations) << method;
+    ASSERT_EQ(r.history.size(), rec.reports.size());
+    double last_elapsed = 0;
+    for (size_t i = 0; i < rec.reports.size(); ++i) {
+      const auto& rep = rec.reports[i];
+      EXPECT_EQ(rep.iteration, static_cast<int>(i) + 1);
+      EXPECT_GE(rep.elapsed_seconds, last_elapsed);
+      last_elapsed = rep.elapsed_seconds;
+      ASSERT_EQ(rep.bodies.size(), 2u);
+      EXPECT_EQ(rep.bodies[0].name, "upper");
+      EXPECT_EQ(rep.bodies[0].elements, 32 * 8);
+      EXPECT_GT(rep.bodies[0].dofs, 0);
+      ASSERT_EQ(rep.pairs.size(), 1u);
+      EXPECT_EQ(rep.pairs[0].positions.size(), rep.pairs[0].pressures.size());
+      EXPECT_EQ(rep.pairs[0].positions.size(), 33u);
+      EXPECT_GT(rep.pairs[0].theta, 0.0);
+    }
+    const auto& last = rec.reports.back();
+    EXPECT_NEAR(last.pairs[0].force, r.steps.back().pairs[0].force, 1e-12 * last.pairs[0].force);
+    EXPECT_GT(last.pairs[0].active_points, 0);
+    EXPECT_GT(last.pairs[0].extent_end, 0.7);  // contact reaches about x = 1
+    EXPECT_LT(last.pairs[0].extent_end, 1.3);
+    if (std::string(method) == "neumann") EXPECT_LE(last.fixed_point_residual, 1e-9);
+  }
+}
+
+TEST(Cancellation, ARunningSolveStopsWithinOneIteration) {
+  for (const char* method : {"neumann", "monolithic"}) {
+    const Problem p = seed(method);
+    Recorder rec;
+    CancelToken cancel;
+    rec.cancel_at_three = &cancel;
+    const Result r = solve(p, rec, cancel);
+    EXPECT_EQ(r.stop_reason, StopReason::cancelled) << method;
+    EXPECT_FALSE(r.converged);
+    EXPECT_EQ(r.iterations, 3) << method;
+    EXPECT_EQ(rec.reports.size(), 3u);
+    EXPECT_EQ(r.steps.size(), 1u);  // the state reached is still returned
+  }
+}
+
+TEST(Cancellation, ACancelledTokenStopsBeforeTheFirstIteration) {
+  const Problem p = seed("neumann");
+  Recorder rec;
+  CancelToken cancel;
+  cancel.cancel();
+  const Result r = solve(p, rec, cancel);
+  EXPECT_EQ(r.stop_reason, StopReason::cancelled);
+  EXPECT_TRUE(rec.reports.empty());
+}
+
+TEST(Divergence, TooLargeGammaIsStoppedEarlyWithAMessageNamingGamma) {
+  Problem p = seed("neumann");
+  p.solver.gamma = 1.0;  // far above the stability bound (about 0.067 here)
+  p.solver.max_iterations = 500;
+  Observer quiet;
+  CancelToken cancel;
+  const Result r = solve(p, quiet, cancel);
+  // gamma = 1 locks the penalty into an on/off cycle: stagnation, reported long before max_iterations.
+  EXPECT_TRUE(r.stop_reason == StopReason::stagnation || r.stop_reason == StopReason::error) << r.message;
+  EXPECT_LT(r.iterations, 200);
+  EXPECT_NE(r.message.find("gamma"), std::string::npos) << r.message;
+  // A gamma far above the bound whose iterates do grow is reported as divergence, not as NaNs.
+  p.solver.gamma = 1.9;
+  p.solver.initial_guess = InitialGuess::zero;
+  const Result d = solve(p, quiet, cancel);
+  EXPECT_NE(d.stop_reason, StopReason::converged);
+  EXPECT_NE(d.message.find("gamma"), std::string::npos) << d.message;
+  for (const auto& pair : d.steps.back().pairs) EXPECT_TRUE(std::isfinite(pair.force));
+}
