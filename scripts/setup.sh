@@ -7,13 +7,13 @@ set -euo pipefail
 
 BUILD_PACKAGES=(
   build-essential cmake pkg-config git
-  libeigen3-dev libsuitesparse-dev libopenblas0-serial nlohmann-json3-dev libhdf5-dev
+  libeigen3-dev libsuitesparse-dev libopenblas0-pthread nlohmann-json3-dev libhdf5-dev
   libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev
   libcpp-httplib-dev
   python3 python3-h5py python3-numpy python3-jsonschema python3-matplotlib
 )
 RUNTIME_PACKAGES=(
-  libcholmod3 libopenblas0-serial libhdf5-103-1 libcpp-httplib0.11 ca-certificates curl python3
+  libcholmod3 libopenblas0-pthread libhdf5-103-1 libcpp-httplib0.11 ca-certificates curl python3
 )
 
 if [[ "${1:-}" == "--runtime" ]]; then

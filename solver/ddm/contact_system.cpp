@@ -1,5 +1,7 @@
 #include "contact_system.hpp"
 
+#include "../fem/blas_threads.hpp"
+
 #include <chrono>
 
 namespace contact::ddm {
@@ -11,6 +13,7 @@ double relative_change(const Eigen::VectorXd& now, const Eigen::VectorXd& before
 
 ContactSystem::ContactSystem(const Problem& problem, TaskRunner& runner, bool factorize) : problem_(problem) {
   const auto t0 = std::chrono::steady_clock::now();
+  fem::limit_blas_threads();
   bodies_.resize(problem.bodies.size());
   runner.run(bodies_.size(), [&](size_t a) {
     bodies_[a] = std::make_unique<fem::BodySolver>(problem.bodies[a], problem.model, factorize);
