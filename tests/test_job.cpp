@@ -617,3 +617,13 @@ TEST(JobErrors, SeveralErrorsAreAllReportedInOneAnswer) {
   EXPECT_EQ(pointers, (std::vector<std::string>{"/bodies/0/material/nu", "/bodies/1/mesh/block/ny", "/colour",
                                                 "/contacts/0/master", "/solver/gamma", "/solver/tolerance"}));
 }
+
+TEST(BadJobs, HugeButFiniteNumberIsRejectedAtItsPointer) {
+  std::ifstream in(std::string(CONTACT_SOURCE_DIR) + "/api/examples/flat_patch.json");
+  nlohmann::json job = nlohmann::json::parse(in);
+  job["bodies"][0]["material"]["E"] = 1e308;
+  const auto r = contact::job::parse(job);
+  ASSERT_EQ(r.errors.size(), 1u) << contact::job::format_errors(r.errors);
+  EXPECT_EQ(r.errors[0].pointer, "/bodies/0/material/E");
+  EXPECT_NE(r.errors[0].message.find("too large"), std::string::npos);
+}

@@ -63,6 +63,14 @@ std::optional<double> number(const json& value, const std::string& pointer, cons
     errors.add(pointer, what + " must be a finite number (this one overflows a double)");
     return std::nullopt;
   }
+  // Finite but huge values (1e308) overflow the stiffness matrices and every product after them: no physical
+  // input in any unit system comes near this bound.
+  if (std::abs(x) > kMaxMagnitude) {
+    std::ostringstream os;
+    os << what << " = " << x << " is too large in magnitude (at most " << kMaxMagnitude << ")";
+    errors.add(pointer, os.str());
+    return std::nullopt;
+  }
   return x;
 }
 

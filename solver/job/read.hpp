@@ -48,6 +48,9 @@ class Errors {
 // reporting the problem: wrong type ("nu must be a number, got string"), or a number that is not finite
 // (nlohmann reads 1e400 as infinity) or, for integers, has a fractional part. 2.0 counts as an integer, as in
 // JSON Schema.
+// Largest magnitude accepted for any number of a job.
+inline constexpr double kMaxMagnitude = 1e30;
+
 std::optional<double> number(const json& value, const std::string& pointer, const std::string& what, Errors& errors);
 std::optional<long long> integer(const json& value, const std::string& pointer, const std::string& what,
                                  Errors& errors);
