@@ -76,19 +76,44 @@ struct PenaltySpec {
   std::optional<double> length;
 };
 
-enum class Method { neumann, monolithic };
+// neumann: the paper's scheme (16)-(17); robin: the Robin-type variant; interface_newton: each body's
+// contact-zone compliance by back-substitutions, then semismooth Newton on the interface; monolithic: all bodies
+// in one system (the reference). See docs/algorithm.md for when to use which.
+enum class Method { neumann, monolithic, interface_newton, robin };
 enum class Criterion { paper, residual };
 enum class InitialGuess { zero, elastic_layer };
+enum class Acceleration { none, anderson };
+enum class Enforcement { penalty, augmented_lagrangian };
+
+// Robin weight psi (force per length^3, like 1/theta): a constant over every contact zone, or 1/theta on the
+// current active set and 0 elsewhere ("active_set").
+struct RobinSettings {
+  bool active_set = true;
+  double psi = 0.0;
+};
+
+// Uzawa updates of the contact pressure around the penalty solve: stop when the relative change of the
+// pressures between two updates is below tolerance.
+struct AugmentedLagrangianSettings {
+  double tolerance = 1e-9;
+  int max_updates = 100;
+};
 
 struct SolverSettings {
   Method method = Method::neumann;
   PenaltySpec penalty;
   double gamma = 0.02;        // relaxation of (17)
+  bool gamma_auto = false;    // estimate the interface compliance and choose gamma (overrides gamma)
   double tolerance = 0.0015;  // eps of the chosen criterion
   Criterion criterion = Criterion::paper;
   int max_iterations = 2000;
   InitialGuess initial_guess = InitialGuess::elastic_layer;
   int threads = 0;            // worker threads for the per-body solves; 0 = one per body up to the cores
+  Acceleration acceleration = Acceleration::none;
+  int anderson_depth = 5;
+  RobinSettings robin;
+  Enforcement enforcement = Enforcement::penalty;
+  AugmentedLagrangianSettings augmented_lagrangian;
 };
 
 struct Problem {

@@ -213,20 +213,31 @@ class JobReader {
     SolverSettings& s = problem_.solver;
     if (const json* v = top.find("solver")) {
       Fields f(*v, top.at("solver"), "solver",
-               {"method", "penalty", "gamma", "tolerance", "criterion", "max_iterations", "initial_guess", "threads"},
+               {"method", "penalty", "gamma", "tolerance", "criterion", "max_iterations", "initial_guess", "threads",
+                "acceleration", "anderson_depth", "robin", "enforcement", "augmented_lagrangian"},
                errors_);
       if (const json* m = f.find("method"))
-        if (auto x = choice(*m, f.at("method"), "method", {"neumann", "monolithic"}, errors_))
-          s.method = *x == "monolithic" ? Method::monolithic : Method::neumann;
+        if (auto x = choice(*m, f.at("method"), "method", {"neumann", "monolithic", "interface_newton", "robin"}, errors_))
+          s.method = *x == "monolithic"         ? Method::monolithic
+                     : *x == "interface_newton" ? Method::interface_newton
+                     : *x == "robin"            ? Method::robin
+                                                : Method::neumann;
       if (const json* p = f.find("penalty")) read_penalty(*p, f.at("penalty"), sub_object(out, "penalty"));
       if (const json* g = f.find("gamma")) {
-        auto x = read::number(*g, f.at("gamma"), "gamma", errors_);
-        if (x && !(*x > 0 && *x < 2))
-          errors_.add(f.at("gamma"),
-                      "gamma = " + format_number(*x) +
-                          " is outside (0, 2): the relaxation weight must be greater than 0 and less than 2");
-        else if (x)
-          s.gamma = *x;
+        if (g->is_string()) {
+          if (g->get<std::string>() == "auto")
+            s.gamma_auto = true;
+          else
+            errors_.add(f.at("gamma"), "gamma must be a number in (0, 2) or \"auto\", got \"" + g->get<std::string>() + "\"");
+        } else {
+          auto x = read::number(*g, f.at("gamma"), "gamma", errors_);
+          if (x && !(*x > 0 && *x < 2))
+            errors_.add(f.at("gamma"),
+                        "gamma = " + format_number(*x) +
+                            " is outside (0, 2): the relaxation weight must be greater than 0 and less than 2");
+          else if (x)
+            s.gamma = *x;
+        }
       }
       if (const json* t = f.find("tolerance"))
         if (auto x = positive(*t, f.at("tolerance"), "tolerance", errors_)) s.tolerance = *x;
@@ -240,6 +251,22 @@ class JobReader {
           s.initial_guess = *x == "zero" ? InitialGuess::zero : InitialGuess::elastic_layer;
       if (const json* t = f.find("threads"))
         if (auto x = bounded_int(*t, f.at("threads"), "threads", 0, errors_)) s.threads = *x;
+      if (const json* a = f.find("acceleration"))
+        if (auto x = choice(*a, f.at("acceleration"), "acceleration", {"none", "anderson"}, errors_))
+          s.acceleration = *x == "anderson" ? Acceleration::anderson : Acceleration::none;
+      if (const json* d = f.find("anderson_depth")) {
+        if (auto x = bounded_int(*d, f.at("anderson_depth"), "anderson_depth", 1, errors_)) {
+          if (*x > 50)
+            errors_.add(f.at("anderson_depth"), "anderson_depth = " + std::to_string(*x) + " is above 50");
+          else
+            s.anderson_depth = *x;
+        }
+      }
+      if (const json* r = f.find("robin")) read_robin(*r, f.at("robin"));
+      if (const json* e = f.find("enforcement"))
+        if (auto x = choice(*e, f.at("enforcement"), "enforcement", {"penalty", "augmented_lagrangian"}, errors_))
+          s.enforcement = *x == "augmented_lagrangian" ? Enforcement::augmented_lagrangian : Enforcement::penalty;
+      if (const json* a = f.find("augmented_lagrangian")) read_augmented_lagrangian(*a, f.at("augmented_lagrangian"));
     }
     set_default(out, "method", "neumann");
     set_default(out, "penalty", json{{"c", 0.05}});
@@ -249,6 +276,38 @@ class JobReader {
     set_default(out, "max_iterations", 2000);
     set_default(out, "initial_guess", "elastic_layer");
     set_default(out, "threads", 0);
+    set_default(out, "acceleration", "none");
+    set_default(out, "anderson_depth", 5);
+    set_default(out, "robin", json{{"psi", "active_set"}});
+    set_default(out, "enforcement", "penalty");
+    set_default(out, "augmented_lagrangian", json{{"tolerance", 1e-9}, {"max_updates", 100}});
+    json& al = out["augmented_lagrangian"];
+    set_default(al, "tolerance", 1e-9);
+    set_default(al, "max_updates", 100);
+  }
+
+  void read_robin(const json& value, const std::string& pointer) {
+    Fields f(value, pointer, "robin", {"psi"}, errors_);
+    if (!f.ok()) return;
+    if (const json* p = f.find("psi")) {
+      if (p->is_string()) {
+        if (p->get<std::string>() != "active_set")
+          errors_.add(f.at("psi"), "psi must be a positive number or \"active_set\", got \"" + p->get<std::string>() + "\"");
+      } else if (auto x = positive(*p, f.at("psi"), "psi", errors_)) {
+        problem_.solver.robin.active_set = false;
+        problem_.solver.robin.psi = *x;
+      }
+    }
+  }
+
+  void read_augmented_lagrangian(const json& value, const std::string& pointer) {
+    Fields f(value, pointer, "augmented_lagrangian", {"tolerance", "max_updates"}, errors_);
+    if (!f.ok()) return;
+    auto& al = problem_.solver.augmented_lagrangian;
+    if (const json* t = f.find("tolerance"))
+      if (auto x = positive(*t, f.at("tolerance"), "tolerance", errors_)) al.tolerance = *x;
+    if (const json* n = f.find("max_updates"))
+      if (auto x = bounded_int(*n, f.at("max_updates"), "max_updates", 1, errors_)) al.max_updates = *x;
   }
 
   void read_penalty(const json& value, const std::string& pointer, json& out) {

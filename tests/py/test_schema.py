@@ -111,7 +111,17 @@ rejected_at("a malformed contact reference", lambda d: d["contacts"][0].update(s
 rejected_at("adaptivity", lambda d: d.update(adaptivity={"indicator": "fem_bem"}), ["adaptivity"], "not")
 rejected_at("both theta and c", lambda d: d["solver"].update(penalty={"theta": 1e-7, "c": 0.05}),
             ["solver", "penalty"], "oneOf")
-rejected_at("gamma = 2", lambda d: d["solver"].update(gamma=2), ["solver", "gamma"], "exclusiveMaximum")
+rejected_at("gamma = 2", lambda d: d["solver"].update(gamma=2), ["solver", "gamma"], "oneOf")
+rejected_at("gamma = \"fast\"", lambda d: d["solver"].update(gamma="fast"), ["solver", "gamma"], "oneOf")
+rejected_at("an unknown acceleration", lambda d: d["solver"].update(acceleration="aitken"), ["solver", "acceleration"], "enum")
+rejected_at("an unknown field in robin", lambda d: d["solver"].update(robin={"phi": 1}), ["solver", "robin"],
+            "additionalProperties")
+check("accepts the fast settings (gamma auto, Anderson, interface Newton, augmented Lagrangian)",
+      not errors_of(mutated(lambda d: d["solver"].update(gamma="auto", acceleration="anderson", anderson_depth=6,
+                                                          method="interface_newton",
+                                                          enforcement="augmented_lagrangian",
+                                                          augmented_lagrangian={"tolerance": 1e-8},
+                                                          robin={"psi": 1e7}))))
 rejected_at("grading towards both bottom and top",
             lambda d: d["bodies"][0]["mesh"]["block"].update(grading={"bottom": 4, "top": 4}), ["bodies", 0, "mesh"])
 rejected_at("a condition with both displacement and traction",
