@@ -32,6 +32,7 @@ struct PairReport {
   int active_points = 0;       // quadrature points in contact
   int changed_points = 0;      // quadrature points whose contact status changed since the last iteration
   double theta = 0.0;          // penalty parameter in use
+  double max_penetration = 0.0;   // largest overlap max(0, -g) at the slave nodes
   std::vector<double> positions;  // arc length along the slave edge of each slave node
   std::vector<double> pressures;  // contact pressure at each slave node
 };
@@ -40,6 +41,9 @@ struct IterationReport {
   int iteration = 0;                // 1-based
   double paper_criterion = 0.0;     // max over bodies of ||u_n^k - u_n^{k-1}|| / ||u_n^k|| (paper, section 4)
   double fixed_point_residual = 0.0;// ||u~_n^{k+1} - u_n^k|| / ||u_n^k|| over all contact zones
+  double gamma = 0.0;               // relaxation in use (0 for methods without one)
+  int update = 0;                   // augmented-Lagrangian update (0 for the pure penalty method)
+  std::string note;                 // what changed in this iteration, if anything (e.g. "gamma reduced")
   std::vector<BodyReport> bodies;
   std::vector<PairReport> pairs;
   double elapsed_seconds = 0.0;
@@ -66,9 +70,9 @@ struct PairField {
   Eigen::VectorXd arc_length;    // along the slave edge from its first node
   Eigen::VectorXd gap;           // initial gap d (geometric + analytic)
   Eigen::VectorXd normal_gap;    // d - u_1n - u_2n after deformation (negative = penetration)
-  Eigen::VectorXd pressure;      // max(0, -normal_gap) / theta, positive in compression
+  Eigen::VectorXd pressure;      // max(0, lambda - normal_gap / theta) (lambda = 0 without augmented Lagrangian)
   Eigen::VectorXd penetration;   // max(0, -normal_gap)
-  Eigen::VectorXi active;        // 1 where in contact
+  Eigen::VectorXi active;        // 1 where the pressure is positive
   double force = 0.0;            // integral of the pressure over the slave edge (quadrature of the solver)
 };
 
@@ -87,6 +91,8 @@ struct Result {
   int iterations = 0;
   std::string method;   // "neumann" or "monolithic"
   double gamma = 0.0;   // relaxation used (0 for monolithic)
+  int subdomain_solves = 0;  // back-substitutions per body (the DDM's unit of work), initial guess included
+  int updates = 0;           // augmented-Lagrangian updates (0 for the pure penalty method)
   std::vector<IterationReport> history;
   std::vector<Step> steps;  // the last one is the final solution
   double wall_seconds = 0.0;

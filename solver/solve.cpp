@@ -1,21 +1,155 @@
 #include "solve.hpp"
 
+#include "ddm/interface_newton.hpp"
 #include "ddm/method.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <exception>
+#include <memory>
+#include <sstream>
 
 namespace contact {
 
 const char* solver_version() { return CONTACT_VERSION; }
 
+namespace {
+
+const char* method_name(Method m) {
+  switch (m) {
+    case Method::neumann: return "neumann";
+    case Method::monolithic: return "monolithic";
+    case Method::interface_newton: return "interface_newton";
+    case Method::robin: return "robin";
+  }
+  return "neumann";
+}
+
+// Numbers the reports of successive augmented-Lagrangian updates continuously and tags them with the update.
+class UpdateObserver final : public Observer {
+ public:
+  UpdateObserver(Observer& inner, int offset, int update) : inner_(inner), offset_(offset), update_(update) {}
+  void on_iteration(const IterationReport& r) override {
+    IterationReport copy = r;
+    copy.iteration += offset_;
+    copy.update = update_;
+    inner_.on_iteration(copy);
+  }
+
+ private:
+  Observer& inner_;
+  int offset_, update_;
+};
+
+// Runs the chosen method once on the pairs' current (possibly multiplier-shifted) gaps.
+class MethodRunner {
+ public:
+  MethodRunner(const ddm::ContactSystem& system, const SolverSettings& settings) : system_(system), settings_(settings) {}
+  ddm::MethodOutcome run(ddm::RunContext& context) {
+    switch (settings_.method) {
+      case Method::monolithic: return ddm::run_monolithic(system_, settings_, context);
+      case Method::robin: return ddm::run_robin(system_, settings_, context);
+      case Method::interface_newton: {
+        if (system_.pairs().empty()) return ddm::run_neumann(system_, settings_, context);
+        int setup = 0;
+        if (!interface_newton_) {
+          interface_newton_ = std::make_unique<ddm::InterfaceNewton>(system_, context.runner);
+          setup = interface_newton_->setup_solves();
+        }
+        ddm::MethodOutcome out = interface_newton_->solve(settings_, context);
+        out.solves_per_body += setup;
+        return out;
+      }
+      case Method::neumann: break;
+    }
+    return ddm::run_neumann(system_, settings_, context);
+  }
+
+ private:
+  const ddm::ContactSystem& system_;
+  const SolverSettings& settings_;
+  std::unique_ptr<ddm::InterfaceNewton> interface_newton_;  // its compliance is reused across updates
+};
+
+// Largest overlap max(0, -g) over the slave nodes of every pair.
+double max_penetration(const Step& step) {
+  double m = 0;
+  for (const auto& p : step.pairs)
+    if (p.penetration.size()) m = std::max(m, p.penetration.maxCoeff());
+  return m;
+}
+
+// Augmented Lagrangian (Uzawa): solve the penalty problem on the gaps shifted by theta lambda, set lambda to
+// the resulting pressures max(0, lambda - g / theta), repeat until the pressures settle. The fixed point has
+// g >= 0 where lambda = 0 and g = 0 where lambda > 0: exact non-penetration, for any theta.
+ddm::MethodOutcome run_augmented_lagrangian(ddm::ContactSystem& system, const SolverSettings& settings,
+                                            ddm::RunContext& context, MethodRunner& runner, int& updates) {
+  ddm::MethodOutcome total;
+  ddm::Displacements warm;
+  const auto& al = settings.augmented_lagrangian;
+  for (int update = 1; update <= al.max_updates; ++update) {
+    UpdateObserver observer(context.observer, total.iterations, update);
+    ddm::RunContext inner{observer, context.cancel, context.runner, context.start, warm.empty() ? nullptr : &warm};
+    ddm::MethodOutcome o = runner.run(inner);
+    updates = update;
+    for (auto& r : o.history) {
+      r.iteration += total.iterations;
+      r.update = update;
+      total.history.push_back(std::move(r));
+    }
+    total.iterations += o.iterations;
+    total.solves_per_body += o.solves_per_body;
+    total.gamma = o.gamma;
+    total.u = std::move(o.u);
+    if (o.reason != StopReason::converged) {
+      total.reason = o.reason;
+      total.message = "augmented Lagrangian update " + std::to_string(update) + ": " + o.message;
+      return total;
+    }
+    // New multipliers, and how much they moved.
+    double diff2 = 0, norm2 = 0;
+    std::vector<Eigen::VectorXd> next(system.pairs().size());
+    for (size_t k = 0; k < system.pairs().size(); ++k) {
+      const auto& pair = system.pairs()[k];
+      const auto& us = total.u[static_cast<size_t>(pair.slave_body)];
+      const auto& um = total.u[static_cast<size_t>(pair.master_body)];
+      next[k] = pair.pressure(pair.normal_gap(us, um));
+      const Eigen::VectorXd old = pair.multiplier.size() ? pair.multiplier : Eigen::VectorXd::Zero(next[k].size());
+      diff2 += pair.weight.dot((next[k] - old).cwiseAbs2());
+      norm2 += pair.weight.dot(next[k].cwiseAbs2());
+    }
+    const double change = norm2 > 0 ? std::sqrt(diff2 / norm2) : 0.0;
+    if (change <= al.tolerance) {
+      // Keep the multipliers the last solve used, so that the reported pressures are exactly its pressures.
+      total.converged = true;
+      total.reason = StopReason::converged;
+      std::ostringstream os;
+      os << "augmented Lagrangian: pressures settled (relative change " << change << " <= " << al.tolerance << ") after "
+         << update << " updates; last inner solve: " << o.message;
+      total.message = os.str();
+      return total;
+    }
+    for (size_t k = 0; k < next.size(); ++k) system.set_multipliers(k, std::move(next[k]));
+    warm = total.u;
+    if (update == al.max_updates) {
+      total.reason = StopReason::max_iterations;
+      std::ostringstream os;
+      os << "augmented Lagrangian: max_updates = " << update << " reached with a relative pressure change of " << change;
+      total.message = os.str();
+    }
+  }
+  return total;
+}
+
+}  // namespace
+
 Result solve(const Problem& problem, Observer& observer, const CancelToken& cancel) {
   const auto start = std::chrono::steady_clock::now();
   Result result;
-  result.method = problem.solver.method == Method::monolithic ? "monolithic" : "neumann";
+  result.method = method_name(problem.solver.method);
   try {
     ddm::ThreadTaskRunner runner(ddm::choose_threads(problem.solver.threads, problem.bodies.size()));
-    // The monolithic reference factorises the coupled system itself; the DDM factorises each body once.
+    // The monolithic reference factorises the coupled system itself; the other methods factorise each body once.
     const bool per_body_factorization = problem.solver.method != Method::monolithic;
     ddm::ContactSystem system(problem, runner, per_body_factorization);
     result.setup_seconds = system.setup_seconds();
@@ -27,16 +161,25 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
       return result;
     }
     ddm::RunContext context{observer, cancel, runner, start};
-    ddm::MethodOutcome outcome = problem.solver.method == Method::monolithic
-                                     ? ddm::run_monolithic(system, problem.solver, context)
-                                     : ddm::run_neumann(system, problem.solver, context);
+    MethodRunner method(system, problem.solver);
+    int updates = 0;
+    ddm::MethodOutcome outcome = problem.solver.enforcement == Enforcement::augmented_lagrangian
+                                     ? run_augmented_lagrangian(system, problem.solver, context, method, updates)
+                                     : method.run(context);
     result.converged = outcome.converged;
     result.stop_reason = outcome.reason;
     result.message = outcome.message;
     result.iterations = outcome.iterations;
     result.gamma = outcome.gamma;
+    result.subdomain_solves = outcome.solves_per_body;
+    result.updates = updates;
     result.history = std::move(outcome.history);
-    result.steps.push_back(system.fields(outcome.u, outcome.iterations));
+    if (!outcome.u.empty()) result.steps.push_back(system.fields(outcome.u, outcome.iterations));
+    if (updates > 0 && !result.steps.empty()) {
+      std::ostringstream os;
+      os << "; remaining penetration " << max_penetration(result.steps.back());
+      result.message += os.str();
+    }
   } catch (const std::exception& e) {
     result.stop_reason = StopReason::error;
     result.message = std::string("internal error: ") + e.what();

@@ -574,8 +574,9 @@ TEST(JobErrors, GammaOfTwoIsOutsideTheOpenInterval) {
 
 TEST(JobErrors, UnknownMethodListsTheChoices) {
   json job = small_job();
-  job["solver"] = {{"method", "robin"}};
-  expect_only_error(parse(job), "/solver/method", "method \"robin\" is not one of \"neumann\" and \"monolithic\"");
+  job["solver"] = {{"method", "uzawa"}};
+  expect_only_error(parse(job), "/solver/method",
+                    "method \"uzawa\" is not one of \"neumann\", \"monolithic\", \"interface_newton\" and \"robin\"");
 }
 
 TEST(JobErrors, ArcRadiusInconsistentWithTheCornersIsReportedAtTheArc) {

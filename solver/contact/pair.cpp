@@ -26,16 +26,16 @@ double analytic_gap(const GapSpec& spec, const Eigen::Vector2d& x) {
   return d;
 }
 
-// Appends n . (interpolated displacement) to a row: weights w0, w1 at nodes n0, n1.
+// Appends n . (interpolated displacement) to a row: weights w0, w1 at nodes n0, n1. Exact zeros are left out
+// (an axis-aligned normal touches one component only), which keeps each body's contact-zone dof set minimal.
 void add_row(std::vector<Eigen::Triplet<double>>& t, int row, const Eigen::Vector2d& n, int n0, double w0, int n1, double w1) {
-  if (w0 != 0.0) {
-    t.emplace_back(row, 2 * n0, w0 * n.x());
-    t.emplace_back(row, 2 * n0 + 1, w0 * n.y());
-  }
-  if (w1 != 0.0) {
-    t.emplace_back(row, 2 * n1, w1 * n.x());
-    t.emplace_back(row, 2 * n1 + 1, w1 * n.y());
-  }
+  auto add = [&](int dof, double value) {
+    if (value != 0.0) t.emplace_back(row, dof, value);
+  };
+  add(2 * n0, w0 * n.x());
+  add(2 * n0 + 1, w0 * n.y());
+  add(2 * n1, w1 * n.x());
+  add(2 * n1 + 1, w1 * n.y());
 }
 
 }  // namespace
@@ -78,7 +78,21 @@ std::optional<Projection> project(const std::vector<Eigen::Vector2d>& polyline, 
 
 Eigen::VectorXd PairDiscretization::pressure(const Eigen::VectorXd& g) const {
   Eigen::VectorXd p(g.size());
-  for (Eigen::Index q = 0; q < g.size(); ++q) p[q] = weight[q] > 0 ? std::max(0.0, -g[q]) / theta : 0.0;
+  const bool shifted = multiplier.size() == g.size();
+  for (Eigen::Index q = 0; q < g.size(); ++q) {
+    const double lambda = shifted ? multiplier[q] : 0.0;
+    p[q] = weight[q] > 0 ? std::max(0.0, lambda - g[q] / theta) : 0.0;
+  }
+  return p;
+}
+
+Eigen::VectorXd PairDiscretization::node_pressure(const Eigen::VectorXd& g, const Eigen::VectorXd& gauss_pressure) const {
+  Eigen::VectorXd p(g.size());
+  for (Eigen::Index j = 0; j < g.size(); ++j) {
+    double v = 0.0;
+    for (const auto& [q, w] : node_from_gauss[static_cast<size_t>(j)]) v += w * gauss_pressure[q];
+    p[j] = node_has_master[j] ? std::max(0.0, v) : 0.0;
+  }
   return p;
 }
 
@@ -164,6 +178,7 @@ PairDiscretization discretize_pair(const Problem& problem, int pair_index, doubl
   // Gauss points: each slave segment split at the projections of the master nodes onto it.
   const double gauss = 0.5 / std::sqrt(3.0);
   double arc0 = 0.0;
+  d.node_from_gauss.assign(S.size(), {});
   for (size_t k = 0; k + 1 < S.size(); ++k) {
     const Eigen::Vector2d a = S[k], e = S[k + 1] - a;
     const double L = e.norm();
@@ -176,6 +191,16 @@ PairDiscretization discretize_pair(const Problem& problem, int pair_index, doubl
     cuts.erase(std::unique(cuts.begin(), cuts.end(), [](double u, double v) { return v - u < 1e-10; }), cuts.end());
     for (size_t c = 0; c + 1 < cuts.size(); ++c) {
       const double t0 = cuts[c], t1 = cuts[c + 1], mid = 0.5 * (t0 + t1), half = t1 - t0;
+      // Linear extrapolation of the piece's two Gauss values to the segment's end nodes it touches.
+      const int qa = static_cast<int>(weights.size()), qb = qa + 1;
+      const double ta = mid - gauss * half, tb = mid + gauss * half;
+      auto extrapolate_to = [&](size_t node, double t_node) {
+        const double s_node = (t_node - ta) / (tb - ta);
+        d.node_from_gauss[node].emplace_back(qa, 1 - s_node);
+        d.node_from_gauss[node].emplace_back(qb, s_node);
+      };
+      if (c == 0) extrapolate_to(k, 0.0);
+      if (c + 2 == cuts.size()) extrapolate_to(k + 1, 1.0);
       for (double t : {mid - gauss * half, mid + gauss * half}) {
         const Eigen::Vector2d x = a + t * e;
         add_point(x, 0.5 * half * L * thickness, arc0 + t * L, d.slave_nodes[k], 1 - t, d.slave_nodes[k + 1], t, ts, tm,
@@ -185,6 +210,8 @@ PairDiscretization discretize_pair(const Problem& problem, int pair_index, doubl
     }
     arc0 += L;
   }
+  for (auto& entries : d.node_from_gauss)  // average over the (one or two) adjacent pieces
+    for (auto& e : entries) e.second *= entries.size() > 2 ? 0.5 : 1.0;
   const int Q = static_cast<int>(weights.size());
   d.weight = Eigen::Map<Eigen::VectorXd>(weights.data(), Q);
   d.gap = Eigen::Map<Eigen::VectorXd>(gaps.data(), Q);

@@ -54,13 +54,30 @@ struct PairDiscretization {
   Eigen::VectorXi node_has_master;      // 0 where the node's projection falls outside the master edge
   Eigen::SparseMatrix<double, Eigen::RowMajor> Hs, Hm;
 
+  // Augmented Lagrangian multipliers (contact pressure estimates) at the Gauss points; empty for the pure
+  // penalty method. With them the pressure is max(0, lambda - g / theta), the penalty pressure of the shifted
+  // gap d - theta lambda (effective_gap).
+  Eigen::VectorXd multiplier;
+  // Per slave node: Gauss points and weights that extrapolate a Gauss-point field linearly to the node
+  // (averaged over the node's one or two adjacent pieces).
+  std::vector<std::vector<std::pair<int, double>>> node_from_gauss;
+
   int n_points() const { return static_cast<int>(weight.size()); }
-  // g at the Gauss points for body displacements us (slave) and um (master), all dofs.
+  // g at the Gauss points for body displacements us (slave) and um (master), all dofs: the physical gap.
   Eigen::VectorXd normal_gap(const Eigen::VectorXd& us, const Eigen::VectorXd& um) const { return gap + Gs * us - Gm * um; }
   Eigen::VectorXd node_normal_gap(const Eigen::VectorXd& us, const Eigen::VectorXd& um) const {
     return node_gap + Hs * us - Hm * um;
   }
-  Eigen::VectorXd pressure(const Eigen::VectorXd& normal_gap_values) const;  // max(0, -g) / theta (0 without master)
+  // The gap the penalty acts on: d - theta lambda (d without multipliers).
+  Eigen::VectorXd effective_gap() const { return multiplier.size() ? Eigen::VectorXd(gap - theta * multiplier) : gap; }
+  // Contact pressure at the Gauss points from the physical gap: max(0, lambda - g / theta) (0 without master).
+  Eigen::VectorXd pressure(const Eigen::VectorXd& normal_gap_values) const;
+  // The pressure at the slave nodes (0 where a node has no master point): the Gauss-point pressures, which
+  // the force integrates, extrapolated linearly to the nodes. Not the penalty formula with the nodes' own gaps:
+  // an analytic gap is not linear between Gauss points, and with a small theta (or multipliers) the nodes of a
+  // convex gap then report no contact where the Gauss points carry it.
+  // node_normal_gap_values is used only for its size (kept for callers that have it at hand).
+  Eigen::VectorXd node_pressure(const Eigen::VectorXd& node_normal_gap_values, const Eigen::VectorXd& gauss_pressure) const;
   // Adds the contact forces of pressures p at the Gauss points: fs += Gs^T W p, fm -= Gm^T W p.
   void add_forces(const Eigen::VectorXd& p, Eigen::VectorXd& fs, Eigen::VectorXd& fm) const;
   double total_force(const Eigen::VectorXd& p) const { return weight.dot(p); }

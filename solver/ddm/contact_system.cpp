@@ -129,13 +129,13 @@ IterationReport ContactSystem::report(int iteration, const Displacements& u, std
       pr.extent_end = pair.arc[q];
       first = false;
     }
-    const Eigen::VectorXd pn = pair.pressure(pair.node_normal_gap(us, um));
-    // node_has_master is encoded in pressure() through the weights of the Gauss points only; mask here.
+    const Eigen::VectorXd gn = pair.node_normal_gap(us, um);
+    const Eigen::VectorXd pn = pair.node_pressure(gn, p);
     pr.positions.assign(pair.node_arc.data(), pair.node_arc.data() + pair.node_arc.size());
-    pr.pressures.resize(static_cast<size_t>(pn.size()));
+    pr.pressures.assign(pn.data(), pn.data() + pn.size());
     for (Eigen::Index j = 0; j < pn.size(); ++j) {
-      pr.pressures[static_cast<size_t>(j)] = pair.node_has_master[j] ? pn[j] : 0.0;
-      pr.max_pressure = std::max(pr.max_pressure, pr.pressures[static_cast<size_t>(j)]);
+      pr.max_pressure = std::max(pr.max_pressure, pn[j]);
+      if (pair.node_has_master[j]) pr.max_penetration = std::max(pr.max_penetration, -gn[j]);
     }
     r.pairs.push_back(std::move(pr));
   }
@@ -180,14 +180,13 @@ Step ContactSystem::fields(const Displacements& u, int iteration) const {
     f.arc_length = pair.node_arc;
     f.gap = pair.node_gap;
     f.normal_gap = pair.node_normal_gap(us, um);
-    f.pressure.resize(n);
+    f.pressure = pair.node_pressure(f.normal_gap, pair.pressure(pair.normal_gap(us, um)));
     f.penetration.resize(n);
     f.active.resize(n);
     for (Eigen::Index j = 0; j < n; ++j) {
       const bool has = pair.node_has_master[j] != 0;
       f.penetration[j] = has ? std::max(0.0, -f.normal_gap[j]) : 0.0;
-      f.pressure[j] = f.penetration[j] / pair.theta;
-      f.active[j] = f.penetration[j] > 0 ? 1 : 0;
+      f.active[j] = f.pressure[j] > 0 ? 1 : 0;
     }
     f.force = pair.total_force(pair.pressure(pair.normal_gap(us, um)));
     step.pairs.push_back(std::move(f));

@@ -34,6 +34,9 @@ class ContactSystem {
   double setup_seconds() const { return setup_seconds_; }
   double factorization_seconds() const { return factorization_seconds_; }  // summed over bodies
 
+  // Augmented-Lagrangian multipliers of pair k at its Gauss points (an empty vector: none).
+  void set_multipliers(size_t k, Eigen::VectorXd gauss) { pairs_[k].multiplier = std::move(gauss); }
+
   // Contact forces on every body from the penalty pressures of displacements u (paper (16)'s last term);
   // the pressures at each pair's Gauss points go to *pressures if given.
   Displacements contact_loads(const Displacements& u, std::vector<Eigen::VectorXd>* pressures = nullptr) const;

@@ -58,7 +58,7 @@ MethodOutcome run_monolithic(const ContactSystem& system, const SolverSettings& 
     GlobalPair gp;
     gp.B.resize(pair.n_points(), n);
     gp.B.setFromTriplets(tb.begin(), tb.end());
-    gp.d = pair.gap + pair.Gs * cs.g() - pair.Gm * cm.g();
+    gp.d = pair.effective_gap() + pair.Gs * cs.g() - pair.Gm * cm.g();  // shifted by theta lambda under AL
     gp.w_over_theta = pair.weight / pair.theta;
     gpairs.push_back(std::move(gp));
   }

@@ -121,6 +121,18 @@ Eigen::VectorXd BodySolver::solve_reduced(const Eigen::VectorXd& reduced_rhs) co
   return factor_->solve(reduced_rhs);
 }
 
+Eigen::MatrixXd BodySolver::solve_reduced(const Eigen::MatrixXd& reduced_rhs) const {
+  if (n_free() == 0) return Eigen::MatrixXd::Zero(0, reduced_rhs.cols());
+  if (!factor_) throw std::logic_error("BodySolver::solve_reduced called on a solver built without factorisation");
+  return factor_->solve(reduced_rhs);
+}
+
+Eigen::VectorXd BodySolver::solve_homogeneous(const Eigen::VectorXd& load) const {
+  if (n_free() == 0) return Eigen::VectorXd::Zero(n_dofs());
+  const Eigen::VectorXd rhs = constraints_.T().transpose() * load;
+  return constraints_.T() * solve_reduced(rhs);
+}
+
 Eigen::VectorXd BodySolver::solve(const Eigen::VectorXd& extra_load) const {
   if (n_free() == 0) return constraints_.g();
   if (!factor_) throw std::logic_error("BodySolver::solve called on a solver built without factorisation");

@@ -42,6 +42,10 @@ class BodySolver {
   // The same for a load that is already reduced (T^T f) and without the body's own loads/prescribed values:
   // the linear response x = K_red^{-1} b. Used by the interface methods.
   Eigen::VectorXd solve_reduced(const Eigen::VectorXd& reduced_rhs) const;
+  // The same for several right-hand sides at once (columns): one blocked back-substitution.
+  Eigen::MatrixXd solve_reduced(const Eigen::MatrixXd& reduced_rhs) const;
+  // Linear response to a load only (no body loads, prescribed values 0): T K_red^{-1} T^T f.
+  Eigen::VectorXd solve_homogeneous(const Eigen::VectorXd& load) const;
 
   // Support reactions: the force the supports exert on the body, K u - f_ext - extra_load, kept at the
   // prescribed (Dirichlet) dofs and zero elsewhere.

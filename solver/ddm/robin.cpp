@@ -1,0 +1,147 @@
+// The Robin-type variant (ALGORITHM.md, "Robin-type variants"; reconstructed from the authors' later papers):
+//   a_a(u~_a, v) + int psi u~_an v_n = l_a(v) + int psi u_an^k v_n + (1/theta) int (d - u_1n^k - u_2n^k)^- v_n,
+// then the same relaxation as the Neumann scheme. psi = 0 is the paper's scheme. Discretely the Robin term is
+// Psi_a = sum over the pairs of body a of G_a^T diag(psi_q w_q) G_a (G_a = G_s or G_m), added to the stiffness.
+// With a constant psi each body is factorised once; with psi = 1/theta on the current active set ("active_set")
+// a body is refactorised only when the active set of one of its pairs changes.
+#include "fixed_point.hpp"
+
+#include <Eigen/CholmodSupport>
+
+#include <memory>
+#include <sstream>
+
+namespace contact::ddm {
+
+namespace {
+
+using Factor = Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower>;
+
+class RobinMap final : public BodyMap {
+ public:
+  RobinMap(const ContactSystem& system, const SolverSettings& settings, TaskRunner& runner)
+      : system_(system), settings_(settings), runner_(runner), psi_(system.n_bodies()), factor_(system.n_bodies()),
+        active_(system.pairs().size()) {}
+
+  std::string error;
+
+  Displacements apply(const Displacements& u) override {
+    update_weights(u);
+    const Displacements contact = system_.contact_loads(u);
+    Displacements out(u.size());
+    runner_.run(u.size(), [&](size_t a) {
+      const auto& body = system_.body(a);
+      const auto& c = body.constraints();
+      const Eigen::VectorXd load = psi_[a] * (u[a] - c.g()) + contact[a];
+      out[a] = c.expand(solve(a, body.reduced_rhs() + c.T().transpose() * load));
+    });
+    return out;
+  }
+
+  Displacements linear_response(const Displacements& du) override {
+    update_weights(du, /*all_active=*/true);
+    const Displacements loads = system_.loads_from_pressures(linear_pressures(system_, du));
+    Displacements out(du.size());
+    runner_.run(du.size(), [&](size_t a) {
+      const auto& c = system_.body(a).constraints();
+      out[a] = c.T() * solve(a, c.T().transpose() * (psi_[a] * du[a] + loads[a]));
+    });
+    return out;
+  }
+
+  int factorizations() const override { return factorizations_; }
+
+ private:
+  Eigen::VectorXd solve(size_t a, const Eigen::VectorXd& rhs) const {
+    if (rhs.size() == 0) return rhs;
+    return factor_[a]->solve(rhs);
+  }
+
+  // Psi per body for the active set of u (or every point, for the gamma estimate with a stationary psi);
+  // refactorises the bodies whose weights changed.
+  void update_weights(const Displacements& u, bool all_active = false) {
+    const auto& pairs = system_.pairs();
+    std::vector<char> changed(system_.n_bodies(), 0);
+    for (size_t k = 0; k < pairs.size(); ++k) {
+      const auto& pair = pairs[k];
+      std::vector<char> now(static_cast<size_t>(pair.n_points()), 1);
+      if (settings_.robin.active_set && !all_active) {
+        const Eigen::VectorXd p = pair.pressure(pair.normal_gap(u[static_cast<size_t>(pair.slave_body)],
+                                                               u[static_cast<size_t>(pair.master_body)]));
+        for (Eigen::Index q = 0; q < p.size(); ++q) now[static_cast<size_t>(q)] = p[q] > 0 ? 1 : 0;
+      }
+      if (now != active_[k] || !factor_[static_cast<size_t>(pair.slave_body)]) {
+        active_[k] = std::move(now);
+        changed[static_cast<size_t>(pair.slave_body)] = changed[static_cast<size_t>(pair.master_body)] = 1;
+      }
+    }
+    for (size_t a = 0; a < system_.n_bodies(); ++a)
+      if (!factor_[a]) changed[a] = 1;
+    std::vector<size_t> todo;
+    for (size_t a = 0; a < changed.size(); ++a)
+      if (changed[a]) todo.push_back(a);
+    if (todo.empty()) return;
+    runner_.run(todo.size(), [&](size_t i) { refactorize(todo[i]); });
+    factorizations_ += static_cast<int>(todo.size());
+    for (size_t a : todo)
+      if (factor_[a]->info() != Eigen::Success)
+        throw std::runtime_error("robin: the stiffness of body " + std::to_string(a) + " plus the Robin term could not be factorised");
+  }
+
+  void refactorize(size_t a) {
+    const auto& body = system_.body(a);
+    const int n = body.n_dofs();
+    Eigen::SparseMatrix<double> Psi(n, n);
+    for (size_t k = 0; k < system_.pairs().size(); ++k) {
+      const auto& pair = system_.pairs()[k];
+      const bool slave = static_cast<size_t>(pair.slave_body) == a, master = static_cast<size_t>(pair.master_body) == a;
+      if (!slave && !master) continue;
+      Eigen::VectorXd w = Eigen::VectorXd::Zero(pair.n_points());
+      for (Eigen::Index q = 0; q < w.size(); ++q)
+        if (active_[k][static_cast<size_t>(q)])
+          w[q] = pair.weight[q] * (settings_.robin.active_set ? 1.0 / pair.theta : settings_.robin.psi);
+      const auto& G = slave ? pair.Gs : pair.Gm;
+      Psi += Eigen::SparseMatrix<double>(G.transpose() * w.asDiagonal() * G);
+    }
+    psi_[a] = Psi;
+    const auto& T = body.constraints().T();
+    const Eigen::SparseMatrix<double> A = body.reduced_stiffness() + Eigen::SparseMatrix<double>(T.transpose() * Psi * T);
+    auto f = std::make_unique<Factor>();
+    f->compute(A);
+    factor_[a] = std::move(f);
+  }
+
+  const ContactSystem& system_;
+  const SolverSettings& settings_;
+  TaskRunner& runner_;
+  std::vector<Eigen::SparseMatrix<double>> psi_;
+  std::vector<std::unique_ptr<Factor>> factor_;
+  std::vector<std::vector<char>> active_;
+  int factorizations_ = 0;
+};
+
+}  // namespace
+
+MethodOutcome run_robin(const ContactSystem& system, const SolverSettings& settings, RunContext& context) {
+  if (system.pairs().empty()) return run_neumann(system, settings, context);
+  const size_t n = system.n_bodies();
+  int initial_solves = 0;
+  Displacements u0(n);
+  if (context.warm_start) {
+    u0 = *context.warm_start;
+  } else if (settings.initial_guess == InitialGuess::elastic_layer) {
+    u0 = system.elastic_layer_guess(context.runner);
+    initial_solves = 2;
+  } else {
+    for (size_t a = 0; a < n; ++a) u0[a] = Eigen::VectorXd::Zero(system.body(a).n_dofs());
+  }
+  RobinMap map(system, settings, context.runner);
+  MethodOutcome out = run_fixed_point(system, settings, context, map, std::move(u0));
+  out.solves_per_body += initial_solves;
+  std::ostringstream os;
+  os << "; " << map.factorizations() << " Robin factorisations";
+  out.message += os.str();
+  return out;
+}
+
+}  // namespace contact::ddm
