@@ -29,11 +29,16 @@ class ProgressPrinter final : public contact::Observer {
   explicit ProgressPrinter(bool quiet) : quiet_(quiet) {}
   void on_iteration(const contact::IterationReport& r) override {
     if (quiet_) return;
-    std::printf("iter %5d  paper %.3e  residual %.3e", r.iteration, r.paper_criterion, r.fixed_point_residual);
+    std::printf("iter %5d", r.iteration);
+    if (r.update > 0) std::printf("  update %3d", r.update);
+    std::printf("  paper %.3e  residual %.3e", r.paper_criterion, r.fixed_point_residual);
+    if (r.gamma > 0) std::printf("  gamma %.3g", r.gamma);
     for (const auto& p : r.pairs)
       std::printf("  | %s: force %.6g  p_max %.6g  active %d (%+d)", p.name.c_str(), p.force, p.max_pressure,
                   p.active_points, p.changed_points);
-    std::printf("  %.2fs\n", r.elapsed_seconds);
+    std::printf("  %.2fs", r.elapsed_seconds);
+    if (!r.note.empty()) std::printf("  [%s]", r.note.c_str());
+    std::printf("\n");
     std::fflush(stdout);
   }
 
