@@ -49,7 +49,8 @@ struct Row {
 };
 
 void bench(const std::string& title, const json& job, bool sweep) {
-  const json tight = {{"criterion", "residual"}, {"tolerance", 1e-8}, {"max_iterations", 20000}};
+  const json tight = {{"criterion", "residual"}, {"tolerance", 1e-8}, {"max_iterations", 20000},
+                      {"acceleration", "none"}, {"enforcement", "penalty"}};
   Problem base = make(job, tight);
   long dofs = 0;
   for (const auto& b : base.bodies) dofs += 2L * b.mesh.num_nodes();
@@ -68,7 +69,7 @@ void bench(const std::string& title, const json& job, bool sweep) {
     }
   }
   rows.push_back({"neumann, gamma auto", {{"method", "neumann"}, {"gamma", "auto"}}});
-  rows.push_back({"neumann, gamma auto + Anderson(5)", {{"method", "neumann"}, {"gamma", "auto"}, {"acceleration", "anderson"}}});
+  rows.push_back({"neumann, gamma auto + Anderson(10)", {{"method", "neumann"}, {"gamma", "auto"}, {"acceleration", "anderson"}}});
   rows.push_back({"robin psi=active_set, auto", {{"method", "robin"}, {"gamma", "auto"}}});
   rows.push_back({"robin psi=active_set + Anderson", {{"method", "robin"}, {"gamma", "auto"}, {"acceleration", "anderson"}}});
   rows.push_back({"interface Newton", {{"method", "interface_newton"}}});

@@ -99,20 +99,23 @@ struct AugmentedLagrangianSettings {
   int max_updates = 100;
 };
 
+// Defaults: fast and exact (interface Newton inside augmented-Lagrangian updates); the paper's scheme is
+// method neumann, gamma 0.02, criterion paper, tolerance 0.0015, acceleration none, enforcement penalty
+// (api/examples/seed_layers.json spells it out).
 struct SolverSettings {
-  Method method = Method::neumann;
+  Method method = Method::interface_newton;
   PenaltySpec penalty;
-  double gamma = 0.02;        // relaxation of (17)
-  bool gamma_auto = false;    // estimate the interface compliance and choose gamma (overrides gamma)
-  double tolerance = 0.0015;  // eps of the chosen criterion
-  Criterion criterion = Criterion::paper;
+  double gamma = 0.02;        // relaxation of (17) when gamma_auto is false
+  bool gamma_auto = true;     // estimate the interface compliance and choose gamma (overrides gamma)
+  double tolerance = 1e-8;    // eps of the chosen criterion
+  Criterion criterion = Criterion::residual;
   int max_iterations = 2000;
   InitialGuess initial_guess = InitialGuess::elastic_layer;
   int threads = 0;            // worker threads for the per-body solves; 0 = one per body up to the cores
-  Acceleration acceleration = Acceleration::none;
-  int anderson_depth = 5;
+  Acceleration acceleration = Acceleration::anderson;
+  int anderson_depth = 10;
   RobinSettings robin;
-  Enforcement enforcement = Enforcement::penalty;
+  Enforcement enforcement = Enforcement::augmented_lagrangian;
   AugmentedLagrangianSettings augmented_lagrangian;
 };
 

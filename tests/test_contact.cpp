@@ -47,6 +47,9 @@ Problem flat_patch(int n_upper, int n_lower, double E_upper, double E_lower, dou
   p.contacts = {pair};
   p.solver.penalty.c = 1.0;  // theta = h / E: a soft penalty lets gamma be large (see ALGORITHM.md section 2)
   p.solver.gamma = 0.5;
+  p.solver.gamma_auto = false;
+  p.solver.acceleration = Acceleration::none;      // the paper's plain relaxation
+  p.solver.enforcement = Enforcement::penalty;     // the formula below has the penalty's theta in it
   p.solver.criterion = Criterion::residual;
   p.solver.tolerance = 1e-12;
   p.solver.max_iterations = 500;

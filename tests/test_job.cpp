@@ -147,9 +147,14 @@ TEST(JobDefaults, MissingFieldsGetTheirDefaultsInProblemAndNormalized) {
   const contact::Problem& p = *r.problem;
   EXPECT_EQ(p.model.plane, contact::Plane::strain);
   EXPECT_EQ(p.model.thickness, 1.0);
-  EXPECT_EQ(p.solver.method, contact::Method::neumann);
-  EXPECT_EQ(p.solver.gamma, 0.02);
-  EXPECT_EQ(p.solver.tolerance, 0.0015);
+  // The defaults are fast and exact (interface Newton inside augmented-Lagrangian updates).
+  EXPECT_EQ(p.solver.method, contact::Method::interface_newton);
+  EXPECT_TRUE(p.solver.gamma_auto);
+  EXPECT_EQ(p.solver.acceleration, contact::Acceleration::anderson);
+  EXPECT_EQ(p.solver.anderson_depth, 10);
+  EXPECT_EQ(p.solver.enforcement, contact::Enforcement::augmented_lagrangian);
+  EXPECT_EQ(p.solver.criterion, contact::Criterion::residual);
+  EXPECT_EQ(p.solver.tolerance, 1e-8);
   EXPECT_EQ(p.solver.max_iterations, 2000);
   EXPECT_EQ(p.solver.threads, 0);
   EXPECT_EQ(p.contacts[0].name, "upper.bottom-lower.top");
@@ -160,11 +165,12 @@ TEST(JobDefaults, MissingFieldsGetTheirDefaultsInProblemAndNormalized) {
   EXPECT_EQ(n["version"], 1);
   EXPECT_EQ(n["model"]["plane"], "strain");
   EXPECT_EQ(n["model"]["thickness"], 1.0);
-  EXPECT_EQ(n["solver"]["method"], "neumann");
+  EXPECT_EQ(n["solver"]["method"], "interface_newton");
   EXPECT_EQ(n["solver"]["penalty"], json({{"c", 0.05}}));
-  EXPECT_EQ(n["solver"]["gamma"], 0.02);
-  EXPECT_EQ(n["solver"]["tolerance"], 0.0015);
-  EXPECT_EQ(n["solver"]["criterion"], "paper");
+  EXPECT_EQ(n["solver"]["gamma"], "auto");
+  EXPECT_EQ(n["solver"]["tolerance"], 1e-8);
+  EXPECT_EQ(n["solver"]["criterion"], "residual");
+  EXPECT_EQ(n["solver"]["enforcement"], "augmented_lagrangian");
   EXPECT_EQ(n["solver"]["max_iterations"], 2000);
   EXPECT_EQ(n["solver"]["initial_guess"], "elastic_layer");
   EXPECT_EQ(n["solver"]["threads"], 0);
@@ -175,6 +181,17 @@ TEST(JobDefaults, MissingFieldsGetTheirDefaultsInProblemAndNormalized) {
   const ParseResult again = parse(n);
   ASSERT_TRUE(again.ok()) << listing(again);
   EXPECT_EQ(again.problem->normalized, n);
+}
+
+TEST(JobDefaults, ANumericGammaSwitchesOffTheAutomaticChoice) {
+  json job = small_job();
+  job["solver"] = {{"gamma", 0.03}};
+  const ParseResult r = parse(job);
+  ASSERT_TRUE(r.ok()) << listing(r);
+  EXPECT_FALSE(r.problem->solver.gamma_auto);
+  EXPECT_EQ(r.problem->solver.gamma, 0.03);
+  job["solver"] = {{"gamma", "auto"}};
+  EXPECT_TRUE(parse(job).problem->solver.gamma_auto);
 }
 
 TEST(JobDefaults, ThetaGivenDirectlyIsKeptAndNoCIsAdded) {

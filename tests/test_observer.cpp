@@ -19,6 +19,8 @@ Problem seed(const std::string& method) {
   job["solver"]["criterion"] = "residual";
   job["solver"]["tolerance"] = 1e-9;
   job["solver"]["gamma"] = 0.05;
+  job["solver"]["acceleration"] = "none";
+  job["solver"]["enforcement"] = "penalty";
   auto r = job::parse(job);
   EXPECT_TRUE(r.ok()) << job::format_errors(r.errors);
   return std::move(*r.problem);

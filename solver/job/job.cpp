@@ -235,8 +235,10 @@ class JobReader {
             errors_.add(f.at("gamma"),
                         "gamma = " + format_number(*x) +
                             " is outside (0, 2): the relaxation weight must be greater than 0 and less than 2");
-          else if (x)
+          else if (x) {
             s.gamma = *x;
+            s.gamma_auto = false;
+          }
         }
       }
       if (const json* t = f.find("tolerance"))
@@ -268,18 +270,18 @@ class JobReader {
           s.enforcement = *x == "augmented_lagrangian" ? Enforcement::augmented_lagrangian : Enforcement::penalty;
       if (const json* a = f.find("augmented_lagrangian")) read_augmented_lagrangian(*a, f.at("augmented_lagrangian"));
     }
-    set_default(out, "method", "neumann");
+    set_default(out, "method", "interface_newton");
     set_default(out, "penalty", json{{"c", 0.05}});
-    set_default(out, "gamma", 0.02);
-    set_default(out, "tolerance", 0.0015);
-    set_default(out, "criterion", "paper");
+    set_default(out, "gamma", "auto");
+    set_default(out, "tolerance", 1e-8);
+    set_default(out, "criterion", "residual");
     set_default(out, "max_iterations", 2000);
     set_default(out, "initial_guess", "elastic_layer");
     set_default(out, "threads", 0);
-    set_default(out, "acceleration", "none");
-    set_default(out, "anderson_depth", 5);
+    set_default(out, "acceleration", "anderson");
+    set_default(out, "anderson_depth", 10);
     set_default(out, "robin", json{{"psi", "active_set"}});
-    set_default(out, "enforcement", "penalty");
+    set_default(out, "enforcement", "augmented_lagrangian");
     set_default(out, "augmented_lagrangian", json{{"tolerance", 1e-9}, {"max_updates", 100}});
     json& al = out["augmented_lagrangian"];
     set_default(al, "tolerance", 1e-9);

@@ -138,9 +138,18 @@ rejected_at("a quad repeating a node",
 
 # The defaults the schema documents are the solver's (solver/problem.hpp): a spot check of the important ones.
 solver_props = schema["$defs"]["solver"]["properties"]
-check("documented defaults match the paper's parameters",
-      solver_props["gamma"]["default"] == 0.02 and solver_props["tolerance"]["default"] == 0.0015
+check("documented defaults are the fast and exact ones",
+      solver_props["method"]["default"] == "interface_newton" and solver_props["gamma"]["default"] == "auto"
+      and solver_props["tolerance"]["default"] == 1e-8 and solver_props["criterion"]["default"] == "residual"
+      and solver_props["enforcement"]["default"] == "augmented_lagrangian"
+      and solver_props["acceleration"]["default"] == "anderson" and solver_props["anderson_depth"]["default"] == 10
       and solver_props["max_iterations"]["default"] == 2000 and solver_props["penalty"]["default"] == {"c": 0.05})
+with open(os.path.join(SOURCE, "api", "examples", "seed_layers.json")) as f:
+    paper = json.load(f)["solver"]
+check("seed_layers.json spells out the paper's scheme (c 0.05, gamma 0.02, eps 0.0015, plain, penalty)",
+      paper == {"method": "neumann", "penalty": {"c": 0.05, "length": 1}, "gamma": 0.02, "tolerance": 0.0015,
+                "criterion": "paper", "max_iterations": 2000, "initial_guess": "elastic_layer",
+                "acceleration": "none", "enforcement": "penalty"}, str(paper))
 
 print(f"{passed} passed, {failed} failed")
 sys.exit(1 if failed else 0)
