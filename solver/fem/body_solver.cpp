@@ -25,6 +25,10 @@ BodySolver::BodySolver(const Body& body, const Model& model, bool factorize_now)
 }
 
 void BodySolver::setup_constraints() {
+  // Hanging nodes of a refined (1-irregular) mesh: for Q1 the value is the mean of the side's end nodes.
+  for (const auto& [node, ends] : mesh::hanging_nodes(body_.mesh))
+    for (int c = 0; c < 2; ++c)
+      constraints_.add_line(2 * node + c, {{2 * ends.first + c, 0.5}, {2 * ends.second + c, 0.5}});
   for (const auto& bc : body_.boundary) {
     if (bc.kind != BoundaryCondition::Kind::displacement) continue;
     for (int node : body_.mesh.edge_set_nodes(bc.edge)) {

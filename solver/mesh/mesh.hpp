@@ -48,6 +48,9 @@ struct Mesh {
   std::map<std::string, std::vector<EdgeRef>> edge_sets;
   // True geometry of named edges that are curved (block edges); absent means straight.
   std::map<std::string, Curve> edge_curves;
+  // Edges split by refinement: (smaller node, larger node) -> midpoint node. A cell side (a, b) whose edge is
+  // split carries a hanging node (the neighbour across it is refined); see hanging_nodes().
+  std::map<std::pair<int, int>, int> edge_midpoint;
 
   int num_nodes() const { return static_cast<int>(nodes.size()); }
   int num_cells() const { return static_cast<int>(cells.size()); }
@@ -91,6 +94,36 @@ std::optional<std::string> fit_curve(Curve& curve, const Point& p, const Point& 
 // naming the offending pair (by its index in `pairs`) if a pair is not a boundary side.
 std::optional<std::string> add_edge_set(Mesh& m, const std::string& name,
                                         const std::vector<std::array<int, 2>>& pairs);
+
+// ---------------------------------------------------------------------------------------------------------
+// Refinement (quadtree): a marked cell splits into four; the mesh is kept 1-irregular (at most one hanging node
+// per side) by also refining coarser neighbours where needed. New nodes on a curved named edge lie on its curve.
+
+// Rule for a node created by refinement: its value of any bilinear field is sum weight * value(parent node).
+struct NewNode {
+  int node = -1;
+  std::vector<std::pair<int, double>> parents;
+};
+
+struct RefinementResult {
+  std::vector<NewNode> new_nodes;  // in creation order (parents precede children)
+  int refined_cells = 0;           // cells split, including those added to keep the mesh 1-irregular
+  int closure_cells = 0;           // of which added for 1-irregularity
+};
+
+// Refines the marked cells (indices into m.cells; refined cells keep their index for the first child, the other
+// three children are appended). Cells at max_level are not refined (they are skipped). Edge sets follow.
+RefinementResult refine(Mesh& m, const std::vector<int>& marked, int max_level = 1 << 20);
+
+// Every cell once.
+RefinementResult refine_uniform(Mesh& m);
+
+// Hanging nodes of the current mesh: node -> the two end nodes of the cell side it hangs on (its value is the
+// mean of theirs for Q1).
+std::map<int, std::pair<int, int>> hanging_nodes(const Mesh& m);
+
+// Values of a nodal field (rows = nodes) extended to the nodes created by a refinement.
+Eigen::MatrixXd transfer(const Eigen::MatrixXd& old_values, const RefinementResult& refinement, int new_node_count);
 
 // Mesh sanity checks used by validation. Each problem is a message naming the cell or edge.
 std::vector<std::string> check_cells(const Mesh& m);

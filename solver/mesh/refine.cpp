@@ -1,0 +1,181 @@
+// Quadtree refinement with hanging nodes (deal.II / MFEM style): see mesh.hpp.
+#include "mesh.hpp"
+
+#include <algorithm>
+#include <set>
+
+namespace contact::mesh {
+
+namespace {
+
+std::pair<int, int> key(int a, int b) { return {std::min(a, b), std::max(a, b)}; }
+
+// Which named edge set, if any, holds each boundary side (for putting midpoints on curves).
+std::map<std::pair<int, int>, std::string> boundary_side_names(const Mesh& m) {
+  std::map<std::pair<int, int>, std::string> out;
+  for (const auto& [name, refs] : m.edge_sets)
+    for (const auto& e : refs) {
+      const auto n = m.edge_nodes(e);
+      out[key(n[0], n[1])] = name;
+    }
+  return out;
+}
+
+// Active cells by side: side key -> cells having it.
+std::map<std::pair<int, int>, std::vector<int>> sides_of(const Mesh& m) {
+  std::map<std::pair<int, int>, std::vector<int>> out;
+  for (int c = 0; c < m.num_cells(); ++c)
+    for (int s = 0; s < 4; ++s) {
+      const auto n = m.edge_nodes({c, s});
+      out[key(n[0], n[1])].push_back(c);
+    }
+  return out;
+}
+
+}  // namespace
+
+std::map<int, std::pair<int, int>> hanging_nodes(const Mesh& m) {
+  std::map<int, std::pair<int, int>> out;
+  for (int c = 0; c < m.num_cells(); ++c)
+    for (int s = 0; s < 4; ++s) {
+      const auto n = m.edge_nodes({c, s});
+      auto it = m.edge_midpoint.find(key(n[0], n[1]));
+      // The side is active on this (coarser) cell but split on the other side: its midpoint hangs.
+      if (it != m.edge_midpoint.end()) out[it->second] = {n[0], n[1]};
+    }
+  return out;
+}
+
+RefinementResult refine(Mesh& m, const std::vector<int>& marked_in, int max_level) {
+  RefinementResult result;
+  std::vector<char> marked(static_cast<size_t>(m.num_cells()), 0);
+  for (int c : marked_in)
+    if (c >= 0 && c < m.num_cells() && m.level[static_cast<size_t>(c)] < max_level) marked[static_cast<size_t>(c)] = 1;
+
+  // Closure: refining a cell whose side is half of a coarser neighbour's side would put two hanging nodes on
+  // that neighbour's side, so the neighbour is refined too (and so on).
+  std::map<int, std::pair<int, int>> parent_edge;  // midpoint -> split edge
+  for (const auto& [edge, mid] : m.edge_midpoint) parent_edge[mid] = edge;
+  const auto sides = sides_of(m);
+  std::vector<int> queue;
+  for (int c = 0; c < m.num_cells(); ++c)
+    if (marked[static_cast<size_t>(c)]) queue.push_back(c);
+  while (!queue.empty()) {
+    const int c = queue.back();
+    queue.pop_back();
+    for (int s = 0; s < 4; ++s) {
+      const auto n = m.edge_nodes({c, s});
+      for (int end = 0; end < 2; ++end) {
+        auto pe = parent_edge.find(n[static_cast<size_t>(end)]);
+        if (pe == parent_edge.end()) continue;
+        const int other = n[static_cast<size_t>(1 - end)];
+        if (pe->second.first != other && pe->second.second != other) continue;
+        // (n0, n1) is half of the split edge pe->second; a coarser active cell with that whole side?
+        auto coarse = sides.find(pe->second);
+        if (coarse == sides.end()) continue;
+        for (int nb : coarse->second)
+          if (!marked[static_cast<size_t>(nb)]) {
+            marked[static_cast<size_t>(nb)] = 1;
+            ++result.closure_cells;
+            queue.push_back(nb);
+          }
+      }
+    }
+  }
+
+  const auto names = boundary_side_names(m);
+  auto add_node = [&](const Point& x, std::vector<std::pair<int, double>> parents) {
+    const int id = m.num_nodes();
+    m.nodes.push_back(x);
+    result.new_nodes.push_back({id, std::move(parents)});
+    return id;
+  };
+  auto midpoint = [&](int a, int b) {
+    auto it = m.edge_midpoint.find(key(a, b));
+    if (it != m.edge_midpoint.end()) return it->second;
+    const Point& pa = m.nodes[static_cast<size_t>(a)];
+    const Point& pb = m.nodes[static_cast<size_t>(b)];
+    Point x = 0.5 * (pa + pb);
+    auto named = names.find(key(a, b));
+    if (named != names.end()) {
+      auto curve = m.edge_curves.find(named->second);
+      if (curve != m.edge_curves.end()) x = curve->second.between(pa, pb, 0.5);  // on the true curve
+    }
+    const int id = add_node(x, {{a, 0.5}, {b, 0.5}});
+    m.edge_midpoint[key(a, b)] = id;
+    return id;
+  };
+
+  // Edge-set entries of refined cells, replaced by their two halves afterwards.
+  const int n_before = m.num_cells();
+  std::vector<std::array<int, 4>> children(static_cast<size_t>(n_before), {-1, -1, -1, -1});
+  for (int c = 0; c < n_before; ++c) {
+    if (!marked[static_cast<size_t>(c)]) continue;
+    const auto q = m.cells[static_cast<size_t>(c)];
+    const int m01 = midpoint(q[0], q[1]), m12 = midpoint(q[1], q[2]), m23 = midpoint(q[2], q[3]), m30 = midpoint(q[3], q[0]);
+    // Centre: the bilinear centre corrected for curved sides (equal to the corner mean for straight ones).
+    const Point centre = 0.5 * (m.nodes[static_cast<size_t>(m01)] + m.nodes[static_cast<size_t>(m12)] +
+                                m.nodes[static_cast<size_t>(m23)] + m.nodes[static_cast<size_t>(m30)]) -
+                         0.25 * (m.nodes[static_cast<size_t>(q[0])] + m.nodes[static_cast<size_t>(q[1])] +
+                                 m.nodes[static_cast<size_t>(q[2])] + m.nodes[static_cast<size_t>(q[3])]);
+    const int ctr = add_node(centre, {{q[0], 0.25}, {q[1], 0.25}, {q[2], 0.25}, {q[3], 0.25}});
+    const int level = m.level[static_cast<size_t>(c)] + 1;
+    m.cells[static_cast<size_t>(c)] = {q[0], m01, ctr, m30};
+    m.level[static_cast<size_t>(c)] = level;
+    children[static_cast<size_t>(c)][0] = c;
+    const std::array<std::array<int, 4>, 3> others = {{{m01, q[1], m12, ctr}, {ctr, m12, q[2], m23}, {m30, ctr, m23, q[3]}}};
+    for (int k = 0; k < 3; ++k) {
+      children[static_cast<size_t>(c)][static_cast<size_t>(k) + 1] = m.num_cells();
+      m.cells.push_back(others[static_cast<size_t>(k)]);
+      m.level.push_back(level);
+    }
+    ++result.refined_cells;
+  }
+  // Side s of a refined cell = side s of two children: (0: child 0, 1), (1: 1, 2), (2: 2, 3), (3: 3, 0).
+  static const int first_child[4] = {0, 1, 2, 3}, second_child[4] = {1, 2, 3, 0};
+  for (auto& [name, refs] : m.edge_sets) {
+    std::vector<EdgeRef> out;
+    out.reserve(refs.size() * 2);
+    for (const auto& e : refs) {
+      if (e.cell >= n_before || children[static_cast<size_t>(e.cell)][0] < 0) {
+        out.push_back(e);
+        continue;
+      }
+      const auto& ch = children[static_cast<size_t>(e.cell)];
+      out.push_back({ch[static_cast<size_t>(first_child[e.side])], e.side});
+      out.push_back({ch[static_cast<size_t>(second_child[e.side])], e.side});
+    }
+    refs = std::move(out);
+  }
+  // Split edges no longer carry a hanging node once both sides are refined; keep the map only for sides that
+  // are still active on some cell (it is also how the next refinement finds coarser neighbours).
+  std::set<std::pair<int, int>> active;
+  for (int c = 0; c < m.num_cells(); ++c)
+    for (int s = 0; s < 4; ++s) {
+      const auto n = m.edge_nodes({c, s});
+      active.insert(key(n[0], n[1]));
+    }
+  for (auto it = m.edge_midpoint.begin(); it != m.edge_midpoint.end();) {
+    if (!active.count(it->first))
+      it = m.edge_midpoint.erase(it);
+    else
+      ++it;
+  }
+  return result;
+}
+
+RefinementResult refine_uniform(Mesh& m) {
+  std::vector<int> all(static_cast<size_t>(m.num_cells()));
+  for (int c = 0; c < m.num_cells(); ++c) all[static_cast<size_t>(c)] = c;
+  return refine(m, all);
+}
+
+Eigen::MatrixXd transfer(const Eigen::MatrixXd& old_values, const RefinementResult& refinement, int new_node_count) {
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(new_node_count, old_values.cols());
+  out.topRows(old_values.rows()) = old_values;
+  for (const auto& nn : refinement.new_nodes)
+    for (const auto& [parent, w] : nn.parents) out.row(nn.node) += w * out.row(parent);
+  return out;
+}
+
+}  // namespace contact::mesh

@@ -1,0 +1,241 @@
+// Refinement with hanging nodes: 1-irregularity, curved boundaries, constraints, patch test and convergence.
+#include "fem/body_solver.hpp"
+#include "mesh/mesh.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+using namespace contact;
+
+namespace {
+
+mesh::Mesh square(int n) {
+  mesh::BlockSpec s;
+  s.corners = {mesh::Point(0, 0), mesh::Point(2, 0), mesh::Point(2, 2), mesh::Point(0, 2)};
+  s.nx = s.ny = n;
+  return mesh::make_block(s);
+}
+
+// Refines cells containing the point p, `times` times (a local refinement towards p). Returns the number of
+// cells the 1-irregularity closure added.
+int refine_towards(mesh::Mesh& m, const mesh::Point& p, int times) {
+  int closure = 0;
+  for (int t = 0; t < times; ++t) {
+    std::vector<int> marked;
+    for (int c = 0; c < m.num_cells(); ++c) {
+      Eigen::Vector2d lo = m.nodes[static_cast<size_t>(m.cells[static_cast<size_t>(c)][0])], hi = lo;
+      for (int k : m.cells[static_cast<size_t>(c)]) {
+        lo = lo.cwiseMin(m.nodes[static_cast<size_t>(k)]);
+        hi = hi.cwiseMax(m.nodes[static_cast<size_t>(k)]);
+      }
+      if ((p.array() >= lo.array() - 1e-12).all() && (p.array() <= hi.array() + 1e-12).all()) marked.push_back(c);
+    }
+    closure += mesh::refine(m, marked).closure_cells;
+  }
+  return closure;
+}
+
+// At most one hanging node per side: no side of an active cell contains two nodes strictly inside it.
+int max_nodes_inside_a_side(const mesh::Mesh& m) {
+  int worst = 0;
+  for (int c = 0; c < m.num_cells(); ++c)
+    for (int s = 0; s < 4; ++s) {
+      const auto e = m.edge_nodes({c, s});
+      const Eigen::Vector2d a = m.nodes[static_cast<size_t>(e[0])], b = m.nodes[static_cast<size_t>(e[1])];
+      int inside = 0;
+      for (int n = 0; n < m.num_nodes(); ++n) {
+        const Eigen::Vector2d x = m.nodes[static_cast<size_t>(n)];
+        const double t = (x - a).dot(b - a) / (b - a).squaredNorm();
+        const double off = std::abs((x - a).x() * (b - a).y() - (x - a).y() * (b - a).x()) / (b - a).norm();
+        if (t > 1e-9 && t < 1 - 1e-9 && off < 1e-9) ++inside;
+      }
+      worst = std::max(worst, inside);
+    }
+  return worst;
+}
+
+}  // namespace
+
+TEST(Refinement, SplitsIntoFourAndKeepsAreaAndEdgeSetsOrdered) {
+  mesh::Mesh m = square(2);
+  const auto r = mesh::refine(m, {0});
+  EXPECT_EQ(r.refined_cells, 1);
+  EXPECT_EQ(m.num_cells(), 4 + 3);
+  double area = 0;
+  for (int c = 0; c < m.num_cells(); ++c) area += m.cell_area(c);
+  EXPECT_NEAR(area, 4.0, 1e-14);
+  EXPECT_TRUE(mesh::check_cells(m).empty());
+  const auto bottom = m.edge_set_nodes("bottom");
+  ASSERT_EQ(bottom.size(), 4u);  // 0, 0.5, 1, 2
+  for (size_t k = 0; k + 1 < bottom.size(); ++k) EXPECT_LT(m.nodes[bottom[k]].x(), m.nodes[bottom[k + 1]].x());
+  // The refined cell's two interior sides now carry hanging nodes on its unrefined neighbours.
+  EXPECT_EQ(mesh::hanging_nodes(m).size(), 2u);
+}
+
+TEST(Refinement, LocalRefinementStaysOneIrregular) {
+  mesh::Mesh m = square(2);
+  // Five levels towards a point near (not at) a corner: the closure must refine coarser neighbours.
+  EXPECT_GT(refine_towards(m, mesh::Point(0.3, 0.01), 5), 0);
+  EXPECT_LE(max_nodes_inside_a_side(m), 1);
+  int max_level = 0;
+  for (int l : m.level) max_level = std::max(max_level, l);
+  EXPECT_EQ(max_level, 5);
+  EXPECT_TRUE(mesh::check_cells(m).empty());
+  double area = 0;
+  for (int c = 0; c < m.num_cells(); ++c) area += m.cell_area(c);
+  EXPECT_NEAR(area, 4.0, 1e-12);
+}
+
+TEST(Refinement, NewBoundaryNodesLieOnTheTrueCurve) {
+  mesh::BlockSpec s;
+  s.corners = {mesh::Point(1, 0), mesh::Point(2, 0), mesh::Point(0, 2), mesh::Point(0, 1)};
+  s.nx = 2;
+  s.ny = 3;
+  mesh::Curve outer, inner;
+  outer.kind = inner.kind = mesh::Curve::Kind::arc;
+  outer.radius = 2;
+  inner.radius = 1;
+  ASSERT_FALSE(mesh::fit_curve(outer, s.corners[1], s.corners[2]).has_value());
+  ASSERT_FALSE(mesh::fit_curve(inner, s.corners[0], s.corners[3]).has_value());
+  s.curves["right"] = outer;
+  s.curves["left"] = inner;
+  mesh::Mesh m = mesh::make_block(s);
+  mesh::refine_uniform(m);
+  mesh::refine_uniform(m);
+  for (int n : m.edge_set_nodes("right")) EXPECT_NEAR(m.nodes[static_cast<size_t>(n)].norm(), 2.0, 1e-13);
+  for (int n : m.edge_set_nodes("left")) EXPECT_NEAR(m.nodes[static_cast<size_t>(n)].norm(), 1.0, 1e-13);
+  EXPECT_EQ(m.edge_set_nodes("right").size(), 3u * 4 + 1);
+}
+
+TEST(Refinement, TransferReproducesABilinearFieldAtTheNewNodes) {
+  mesh::Mesh m = square(3);
+  auto field = [](const mesh::Point& x) { return 1.0 + 2.0 * x.x() - 0.5 * x.y() + 0.25 * x.x() * x.y(); };
+  Eigen::MatrixXd u(m.num_nodes(), 1);
+  for (int n = 0; n < m.num_nodes(); ++n) u(n, 0) = field(m.nodes[static_cast<size_t>(n)]);
+  const auto r = mesh::refine(m, {0, 4, 8});
+  const Eigen::MatrixXd v = mesh::transfer(u, r, m.num_nodes());
+  for (int n = 0; n < m.num_nodes(); ++n) EXPECT_NEAR(v(n, 0), field(m.nodes[static_cast<size_t>(n)]), 1e-13);
+}
+
+TEST(HangingNodes, PatchTestLinearFieldIsExactOnANonConformingMesh) {
+  // Several levels of local refinement: many hanging nodes. With the exact linear field u* (which satisfies
+  // every hanging-node constraint), the constrained equations at the free interior unknowns hold exactly:
+  // T^T K u* = 0 there, so the FE solution with u*'s boundary values is u*.
+  Body body;
+  body.name = "patch";
+  body.material = {2.1e5, 0.3};
+  body.mesh = square(3);
+  refine_towards(body.mesh, mesh::Point(0.7, 1.3), 3);
+  refine_towards(body.mesh, mesh::Point(1.6, 0.4), 2);
+  const auto hanging = mesh::hanging_nodes(body.mesh);
+  ASSERT_GE(hanging.size(), 6u);
+  BoundaryCondition fix{"left", BoundaryCondition::Kind::displacement};
+  fix.ux = 0.0;
+  fix.uy = 0.0;
+  body.boundary = {fix};
+  fem::BodySolver solver(body, Model{});
+  ASSERT_TRUE(solver.ok()) << solver.error();
+  Eigen::VectorXd ustar(2 * body.mesh.num_nodes());
+  for (int n = 0; n < body.mesh.num_nodes(); ++n) {
+    const auto& x = body.mesh.nodes[static_cast<size_t>(n)];
+    ustar.segment<2>(2 * n) = Eigen::Vector2d(1e-3 * x.x() + 4e-4 * x.y(), -2e-4 * x.x() - 6e-4 * x.y());
+  }
+  const auto& c = solver.constraints();
+  for (const auto& [node, ends] : hanging) {  // u* satisfies every hanging-node constraint, and the constraint
+    EXPECT_TRUE(c.is_constrained(2 * node) && c.is_constrained(2 * node + 1));  // object holds them
+    EXPECT_NEAR((ustar.segment<2>(2 * node) - 0.5 * (ustar.segment<2>(2 * ends.first) + ustar.segment<2>(2 * ends.second))).norm(),
+                0.0, 1e-15);
+  }
+  const Eigen::VectorXd r = c.T().transpose() * (solver.stiffness() * ustar);
+  const double scale = (solver.stiffness().cwiseAbs() * ustar.cwiseAbs()).maxCoeff();
+  int interior = 0;
+  for (int k = 0; k < c.n_free(); ++k) {
+    const int dof = c.free_dofs()[static_cast<size_t>(k)];
+    const auto& x = body.mesh.nodes[static_cast<size_t>(dof / 2)];
+    if (x.x() <= 0 || x.x() >= 2 || x.y() <= 0 || x.y() >= 2) continue;
+    ++interior;
+    EXPECT_LE(std::abs(r[k]), 1e-12 * scale) << "dof " << dof;
+  }
+  EXPECT_GT(interior, 40);
+}
+
+TEST(HangingNodes, UniformStressUnderTractionsOnANonConformingMesh) {
+  Body body;
+  body.name = "patch";
+  body.material = {2.1e5, 0.3};
+  body.mesh = square(3);
+  refine_towards(body.mesh, mesh::Point(1.0, 1.0), 3);
+  ASSERT_FALSE(mesh::hanging_nodes(body.mesh).empty());
+  BoundaryCondition left{"left", BoundaryCondition::Kind::displacement};
+  left.ux = 0.0;
+  BoundaryCondition bottom{"bottom", BoundaryCondition::Kind::displacement};
+  bottom.uy = 0.0;
+  BoundaryCondition right{"right", BoundaryCondition::Kind::traction};
+  right.traction = Eigen::Vector2d(30, 0);
+  BoundaryCondition top{"top", BoundaryCondition::Kind::traction};
+  top.traction = Eigen::Vector2d(0, -50);
+  body.boundary = {left, bottom, right, top};
+  fem::BodySolver solver(body, Model{});
+  ASSERT_TRUE(solver.ok()) << solver.error();
+  const auto s = solver.stresses(solver.solve(Eigen::VectorXd()));
+  for (int c = 0; c < body.mesh.num_cells(); ++c) {
+    EXPECT_NEAR(s.cell(c, 0), 30.0, 1e-7);
+    EXPECT_NEAR(s.cell(c, 1), -50.0, 1e-7);
+    EXPECT_NEAR(s.cell(c, 2), 0.0, 1e-7);
+  }
+}
+
+TEST(HangingNodes, LameRingConvergesAtTheOptimalRateUnderUniformRefinement) {
+  // Quarter of a thick ring a = 1 <= r <= b = 2 under internal pressure P, plane strain, symmetry on both
+  // straight edges: u_r = A r + B / r with A = (1+nu)(1-2nu) P a^2 / (E (b^2 - a^2)),
+  // B = (1+nu) P a^2 b^2 / (E (b^2 - a^2)). Q1 on the curved mesh: nodal displacement error O(h^2).
+  const double E = 1000.0, nu = 0.3, P = 1.0, a = 1.0, b = 2.0;
+  const double A = (1 + nu) * (1 - 2 * nu) * P * a * a / (E * (b * b - a * a));
+  const double Bc = (1 + nu) * P * a * a * b * b / (E * (b * b - a * a));
+  Body body;
+  body.name = "ring";
+  body.material = {E, nu};
+  mesh::BlockSpec s;
+  s.corners = {mesh::Point(a, 0), mesh::Point(b, 0), mesh::Point(0, b), mesh::Point(0, a)};
+  s.nx = 4;
+  s.ny = 4;
+  mesh::Curve outer, inner;
+  outer.kind = inner.kind = mesh::Curve::Kind::arc;
+  outer.radius = b;
+  inner.radius = a;
+  mesh::fit_curve(outer, s.corners[1], s.corners[2]);
+  mesh::fit_curve(inner, s.corners[0], s.corners[3]);
+  s.curves["right"] = outer;
+  s.curves["left"] = inner;
+  body.mesh = mesh::make_block(s);
+  BoundaryCondition sym_x{"bottom", BoundaryCondition::Kind::displacement};  // y = 0 line: u_y = 0
+  sym_x.uy = 0.0;
+  BoundaryCondition sym_y{"top", BoundaryCondition::Kind::displacement};     // x = 0 line: u_x = 0
+  sym_y.ux = 0.0;
+  BoundaryCondition pressure{"left", BoundaryCondition::Kind::traction};     // inner arc
+  pressure.normal_pressure = true;
+  pressure.pressure = P;
+  body.boundary = {sym_x, sym_y, pressure};
+  std::vector<double> errors;
+  for (int level = 0; level < 3; ++level) {
+    if (level > 0) mesh::refine_uniform(body.mesh);
+    fem::BodySolver solver(body, Model{});
+    ASSERT_TRUE(solver.ok()) << solver.error();
+    const Eigen::VectorXd u = solver.solve(Eigen::VectorXd());
+    double err = 0;
+    for (int n = 0; n < body.mesh.num_nodes(); ++n) {
+      const Eigen::Vector2d x = body.mesh.nodes[static_cast<size_t>(n)];
+      const double r = x.norm();
+      const Eigen::Vector2d exact = (A * r + Bc / r) * x / r;
+      err = std::max(err, (u.segment<2>(2 * n) - exact).norm());
+    }
+    errors.push_back(err / (A * b + Bc / a));
+  }
+  for (size_t k = 1; k < errors.size(); ++k) {
+    const double rate = std::log2(errors[k - 1] / errors[k]);
+    EXPECT_GT(rate, 1.8) << "level " << k << ": errors " << errors[k - 1] << " -> " << errors[k];
+  }
+  EXPECT_LT(errors.back(), 2e-3);
+}
