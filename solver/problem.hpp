@@ -119,12 +119,30 @@ struct SolverSettings {
   AugmentedLagrangianSettings augmented_lagrangian;
 };
 
+// h-adaptivity (paper section 3): indicator per cell, refine where it exceeds delta.
+enum class Indicator { fem_bem, zz };
+// paper: one DDM update, then estimate and refine, every iteration (the paper's interleaving);
+// converge_then_refine: solve on the mesh, then estimate and refine; repeat.
+enum class AdaptStrategy { paper, converge_then_refine };
+
+struct AdaptivitySettings {
+  bool enabled = false;
+  Indicator indicator = Indicator::fem_bem;
+  double delta = 0.1;
+  std::vector<int> bodies;  // indices of the adaptive bodies; empty = all
+  int max_level = 8;        // refinement levels above the initial mesh
+  long max_dofs = 400000;   // per body; refinement that would exceed it is cut back (and reported)
+  AdaptStrategy strategy = AdaptStrategy::converge_then_refine;
+  int max_steps = 20;       // refinement steps (converge_then_refine)
+};
+
 struct Problem {
   std::string name;
   Model model;
   std::vector<Body> bodies;
   std::vector<ContactPair> contacts;
   SolverSettings solver;
+  AdaptivitySettings adaptivity;
   nlohmann::json submitted;   // the job JSON as submitted
   nlohmann::json normalized;  // the same with every default filled in
 };

@@ -338,10 +338,31 @@ TEST(JobErrors, UnknownFieldNamesAreEscapedInThePointer) {
   expect_only_error(parse(job), "/a~1b~0c", "unknown field 'a/b~c'");
 }
 
-TEST(JobErrors, AdaptivityIsRefusedInThisVersion) {
+TEST(JobErrors, AdaptivityWithAnUnknownBodyNamesTheBodies) {
   json job = small_job();
-  job["adaptivity"] = {{"indicator", "fem_bem"}};
-  expect_only_error(parse(job), "/adaptivity", "adaptivity is not available in this version of the solver");
+  job["adaptivity"] = {{"indicator", "fem_bem"}, {"bodies", {"lower", "middle"}}};
+  expect_only_error(parse(job), "/adaptivity/bodies/1", "unknown body 'middle'");
+}
+
+TEST(JobErrors, AdaptivityWithAnUnknownIndicatorListsTheChoices) {
+  json job = small_job();
+  job["adaptivity"] = {{"indicator", "residual"}};
+  expect_only_error(parse(job), "/adaptivity/indicator", "\"fem_bem\"");
+}
+
+TEST(JobDefaults, AdaptivityDefaultsToAllBodiesAndTheFemBemIndicator) {
+  json job = small_job();
+  job["adaptivity"] = json::object();
+  const ParseResult r = parse(job);
+  ASSERT_TRUE(r.ok()) << listing(r);
+  EXPECT_TRUE(r.problem->adaptivity.enabled);
+  EXPECT_TRUE(r.problem->adaptivity.bodies.empty());  // empty = all
+  EXPECT_EQ(r.problem->adaptivity.indicator, contact::Indicator::fem_bem);
+  EXPECT_EQ(r.problem->normalized["adaptivity"]["bodies"].size(), 2u);
+  EXPECT_EQ(r.problem->normalized["adaptivity"]["delta"], 0.1);
+  const ParseResult again = parse(r.problem->normalized);
+  ASSERT_TRUE(again.ok()) << listing(again);
+  EXPECT_EQ(again.problem->adaptivity.bodies.size(), 2u);
 }
 
 TEST(JobErrors, UnsupportedVersionIsRejected) {

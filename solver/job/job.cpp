@@ -158,8 +158,7 @@ class JobReader {
     read_bodies(top);
     read_contacts(top);
     read_solver(top);
-    if (top.has("adaptivity"))
-      errors_.add("/adaptivity", "adaptivity is not available in this version of the solver; remove the field");
+    if (const json* a = top.find("adaptivity")) read_adaptivity(*a, top.at("adaptivity"));
     return finish();
   }
 
@@ -286,6 +285,71 @@ class JobReader {
     json& al = out["augmented_lagrangian"];
     set_default(al, "tolerance", 1e-9);
     set_default(al, "max_updates", 100);
+  }
+
+  void read_adaptivity(const json& value, const std::string& pointer) {
+    Fields f(value, pointer, "adaptivity",
+             {"indicator", "delta", "bodies", "max_level", "max_dofs", "strategy", "max_steps"}, errors_);
+    if (!f.ok()) return;
+    AdaptivitySettings& a = problem_.adaptivity;
+    a.enabled = true;
+    json& out = normalized_["adaptivity"];
+    if (const json* i = f.find("indicator"))
+      if (auto x = choice(*i, f.at("indicator"), "indicator", {"fem_bem", "zz"}, errors_))
+        a.indicator = *x == "zz" ? Indicator::zz : Indicator::fem_bem;
+    if (const json* d = f.find("delta"))
+      if (auto x = positive(*d, f.at("delta"), "delta", errors_)) a.delta = *x;
+    if (const json* l = f.find("max_level"))
+      if (auto x = bounded_int(*l, f.at("max_level"), "max_level", 0, errors_)) {
+        if (*x > 30)
+          errors_.add(f.at("max_level"), "max_level = " + std::to_string(*x) + " is above 30");
+        else
+          a.max_level = *x;
+      }
+    if (const json* d = f.find("max_dofs"))
+      if (auto x = bounded_int(*d, f.at("max_dofs"), "max_dofs", 1, errors_)) a.max_dofs = *x;
+    if (const json* st = f.find("strategy"))
+      if (auto x = choice(*st, f.at("strategy"), "strategy", {"paper", "converge_then_refine"}, errors_))
+        a.strategy = *x == "paper" ? AdaptStrategy::paper : AdaptStrategy::converge_then_refine;
+    if (const json* n = f.find("max_steps"))
+      if (auto x = bounded_int(*n, f.at("max_steps"), "max_steps", 1, errors_)) a.max_steps = *x;
+    if (const json* b = f.find("bodies")) {
+      const std::string bp = f.at("bodies");
+      if (!b->is_array()) {
+        errors_.add(bp, "bodies must be an array of body names, got " + read::type_name(*b));
+      } else {
+        for (size_t i = 0; i < b->size(); ++i) {
+          const std::string ip = child(bp, i);
+          if (!(*b)[i].is_string()) {
+            errors_.add(ip, "a body name must be a string, got " + read::type_name((*b)[i]));
+            continue;
+          }
+          const std::string name = (*b)[i].get<std::string>();
+          int found = -1;
+          std::string known;
+          for (size_t k = 0; k < inputs_.size(); ++k) {
+            if (inputs_[k].has_name && inputs_[k].body.name == name) found = static_cast<int>(k);
+            if (inputs_[k].has_name) known += (known.empty() ? "" : ", ") + inputs_[k].body.name;
+          }
+          if (found < 0)
+            errors_.add(ip, "unknown body '" + name + "'; the bodies are " + known);
+          else if (std::find(a.bodies.begin(), a.bodies.end(), found) == a.bodies.end())
+            a.bodies.push_back(found);
+        }
+      }
+    }
+    set_default(out, "indicator", "fem_bem");
+    set_default(out, "delta", 0.1);
+    if (!out.contains("bodies")) {
+      json all = json::array();
+      for (const auto& in : inputs_)
+        if (in.has_name) all.push_back(in.body.name);
+      out["bodies"] = all;
+    }
+    set_default(out, "max_level", 8);
+    set_default(out, "max_dofs", 400000);
+    set_default(out, "strategy", "converge_then_refine");
+    set_default(out, "max_steps", 20);
   }
 
   void read_robin(const json& value, const std::string& pointer) {

@@ -108,7 +108,11 @@ rejected_at("a body name with a dot", lambda d: d["bodies"][0].update(name="up.p
             ["bodies", 0, "name"], "pattern")
 rejected_at("a malformed contact reference", lambda d: d["contacts"][0].update(slave="upper"),
             ["contacts", 0, "slave"], "pattern")
-rejected_at("adaptivity", lambda d: d.update(adaptivity={"indicator": "fem_bem"}), ["adaptivity"], "not")
+rejected_at("an unknown adaptivity indicator", lambda d: d.update(adaptivity={"indicator": "residual"}),
+            ["adaptivity", "indicator"], "enum")
+check("accepts the paper's adaptivity settings",
+      not errors_of(mutated(lambda d: d.update(adaptivity={"indicator": "fem_bem", "delta": 0.1, "bodies": ["lower"],
+                                                          "strategy": "paper", "max_level": 6}))))
 rejected_at("both theta and c", lambda d: d["solver"].update(penalty={"theta": 1e-7, "c": 0.05}),
             ["solver", "penalty"], "oneOf")
 rejected_at("gamma = 2", lambda d: d["solver"].update(gamma=2), ["solver", "gamma"], "oneOf")
