@@ -37,9 +37,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double now_unix() {
-  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
+double now_unix() { return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count(); }
 
 // "2024-05-01T12:00:00.123456Z" -> seconds since the epoch (UTC).
 double parse_iso(const std::string& t) {
@@ -158,9 +156,12 @@ int main(int argc, char** argv) {
   int jobs = 40, subscribers = 100;
   double seconds = 3.0;
   for (int i = 1; i + 1 < argc; ++i) {
-    if (!std::strcmp(argv[i], "--jobs")) jobs = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--subscribers")) subscribers = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--seconds")) seconds = std::atof(argv[++i]);
+    if (!std::strcmp(argv[i], "--jobs"))
+      jobs = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--subscribers"))
+      subscribers = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--seconds"))
+      seconds = std::atof(argv[++i]);
   }
   std::printf("bench_server: contactd %s, %u cores\n\n", CONTACTD_PATH, std::thread::hardware_concurrency());
   std::printf("| %-52s | %-4s | %9s | %9s | %9s | %s\n", "measure", "unit", "median", "p90", "max", "note");
@@ -188,7 +189,8 @@ int main(int argc, char** argv) {
       if (id.empty()) continue;
       double solve = 0;
       stream(server.port, id, [&](const std::string& line, double) {
-        if (line.find("\"type\":\"end\"") != std::string::npos) solve = nlohmann::json::parse(line).value("solve_seconds", 0.0);
+        if (line.find("\"type\":\"end\"") != std::string::npos)
+          solve = nlohmann::json::parse(line).value("solve_seconds", 0.0);
       });
       const double total = std::chrono::duration<double>(Clock::now() - t0).count();
       total_ms.push_back(total * 1e3);
@@ -229,8 +231,8 @@ int main(int argc, char** argv) {
       stop = true;
       for (auto& t : pool) t.join();
       const double rate = static_cast<double>(count.load()) / std::chrono::duration<double>(Clock::now() - t0).count();
-      const std::string what = "GET /v1/jobs/{id}, " + std::to_string(threads) + " keep-alive client" +
-                               (threads > 1 ? "s" : "");
+      const std::string what =
+          "GET /v1/jobs/{id}, " + std::to_string(threads) + " keep-alive client" + (threads > 1 ? "s" : "");
       std::printf("| %-52s | %-4s | %9.0f | %9s | %9s | %s\n", what.c_str(), "1/s", rate, "", "",
                   "requests per second (client on the same 2-core machine)");
     }
@@ -289,8 +291,8 @@ int main(int argc, char** argv) {
     char p99[48];
     std::snprintf(p99, sizeof p99, "; p99 %.3f ms", percentile(latency_ms, 0.99));
     const std::string what = "event latency, " + std::to_string(subscribers) + " concurrent subscribers";
-    print_row(what.c_str(), "ms", percentile(latency_ms, 0.5), percentile(latency_ms, 0.9),
-              percentile(latency_ms, 1.0), note + p99);
+    print_row(what.c_str(), "ms", percentile(latency_ms, 0.5), percentile(latency_ms, 0.9), percentile(latency_ms, 1.0),
+              note + p99);
     server.stop();
   }
   return 0;

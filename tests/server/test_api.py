@@ -16,10 +16,12 @@ from harness import (CONTACT_SOLVE, SRC, Checks, Server, Stream, example, flat_p
 checks = Checks()
 check = checks.check
 
-ITERATION_FIELDS = {"iteration", "paper_criterion", "fixed_point_residual", "elapsed_seconds", "bodies", "pairs"}
+# Every field of the solver's IterationReport, BodyReport and PairReport (solver/result.hpp).
+ITERATION_FIELDS = {"iteration", "paper_criterion", "fixed_point_residual", "elapsed_seconds", "gamma", "update",
+                    "note", "bodies", "pairs"}
 BODY_FIELDS = {"name", "elements", "dofs", "elements_refined"}
 PAIR_FIELDS = {"name", "force", "max_pressure", "extent_begin", "extent_end", "active_points", "changed_points",
-               "theta", "positions", "pressures"}
+               "theta", "max_penetration", "positions", "pressures"}
 END_FIELDS = {"state", "stop_reason", "message", "converged"}
 
 

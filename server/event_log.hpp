@@ -1,0 +1,80 @@
+// The progress events of one job: an append-only sequence kept in memory (the recent tail) and in
+// `events.ndjson` (every event, one JSON object per line), with waiting for new events.
+//
+// Events are numbered 1, 2, 3, ... (`seq`); the numbering continues across restarts of the server, so a client's
+// Last-Event-ID stays meaningful. Each line is a complete JSON object that starts
+// {"seq":N,"type":"...","time":"...", followed by the type's own fields (see docs/server.md).
+//
+// Thread safety: every member may be called from any thread. append() (the worker) never waits for readers: it
+// holds the lock only to write one line and to notify.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <mutex>
+#include <string>
+#include <vector>
+
+namespace contactd {
+
+struct Event {
+  std::int64_t seq = 0;
+  std::string type;  // "state", "iteration", "step" or "end"
+  std::string json;  // the whole event, one line without the newline
+};
+
+class EventLog {
+ public:
+  // `path` is the job's events.ndjson; it is created on the first append.
+  explicit EventLog(std::string path);
+  ~EventLog();
+  EventLog(const EventLog&) = delete;
+  EventLog& operator=(const EventLog&) = delete;
+
+  // Reads an existing file back (start-up): indexes every complete line and cuts off a torn last line (a crash
+  // in the middle of a write) or anything after the first line that is not the next event. Returns the number of
+  // events kept.
+  std::int64_t load();
+
+  // Appends one event of `type` with `fields` (a JSON object; seq, type and time are added) and wakes waiters.
+  // Returns the event's seq. An I/O error is logged, not thrown: the event still reaches live subscribers.
+  std::int64_t append(const std::string& type, const nlohmann::json& fields);
+
+  // Up to `max_count` events with seq > after, in order (from memory when recent, from the file otherwise).
+  std::vector<Event> read_after(std::int64_t after, std::size_t max_count) const;
+
+  // Waits until an event with seq > after exists, the log is discarded, or `timeout` passes.
+  void wait_after(std::int64_t after, std::chrono::milliseconds timeout) const;
+
+  std::int64_t last_seq() const;
+  std::string last_type() const;  // "" when empty
+
+  // Flushes the file to disk (fsync) and closes it; the next append reopens it. Called when a job ends or stops.
+  void sync_and_close();
+
+  // The job was deleted: wakes waiters; reads return nothing from now on.
+  void discard();
+  bool discarded() const;
+
+ private:
+  void open_for_append_locked();
+
+  static constexpr std::size_t kRecent = 512;  // events kept in memory per job
+
+  const std::string path_;
+  mutable std::mutex mutex_;
+  mutable std::condition_variable changed_;
+  int fd_ = -1;
+  std::uint64_t file_size_ = 0;
+  std::vector<std::uint64_t> offsets_;  // offsets_[seq - 1]: where event seq starts in the file
+  std::vector<std::uint8_t> types_;     // types_[seq - 1]: index into kTypes
+  std::deque<std::string> recent_;      // the last events; recent_.back() is seq == offsets_.size()
+  bool discarded_ = false;
+  bool file_ok_ = true;  // false after a write error: older events may be missing from the file
+};
+
+}  // namespace contactd

@@ -1,0 +1,70 @@
+#include "events.hpp"
+
+#include <utility>
+
+namespace contactd {
+
+namespace {
+
+nlohmann::json report_json(const contact::IterationReport& report, bool with_profiles) {
+  nlohmann::json bodies = nlohmann::json::array();
+  for (const auto& b : report.bodies)
+    bodies.push_back(
+        {{"name", b.name}, {"elements", b.elements}, {"dofs", b.dofs}, {"elements_refined", b.elements_refined}});
+  nlohmann::json pairs = nlohmann::json::array();
+  for (const auto& p : report.pairs) {
+    nlohmann::json pair = {{"name", p.name},
+                           {"force", p.force},
+                           {"max_pressure", p.max_pressure},
+                           {"extent_begin", p.extent_begin},
+                           {"extent_end", p.extent_end},
+                           {"active_points", p.active_points},
+                           {"changed_points", p.changed_points},
+                           {"theta", p.theta},
+                           {"max_penetration", p.max_penetration}};
+    if (with_profiles) {
+      pair["positions"] = p.positions;
+      pair["pressures"] = p.pressures;
+    }
+    pairs.push_back(std::move(pair));
+  }
+  nlohmann::json j = {{"iteration", report.iteration},
+                      {"paper_criterion", report.paper_criterion},
+                      {"fixed_point_residual", report.fixed_point_residual},
+                      {"elapsed_seconds", report.elapsed_seconds},
+                      {"gamma", report.gamma},
+                      {"update", report.update},
+                      {"note", report.note},
+                      {"bodies", bodies},
+                      {"pairs", pairs}};
+  return j;
+}
+
+}  // namespace
+
+nlohmann::json state_event(JobState state, const std::string& message, int attempt) {
+  return {{"state", to_string(state)}, {"message", message}, {"attempt", attempt}};
+}
+
+nlohmann::json iteration_event(const contact::IterationReport& report) { return report_json(report, true); }
+
+nlohmann::json progress_summary(const contact::IterationReport& report) { return report_json(report, false); }
+
+nlohmann::json step_event(const contact::Step& step) {
+  nlohmann::json bodies = nlohmann::json::array();
+  for (const auto& b : step.bodies)
+    bodies.push_back({{"name", b.name}, {"elements", b.mesh.num_cells()}, {"nodes", b.mesh.num_nodes()}});
+  return {{"step", step.index}, {"iteration", step.iteration}, {"bodies", bodies}};
+}
+
+nlohmann::json end_event(const JobRecord& r) {
+  return {{"state", to_string(r.state)},
+          {"stop_reason", r.stop_reason},
+          {"message", r.message},
+          {"converged", r.converged.value_or(false)},
+          {"iterations", r.iterations},
+          {"solve_seconds", r.solve_seconds},
+          {"result_available", r.result_available}};
+}
+
+}  // namespace contactd

@@ -1,0 +1,562 @@
+#include "job_queue.hpp"
+
+#include "events.hpp"
+#include "util.hpp"
+
+#include "io/result_file.hpp"
+#include "solve.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <functional>
+#include <new>
+#include <string_view>
+
+namespace contactd {
+
+namespace {
+
+std::size_t hash_body(const std::string& body) { return std::hash<std::string_view>{}(body); }
+
+std::string format_seconds(double s) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", s);
+  return text;
+}
+
+// Appends one `iteration` event per solver iteration and keeps the job's progress summary current.
+// Runs on the worker's thread; it only takes short locks and never waits for a client.
+class EventObserver final : public contact::Observer {
+ public:
+  EventObserver(Job& job, std::mutex& records_mutex, Metrics& metrics)
+      : job_(job), records_mutex_(records_mutex), metrics_(metrics) {}
+
+  void on_iteration(const contact::IterationReport& report) override {
+    job_.events.append("iteration", iteration_event(report));
+    nlohmann::json summary = progress_summary(report);
+    {
+      std::lock_guard<std::mutex> lock(records_mutex_);
+      job_.record.iterations = report.iteration;
+      job_.record.progress = std::move(summary);
+    }
+    metrics_.iteration_done();
+  }
+
+ private:
+  Job& job_;
+  std::mutex& records_mutex_;
+  Metrics& metrics_;
+};
+
+}  // namespace
+
+JobQueue::JobQueue(JobStore& store, Metrics& metrics, QueueSettings settings)
+    : store_(store), metrics_(metrics), settings_(settings) {}
+
+JobQueue::~JobQueue() {
+  shutdown(std::chrono::milliseconds(0));
+  for (auto& t : threads_)
+    if (t.joinable()) t.detach();  // shutdown() gave up on it; the process is exiting
+  if (watchdog_thread_.joinable()) watchdog_thread_.join();
+}
+
+void JobQueue::set_state_locked(Job& job, JobState state) {
+  --state_counts_[static_cast<std::size_t>(job.record.state)];
+  job.record.state = state;
+  ++state_counts_[static_cast<std::size_t>(state)];
+}
+
+void JobQueue::register_locked(const std::shared_ptr<Job>& job) {
+  const JobRecord& r = job->record;
+  jobs_[r.id] = job;
+  by_time_[{r.created_us, r.id}] = job;
+  if (!r.idempotency_key.empty()) by_key_[r.idempotency_key] = r.id;
+  ++state_counts_[static_cast<std::size_t>(r.state)];
+  last_created_us_ = std::max(last_created_us_, r.created_us);
+}
+
+void JobQueue::unregister_locked(const std::shared_ptr<Job>& job) {
+  const JobRecord& r = job->record;
+  jobs_.erase(r.id);
+  by_time_.erase({r.created_us, r.id});
+  const auto key = by_key_.find(r.idempotency_key);
+  if (key != by_key_.end() && key->second == r.id) by_key_.erase(key);
+  body_hash_.erase(r.id);
+  --state_counts_[static_cast<std::size_t>(r.state)];
+}
+
+void JobQueue::persist(const std::shared_ptr<Job>& job, bool durable) {
+  std::lock_guard<std::mutex> persist_lock(job->persist_mutex);
+  JobRecord copy;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    copy = job->record;
+  }
+  try {
+    store_.save_state(copy, durable);
+  } catch (const std::exception& e) {
+    log_line("job " + copy.id + ": " + e.what());
+  }
+}
+
+void JobQueue::recover() {
+  const std::vector<JobRecord> records = store_.load_all();
+  int requeued = 0;
+  for (const JobRecord& loaded : records) {
+    auto job = std::make_shared<Job>(loaded, store_.events_path(loaded.id));
+    job->events.load();
+    JobRecord& r = job->record;
+    if (!r.idempotency_key.empty()) {
+      try {
+        body_hash_[r.id] = hash_body(store_.read_job(r.id));
+      } catch (const std::exception& e) {
+        log_line("job " + r.id + ": " + e.what());
+      }
+    }
+    if (is_terminal(r.state)) {
+      if (job->events.last_type() != "end") {  // crashed between storing the outcome and announcing it
+        job->events.append("end", end_event(r));
+        job->events.sync_and_close();
+      }
+      job->settled = true;
+      std::lock_guard<std::mutex> lock(mutex_);
+      register_locked(job);
+      continue;
+    }
+    const bool interrupted = r.state == JobState::running;
+    r.state = JobState::queued;
+    r.started_us = 0;
+    r.iterations = 0;
+    r.progress = nullptr;
+    if (interrupted) {
+      store_.remove_result(r.id);  // of the interrupted run, if it got that far
+      r.message = "re-queued: its run was interrupted (the server stopped)";
+      persist(job);
+      job->events.append("state", state_event(JobState::queued, r.message, r.attempts));
+      job->events.sync_and_close();
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    register_locked(job);
+    queue_.push_back(job);
+    ++requeued;
+  }
+  log_line("store: " + std::to_string(records.size()) + " jobs read back from " + store_.data_dir() + ", " +
+           std::to_string(requeued) + " queued to run");
+}
+
+void JobQueue::start() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (started_) return;
+  started_ = true;
+  for (int i = 0; i < settings_.workers; ++i) {
+    ++workers_alive_;
+    threads_.emplace_back([this] { worker_loop(); });
+  }
+  watchdog_thread_ = std::thread([this] { watchdog_loop(); });
+}
+
+bool JobQueue::shutdown(std::chrono::milliseconds grace) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  if (!stopping_) {
+    stopping_ = true;
+    for (const auto& job : running_) job->request_cancel(CancelReason::shutdown);
+  }
+  work_.notify_all();
+  watchdog_.notify_all();
+  const bool stopped = idle_.wait_for(lock, grace, [this] { return workers_alive_.load() == 0; });
+  lock.unlock();
+  if (stopped) {
+    for (auto& t : threads_)
+      if (t.joinable()) t.join();
+  }
+  if (watchdog_thread_.joinable()) watchdog_thread_.join();
+  return stopped;
+}
+
+bool JobQueue::stopping() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return stopping_;
+}
+
+void JobQueue::worker_loop() {
+  while (true) {
+    std::shared_ptr<Job> job;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      work_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
+      if (stopping_) break;
+      job = queue_.front();
+      queue_.pop_front();
+      if (job->record.state != JobState::queued) continue;  // cancelled while waiting
+      set_state_locked(*job, JobState::running);
+      job->record.started_us = now_unix_us();
+      job->record.attempts += 1;
+      job->record.iterations = 0;
+      job->record.progress = nullptr;
+      job->record.message.clear();
+      job->deadline = settings_.time_limit_seconds > 0
+                          ? std::chrono::steady_clock::now() +
+                                std::chrono::microseconds(static_cast<std::int64_t>(settings_.time_limit_seconds * 1e6))
+                          : std::chrono::steady_clock::time_point::max();
+      running_.push_back(job);
+    }
+    try {
+      run(job);
+    } catch (const std::exception& e) {  // run() handles the solver's failures; this is a bug or no memory
+      log_line("job " + job->record.id + ": unexpected error: " + e.what());
+    }
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      running_.erase(std::remove(running_.begin(), running_.end(), job), running_.end());
+    }
+    idle_.notify_all();
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    --workers_alive_;
+  }
+  idle_.notify_all();
+}
+
+void JobQueue::watchdog_loop() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (!stopping_) {
+    watchdog_.wait_for(lock, std::chrono::milliseconds(100));
+    const auto now = std::chrono::steady_clock::now();
+    for (const auto& job : running_) {
+      if (now >= job->deadline && job->cancel_reason.load() == static_cast<int>(CancelReason::none)) {
+        job->request_cancel(CancelReason::time_limit);
+        log_line("job " + job->record.id + ": time limit of " + format_seconds(settings_.time_limit_seconds) +
+                 " s reached; stopping it");
+      }
+    }
+  }
+}
+
+void JobQueue::run(const std::shared_ptr<Job>& job) {
+  const std::string id = job->record.id;
+  int attempt = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    attempt = job->record.attempts;
+  }
+  // Not fsync'ed: whether a crash leaves QUEUED or RUNNING on disk, the job is queued again at start-up.
+  persist(job, /*durable=*/false);
+  job->events.append("state", state_event(JobState::running, "a worker started the job", attempt));
+  log_line("job " + id + ": started (attempt " + std::to_string(attempt) + ")");
+
+  JobRecord outcome;
+  outcome.converged = false;
+  contact::Result result;
+  std::optional<contact::Problem> problem;
+  try {
+    contact::job::Limits limits;
+    limits.max_dofs = settings_.max_dofs;
+    auto parsed = contact::job::parse_text(store_.read_job(id), limits);
+    if (!parsed.ok()) {
+      // Valid when submitted; invalid now (a smaller --max-dofs since, or another solver version).
+      result.stop_reason = contact::StopReason::error;
+      result.message = "the job is no longer valid: " + contact::job::format_errors(parsed.errors);
+    } else {
+      problem = std::move(parsed.problem);
+      EventObserver observer(*job, mutex_, metrics_);
+      result = contact::solve(*problem, observer, job->cancel);
+    }
+  } catch (const std::bad_alloc&) {
+    result = contact::Result{};
+    result.stop_reason = contact::StopReason::error;
+    result.message = "out of memory";
+  } catch (const std::exception& e) {
+    result = contact::Result{};
+    result.stop_reason = contact::StopReason::error;
+    result.message = std::string("internal error: ") + e.what();
+  }
+  metrics_.solve_finished(result.wall_seconds);
+
+  const auto reason = static_cast<CancelReason>(job->cancel_reason.load());
+  if (result.stop_reason == contact::StopReason::cancelled && reason == CancelReason::shutdown) {
+    requeue_after_shutdown(job);
+    return;
+  }
+
+  outcome.iterations = result.iterations;
+  outcome.solve_seconds = result.wall_seconds;
+  outcome.message = result.message;
+  outcome.stop_reason = contact::to_string(result.stop_reason);
+  switch (result.stop_reason) {
+    case contact::StopReason::converged:
+      outcome.state = JobState::succeeded;
+      outcome.converged = true;
+      break;
+    case contact::StopReason::max_iterations:
+    case contact::StopReason::stagnation:
+      outcome.state = JobState::succeeded;
+      break;
+    case contact::StopReason::error:
+      outcome.state = JobState::failed;
+      break;
+    case contact::StopReason::cancelled:
+      if (reason == CancelReason::time_limit) {
+        outcome.state = JobState::failed;
+        outcome.stop_reason = "time_limit";
+        outcome.message = "stopped by the time limit of " + format_seconds(settings_.time_limit_seconds) + " s after " +
+                          std::to_string(result.iterations) + " iterations";
+      } else {
+        outcome.state = JobState::cancelled;
+        outcome.message = "cancelled after " + std::to_string(result.iterations) + " iterations";
+      }
+      break;
+  }
+
+  // The result file: written before the job is marked done, so that `end` means "downloadable now".
+  if (problem && !result.steps.empty() && result.stop_reason != contact::StopReason::error) {
+    try {
+      contact::io::WriteInfo info;
+      info.job_id = id;
+      contact::io::write_result(store_.result_path(id), *problem, result, info);
+      contact::io::write_xdmf(store_.xmf_path(id), "result.hdf", result);
+      outcome.result_available = true;
+    } catch (const std::exception& e) {
+      store_.remove_result(id);
+      outcome.state = JobState::failed;
+      outcome.stop_reason = "error";
+      outcome.message = std::string("cannot write the result file: ") + e.what();
+    }
+  }
+  for (const auto& step : result.steps) job->events.append("step", step_event(step));
+  finish(job, std::move(outcome));
+}
+
+void JobQueue::finish(const std::shared_ptr<Job>& job, JobRecord outcome) {
+  JobRecord after;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    JobRecord& r = job->record;
+    set_state_locked(*job, outcome.state);
+    r.finished_us = now_unix_us();
+    r.stop_reason = outcome.stop_reason;
+    r.message = outcome.message;
+    r.converged = outcome.converged;
+    r.iterations = outcome.iterations;
+    r.solve_seconds = outcome.solve_seconds;
+    r.result_available = outcome.result_available;
+    after = r;
+  }
+  persist(job);
+  job->events.append("end", end_event(after));
+  job->events.sync_and_close();
+  job->settled = true;
+  log_line("job " + after.id + ": " + to_string(after.state) + " (" + after.stop_reason + ", " +
+           std::to_string(after.iterations) + " iterations, " + format_seconds(after.solve_seconds) + " s)");
+}
+
+void JobQueue::requeue_after_shutdown(const std::shared_ptr<Job>& job) {
+  JobRecord after;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    JobRecord& r = job->record;
+    set_state_locked(*job, JobState::queued);
+    r.started_us = 0;
+    r.iterations = 0;
+    r.progress = nullptr;
+    r.message = "interrupted by a shutdown; it runs again when the server restarts";
+    after = r;
+  }
+  store_.remove_result(after.id);
+  persist(job);
+  job->events.append("state", state_event(JobState::queued, after.message, after.attempts));
+  job->events.sync_and_close();
+  log_line("job " + after.id + ": interrupted by the shutdown, stored as QUEUED");
+}
+
+contact::job::ParseResult JobQueue::validate(const std::string& body) const {
+  contact::job::Limits limits;
+  limits.max_dofs = settings_.max_dofs;
+  return contact::job::parse_text(body, limits);
+}
+
+JobQueue::Submission JobQueue::submit(const std::string& body, const std::string& idempotency_key) {
+  Submission submission;
+  auto parsed = validate(body);
+  if (!parsed.ok()) {
+    submission.outcome = Submission::Outcome::invalid;
+    submission.errors = std::move(parsed.errors);
+    return submission;
+  }
+  const std::size_t hash = hash_body(body);
+
+  std::unique_lock<std::mutex> lock(mutex_);
+  if (!idempotency_key.empty()) {
+    const auto known = by_key_.find(idempotency_key);
+    if (known != by_key_.end()) {
+      const auto job = jobs_.at(known->second);
+      const auto h = body_hash_.find(known->second);
+      const bool same = h != body_hash_.end() && h->second == hash &&
+                        job->record.body_bytes == static_cast<std::int64_t>(body.size());
+      submission.outcome = same ? Submission::Outcome::replayed : Submission::Outcome::key_conflict;
+      submission.job = job;
+      return submission;
+    }
+  }
+  if (stopping_) {
+    submission.outcome = Submission::Outcome::unavailable;
+    return submission;
+  }
+  if (static_cast<std::size_t>(state_counts_[static_cast<std::size_t>(JobState::queued)]) >= settings_.max_queued) {
+    submission.outcome = Submission::Outcome::queue_full;
+    return submission;
+  }
+  JobRecord record;
+  record.id = new_job_id();
+  record.name = parsed.problem->name;
+  record.state = JobState::queued;
+  record.created_us = std::max(now_unix_us(), last_created_us_ + 1);  // strictly increasing: a total order
+  record.idempotency_key = idempotency_key;
+  record.body_bytes = static_cast<std::int64_t>(body.size());
+  auto job = std::make_shared<Job>(record, store_.events_path(record.id));
+  // Held until the files exist: anyone persisting this job (a cancel) waits for them.
+  std::unique_lock<std::mutex> persist_lock(job->persist_mutex);
+  register_locked(job);
+  if (!idempotency_key.empty()) body_hash_[record.id] = hash;
+  lock.unlock();
+
+  try {
+    store_.create(record, body);
+  } catch (const std::exception& e) {
+    log_line("job " + record.id + ": not accepted: " + e.what());
+    lock.lock();
+    unregister_locked(job);
+    submission.outcome = Submission::Outcome::store_error;
+    submission.detail = e.what();
+    return submission;
+  }
+  job->events.append("state", state_event(JobState::queued, "accepted", 0));
+  persist_lock.unlock();
+  metrics_.job_submitted();
+
+  lock.lock();
+  if (job->record.state == JobState::queued && !stopping_) {
+    queue_.push_back(job);
+    work_.notify_one();
+  }
+  submission.outcome = Submission::Outcome::accepted;
+  submission.job = job;
+  return submission;
+}
+
+std::shared_ptr<Job> JobQueue::find(const std::string& id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = jobs_.find(id);
+  return it == jobs_.end() ? nullptr : it->second;
+}
+
+JobRecord JobQueue::snapshot(const Job& job, int* queue_position) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (queue_position) {
+    *queue_position = 0;
+    if (job.record.state == JobState::queued) {
+      int position = 1;
+      for (const auto& waiting : queue_) {
+        if (waiting.get() == &job) break;
+        if (waiting->record.state == JobState::queued) ++position;
+      }
+      *queue_position = position;
+    }
+  }
+  return job.record;
+}
+
+JobQueue::CancelOutcome JobQueue::cancel(const std::string& id) {
+  std::shared_ptr<Job> job;
+  JobRecord after;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = jobs_.find(id);
+    if (it == jobs_.end()) return CancelOutcome::not_found;
+    job = it->second;
+    switch (job->record.state) {
+      case JobState::running:
+        job->request_cancel(CancelReason::user);  // the solver stops within one iteration
+        return CancelOutcome::cancelling;
+      case JobState::cancelled:
+        return CancelOutcome::already_cancelled;
+      case JobState::succeeded:
+      case JobState::failed:
+        return CancelOutcome::already_done;
+      case JobState::queued:
+        break;
+    }
+    // Queued: it never starts. (A worker only starts a job it finds QUEUED under this same lock.)
+    queue_.erase(std::remove(queue_.begin(), queue_.end(), job), queue_.end());
+    set_state_locked(*job, JobState::cancelled);
+    JobRecord& r = job->record;
+    r.finished_us = now_unix_us();
+    r.stop_reason = "cancelled";
+    r.message = "cancelled before it started";
+    r.converged = false;
+    after = r;
+  }
+  persist(job);
+  job->events.append("end", end_event(after));
+  job->events.sync_and_close();
+  job->settled = true;
+  log_line("job " + id + ": cancelled while queued");
+  return CancelOutcome::cancelled;
+}
+
+JobQueue::RemoveOutcome JobQueue::remove(const std::string& id, std::string& detail) {
+  std::shared_ptr<Job> job;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = jobs_.find(id);
+    if (it == jobs_.end()) return RemoveOutcome::not_found;
+    job = it->second;
+    if (!is_terminal(job->record.state) || !job->settled.load()) return RemoveOutcome::not_done;
+    unregister_locked(job);
+  }
+  job->events.discard();  // open streams end
+  std::lock_guard<std::mutex> persist_lock(job->persist_mutex);
+  try {
+    store_.remove(id);
+  } catch (const std::exception& e) {
+    detail = e.what();
+    log_line("job " + id + ": " + detail);
+    return RemoveOutcome::store_error;
+  }
+  log_line("job " + id + ": deleted");
+  return RemoveOutcome::removed;
+}
+
+JobQueue::Page JobQueue::list(std::optional<JobState> state, std::size_t page_size,
+                              const std::optional<Cursor>& after) const {
+  Page page;
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto it = after ? by_time_.lower_bound({after->created_us, after->id}) : by_time_.end();
+  while (it != by_time_.begin()) {
+    --it;
+    const JobRecord& r = it->second->record;
+    if (state && r.state != *state) continue;
+    if (page.jobs.size() == page_size) {  // one more exists: this page is full and another follows
+      const JobRecord& last = page.jobs.back();
+      page.next = Cursor{last.created_us, last.id};
+      break;
+    }
+    page.jobs.push_back(r);
+  }
+  return page;
+}
+
+JobCounts JobQueue::counts() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  JobCounts counts;
+  counts.by_state = state_counts_;
+  counts.queue_length = state_counts_[static_cast<std::size_t>(JobState::queued)];
+  return counts;
+}
+
+int JobQueue::workers_busy() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return static_cast<int>(running_.size());
+}
+
+}  // namespace contactd
