@@ -124,10 +124,16 @@ enum class Indicator { fem_bem, zz };
 // paper: one DDM update, then estimate and refine, every iteration (the paper's interleaving);
 // converge_then_refine: solve on the mesh, then estimate and refine; repeat.
 enum class AdaptStrategy { paper, converge_then_refine };
+// How eta is normalised (docs/algorithm.md, "Indicators"): rms = (||.||_e / sqrt|e|) / (||.||_Omega / sqrt|Omega|),
+// root-mean-square error over the cell against root-mean-square stress over the body; area = the formula as
+// printed in the paper, (||.||_e / |e|) / (||.||_Omega / |Omega|), which grows like 1/sqrt|e| under refinement
+// and so never stops refining where the relative error is only O(h).
+enum class Normalization { rms, area };
 
 struct AdaptivitySettings {
   bool enabled = false;
   Indicator indicator = Indicator::fem_bem;
+  Normalization normalization = Normalization::rms;
   double delta = 0.1;
   std::vector<int> bodies;  // indices of the adaptive bodies; empty = all
   int max_level = 8;        // refinement levels above the initial mesh

@@ -11,7 +11,8 @@ double relative_change(const Eigen::VectorXd& now, const Eigen::VectorXd& before
   return scale > 0 ? (now - before).norm() / scale : 0.0;
 }
 
-ContactSystem::ContactSystem(const Problem& problem, TaskRunner& runner, bool factorize) : problem_(problem) {
+ContactSystem::ContactSystem(const Problem& problem, TaskRunner& runner, bool factorize)
+    : problem_(problem), factorize_(factorize) {
   const auto t0 = std::chrono::steady_clock::now();
   fem::limit_blas_threads();
   bodies_.resize(problem.bodies.size());
@@ -30,6 +31,26 @@ ContactSystem::ContactSystem(const Problem& problem, TaskRunner& runner, bool fa
       error_ += (error_.empty() ? "" : "; ") + ("contact '" + pairs_.back().name + "': the penalty theta is not positive");
   }
   setup_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void ContactSystem::rebuild(const std::vector<char>& changed, TaskRunner& runner) {
+  std::vector<size_t> todo;
+  for (size_t a = 0; a < bodies_.size(); ++a)
+    if (changed[a]) todo.push_back(a);
+  runner.run(todo.size(), [&](size_t i) {
+    const size_t a = todo[i];
+    bodies_[a] = std::make_unique<fem::BodySolver>(problem_.bodies[a], problem_.model, factorize_);
+  });
+  for (size_t a : todo) {
+    if (!bodies_[a]->ok()) error_ += (error_.empty() ? "" : "; ") + bodies_[a]->error();
+    factorization_seconds_ += bodies_[a]->factorization_seconds();
+  }
+  pairs_.clear();
+  penalties_.clear();
+  for (int k = 0; k < static_cast<int>(problem_.contacts.size()); ++k) {
+    penalties_.push_back(interface::choose_penalty(problem_, k));
+    pairs_.push_back(interface::discretize_pair(problem_, k, penalties_.back().theta));
+  }
 }
 
 Displacements ContactSystem::loads_from_pressures(const std::vector<Eigen::VectorXd>& pressures) const {

@@ -23,8 +23,15 @@ class ContactSystem {
   // discretises every pair. Check ok() / error().
   ContactSystem(const Problem& problem, TaskRunner& runner, bool factorize = true);
 
+  // After the meshes of the bodies flagged in `changed` were refined (in the Problem this system refers to):
+  // reassembles and refactorises those bodies only (an unchanged body keeps its factorisation) and rediscretises
+  // every pair. Multipliers are dropped. Check ok() afterwards.
+  void rebuild(const std::vector<char>& changed, TaskRunner& runner);
+
   bool ok() const { return error_.empty(); }
   const std::string& error() const { return error_; }
+  // Assembly and factorisation seconds of all bodies built so far (summed over bodies).
+  double total_factorization_seconds() const { return factorization_seconds_; }
 
   const Problem& problem() const { return problem_; }
   size_t n_bodies() const { return bodies_.size(); }
@@ -62,6 +69,7 @@ class ContactSystem {
 
  private:
   const Problem& problem_;
+  bool factorize_ = true;
   std::vector<std::unique_ptr<fem::BodySolver>> bodies_;
   std::vector<interface::PairDiscretization> pairs_;
   std::vector<interface::PenaltyChoice> penalties_;

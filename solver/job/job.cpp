@@ -289,7 +289,8 @@ class JobReader {
 
   void read_adaptivity(const json& value, const std::string& pointer) {
     Fields f(value, pointer, "adaptivity",
-             {"indicator", "delta", "bodies", "max_level", "max_dofs", "strategy", "max_steps"}, errors_);
+             {"indicator", "normalization", "delta", "bodies", "max_level", "max_dofs", "strategy", "max_steps"},
+             errors_);
     if (!f.ok()) return;
     AdaptivitySettings& a = problem_.adaptivity;
     a.enabled = true;
@@ -297,6 +298,9 @@ class JobReader {
     if (const json* i = f.find("indicator"))
       if (auto x = choice(*i, f.at("indicator"), "indicator", {"fem_bem", "zz"}, errors_))
         a.indicator = *x == "zz" ? Indicator::zz : Indicator::fem_bem;
+    if (const json* nz = f.find("normalization"))
+      if (auto x = choice(*nz, f.at("normalization"), "normalization", {"rms", "area"}, errors_))
+        a.normalization = *x == "area" ? Normalization::area : Normalization::rms;
     if (const json* d = f.find("delta"))
       if (auto x = positive(*d, f.at("delta"), "delta", errors_)) a.delta = *x;
     if (const json* l = f.find("max_level"))
@@ -339,6 +343,7 @@ class JobReader {
       }
     }
     set_default(out, "indicator", "fem_bem");
+    set_default(out, "normalization", "rms");
     set_default(out, "delta", 0.1);
     if (!out.contains("bodies")) {
       json all = json::array();

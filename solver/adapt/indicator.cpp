@@ -1,0 +1,237 @@
+#include "indicator.hpp"
+
+#include "../bem/bem.hpp"
+#include "../fem/elasticity.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <numeric>
+#include <set>
+#include <stdexcept>
+
+namespace contact::adapt {
+
+namespace {
+
+std::pair<int, int> key(int a, int b) { return {std::min(a, b), std::max(a, b)}; }
+
+double squared_norm(const Eigen::Vector3d& s) { return s[0] * s[0] + s[1] * s[1] + 2 * s[2] * s[2]; }
+
+// eta from FE and reference stresses at the 2x2 Gauss points of every cell (3 x 4 per cell).
+Eigen::VectorXd normalised(const mesh::Mesh& m, const std::vector<Eigen::Matrix<double, 3, 4>>& fe,
+                           const std::vector<Eigen::Matrix<double, 3, 4>>& ref, Normalization normalization) {
+  const int n = m.num_cells();
+  Eigen::VectorXd diff2(n), area(n);
+  double ref2 = 0.0, total_area = 0.0;
+  for (int c = 0; c < n; ++c) {
+    const auto x = fem::cell_coordinates(m, c);
+    diff2[c] = 0.0;
+    area[c] = 0.0;
+    for (int q = 0; q < 4; ++q) {
+      double det = 0;
+      fem::strain_matrix(x, fem::kGaussPoints[static_cast<size_t>(q)].x(), fem::kGaussPoints[static_cast<size_t>(q)].y(), det);
+      diff2[c] += det * squared_norm(ref[static_cast<size_t>(c)].col(q) - fe[static_cast<size_t>(c)].col(q));
+      ref2 += det * squared_norm(ref[static_cast<size_t>(c)].col(q));
+      area[c] += det;
+    }
+    total_area += area[c];
+  }
+  const bool rms = normalization == Normalization::rms;
+  const double scale = std::sqrt(ref2) / (rms ? std::sqrt(total_area) : total_area);
+  Eigen::VectorXd eta(n);
+  for (int c = 0; c < n; ++c)
+    eta[c] = scale > 0 ? (std::sqrt(diff2[c]) / (rms ? std::sqrt(area[c]) : area[c])) / scale : 0.0;
+  return eta;
+}
+
+std::vector<Eigen::Matrix<double, 3, 4>> fe_gauss_stresses(const Body& body, const fem::BodySolver& solver,
+                                                          const Eigen::VectorXd& u) {
+  const auto& m = body.mesh;
+  std::vector<Eigen::Matrix<double, 3, 4>> out(static_cast<size_t>(m.num_cells()));
+  for (int c = 0; c < m.num_cells(); ++c) {
+    fem::Vector8d ue;
+    for (int k = 0; k < 4; ++k) ue.segment<2>(2 * k) = u.segment<2>(2 * m.cells[static_cast<size_t>(c)][static_cast<size_t>(k)]);
+    out[static_cast<size_t>(c)] = fem::gauss_stresses(fem::cell_coordinates(m, c), ue, solver.elasticity());
+  }
+  return out;
+}
+
+// Physical position of a reference point of a cell.
+Eigen::Vector2d map_point(const Eigen::Matrix<double, 4, 2>& x, double xi, double eta) {
+  static const double xs[4] = {-1, 1, 1, -1}, es[4] = {-1, -1, 1, 1};
+  Eigen::Vector2d p = Eigen::Vector2d::Zero();
+  for (int k = 0; k < 4; ++k) p += 0.25 * (1 + xs[k] * xi) * (1 + es[k] * eta) * x.row(k).transpose();
+  return p;
+}
+
+}  // namespace
+
+std::vector<int> boundary_loop(const mesh::Mesh& m) {
+  // Sides seen once are boundary, except the two sides of a hanging node's split edge and the coarse side
+  // itself (both are interior: the neighbour is refined).
+  std::map<std::pair<int, int>, int> count;
+  for (int c = 0; c < m.num_cells(); ++c)
+    for (int s = 0; s < 4; ++s) {
+      const auto n = m.edge_nodes({c, s});
+      count[key(n[0], n[1])]++;
+    }
+  std::set<std::pair<int, int>> interior;
+  for (const auto& [edge, mid] : m.edge_midpoint) {
+    interior.insert(edge);
+    interior.insert(key(edge.first, mid));
+    interior.insert(key(mid, edge.second));
+  }
+  std::map<int, int> next;  // boundary side a -> b in the cells' counter-clockwise direction
+  size_t sides = 0;
+  for (int c = 0; c < m.num_cells(); ++c)
+    for (int s = 0; s < 4; ++s) {
+      const auto n = m.edge_nodes({c, s});
+      if (count[key(n[0], n[1])] != 1 || interior.count(key(n[0], n[1]))) continue;
+      if (next.count(n[0])) return {};  // a node starting two boundary sides: not a simple loop
+      next[n[0]] = n[1];
+      ++sides;
+    }
+  if (next.empty()) return {};
+  std::vector<int> loop;
+  int cur = next.begin()->first;
+  for (size_t i = 0; i < sides; ++i) {
+    loop.push_back(cur);
+    auto it = next.find(cur);
+    if (it == next.end()) return {};
+    cur = it->second;
+  }
+  if (cur != loop.front()) return {};  // more than one loop (a hole) or an open chain
+  return loop;
+}
+
+IndicatorResult zz_indicator(const Body& body, const fem::BodySolver& solver, const Eigen::VectorXd& u,
+                             Normalization normalization) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto& m = body.mesh;
+  const auto fe = fe_gauss_stresses(body, solver, u);
+  const auto recovered = solver.stresses(u).node;  // nodal averages of the extrapolated Gauss values
+  std::vector<Eigen::Matrix<double, 3, 4>> ref(fe.size());
+  static const double xs[4] = {-1, 1, 1, -1}, es[4] = {-1, -1, 1, 1};
+  for (int c = 0; c < m.num_cells(); ++c) {
+    const auto& cell = m.cells[static_cast<size_t>(c)];
+    for (int q = 0; q < 4; ++q) {
+      const auto& gp = fem::kGaussPoints[static_cast<size_t>(q)];
+      Eigen::Vector3d s = Eigen::Vector3d::Zero();
+      for (int k = 0; k < 4; ++k)
+        s += 0.25 * (1 + xs[k] * gp.x()) * (1 + es[k] * gp.y()) * recovered.row(cell[static_cast<size_t>(k)]).head<3>().transpose();
+      ref[static_cast<size_t>(c)].col(q) = s;
+    }
+  }
+  IndicatorResult r;
+  r.eta = normalised(m, fe, ref, normalization);
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fem::BodySolver& solver,
+                                  const Eigen::VectorXd& u, const Eigen::VectorXd& contact_load,
+                                  Normalization normalization) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto& m = body.mesh;
+  const std::vector<int> loop = boundary_loop(m);
+  if (loop.size() < 3) {
+    IndicatorResult r = zz_indicator(body, solver, u, normalization);
+    r.note = "body '" + body.name + "': its boundary is not one closed polygon; zz indicator used instead of fem_bem";
+    return r;
+  }
+  // Boundary conditions per side, from the body's edge sets.
+  std::map<std::pair<int, int>, const BoundaryCondition*> condition;
+  for (const auto& bc : body.boundary) {
+    auto it = m.edge_sets.find(bc.edge);
+    if (it == m.edge_sets.end()) continue;
+    for (const auto& e : it->second) {
+      const auto n = m.edge_nodes(e);
+      condition[key(n[0], n[1])] = &bc;
+    }
+  }
+  const size_t nb = loop.size();
+  // Contact forces to tractions: lumped over the boundary sides that carry them.
+  std::vector<double> half_length(nb, 0.0);
+  for (size_t i = 0; i < nb; ++i) {
+    const double L = (m.nodes[static_cast<size_t>(loop[(i + 1) % nb])] - m.nodes[static_cast<size_t>(loop[i])]).norm();
+    half_length[i] += 0.5 * L;
+    half_length[(i + 1) % nb] += 0.5 * L;
+  }
+  bem::BoundaryProblem bp;
+  bp.material = {body.material.E, body.material.nu, model.plane == Plane::strain};
+  const double thickness = model.plane == Plane::stress ? model.thickness : 1.0;
+  for (int n : loop) bp.nodes.push_back(m.nodes[static_cast<size_t>(n)]);
+  bp.elements.resize(nb);
+  for (size_t i = 0; i < nb; ++i) {
+    const int a = loop[i], b = loop[(i + 1) % nb];
+    auto& el = bp.elements[i];
+    auto c = condition.find(key(a, b));
+    const BoundaryCondition* bc = c == condition.end() ? nullptr : c->second;
+    const Eigen::Vector2d pa = m.nodes[static_cast<size_t>(a)], pb = m.nodes[static_cast<size_t>(b)];
+    const Eigen::Vector2d outward((pb - pa).y(), -(pb - pa).x());
+    Eigen::Vector2d traction = Eigen::Vector2d::Zero();
+    if (bc && bc->kind == BoundaryCondition::Kind::traction)
+      traction = bc->normal_pressure ? Eigen::Vector2d(-bc->pressure * outward.normalized()) : bc->traction;
+    for (int comp = 0; comp < 2; ++comp) {
+      const bool prescribed = bc && bc->kind == BoundaryCondition::Kind::displacement && (comp == 0 ? bc->ux : bc->uy);
+      el.displacement_prescribed[static_cast<size_t>(comp)] = prescribed;
+      if (prescribed) {
+        el.value(comp, 0) = u[2 * a + comp];
+        el.value(comp, 1) = u[2 * b + comp];
+      } else {
+        // Contact forces are per thickness-weighted length: divide the lumped force by length x thickness.
+        const double ta = contact_load.size() ? contact_load[2 * a + comp] / (half_length[i] * thickness) : 0.0;
+        const double tb = contact_load.size() ? contact_load[2 * b + comp] / (half_length[(i + 1) % nb] * thickness) : 0.0;
+        el.value(comp, 0) = traction[comp] + ta;
+        el.value(comp, 1) = traction[comp] + tb;
+      }
+    }
+  }
+  IndicatorResult r;
+  try {
+    const bem::BoundarySolution sol = bem::solve(bp);
+    std::vector<Eigen::Vector2d> points;
+    points.reserve(static_cast<size_t>(m.num_cells()) * 4);
+    for (int c = 0; c < m.num_cells(); ++c) {
+      const auto x = fem::cell_coordinates(m, c);
+      for (const auto& gp : fem::kGaussPoints) points.push_back(map_point(x, gp.x(), gp.y()));
+    }
+    const Eigen::MatrixX3d sb = bem::interior_stresses(bp, sol, points);
+    std::vector<Eigen::Matrix<double, 3, 4>> ref(static_cast<size_t>(m.num_cells()));
+    for (int c = 0; c < m.num_cells(); ++c)
+      for (int q = 0; q < 4; ++q) ref[static_cast<size_t>(c)].col(q) = sb.row(4 * c + q).transpose();
+    r.eta = normalised(m, fe_gauss_stresses(body, solver, u), ref, normalization);
+  } catch (const std::exception& e) {
+    r = zz_indicator(body, solver, u, normalization);
+    r.note = "body '" + body.name + "': the boundary-element solve failed (" + e.what() + "); zz indicator used";
+  }
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+Marking mark(const mesh::Mesh& mesh, const Eigen::VectorXd& eta, double delta, int max_level, long max_dofs) {
+  Marking out;
+  std::vector<int> candidates;
+  for (int c = 0; c < mesh.num_cells(); ++c) {
+    if (!(eta[c] > delta)) continue;
+    if (mesh.level[static_cast<size_t>(c)] >= max_level) {
+      out.level_limit_hit = true;
+      continue;
+    }
+    candidates.push_back(c);
+  }
+  std::sort(candidates.begin(), candidates.end(), [&](int a, int b) { return eta[a] > eta[b]; });
+  // A split adds at most 5 nodes (4 midpoints, 1 centre), 10 dofs; the 1-irregularity closure can add more,
+  // so keep a margin of one extra split per marked cell.
+  const long dofs = 2L * mesh.num_nodes();
+  const long room = (max_dofs - dofs) / 20;
+  if (static_cast<long>(candidates.size()) > room) {
+    out.dof_limit_hit = true;
+    candidates.resize(static_cast<size_t>(std::max(0L, room)));
+  }
+  out.cells = std::move(candidates);
+  return out;
+}
+
+}  // namespace contact::adapt

@@ -1,0 +1,54 @@
+// Error indicators per cell and marking (paper section 3; ALGORITHM.md section 3).
+//
+// Both indicators compare the FE stresses sigma_F with a reference field sigma_R, ||s||_D = sqrt(int_D s_ij s_ij)
+// (in-plane components: sxx^2 + syy^2 + 2 sxy^2, the 2x2 Gauss rule of each element), normalised
+//   rms:  eta(e) = ( ||sigma_R - sigma_F||_e / sqrt|e| ) / ( ||sigma_R||_Omega / sqrt|Omega| )   (default)
+//   area: eta(e) = ( ||sigma_R - sigma_F||_e / |e| ) / ( ||sigma_R||_Omega / |Omega| )   (the paper, as printed)
+// The printed form divides an L2 norm by an area, so it scales like 1/sqrt|e|: for Q1 (stress error O(h)) it
+// does not fall under refinement, and on seed_layers it marks almost every cell at every step. The rms form
+// is the same comparison made scale-consistent (RMS error over the cell against RMS stress over the body).
+//  * fem_bem: sigma_R = sigma_B, the boundary-element stresses of the same body problem (same prescribed
+//    displacements, tractions and the current contact traction) on the boundary mesh the FE mesh induces.
+//  * zz: sigma_R = sigma*, the nodally recovered FE stresses (Zienkiewicz-Zhu) interpolated in each element.
+#pragma once
+
+#include "../fem/body_solver.hpp"
+#include "../problem.hpp"
+
+#include <string>
+#include <vector>
+
+namespace contact::adapt {
+
+struct IndicatorResult {
+  Eigen::VectorXd eta;   // per cell
+  std::string note;      // e.g. why fem_bem fell back to zz
+  double seconds = 0.0;  // time spent (BEM solve and interior evaluations for fem_bem)
+};
+
+// Zienkiewicz-Zhu recovery indicator of body displacements u (all dofs).
+IndicatorResult zz_indicator(const Body& body, const fem::BodySolver& solver, const Eigen::VectorXd& u,
+                             Normalization normalization = Normalization::rms);
+
+// The paper's FEM-BEM indicator. contact_load: the body's contact forces (all dofs) of the current iterate,
+// turned into boundary tractions by lumping over the boundary sides. Falls back to zz (with a note) where the
+// BEM cannot be set up (a body with a hole: its boundary is not one closed polygon).
+IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fem::BodySolver& solver,
+                                  const Eigen::VectorXd& u, const Eigen::VectorXd& contact_load,
+                                  Normalization normalization = Normalization::rms);
+
+struct Marking {
+  std::vector<int> cells;  // to refine
+  bool dof_limit_hit = false;
+  bool level_limit_hit = false;
+};
+
+// Cells with eta > delta below max_level; if refining them all would take the body above max_dofs (counted as
+// 2 x nodes, an upper bound on its unknowns), only the largest-eta cells that fit are kept.
+Marking mark(const mesh::Mesh& mesh, const Eigen::VectorXd& eta, double delta, int max_level, long max_dofs);
+
+// The boundary of a mesh as one closed counter-clockwise loop of nodes (hanging nodes are interior). Empty if
+// the boundary is not a single loop.
+std::vector<int> boundary_loop(const mesh::Mesh& mesh);
+
+}  // namespace contact::adapt

@@ -1,0 +1,157 @@
+// The adaptive loop: the paper's run on seed_layers, both strategies and indicators, the limits, and the cycle
+// transcript (deal.II style: the per-step elements, DOFs and iterations are compared with a checked-in file).
+#include "job/job.hpp"
+#include "solve.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+using namespace contact;
+using nlohmann::json;
+
+namespace {
+
+json example(const std::string& name) {
+  std::ifstream in(std::string(CONTACT_SOURCE_DIR) + "/api/examples/" + name);
+  return json::parse(in);
+}
+
+Result run(const json& job) {
+  auto parsed = job::parse(job);
+  EXPECT_TRUE(parsed.ok()) << job::format_errors(parsed.errors);
+  if (!parsed.ok()) return {};
+  Observer quiet;
+  CancelToken cancel;
+  return solve(*parsed.problem, quiet, cancel);
+}
+
+const BodyField& body(const Step& s, const std::string& name) {
+  for (const auto& b : s.bodies)
+    if (b.name == name) return b;
+  throw std::runtime_error("no body " + name);
+}
+
+// Number of cells whose centre lies in [x0, x1), and their largest level.
+std::pair<int, int> cells_in(const BodyField& b, double x0, double x1) {
+  int count = 0, level = -1;
+  for (int c = 0; c < b.mesh.num_cells(); ++c) {
+    double x = 0;
+    for (int k : b.mesh.cells[static_cast<size_t>(c)]) x += 0.25 * b.mesh.nodes[static_cast<size_t>(k)].x();
+    if (x < x0 || x >= x1) continue;
+    ++count;
+    level = std::max(level, b.mesh.level[static_cast<size_t>(c)]);
+  }
+  return {count, level};
+}
+
+}  // namespace
+
+TEST(SeedLayersAdaptive, RefinesAtTheContactEdgeNeverInTheRightHalfAndMatchesAFineMesh) {
+  const json job = example("seed_layers_adaptive.json");
+  const Result r = run(job);
+  ASSERT_TRUE(r.converged) << r.message;
+  ASSERT_GE(r.steps.size(), 3u);
+  const Step& last = r.steps.back();
+  const BodyField& lower = body(last, "lower");
+  const BodyField& upper = body(last, "upper");
+  // Only body 2 adapts (the paper): the upper body keeps its 32 x 8 mesh.
+  EXPECT_EQ(upper.mesh.num_cells(), 32 * 8);
+  // The right half of body 2 (x > 2), where there is no contact, is never refined: its 4 x 2 initial cells.
+  const auto right = cells_in(lower, 2.0, 4.0);
+  EXPECT_EQ(right.first, 8);
+  EXPECT_EQ(right.second, 0);
+  // Refinement concentrates at the edge of the contact zone (x about 1): the finest cells are there, and the
+  // band around it holds more cells per unit length than the contact's interior.
+  const auto edge = cells_in(lower, 0.8, 1.3), inner = cells_in(lower, 0.3, 0.8), outside = cells_in(lower, 1.5, 2.0);
+  EXPECT_EQ(edge.second, job["adaptivity"]["max_level"].get<int>());
+  EXPECT_GT(edge.first / 0.5, inner.first / 0.5);
+  EXPECT_GT(edge.first, 4 * outside.first);
+  // Every step carries the indicator of the adapted body.
+  for (const auto& s : r.steps) EXPECT_EQ(body(s, "lower").indicator_cell.size(), body(s, "lower").mesh.num_cells());
+  // The final contact pressure is within 2 % of a uniform fine-mesh solution of the same (penalty) problem.
+  json fine = example("seed_layers.json");
+  for (auto& b : fine["bodies"]) {
+    b["mesh"]["block"]["nx"] = 128;
+    b["mesh"]["block"]["ny"] = 32;
+  }
+  fine["solver"]["method"] = "monolithic";
+  const Result ref = run(fine);
+  ASSERT_TRUE(ref.converged);
+  const auto& pa = last.pairs.at(0);
+  const auto& pf = ref.steps.back().pairs.at(0);
+  EXPECT_NEAR(pa.force, pf.force, 0.02 * pf.force);
+  EXPECT_NEAR(pa.pressure.maxCoeff(), pf.pressure.maxCoeff(), 0.02 * pf.pressure.maxCoeff());
+}
+
+TEST(Adaptivity, ConvergeThenRefineWithBothIndicatorsRefinesTowardsTheContactAndStops) {
+  for (const char* indicator : {"fem_bem", "zz"}) {
+    json job = example("seed_layers_adaptive.json");
+    job["adaptivity"]["strategy"] = "converge_then_refine";
+    job["adaptivity"]["indicator"] = indicator;
+    job["solver"] = {{"method", "interface_newton"}, {"enforcement", "penalty"}, {"penalty", {{"c", 0.05}, {"length", 1}}}};
+    const Result r = run(job);
+    ASSERT_TRUE(r.converged) << indicator << ": " << r.message;
+    ASSERT_GE(r.steps.size(), 3u) << indicator;
+    for (size_t k = 1; k < r.steps.size(); ++k)
+      EXPECT_GT(body(r.steps[k], "lower").mesh.num_cells(), body(r.steps[k - 1], "lower").mesh.num_cells()) << indicator;
+    EXPECT_EQ(cells_in(body(r.steps.back(), "lower"), 2.0, 4.0).first, 8) << indicator;
+    // Each step's report says how many elements were refined.
+    int refined = 0;
+    for (const auto& it : r.history) refined += it.bodies[1].elements_refined;
+    EXPECT_GT(refined, 0);
+  }
+}
+
+TEST(Adaptivity, MaxDofsIsNeverExceededAndIsReported) {
+  json job = example("seed_layers_adaptive.json");
+  job["adaptivity"]["strategy"] = "converge_then_refine";
+  job["adaptivity"]["max_dofs"] = 200;
+  job["solver"] = {{"method", "interface_newton"}, {"enforcement", "penalty"}};
+  const Result r = run(job);
+  ASSERT_FALSE(r.steps.empty()) << r.message;
+  for (const auto& s : r.steps) EXPECT_LE(2 * body(s, "lower").mesh.num_nodes(), 200);
+  EXPECT_NE(r.message.find("max_dofs"), std::string::npos) << r.message;
+}
+
+TEST(Adaptivity, MaxLevelCapsTheRefinement) {
+  json job = example("seed_layers_adaptive.json");
+  job["adaptivity"]["max_level"] = 2;
+  const Result r = run(job);
+  ASSERT_TRUE(r.converged) << r.message;
+  for (int l : body(r.steps.back(), "lower").mesh.level) EXPECT_LE(l, 2);
+}
+
+TEST(Adaptivity, CycleTranscriptMatchesTheCheckedInExpectedOutput) {
+  // A small adaptive run's per-step transcript (elements, DOFs per body, solver iterations): any unintended
+  // change of the adaptive behaviour changes it. Regenerate deliberately with CONTACT_UPDATE_TRANSCRIPT=1.
+  json job = example("seed_layers_adaptive.json");
+  job["adaptivity"]["strategy"] = "converge_then_refine";
+  job["adaptivity"]["max_steps"] = 4;
+  job["solver"] = {{"method", "interface_newton"}, {"enforcement", "penalty"}};
+  const Result r = run(job);
+  ASSERT_FALSE(r.steps.empty()) << r.message;
+  std::ostringstream os;
+  int previous_iteration = 0;
+  for (const auto& s : r.steps) {
+    // Unknowns after the constraints (Dirichlet and hanging nodes), from the step's last iteration report.
+    const IterationReport* rep = nullptr;
+    for (const auto& it : r.history)
+      if (it.iteration == s.iteration) rep = &it;
+    ASSERT_NE(rep, nullptr);
+    os << "step " << s.index;
+    for (size_t a = 0; a < s.bodies.size(); ++a)
+      os << " | " << s.bodies[a].name << ": " << s.bodies[a].mesh.num_cells() << " cells, " << rep->bodies[a].dofs << " dofs";
+    os << " | iterations " << s.iteration - previous_iteration << "\n";
+    previous_iteration = s.iteration;
+  }
+  const std::string path = std::string(CONTACT_SOURCE_DIR) + "/tests/data/adaptive_transcript.txt";
+  if (std::getenv("CONTACT_UPDATE_TRANSCRIPT")) std::ofstream(path) << os.str();
+  std::ifstream in(path);
+  ASSERT_TRUE(in.good()) << "missing " << path;
+  std::stringstream expected;
+  expected << in.rdbuf();
+  EXPECT_EQ(os.str(), expected.str());
+}
