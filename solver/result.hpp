@@ -98,6 +98,7 @@ struct Result {
   double wall_seconds = 0.0;
   double setup_seconds = 0.0;       // assembly + factorisations
   double factorization_seconds = 0.0;
+  double indicator_seconds = 0.0;   // adaptivity: estimating (for fem_bem: the boundary-element work)
 };
 
 // Receives progress. Called from the thread that runs solve(), once per iteration, in order.

@@ -68,6 +68,7 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
     result.gamma = outcome.gamma;
     result.subdomain_solves = outcome.solves_per_body;
     result.updates = updates;
+    result.indicator_seconds = outcome.indicator_seconds;
     result.history = std::move(outcome.history);
     result.factorization_seconds = system.total_factorization_seconds();
     if (adaptive) {

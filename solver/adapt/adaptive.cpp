@@ -109,6 +109,7 @@ ddm::MethodOutcome converge_then_refine(Problem& working, ddm::ContactSystem& sy
     total.message = o.message;
     if (o.u.empty()) return total;
     const auto eta = estimate(working, system, o.u, system.contact_loads(o.u), context.runner);
+    for (const auto& e : eta) total.indicator_seconds += e.seconds;
     steps.push_back(make_step(system, o.u, total.iterations, step, eta));
     if (!o.converged) return total;
     if (step >= s.max_steps) {
@@ -180,6 +181,7 @@ ddm::MethodOutcome paper_interleaving(Problem& working, ddm::ContactSystem& syst
     const bool ddm_converged = (settings.criterion == Criterion::paper ? paper : residual) <= settings.tolerance;
     // Estimate on the body solutions of (16) with the contact tractions they were solved with.
     const auto eta = estimate(working, system, u_tilde, loads, context.runner);
+    for (const auto& e : eta) out.indicator_seconds += e.seconds;
     IterationReport rep = system.report(k, u_new, active);
     rep.paper_criterion = paper;
     rep.fixed_point_residual = residual;

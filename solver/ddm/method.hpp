@@ -28,6 +28,7 @@ struct MethodOutcome {
   int iterations = 0;
   double gamma = 0.0;
   int solves_per_body = 0;  // subdomain solves (back-substitutions) per body, initial guess included
+  double indicator_seconds = 0.0;  // adaptivity: time spent estimating (BEM solves and evaluations)
   std::vector<IterationReport> history;
 };
 

@@ -1,0 +1,64 @@
+#!/usr/bin/env python3
+"""An adaptive run's result file: every adaptive step's meshes with refinement level and indicator per cell,
+the step history, the XDMF sidecar stepping through them, and the VTKHDF view of the final step.
+Standard library plus Debian's python3-h5py and python3-numpy; exits non-zero on any failure."""
+import os
+import subprocess
+import sys
+import tempfile
+import xml.etree.ElementTree as ET
+
+import h5py
+import numpy as np
+
+SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
+BIN = os.environ.get("CONTACT_BINARY_DIR", os.path.join(SRC, "build"))
+passed, failed = 0, 0
+
+
+def check(name, condition, detail=""):
+    global passed, failed
+    if condition:
+        passed += 1
+    else:
+        failed += 1
+        print(f"FAIL {name}: {detail}")
+
+
+with tempfile.TemporaryDirectory() as tmp:
+    out = os.path.join(tmp, "adaptive.hdf")
+    r = subprocess.run([os.path.join(BIN, "contact-solve"), os.path.join(SRC, "api", "examples", "seed_layers_adaptive.json"),
+                        "-o", out, "-q"], capture_output=True, text=True, timeout=300)
+    check("the adaptive example converges", r.returncode == 0, r.stdout[-500:] + r.stderr)
+    with h5py.File(out, "r") as f:
+        steps = sorted(f["steps"].keys(), key=int)
+        check("several adaptive steps are stored", len(steps) >= 3, str(steps))
+        cells = []
+        for k in steps:
+            lower = f[f"steps/{k}/bodies/lower"]
+            n = lower["quads"].shape[0]
+            cells.append(n)
+            check(f"step {k}: level per cell", lower["level"].shape == (n,), str(lower["level"].shape))
+            check(f"step {k}: indicator per cell of the adapted body", "indicator" in lower and lower["indicator"].shape == (n,))
+            check(f"step {k}: the upper body does not adapt", f[f"steps/{k}/bodies/upper/quads"].shape[0] == 256)
+        check("the adapted mesh grows step by step", all(b > a for a, b in zip(cells, cells[1:])), str(cells))
+        final = f[f"steps/{steps[-1]}/bodies/lower"]
+        check("the final mesh is refined (levels above 0)", int(np.max(final["level"][:])) > 0)
+        hs = f["history/steps"]
+        check("/history/steps has one row per step", hs["step"].shape[0] == len(steps), str(hs["step"].shape))
+        vtk = f["VTKHDF"]
+        n_final = final["quads"].shape[0] + f[f"steps/{steps[-1]}/bodies/upper/quads"].shape[0]
+        check("VTKHDF holds the final step", int(np.sum(vtk["NumberOfCells"][:])) == n_final)
+        check("VTKHDF carries the refinement level", vtk["CellData/level"].shape[0] == n_final)
+    xmf = os.path.join(tmp, "adaptive.xmf")
+    check("the XDMF sidecar is written", os.path.exists(xmf))
+    if os.path.exists(xmf):
+        root = ET.parse(xmf).getroot()
+        times = [t.get("Value") for t in root.iter("Time")]
+        text = open(xmf).read()
+        check("the sidecar has one time per step", len(times) >= len(steps), f"{len(times)} times, {len(steps)} steps")
+        check("the sidecar references every step's meshes",
+              all(f"/steps/{k}/bodies/lower/quads" in text for k in steps))
+
+print(f"{passed} passed, {failed} failed")
+sys.exit(1 if failed else 0)
