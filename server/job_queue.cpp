@@ -327,6 +327,14 @@ void JobQueue::run(const std::shared_ptr<Job>& job) {
   finish(job, std::move(outcome));
 }
 
+void JobQueue::mark_settled(const std::shared_ptr<Job>& job) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    job->settled = true;
+  }
+  settled_.notify_all();
+}
+
 void JobQueue::finish(const std::shared_ptr<Job>& job, JobRecord outcome) {
   JobRecord after;
   {
@@ -345,7 +353,7 @@ void JobQueue::finish(const std::shared_ptr<Job>& job, JobRecord outcome) {
   persist(job);
   job->events.append("end", end_event(after));
   job->events.sync_and_close();
-  job->settled = true;
+  mark_settled(job);
   log_line("job " + after.id + ": " + to_string(after.state) + " (" + after.stop_reason + ", " +
            std::to_string(after.iterations) + " iterations, " + format_seconds(after.solve_seconds) + " s)");
 }
@@ -499,7 +507,7 @@ JobQueue::CancelOutcome JobQueue::cancel(const std::string& id) {
   persist(job);
   job->events.append("end", end_event(after));
   job->events.sync_and_close();
-  job->settled = true;
+  mark_settled(job);
   log_line("job " + id + ": cancelled while queued");
   return CancelOutcome::cancelled;
 }
@@ -507,11 +515,15 @@ JobQueue::CancelOutcome JobQueue::cancel(const std::string& id) {
 JobQueue::RemoveOutcome JobQueue::remove(const std::string& id, std::string& detail) {
   std::shared_ptr<Job> job;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::unique_lock<std::mutex> lock(mutex_);
     const auto it = jobs_.find(id);
     if (it == jobs_.end()) return RemoveOutcome::not_found;
     job = it->second;
-    if (!is_terminal(job->record.state) || !job->settled.load()) return RemoveOutcome::not_done;
+    if (!is_terminal(job->record.state)) return RemoveOutcome::not_done;
+    // A terminal job whose `end` event is still being written (a client that saw `end` may delete at once):
+    // wait for it briefly rather than answer 409.
+    if (!settled_.wait_for(lock, std::chrono::seconds(5), [&] { return job->settled.load(); }))
+      return RemoveOutcome::not_done;
     unregister_locked(job);
   }
   job->events.discard();  // open streams end

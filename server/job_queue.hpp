@@ -107,6 +107,8 @@ class JobQueue {
   void worker_loop();
   void watchdog_loop();
   void run(const std::shared_ptr<Job>& job);
+  // Sets job->settled under the queue lock and wakes remove() calls waiting for it.
+  void mark_settled(const std::shared_ptr<Job>& job);
   void finish(const std::shared_ptr<Job>& job, JobRecord outcome);
   void requeue_after_shutdown(const std::shared_ptr<Job>& job);
   void persist(const std::shared_ptr<Job>& job, bool durable = true);
@@ -122,6 +124,7 @@ class JobQueue {
   std::condition_variable work_;      // a job was queued, or stopping
   std::condition_variable watchdog_;  // stopping
   std::condition_variable idle_;      // a worker finished a job or exited
+  std::condition_variable settled_;   // a job's `end` event was written (it may now be deleted)
   std::unordered_map<std::string, std::shared_ptr<Job>> jobs_;
   std::map<TimeKey, std::shared_ptr<Job>> by_time_;         // (created_us, id), oldest first
   std::unordered_map<std::string, std::string> by_key_;     // idempotency key -> id

@@ -222,6 +222,14 @@ with Server() as server, tempfile.TemporaryDirectory() as tmp:
     check("deleted job is 404", server.get(f"/v1/jobs/{ids[1]}").status == 404)
     check("deleted job's files are gone", not os.path.exists(job_dir), os.listdir(os.path.dirname(job_dir)))
     check("DELETE again 404", server.request("DELETE", f"/v1/jobs/{ids[1]}").status == 404)
+    # A client that deletes as soon as it sees `end` must not get 409: the server waits for the job to settle
+    # (its `end` event is visible a moment before the event log is synced). Repeated to catch the race.
+    statuses = []
+    for i in range(15):
+        jid = server.submit(flat_patch(name=f"race-{i}")).json()["id"]
+        events = read_all_events(server, jid)
+        statuses.append((events[-1]["type"] if events else None, server.request("DELETE", f"/v1/jobs/{jid}").status))
+    check("DELETE right after the end event succeeds", all(s == ("end", 204) for s in statuses), statuses)
     check("still listed: the others", len(server.get("/v1/jobs").json()["jobs"]) == 6)
 
     # The data directory holds what docs/server.md says.
