@@ -143,11 +143,7 @@ ddm::MethodOutcome paper_interleaving(Problem& working, ddm::ContactSystem& syst
   const SolverSettings& settings = working.solver;
   ddm::MethodOutcome out;
   const size_t n = working.bodies.size();
-  ddm::Displacements u = settings.initial_guess == InitialGuess::elastic_layer ? system.elastic_layer_guess(context.runner)
-                                                                                : ddm::Displacements(n);
-  out.solves_per_body = settings.initial_guess == InitialGuess::elastic_layer ? 2 : 0;
-  for (size_t a = 0; a < n; ++a)
-    if (u[a].size() == 0) u[a] = Eigen::VectorXd::Zero(system.body(a).n_dofs());
+  ddm::Displacements u = ddm::initial_iterate(system, settings, context, out.solves_per_body);
   double gamma = settings.gamma;
   if (settings.gamma_auto) {
     ddm::NeumannMap map(system, context.runner);

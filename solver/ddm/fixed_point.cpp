@@ -65,6 +65,18 @@ Displacements NeumannMap::linear_response(const Displacements& du) {
   return out;
 }
 
+Displacements initial_iterate(const ContactSystem& system, const SolverSettings& settings, const RunContext& context,
+                              int& solves) {
+  if (context.warm_start) return *context.warm_start;
+  if (settings.initial_guess == InitialGuess::elastic_layer) {
+    solves += 2;
+    return system.elastic_layer_guess(context.runner);
+  }
+  Displacements u(system.n_bodies());
+  for (size_t a = 0; a < u.size(); ++a) u[a] = Eigen::VectorXd::Zero(system.body(a).n_dofs());
+  return u;
+}
+
 double estimate_spectral_radius(const ContactSystem& system, BodyMap& map, int iterations, int& solves) {
   // Start from a random interface perturbation pushed once through the map (so it lies in its range).
   std::mt19937 rng(12345);

@@ -24,6 +24,11 @@ class BodyMap {
   virtual int factorizations() const { return 0; }
 };
 
+// The iteration's start: the context's warm start if any, else the settings' initial guess (zero, or the
+// elastic-layer model: 2 solves per body, added to `solves`).
+Displacements initial_iterate(const ContactSystem& system, const SolverSettings& settings, const RunContext& context,
+                              int& solves);
+
 // Runs the iteration from u0 with the settings' gamma (or auto), acceleration, criterion and limits.
 MethodOutcome run_fixed_point(const ContactSystem& system, const SolverSettings& settings, RunContext& context,
                               BodyMap& map, Displacements u0);

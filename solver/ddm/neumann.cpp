@@ -26,15 +26,7 @@ MethodOutcome run_neumann(const ContactSystem& system, const SolverSettings& set
     return out;
   }
   int initial_solves = 0;
-  Displacements u0(n);
-  if (context.warm_start) {
-    u0 = *context.warm_start;
-  } else if (settings.initial_guess == InitialGuess::elastic_layer) {
-    u0 = system.elastic_layer_guess(context.runner);
-    initial_solves = 2;
-  } else {
-    for (size_t a = 0; a < n; ++a) u0[a] = Eigen::VectorXd::Zero(system.body(a).n_dofs());
-  }
+  Displacements u0 = initial_iterate(system, settings, context, initial_solves);
   NeumannMap map(system, context.runner);
   MethodOutcome out = run_fixed_point(system, settings, context, map, std::move(u0));
   out.solves_per_body += initial_solves;
