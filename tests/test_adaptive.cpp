@@ -2,6 +2,7 @@
 // transcript (deal.II style: the per-step elements, DOFs and iterations are compared with a checked-in file).
 #include "job/job.hpp"
 #include "solve.hpp"
+#include "support.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,22 +12,10 @@
 
 using namespace contact;
 using nlohmann::json;
+using contact::testing::example;
+using contact::testing::run;
 
 namespace {
-
-json example(const std::string& name) {
-  std::ifstream in(std::string(CONTACT_SOURCE_DIR) + "/api/examples/" + name);
-  return json::parse(in);
-}
-
-Result run(const json& job) {
-  auto parsed = job::parse(job);
-  EXPECT_TRUE(parsed.ok()) << job::format_errors(parsed.errors);
-  if (!parsed.ok()) return {};
-  Observer quiet;
-  CancelToken cancel;
-  return solve(*parsed.problem, quiet, cancel);
-}
 
 const BodyField& body(const Step& s, const std::string& name) {
   for (const auto& b : s.bodies)

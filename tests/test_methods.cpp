@@ -2,6 +2,7 @@
 // monolithic reference and against exact answers.
 #include "job/job.hpp"
 #include "solve.hpp"
+#include "support.hpp"
 
 #include <gtest/gtest.h>
 
@@ -10,22 +11,10 @@
 
 using namespace contact;
 using nlohmann::json;
+using contact::testing::example;
+using contact::testing::run;
 
 namespace {
-
-json example(const std::string& name) {
-  std::ifstream in(std::string(CONTACT_SOURCE_DIR) + "/api/examples/" + name);
-  return json::parse(in);
-}
-
-Result run(const json& job) {
-  auto parsed = job::parse(job);
-  EXPECT_TRUE(parsed.ok()) << job::format_errors(parsed.errors);
-  if (!parsed.ok()) return {};
-  Observer quiet;
-  CancelToken cancel;
-  return solve(*parsed.problem, quiet, cancel);
-}
 
 double max_abs(const Eigen::MatrixXd& m) { return m.size() ? m.cwiseAbs().maxCoeff() : 0.0; }
 
