@@ -7,6 +7,7 @@
 // the solves.
 #include "job/job.hpp"
 #include "solve.hpp"
+#include "bench_support.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -17,22 +18,15 @@
 
 using namespace contact;
 using nlohmann::json;
+using contact::bench::now;
 
 namespace {
 
-double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
-
 Result run(const json& job) {
-  job::Limits limits;
-  limits.max_dofs = 10'000'000;
-  auto r = job::parse(job, limits);
-  if (!r.ok()) {
-    std::fprintf(stderr, "%s", job::format_errors(r.errors).c_str());
-    std::exit(2);
-  }
+  const Problem problem = bench::parse_or_exit(job);
   Observer quiet;
   CancelToken cancel;
-  return solve(*r.problem, quiet, cancel);
+  return solve(problem, quiet, cancel);
 }
 
 // Reference pressure profile p(x) along the slave edge, piecewise linear between its nodes.

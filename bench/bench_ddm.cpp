@@ -7,6 +7,7 @@
 #include "ddm/contact_system.hpp"
 #include "job/job.hpp"
 #include "solve.hpp"
+#include "bench_support.hpp"
 
 #include <chrono>
 #include <cstdio>
@@ -16,10 +17,9 @@
 
 using namespace contact;
 using nlohmann::json;
+using contact::bench::now;
 
 namespace {
-
-double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
 Problem make(const json& base, int nx, int ny, const json& solver_overrides) {
   json job = base;
@@ -28,14 +28,7 @@ Problem make(const json& base, int nx, int ny, const json& solver_overrides) {
     body["mesh"]["block"]["ny"] = ny;
   }
   for (auto& [key, value] : solver_overrides.items()) job["solver"][key] = value;
-  job::Limits limits;
-  limits.max_dofs = 10'000'000;
-  auto r = job::parse(job, limits);
-  if (!r.ok()) {
-    std::fprintf(stderr, "%s", job::format_errors(r.errors).c_str());
-    std::exit(2);
-  }
-  return std::move(*r.problem);
+  return bench::parse_or_exit(job);
 }
 
 struct Run {

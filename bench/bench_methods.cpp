@@ -8,6 +8,7 @@
 #include "ddm/contact_system.hpp"
 #include "job/job.hpp"
 #include "solve.hpp"
+#include "bench_support.hpp"
 
 #include <chrono>
 #include <cstdio>
@@ -17,21 +18,13 @@
 
 using namespace contact;
 using nlohmann::json;
+using contact::bench::now;
 
 namespace {
 
-double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
-
 Problem make(json job, const json& solver) {
   for (auto& [key, value] : solver.items()) job["solver"][key] = value;
-  job::Limits limits;
-  limits.max_dofs = 10'000'000;
-  auto r = job::parse(job, limits);
-  if (!r.ok()) {
-    std::fprintf(stderr, "%s", job::format_errors(r.errors).c_str());
-    std::exit(2);
-  }
-  return std::move(*r.problem);
+  return bench::parse_or_exit(job);
 }
 
 double one_solve_seconds(const Problem& p) {
@@ -48,7 +41,7 @@ struct Row {
   json solver;
 };
 
-void bench(const std::string& title, const json& job, bool sweep) {
+void run_table(const std::string& title, const json& job, bool sweep) {
   const json tight = {{"criterion", "residual"}, {"tolerance", 1e-8}, {"max_iterations", 20000},
                       {"acceleration", "none"}, {"enforcement", "penalty"}};
   Problem base = make(job, tight);
@@ -108,9 +101,9 @@ int main(int argc, char** argv) {
       b["mesh"]["block"]["nx"] = nx;
       b["mesh"]["block"]["ny"] = ny;
     }
-    bench("seed_layers " + std::to_string(nx) + "x" + std::to_string(ny) + " per body", job, true);
+    run_table("seed_layers " + std::to_string(nx) + "x" + std::to_string(ny) + " per body", job, true);
   }
-  bench("stack3", json::parse(std::ifstream(dir + "stack3.json")), false);
+  run_table("stack3", json::parse(std::ifstream(dir + "stack3.json")), false);
   std::printf("\n(force: sum over the pairs; 'solves' for monolithic is 0: it factorises the coupled system instead)\n");
   return 0;
 }

@@ -1,0 +1,28 @@
+// Helpers shared by the benchmark programs: wall time, and parsing a job with a large DOF limit (exiting with
+// the validation errors if the job is bad).
+#pragma once
+
+#include "job/job.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+
+namespace contact::bench {
+
+inline double now() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+inline Problem parse_or_exit(const nlohmann::json& job) {
+  job::Limits limits;
+  limits.max_dofs = 10'000'000;
+  auto r = job::parse(job, limits);
+  if (!r.ok()) {
+    std::fprintf(stderr, "%s", job::format_errors(r.errors).c_str());
+    std::exit(2);
+  }
+  return std::move(*r.problem);
+}
+
+}  // namespace contact::bench
