@@ -465,6 +465,9 @@ def read_events(path):
 
 
 # ---------------------------------------------------------------------------------------------------- results
+RESULT_FORMAT_VERSION = 2  # docs/results-format.md; 2: mortar contact (per-node multipliers, contact surfaces)
+
+
 def read_result(path):
     """Reads a result file (docs/results-format.md) into numpy arrays:
 
@@ -508,9 +511,9 @@ def read_result(path):
         result["attrs"] = {k: attr(v) for k, v in f.attrs.items()}
         if result["attrs"].get("format") != "contact-ddm-result":
             raise BadInput(f"{path}: not a contact-ddm result file")
-        if int(result["attrs"].get("format_version", 0)) > 1:
+        if int(result["attrs"].get("format_version", 0)) > RESULT_FORMAT_VERSION:
             raise BadInput(f"{path}: result format version {result['attrs']['format_version']} is newer than "
-                           "this client knows (1)")
+                           f"this client knows ({RESULT_FORMAT_VERSION})")
         steps = []
         if "steps" in f:
             count = int(f["steps"].attrs.get("count", len(f["steps"])))
@@ -767,11 +770,25 @@ class Progress:
             self.out.flush()
 
 
+def _measure_parts(e, width=True):
+    """What decides convergence in an iteration event (its "measure"): the active set, its changes and the
+    complementarity residual for the active-set methods; both residuals for the fixed-point schemes."""
+    measure = e.get("measure", "fixed_point")
+    if measure == "complementarity":
+        return [f"active {e.get('active_nodes', 0)} ({e.get('active_set_changes', 0)} changed)",
+                f"compl {e.get('complementarity', float('nan')):.2e}"]
+    if measure == "gradient":
+        return [f"gradient {e.get('fixed_point_residual', float('nan')):.2e}",
+                f"active {e.get('active_nodes', 0)} ({e.get('active_set_changes', 0)} changed)"]
+    return [f"paper {e.get('paper_criterion', float('nan')):.{3 if width else 2}e}",
+            f"{'residual' if width else 'res'} {e.get('fixed_point_residual', float('nan')):.{3 if width else 2}e}"]
+
+
 def format_iteration(e):
-    """ "iter 12  paper 1.23e-03  residual 2.22e-02  dofs upper 528 lower 528  | pair: force 140.9 p_max 166.4" """
-    parts = [f"iter {e.get('iteration', 0):5d}",
-             f"paper {e.get('paper_criterion', float('nan')):.3e}",
-             f"residual {e.get('fixed_point_residual', float('nan')):.3e}"]
+    """ "iter 12  paper 1.23e-03  residual 2.22e-02  dofs upper 528 lower 528  | pair: force 140.9 p_max 166.4"
+    (active-set methods: "step 3  active 245 (2 changed)  compl 1.2e-03 ...") """
+    label = "step" if e.get("measure") == "complementarity" else "iter"
+    parts = [f"{label} {e.get('iteration', 0):5d}"] + _measure_parts(e)
     bodies = e.get("bodies") or []
     if bodies:
         parts.append("dofs " + " ".join(f"{b.get('name')} {b.get('dofs')}" for b in bodies))
@@ -790,9 +807,8 @@ def compact_iterations(e):
     "iter 12  paper 1.23e-03  res 2.22e-02  force 140.9  p_max 166.4  dofs 528/528  0.05s" (several pairs or
     bodies: values joined by '/', in the order of the job)."""
     pairs, bodies = e.get("pairs") or [], e.get("bodies") or []
-    parts = [f"iter {e.get('iteration', 0)}",
-             f"paper {e.get('paper_criterion', float('nan')):.2e}",
-             f"res {e.get('fixed_point_residual', float('nan')):.2e}"]
+    label = "step" if e.get("measure") == "complementarity" else "iter"
+    parts = [f"{label} {e.get('iteration', 0)}"] + _measure_parts(e, width=False)
     if pairs:
         parts.append("force " + "/".join(f"{p.get('force', 0):.5g}" for p in pairs))
         parts.append("p_max " + "/".join(f"{p.get('max_pressure', 0):.5g}" for p in pairs))

@@ -18,8 +18,8 @@ nlohmann::json report_json(const contact::IterationReport& report, bool with_pro
                            {"max_pressure", p.max_pressure},
                            {"extent_begin", p.extent_begin},
                            {"extent_end", p.extent_end},
-                           {"active_points", p.active_points},
-                           {"changed_points", p.changed_points},
+                           {"active_nodes", p.active_nodes},
+                           {"changed_nodes", p.changed_nodes},
                            {"theta", p.theta},
                            {"max_penetration", p.max_penetration}};
     if (with_profiles) {
@@ -29,8 +29,12 @@ nlohmann::json report_json(const contact::IterationReport& report, bool with_pro
     pairs.push_back(std::move(pair));
   }
   nlohmann::json j = {{"iteration", report.iteration},
+                      {"measure", contact::to_string(report.measure)},
                       {"paper_criterion", report.paper_criterion},
                       {"fixed_point_residual", report.fixed_point_residual},
+                      {"complementarity", report.complementarity},
+                      {"active_nodes", report.active_nodes},
+                      {"active_set_changes", report.active_set_changes},
                       {"elapsed_seconds", report.elapsed_seconds},
                       {"gamma", report.gamma},
                       {"update", report.update},

@@ -76,14 +76,18 @@ struct PenaltySpec {
   std::optional<double> length;
 };
 
-// neumann: the paper's scheme (16)-(17); robin: the Robin-type variant; interface_newton: each body's
-// contact-zone compliance by back-substitutions, then semismooth Newton on the interface; monolithic: all bodies
-// in one system (the reference). See docs/algorithm.md for when to use which.
+// interface_newton: each body's Schur complement on its contact unknowns (from its factorisation), the primal-dual
+// active set (semismooth Newton) on the nodal pressures, one final solve per body; neumann: the paper's scheme
+// (16)-(17); robin: the Robin-type variant; monolithic: all bodies in one system (the reference). See
+// docs/algorithm.md for when to use which.
 enum class Method { neumann, monolithic, interface_newton, robin };
 enum class Criterion { paper, residual };
 enum class InitialGuess { zero, elastic_layer };
 enum class Acceleration { none, anderson };
-enum class Enforcement { penalty, augmented_lagrangian };
+// exact: z >= 0, g >= 0, z g = 0 at every contact node (dual mortar multipliers); penalty: the paper's
+// z = max(0, -g / theta) in nodal form; augmented_lagrangian: Uzawa updates of the penalty problem, exact in the
+// limit (for the penalty-based fixed-point schemes neumann and robin).
+enum class Enforcement { exact, penalty, augmented_lagrangian };
 
 // Robin weight psi (force per length^3, like 1/theta): a constant over every contact zone, or 1/theta on the
 // current active set and 0 elsewhere ("active_set").
@@ -99,23 +103,24 @@ struct AugmentedLagrangianSettings {
   int max_updates = 100;
 };
 
-// Defaults: fast and exact (interface Newton inside augmented-Lagrangian updates); the paper's scheme is
-// method neumann, gamma 0.02, criterion paper, tolerance 0.0015, acceleration none, enforcement penalty
+// Defaults: exact contact by interface Newton. The job parser fills the defaults that depend on the method
+// (enforcement: exact for interface_newton and monolithic, penalty for neumann and robin); the paper's scheme is
+// method neumann, gamma 0.02, criterion paper, tolerance 0.0015, acceleration none
 // (api/examples/seed_layers.json spells it out).
 struct SolverSettings {
   Method method = Method::interface_newton;
   PenaltySpec penalty;
   double gamma = 0.02;        // relaxation of (17) when gamma_auto is false
   bool gamma_auto = true;     // estimate the interface compliance and choose gamma (overrides gamma)
-  double tolerance = 1e-8;    // eps of the chosen criterion
+  double tolerance = 1e-8;    // eps of the chosen criterion (fixed-point methods)
   Criterion criterion = Criterion::residual;
-  int max_iterations = 2000;
+  int max_iterations = 2000;  // iterations (fixed-point methods) or active-set / Newton steps
   InitialGuess initial_guess = InitialGuess::elastic_layer;
   int threads = 0;            // worker threads for the per-body solves; 0 = one per body up to the cores
   Acceleration acceleration = Acceleration::anderson;
   int anderson_depth = 10;
   RobinSettings robin;
-  Enforcement enforcement = Enforcement::augmented_lagrangian;
+  Enforcement enforcement = Enforcement::exact;
   AugmentedLagrangianSettings augmented_lagrangian;
 };
 

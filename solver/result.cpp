@@ -18,4 +18,16 @@ const char* to_string(StopReason r) {
   return "error";
 }
 
+const char* to_string(Measure m) {
+  switch (m) {
+    case Measure::fixed_point:
+      return "fixed_point";
+    case Measure::complementarity:
+      return "complementarity";
+    case Measure::gradient:
+      return "gradient";
+  }
+  return "fixed_point";
+}
+
 }  // namespace contact

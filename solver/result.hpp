@@ -22,25 +22,37 @@ struct BodyReport {
   int elements_refined = 0; // in this iteration (0 without adaptivity)
 };
 
-// Contact pressure is positive in compression. Positions are the slave evaluation points (see PairField).
+// Contact pressure is positive in compression; it is the nodal multiplier of the dual mortar discretisation
+// (contact/pair.hpp), one value per slave node (0 where a node carries none).
 struct PairReport {
   std::string name;
   double force = 0.0;          // total normal contact force (per unit thickness in plane strain)
   double max_pressure = 0.0;
-  double extent_begin = 0.0;   // arc length along the slave edge of the first and last active point
+  double extent_begin = 0.0;   // arc length along the slave edge of the first and last active node
   double extent_end = 0.0;     // (both 0 when nothing is in contact)
-  int active_points = 0;       // quadrature points in contact
-  int changed_points = 0;      // quadrature points whose contact status changed since the last iteration
-  double theta = 0.0;          // penalty parameter in use
-  double max_penetration = 0.0;   // largest overlap max(0, -g) at the slave nodes
+  int active_nodes = 0;        // slave nodes in contact (pressure > 0)
+  int changed_nodes = 0;       // slave nodes whose contact status changed since the last iteration
+  double theta = 0.0;          // penalty parameter (0 when contact is enforced exactly)
+  double max_penetration = 0.0;   // largest overlap max(0, -g) of the nodal gaps
   std::vector<double> positions;  // arc length along the slave edge of each slave node
   std::vector<double> pressures;  // contact pressure at each slave node
 };
 
+// Which number decides convergence in a report: the fixed-point residual (Neumann, Robin, the paper's adaptive
+// loop), the complementarity residual with the active-set changes (interface Newton, exact monolithic), or the
+// energy gradient (penalty monolithic Newton, stored in fixed_point_residual).
+enum class Measure { fixed_point, complementarity, gradient };
+const char* to_string(Measure m);
+
 struct IterationReport {
   int iteration = 0;                // 1-based
+  Measure measure = Measure::fixed_point;
   double paper_criterion = 0.0;     // max over bodies of ||u_n^k - u_n^{k-1}|| / ||u_n^k|| (paper, section 4)
-  double fixed_point_residual = 0.0;// ||u~_n^{k+1} - u_n^k|| / ||u_n^k|| over all contact zones
+  double fixed_point_residual = 0.0;// ||u~_n^{k+1} - u_n^k|| / ||u_n^k|| over all contact zones (fixed-point
+                                    // methods); the relative energy gradient (monolithic penalty Newton)
+  double complementarity = 0.0;     // active-set methods: ||z - max(0, z - c g)|| / ||z|| over all contact nodes
+  int active_nodes = 0;             // contact nodes in contact, all pairs
+  int active_set_changes = 0;       // contact nodes whose status changed since the last iteration, all pairs
   double gamma = 0.0;               // relaxation in use (0 for methods without one)
   int update = 0;                   // augmented-Lagrangian update (0 for the pure penalty method)
   std::string note;                 // what changed in this iteration, if anything (e.g. "gamma reduced")
@@ -61,19 +73,25 @@ struct BodyField {
   Eigen::MatrixX2d reaction;      // per node: force the supports exert (zero where nothing is prescribed)
 };
 
-// Contact quantities along one pair, at the slave edge's nodes, ordered along the slave edge.
+// Contact quantities along one pair, at the slave edge's nodes, ordered along the slave edge. The gaps are the
+// mortar (dual-weighted) nodal gaps, weighted gap / D; NaN where a slave node carries no multiplier (status).
 struct PairField {
   std::string name;
   std::string slave_body, slave_edge, master_body, master_edge;
-  double theta = 0.0;
+  std::string enforcement;       // "exact", "penalty" or "augmented_lagrangian"
+  double theta = 0.0;            // penalty parameter (0 for exact enforcement)
+  Eigen::VectorXi node;          // the slave nodes' indices in the slave body's mesh
   Eigen::MatrixX2d position;     // slave node coordinates
+  Eigen::MatrixX2d normal;       // unit contact normal (outward of the slave); 0 where no multiplier
   Eigen::VectorXd arc_length;    // along the slave edge from its first node
-  Eigen::VectorXd gap;           // initial gap d (geometric + analytic)
+  Eigen::VectorXd weight;        // D of the node's multiplier (length x thickness); 0 where none
+  Eigen::VectorXd gap;           // initial nodal gap d (geometric + analytic)
   Eigen::VectorXd normal_gap;    // d - u_1n - u_2n after deformation (negative = penetration)
-  Eigen::VectorXd pressure;      // max(0, lambda - normal_gap / theta) (lambda = 0 without augmented Lagrangian)
-  Eigen::VectorXd penetration;   // max(0, -normal_gap)
+  Eigen::VectorXd pressure;      // the nodal multiplier z (exact) or max(0, lambda - normal_gap / theta)
+  Eigen::VectorXd penetration;   // max(0, -normal_gap) (0 where no multiplier)
   Eigen::VectorXi active;        // 1 where the pressure is positive
-  double force = 0.0;            // integral of the pressure over the slave edge (quadrature of the solver)
+  Eigen::VectorXi status;        // 0 contact node, 1 not opposite the master, 2 crosspoint, 3 barely covered
+  double force = 0.0;            // sum of weight x pressure: the total normal force
 };
 
 // One mesh state: without adaptivity there is a single step.
@@ -89,7 +107,8 @@ struct Result {
   StopReason stop_reason = StopReason::error;
   std::string message;  // human-readable detail of the stop (error text when stop_reason == error)
   int iterations = 0;
-  std::string method;   // "neumann" or "monolithic"
+  std::string method;   // "interface_newton", "neumann", "robin" or "monolithic"
+  std::string enforcement;  // "exact", "penalty" or "augmented_lagrangian"
   double gamma = 0.0;   // relaxation used (0 for monolithic)
   int subdomain_solves = 0;  // back-substitutions per body (the DDM's unit of work), initial guess included
   int updates = 0;           // augmented-Lagrangian updates (0 for the pure penalty method)

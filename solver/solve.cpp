@@ -13,6 +13,15 @@ const char* solver_version() { return CONTACT_VERSION; }
 
 namespace {
 
+const char* enforcement_name(Enforcement e) {
+  switch (e) {
+    case Enforcement::exact: return "exact";
+    case Enforcement::penalty: return "penalty";
+    case Enforcement::augmented_lagrangian: return "augmented_lagrangian";
+  }
+  return "exact";
+}
+
 const char* method_name(Method m) {
   switch (m) {
     case Method::neumann: return "neumann";
@@ -37,6 +46,7 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
   const auto start = std::chrono::steady_clock::now();
   Result result;
   result.method = method_name(problem.solver.method);
+  result.enforcement = enforcement_name(problem.solver.enforcement);
   try {
     ddm::ThreadTaskRunner runner(ddm::choose_threads(problem.solver.threads, problem.bodies.size()));
     // Adaptivity refines the meshes: it works on its own copy of the problem.
@@ -44,9 +54,12 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
     const bool adaptive = problem.adaptivity.enabled;
     if (adaptive) working = problem;
     const Problem& active = adaptive ? working : problem;
-    // The monolithic reference factorises the coupled system itself; the other methods factorise each body once.
-    const bool per_body_factorization = problem.solver.method != Method::monolithic;
-    ddm::ContactSystem system(active, runner, per_body_factorization);
+    // The monolithic reference factorises the coupled system itself; the other methods factorise each body once,
+    // interface Newton with the contact unknowns last (its Schur complements come from the factor).
+    const auto factorization = problem.solver.method == Method::monolithic         ? ddm::ContactSystem::Factorization::none
+                               : problem.solver.method == Method::interface_newton ? ddm::ContactSystem::Factorization::interface
+                                                                                   : ddm::ContactSystem::Factorization::plain;
+    ddm::ContactSystem system(active, runner, factorization);
     result.setup_seconds = system.setup_seconds();
     result.factorization_seconds = system.factorization_seconds();
     if (!system.ok()) {
@@ -74,7 +87,8 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
     if (adaptive) {
       result.steps = std::move(steps);
     } else if (!outcome.u.empty()) {
-      result.steps.push_back(system.fields(outcome.u, outcome.iterations));
+      result.steps.push_back(outcome.z.empty() ? system.fields(outcome.u, outcome.iterations)
+                                               : system.fields(outcome.u, outcome.z, outcome.iterations));
     }
     if (updates > 0 && !result.steps.empty()) {
       std::ostringstream os;

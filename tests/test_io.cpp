@@ -70,16 +70,25 @@ PairField pair_field(const BodyField& slave, double theta) {
   p.theta = theta;
   const auto nodes = slave.mesh.edge_set_nodes("bottom");
   const auto n = static_cast<Eigen::Index>(nodes.size());
+  p.enforcement = "penalty";
+  p.node.resize(n);
   p.position.resize(n, 2);
+  p.normal.resize(n, 2);
   p.arc_length.resize(n);
+  p.weight.resize(n);
   p.gap.resize(n);
   p.normal_gap.resize(n);
   p.pressure.resize(n);
   p.penetration.resize(n);
   p.active.resize(n);
+  p.status.resize(n);
   for (Eigen::Index k = 0; k < n; ++k) {
     const auto& x = slave.mesh.nodes[static_cast<size_t>(nodes[static_cast<size_t>(k)])];
+    p.node[k] = nodes[static_cast<size_t>(k)];
     p.position.row(k) = x.transpose();
+    p.normal.row(k) << 0.0, -1.0;
+    p.weight(k) = k == 0 || k == n - 1 ? 0.25 : 0.5;
+    p.status(k) = k == 0 ? 2 : 0;
     p.arc_length(k) = x.x() - slave.mesh.nodes[static_cast<size_t>(nodes.front())].x();
     p.gap(k) = 1e-3 * x.x() * x.x();
     p.normal_gap(k) = p.gap(k) - 2e-3;
@@ -96,6 +105,10 @@ IterationReport report(int iteration, const Step& s) {
   r.iteration = iteration;
   r.paper_criterion = 0.1 / iteration;
   r.fixed_point_residual = 0.05 / iteration;
+  r.complementarity = 0.01 / iteration;
+  r.active_nodes = 3 + iteration;
+  r.active_set_changes = 2 - iteration;
+  r.update = iteration - 1;
   r.elapsed_seconds = 0.25 * iteration;
   for (const auto& b : s.bodies)
     r.bodies.push_back({b.name, b.mesh.num_cells(), 2 * b.mesh.num_nodes() - 4, iteration == 2 ? 3 : 0});
@@ -106,8 +119,8 @@ IterationReport report(int iteration, const Step& s) {
     pr.max_pressure = p.pressure.maxCoeff();
     pr.extent_begin = 0.5;
     pr.extent_end = 1.5 + iteration;
-    pr.active_points = p.active.sum();
-    pr.changed_points = 2 - iteration;
+    pr.active_nodes = p.active.sum();
+    pr.changed_nodes = 2 - iteration;
     pr.theta = p.theta;
     pr.positions = {0.0, 1.0};
     pr.pressures = {1.0, 2.0};
@@ -256,7 +269,7 @@ TEST(ResultFile, ReadBackEqualsWhatWasWritten) {
 
   const io::ResultFile r = io::read_result(path.string());
   EXPECT_EQ(r.format, "contact-ddm-result");
-  EXPECT_EQ(r.format_version, 1);
+  EXPECT_EQ(r.format_version, 2);
   EXPECT_EQ(r.solver_version, CONTACT_VERSION);
   EXPECT_EQ(r.job_id, info.job_id);
   EXPECT_EQ(r.job_name, "fake");
@@ -298,6 +311,10 @@ TEST(ResultFile, ReadBackEqualsWhatWasWritten) {
     EXPECT_EQ(h.iteration[i], reports[i].iteration);
     EXPECT_EQ(h.paper_criterion[i], reports[i].paper_criterion);
     EXPECT_EQ(h.fixed_point_residual[i], reports[i].fixed_point_residual);
+    EXPECT_EQ(h.complementarity[i], reports[i].complementarity);
+    EXPECT_EQ(h.active_nodes_total[i], reports[i].active_nodes);
+    EXPECT_EQ(h.active_set_changes[i], reports[i].active_set_changes);
+    EXPECT_EQ(h.update[i], reports[i].update);
     EXPECT_EQ(h.elapsed_seconds[i], reports[i].elapsed_seconds);
     for (size_t b = 0; b < 2; ++b) {
       const auto col = static_cast<Eigen::Index>(b);
@@ -310,9 +327,10 @@ TEST(ResultFile, ReadBackEqualsWhatWasWritten) {
     EXPECT_EQ(h.max_pressure(row, 0), p.max_pressure);
     EXPECT_EQ(h.extent_begin(row, 0), p.extent_begin);
     EXPECT_EQ(h.extent_end(row, 0), p.extent_end);
-    EXPECT_EQ(h.active_points(row, 0), p.active_points);
-    EXPECT_EQ(h.changed_points(row, 0), p.changed_points);
+    EXPECT_EQ(h.active_nodes(row, 0), p.active_nodes);
+    EXPECT_EQ(h.changed_nodes(row, 0), p.changed_nodes);
     EXPECT_EQ(h.theta(row, 0), p.theta);
+    EXPECT_EQ(h.max_penetration(row, 0), p.max_penetration);
   }
 
   // /history/steps
@@ -357,10 +375,15 @@ TEST(ResultFile, ReadBackEqualsWhatWasWritten) {
     EXPECT_EQ(g.slave_edge, w.slave_edge);
     EXPECT_EQ(g.master_body, w.master_body);
     EXPECT_EQ(g.master_edge, w.master_edge);
+    EXPECT_EQ(g.enforcement, w.enforcement);
     EXPECT_EQ(g.theta, w.theta);
     EXPECT_EQ(g.force, w.force);
+    expect_same(g.node, w.node, "node");
     expect_same(g.position, w.position, "position");
+    expect_same(g.normal, w.normal, "normal");
     expect_same(g.arc_length, w.arc_length, "arc_length");
+    expect_same(g.weight, w.weight, "weight");
+    expect_same(g.status, w.status, "status");
     expect_same(g.gap, w.gap, "gap");
     expect_same(g.normal_gap, w.normal_gap, "normal_gap");
     expect_same(g.pressure, w.pressure, "pressure");
@@ -370,7 +393,7 @@ TEST(ResultFile, ReadBackEqualsWhatWasWritten) {
   }
 }
 
-TEST(ResultFile, VtkHdfPartitionsOneBodyEachAndSizesAgree) {
+TEST(ResultFile, VtkHdfPartitionsOneBodyEachThenOnePairEachAndSizesAgree) {
   const Fixture f = make_fixture();
   const fs::path path = output_dir() / "vtkhdf.hdf";
   io::write_result(path.string(), f.problem, f.result);
@@ -384,9 +407,10 @@ TEST(ResultFile, VtkHdfPartitionsOneBodyEachAndSizesAgree) {
   EXPECT_TRUE(v.type_storage.fixed_length);
   EXPECT_EQ(v.type_storage.size, 16u);  // no terminator counted: ParaView 5.11 compares all stored bytes
 
-  ASSERT_EQ(v.number_of_points.size(), last.bodies.size());
-  ASSERT_EQ(v.number_of_cells.size(), last.bodies.size());
-  ASSERT_EQ(v.number_of_connectivity_ids.size(), last.bodies.size());
+  const size_t partitions = last.bodies.size() + last.pairs.size();
+  ASSERT_EQ(v.number_of_points.size(), partitions);
+  ASSERT_EQ(v.number_of_cells.size(), partitions);
+  ASSERT_EQ(v.number_of_connectivity_ids.size(), partitions);
   std::int64_t points = 0, cells = 0, ids = 0;
   size_t offset_at = 0;
   for (size_t b = 0; b < last.bodies.size(); ++b) {
@@ -415,11 +439,40 @@ TEST(ResultFile, VtkHdfPartitionsOneBodyEachAndSizesAgree) {
     ids += v.number_of_connectivity_ids[b];
     offset_at += static_cast<size_t>(v.number_of_cells[b]) + 1;
   }
+  const std::int64_t body_points = points, body_cells = cells;
+  EXPECT_TRUE(std::all_of(v.types.begin(), v.types.begin() + body_cells, [](std::uint8_t t) { return t == 9; }));
+  // The contact partitions: the slave polyline as lines, with the pair's pressure and active flags.
+  for (size_t k = 0; k < last.pairs.size(); ++k) {
+    const PairField& p = last.pairs[k];
+    const size_t part = last.bodies.size() + k;
+    const Eigen::Index n = p.position.rows();
+    EXPECT_EQ(v.number_of_points[part], n);
+    EXPECT_EQ(v.number_of_cells[part], n - 1);
+    EXPECT_EQ(v.number_of_connectivity_ids[part], 2 * (n - 1));
+    for (Eigen::Index j = 0; j < n; ++j) {
+      EXPECT_EQ(v.points(points + j, 0), p.position(j, 0));
+      EXPECT_EQ(v.point_data.at("pressure")(points + j, 0), p.pressure[j]);
+      EXPECT_EQ(v.point_data.at("active")(points + j, 0), p.active[j]);
+      // The slave body's displacement at that node.
+      EXPECT_EQ(v.point_data.at("displacement")(points + j, 1), last.bodies[0].displacement(p.node[j], 1));
+    }
+    for (Eigen::Index e = 0; e < n - 1; ++e) {
+      EXPECT_EQ(v.types[static_cast<size_t>(cells + e)], 3);  // VTK_LINE
+      EXPECT_EQ(v.cell_data.at("pair_id")(cells + e, 0), static_cast<double>(k));
+      EXPECT_EQ(v.cell_data.at("body_id")(cells + e, 0), -1.0);
+    }
+    points += n;
+    cells += n - 1;
+    ids += 2 * (n - 1);
+    offset_at += static_cast<size_t>(n);
+  }
   EXPECT_EQ(v.points.rows(), points);
   EXPECT_EQ(static_cast<std::int64_t>(v.connectivity.size()), ids);
   EXPECT_EQ(v.offsets.size(), offset_at);
   EXPECT_EQ(static_cast<std::int64_t>(v.types.size()), cells);
-  EXPECT_TRUE(std::all_of(v.types.begin(), v.types.end(), [](std::uint8_t t) { return t == 9; }));
+  // Body points are no contact points: pressure NaN, active -1.
+  EXPECT_TRUE(std::isnan(v.point_data.at("pressure")(0, 0)));
+  EXPECT_EQ(v.point_data.at("active")(0, 0), -1.0);
 
   const Eigen::MatrixXd& u = v.point_data.at("displacement");
   ASSERT_EQ(u.rows(), points);
@@ -431,11 +484,12 @@ TEST(ResultFile, VtkHdfPartitionsOneBodyEachAndSizesAgree) {
   EXPECT_EQ(v.cell_data.at("stress").cols(), 4);
   EXPECT_EQ(v.cell_data.at("von_mises").rows(), cells);
   const Eigen::MatrixXd& level = v.cell_data.at("level");
-  EXPECT_EQ(level(cells - 1, 0), 1.0);  // the refined lower body comes last
+  EXPECT_EQ(level(body_cells - 1, 0), 1.0);  // the refined lower body is the last body
   // Only the lower body has an indicator: the upper body's cells are NaN, not a made-up 0.
   const Eigen::MatrixXd& indicator = v.cell_data.at("indicator");
   EXPECT_TRUE(std::isnan(indicator(0, 0)));
-  EXPECT_EQ(indicator(cells - 1, 0), last.bodies[1].indicator_cell(last.bodies[1].indicator_cell.size() - 1));
+  EXPECT_EQ(indicator(body_cells - 1, 0), last.bodies[1].indicator_cell(last.bodies[1].indicator_cell.size() - 1));
+  (void)body_points;
 }
 
 TEST(ResultFile, CreatedAndHostAreFilledWhenNotGiven) {
@@ -545,7 +599,7 @@ TEST(ResultFile, ConcurrentWritersOfDifferentFilesDoNotInterfere) {
   for (const auto& e : errors) EXPECT_EQ(e, "");
 }
 
-TEST(Xdmf, SidecarIsWellFormedAndNamesEveryStepAndBody) {
+TEST(Xdmf, SidecarIsWellFormedAndNamesEveryStepBodyAndContactSurface) {
   const Fixture f = make_fixture();
   const fs::path hdf = output_dir() / "sidecar.hdf";
   io::write_result(hdf.string(), f.problem, f.result);
@@ -568,7 +622,14 @@ TEST(Xdmf, SidecarIsWellFormedAndNamesEveryStepAndBody) {
       EXPECT_NE(text.find(base + "/von_mises</DataItem>"), std::string::npos) << base;
       EXPECT_NE(text.find(base + "/level</DataItem>"), std::string::npos) << base;
     }
+    // The contact surface of every pair: the slave polyline with pressure, gap and active.
+    for (const auto& p : f.result.steps[k].pairs) {
+      const std::string base = "sidecar.hdf:/steps/" + std::to_string(k) + "/contacts/" + p.name;
+      for (const char* array : {"/segments", "/position", "/pressure", "/normal_gap", "/active"})
+        EXPECT_NE(text.find(base + array + "</DataItem>"), std::string::npos) << base << array;
+    }
   }
+  EXPECT_EQ(count(text, "TopologyType=\"Polyline\""), f.result.steps.size());
   EXPECT_EQ(count(text, "<Grid Name=\"upper\""), f.result.steps.size());
   EXPECT_EQ(count(text, "<Grid Name=\"lower\""), f.result.steps.size());
   EXPECT_EQ(count(text, "/indicator</DataItem>"), f.result.steps.size());  // lower body only

@@ -147,12 +147,12 @@ TEST(JobDefaults, MissingFieldsGetTheirDefaultsInProblemAndNormalized) {
   const contact::Problem& p = *r.problem;
   EXPECT_EQ(p.model.plane, contact::Plane::strain);
   EXPECT_EQ(p.model.thickness, 1.0);
-  // The defaults are fast and exact (interface Newton inside augmented-Lagrangian updates).
+  // The defaults are fast and exact (dual mortar contact by interface Newton).
   EXPECT_EQ(p.solver.method, contact::Method::interface_newton);
   EXPECT_TRUE(p.solver.gamma_auto);
   EXPECT_EQ(p.solver.acceleration, contact::Acceleration::anderson);
   EXPECT_EQ(p.solver.anderson_depth, 10);
-  EXPECT_EQ(p.solver.enforcement, contact::Enforcement::augmented_lagrangian);
+  EXPECT_EQ(p.solver.enforcement, contact::Enforcement::exact);
   EXPECT_EQ(p.solver.criterion, contact::Criterion::residual);
   EXPECT_EQ(p.solver.tolerance, 1e-8);
   EXPECT_EQ(p.solver.max_iterations, 2000);
@@ -170,7 +170,7 @@ TEST(JobDefaults, MissingFieldsGetTheirDefaultsInProblemAndNormalized) {
   EXPECT_EQ(n["solver"]["gamma"], "auto");
   EXPECT_EQ(n["solver"]["tolerance"], 1e-8);
   EXPECT_EQ(n["solver"]["criterion"], "residual");
-  EXPECT_EQ(n["solver"]["enforcement"], "augmented_lagrangian");
+  EXPECT_EQ(n["solver"]["enforcement"], "exact");
   EXPECT_EQ(n["solver"]["max_iterations"], 2000);
   EXPECT_EQ(n["solver"]["initial_guess"], "elastic_layer");
   EXPECT_EQ(n["solver"]["threads"], 0);
@@ -181,6 +181,57 @@ TEST(JobDefaults, MissingFieldsGetTheirDefaultsInProblemAndNormalized) {
   const ParseResult again = parse(n);
   ASSERT_TRUE(again.ok()) << listing(again);
   EXPECT_EQ(again.problem->normalized, n);
+}
+
+TEST(JobDefaults, TheEnforcementDefaultFollowsTheMethodAndTheNormalizedJobSaysWhatRuns) {
+  struct Case {
+    json solver, adaptivity;
+    const char* method;
+    const char* enforcement;
+  };
+  const std::vector<Case> cases = {
+      {json::object(), nullptr, "interface_newton", "exact"},
+      {{{"method", "monolithic"}}, nullptr, "monolithic", "exact"},
+      {{{"method", "neumann"}}, nullptr, "neumann", "penalty"},
+      {{{"method", "robin"}}, nullptr, "robin", "penalty"},
+      {{{"method", "neumann"}, {"enforcement", "augmented_lagrangian"}}, nullptr, "neumann", "augmented_lagrangian"},
+      // The paper's adaptive strategy is a Neumann iteration: without a method it runs the paper's penalty scheme.
+      {json::object(), {{"strategy", "paper"}}, "neumann", "penalty"},
+      {json::object(), {{"strategy", "converge_then_refine"}}, "interface_newton", "exact"},
+  };
+  for (const auto& c : cases) {
+    json job = small_job();
+    job["solver"] = c.solver;
+    if (!c.adaptivity.is_null()) job["adaptivity"] = c.adaptivity;
+    const ParseResult r = parse(job);
+    ASSERT_TRUE(r.ok()) << c.solver.dump() << ": " << listing(r);
+    EXPECT_EQ(r.problem->normalized["solver"]["method"], c.method) << c.solver.dump() << c.adaptivity.dump();
+    EXPECT_EQ(r.problem->normalized["solver"]["enforcement"], c.enforcement) << c.solver.dump() << c.adaptivity.dump();
+  }
+}
+
+TEST(JobErrors, CombinationsThatCannotRunAreRejectedWithThePointerAndTheReason) {
+  struct Case {
+    json solver, adaptivity;
+    const char* pointer;
+    const char* words;
+  };
+  const std::vector<Case> cases = {
+      {{{"method", "neumann"}, {"enforcement", "exact"}}, nullptr, "/solver/enforcement", "penalty problem"},
+      {{{"method", "robin"}, {"enforcement", "exact"}}, nullptr, "/solver/enforcement", "penalty problem"},
+      {{{"method", "interface_newton"}}, {{"strategy", "paper"}}, "/solver/method", "needs method \"neumann\""},
+      {{{"enforcement", "exact"}}, {{"strategy", "paper"}}, "/solver/enforcement", "must be \"penalty\""},
+  };
+  for (const auto& c : cases) {
+    json job = small_job();
+    job["solver"] = c.solver;
+    if (!c.adaptivity.is_null()) job["adaptivity"] = c.adaptivity;
+    const ParseResult r = parse(job);
+    ASSERT_FALSE(r.ok()) << c.solver.dump();
+    ASSERT_EQ(r.errors.size(), 1u) << listing(r);
+    EXPECT_EQ(r.errors[0].pointer, c.pointer) << listing(r);
+    EXPECT_NE(r.errors[0].message.find(c.words), std::string::npos) << r.errors[0].message;
+  }
 }
 
 TEST(JobDefaults, ANumericGammaSwitchesOffTheAutomaticChoice) {

@@ -72,9 +72,9 @@ void transfer(ddm::Displacements& u, const Problem& problem, const RefineOutcome
   }
 }
 
-Step make_step(const ddm::ContactSystem& system, const ddm::Displacements& u, int iteration, int index,
-               const std::vector<IndicatorResult>& eta) {
-  Step st = system.fields(u, iteration);
+Step make_step(const ddm::ContactSystem& system, const ddm::Displacements& u, const ddm::Pressures& z, int iteration,
+               int index, const std::vector<IndicatorResult>& eta) {
+  Step st = z.empty() ? system.fields(u, iteration) : system.fields(u, z, iteration);
   st.index = index;
   for (size_t a = 0; a < st.bodies.size() && a < eta.size(); ++a)
     if (eta[a].eta.size() == st.bodies[a].mesh.num_cells()) st.bodies[a].indicator_cell = eta[a].eta;
@@ -104,13 +104,15 @@ ddm::MethodOutcome converge_then_refine(Problem& working, ddm::ContactSystem& sy
     total.solves_per_body += o.solves_per_body;
     total.gamma = o.gamma;
     total.u = o.u;
+    total.z = o.z;
     total.reason = o.reason;
     total.converged = o.converged;
     total.message = o.message;
     if (o.u.empty()) return total;
-    const auto eta = estimate(working, system, o.u, system.contact_loads(o.u), context.runner);
+    const ddm::Displacements loads = o.z.empty() ? system.contact_loads(o.u) : system.loads_from_pressures(o.z);
+    const auto eta = estimate(working, system, o.u, loads, context.runner);
     for (const auto& e : eta) total.indicator_seconds += e.seconds;
-    steps.push_back(make_step(system, o.u, total.iterations, step, eta));
+    steps.push_back(make_step(system, o.u, o.z, total.iterations, step, eta));
     if (!o.converged) return total;
     if (step >= s.max_steps) {
       total.message = "adaptive: max_steps = " + std::to_string(s.max_steps) + " refinement steps done; " + o.message;
@@ -183,7 +185,7 @@ ddm::MethodOutcome paper_interleaving(Problem& working, ddm::ContactSystem& syst
     rep.fixed_point_residual = residual;
     rep.gamma = gamma;
     // Record the mesh state (before it is refined), then refine.
-    Step st = make_step(system, u_new, k, step, eta);
+    Step st = make_step(system, u_new, {}, k, step, eta);
     RefineOutcome r = mark_and_refine(working, eta);
     for (size_t a = 0; a < n; ++a) rep.bodies[a].elements_refined = r.refined[a];
     rep.note = r.note;
@@ -197,8 +199,7 @@ ddm::MethodOutcome paper_interleaving(Problem& working, ddm::ContactSystem& syst
         out.converged = true;
         out.reason = StopReason::converged;
         std::ostringstream os;
-        os << "adaptive (paper): the DDM criterion holds and no cell is marked after " << k << " iterations, " << step
-           << " refinements";
+        os << "adaptive (paper): the DDM criterion holds and no cell is marked (" << step << " refinements)";
         out.message = os.str();
         u = std::move(u_new);
         break;
@@ -225,7 +226,7 @@ ddm::MethodOutcome paper_interleaving(Problem& working, ddm::ContactSystem& syst
     if (k == settings.max_iterations) {
       out.reason = StopReason::max_iterations;
       out.message = "adaptive (paper): max_iterations reached";
-      steps.push_back(make_step(system, u, k, step, {}));
+      steps.push_back(make_step(system, u, {}, k, step, {}));
     }
   }
   out.u = std::move(u);

@@ -23,19 +23,47 @@ extern "C" void on_interrupt(int) {
   if (g_cancel) g_cancel->cancel();  // an atomic store: async-signal-safe
 }
 
-// One line per iteration: both stopping measures, then per pair force, max pressure and active points.
+const char* method_name(contact::Method m) {
+  switch (m) {
+    case contact::Method::interface_newton: return "interface_newton";
+    case contact::Method::neumann: return "neumann";
+    case contact::Method::robin: return "robin";
+    case contact::Method::monolithic: return "monolithic";
+  }
+  return "?";
+}
+
+const char* enforcement_name(contact::Enforcement e) {
+  switch (e) {
+    case contact::Enforcement::exact: return "exact";
+    case contact::Enforcement::penalty: return "penalty";
+    case contact::Enforcement::augmented_lagrangian: return "augmented_lagrangian";
+  }
+  return "?";
+}
+
+// One line per iteration with what decides convergence: for the active-set methods (interface Newton, and the
+// exact monolithic reference) the active set, its changes and the complementarity residual; for the
+// fixed-point schemes both stopping measures; then per pair force, max pressure and active nodes.
 class ProgressPrinter final : public contact::Observer {
  public:
   explicit ProgressPrinter(bool quiet) : quiet_(quiet) {}
   void on_iteration(const contact::IterationReport& r) override {
     if (quiet_) return;
-    std::printf("iter %5d", r.iteration);
+    const bool active_set = r.measure == contact::Measure::complementarity;
+    std::printf("%s %4d", active_set ? "step" : "iter", r.iteration);
     if (r.update > 0) std::printf("  update %3d", r.update);
-    std::printf("  paper %.3e  residual %.3e", r.paper_criterion, r.fixed_point_residual);
+    if (active_set)
+      std::printf("  active %4d (changed %3d)  complementarity %.3e", r.active_nodes, r.active_set_changes,
+                  r.complementarity);
+    else if (r.measure == contact::Measure::gradient)
+      std::printf("  gradient %.3e  active %4d (changed %3d)", r.fixed_point_residual, r.active_nodes, r.active_set_changes);
+    else
+      std::printf("  paper %.3e  residual %.3e", r.paper_criterion, r.fixed_point_residual);
     if (r.gamma > 0) std::printf("  gamma %.3g", r.gamma);
     for (const auto& p : r.pairs)
       std::printf("  | %s: force %.6g  p_max %.6g  active %d (%+d)", p.name.c_str(), p.force, p.max_pressure,
-                  p.active_points, p.changed_points);
+                  p.active_nodes, p.changed_nodes);
     std::printf("  %.2fs", r.elapsed_seconds);
     if (!r.note.empty()) std::printf("  [%s]", r.note.c_str());
     std::printf("\n");
@@ -57,7 +85,12 @@ std::string read_file(const std::string& path) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"contact-solve: frictionless contact of elastic bodies by the penalty Neumann DDM"};
+  CLI::App app{
+      "contact-solve: frictionless contact of elastic bodies by domain decomposition (each body solved on its own).\n"
+      "Methods (job field solver.method): interface_newton (default: exact dual-mortar contact, primal-dual active\n"
+      "set on the bodies' interface Schur complements), neumann (the paper's penalty Neumann DDM (16)-(17)), robin,\n"
+      "monolithic (reference). See docs/job-format.md."};
+  app.set_version_flag("--version", std::string("contact-solve ") + contact::solver_version());
   std::string job_path, output;
   bool validate_only = false, quiet = false;
   long max_dofs = contact::job::Limits{}.max_dofs;
@@ -103,14 +136,21 @@ int main(int argc, char** argv) {
   std::signal(SIGINT, on_interrupt);
   std::signal(SIGTERM, on_interrupt);
 
-  std::printf("%s: %zu bodies, %zu contact pairs, method %s\n", problem.name.c_str(), problem.bodies.size(),
-              problem.contacts.size(), problem.solver.method == contact::Method::monolithic ? "monolithic" : "neumann");
+  const bool fixed_point = problem.solver.method == contact::Method::neumann || problem.solver.method == contact::Method::robin;
+  const bool adaptive_paper = problem.adaptivity.enabled && problem.adaptivity.strategy == contact::AdaptStrategy::paper;
+  const bool active_set = !fixed_point && !adaptive_paper &&
+                          (problem.solver.method == contact::Method::interface_newton ||
+                           problem.solver.enforcement == contact::Enforcement::exact);
+  std::printf("%s: %zu bodies, %zu contact pairs, method %s, enforcement %s\n", problem.name.c_str(),
+              problem.bodies.size(), problem.contacts.size(), method_name(problem.solver.method),
+              enforcement_name(problem.solver.enforcement));
   ProgressPrinter printer(quiet);
   const contact::Result result = contact::solve(problem, printer, cancel);
   g_cancel = nullptr;
 
-  std::printf("stop: %s (%s) after %d iterations, %.3f s (setup %.3f s)\n", contact::to_string(result.stop_reason),
-              result.message.c_str(), result.iterations, result.wall_seconds, result.setup_seconds);
+  std::printf("stop: %s after %d %s, %.3f s (setup %.3f s): %s\n", contact::to_string(result.stop_reason),
+              result.iterations, active_set ? "steps" : "iterations", result.wall_seconds, result.setup_seconds,
+              result.message.c_str());
   if (result.steps.empty()) {
     std::cerr << "error: " << result.message << "\n";
     return 1;
@@ -121,8 +161,12 @@ int main(int argc, char** argv) {
       p_max = std::max(p_max, p.pressure[j]);
       penetration = std::max(penetration, p.penetration[j]);
     }
-    std::printf("pair %s: theta %.4g, force %.8g, max pressure %.8g, max penetration %.4g\n", p.name.c_str(), p.theta,
-                p.force, p_max, penetration);
+    if (p.enforcement == "exact")
+      std::printf("pair %s: exact contact, force %.8g, max pressure %.8g, max penetration %.4g\n", p.name.c_str(),
+                  p.force, p_max, penetration);
+    else
+      std::printf("pair %s: %s, theta %.4g, force %.8g, max pressure %.8g, max penetration %.4g\n", p.name.c_str(),
+                  p.enforcement.c_str(), p.theta, p.force, p_max, penetration);
   }
   try {
     contact::io::write_result(output, problem, result);

@@ -1,17 +1,18 @@
 #include "pair.hpp"
 
+#include "dual_basis.hpp"
+#include "segments.hpp"
+
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <optional>
 
-namespace contact::interface {
+namespace contact::mortar {
 
 namespace {
-
-Eigen::Vector2d outward_normal(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-  const Eigen::Vector2d e = (b - a).normalized();
-  return {e.y(), -e.x()};
-}
 
 std::vector<Eigen::Vector2d> coordinates(const mesh::Mesh& m, const std::vector<int>& nodes) {
   std::vector<Eigen::Vector2d> out;
@@ -26,80 +27,50 @@ double analytic_gap(const GapSpec& spec, const Eigen::Vector2d& x) {
   return d;
 }
 
-// Appends n . (interpolated displacement) to a row: weights w0, w1 at nodes n0, n1. Exact zeros are left out
-// (an axis-aligned normal touches one component only), which keeps each body's contact-zone dof set minimal.
-void add_row(std::vector<Eigen::Triplet<double>>& t, int row, const Eigen::Vector2d& n, int n0, double w0, int n1, double w1) {
-  auto add = [&](int dof, double value) {
-    if (value != 0.0) t.emplace_back(row, dof, value);
-  };
-  add(2 * n0, w0 * n.x());
-  add(2 * n0 + 1, w0 * n.y());
-  add(2 * n1, w1 * n.x());
-  add(2 * n1 + 1, w1 * n.y());
+// Prescribed displacement components (x, y) of every node of a body.
+std::map<int, std::array<bool, 2>> prescribed_components(const Body& body) {
+  std::map<int, std::array<bool, 2>> out;
+  for (const auto& bc : body.boundary) {
+    if (bc.kind != BoundaryCondition::Kind::displacement) continue;
+    for (int node : body.mesh.edge_set_nodes(bc.edge)) {
+      auto& p = out[node];
+      p[0] = p[0] || bc.ux.has_value();
+      p[1] = p[1] || bc.uy.has_value();
+    }
+  }
+  return out;
 }
+
+// A crosspoint: the node's displacement along its normal is prescribed (both components, or the one component
+// within 10 degrees of the normal), so the slave side cannot move to open or close the contact there.
+bool normal_is_prescribed(const std::array<bool, 2>& p, const Eigen::Vector2d& n) {
+  if (p[0] && p[1]) return true;
+  const double cos10 = 0.984807753;
+  return (p[0] && std::abs(n.x()) >= cos10) || (p[1] && std::abs(n.y()) >= cos10);
+}
+
+// Three-point Gauss-Legendre on [0, 1]: exact to degree 5 (the products here are at most cubic).
+constexpr std::array<double, 3> kGaussX = {0.1127016653792583, 0.5, 0.8872983346207417};
+constexpr std::array<double, 3> kGaussW = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
 
 }  // namespace
 
-std::optional<Projection> project(const std::vector<Eigen::Vector2d>& polyline, const Eigen::Vector2d& x) {
-  std::optional<Projection> best;
-  double best_distance = std::numeric_limits<double>::infinity();
-  const double tol = 1e-9;
-  for (size_t i = 0; i + 1 < polyline.size(); ++i) {
-    const Eigen::Vector2d a = polyline[i], e = polyline[i + 1] - a;
-    const double L2 = e.squaredNorm();
-    if (!(L2 > 0)) continue;
-    double t = (x - a).dot(e) / L2;
-    if (t < -tol || t > 1 + tol) continue;
-    t = std::clamp(t, 0.0, 1.0);
-    const Eigen::Vector2d foot = a + t * e;
-    const double dist = (x - foot).norm();
-    if (dist < best_distance) {
-      best_distance = dist;
-      best = Projection{static_cast<int>(i), t, foot, outward_normal(a, polyline[i + 1])};
-    }
-  }
-  // Interior vertices: x in the wedge outside a convex corner (beyond the end of the segment before it and
-  // before the start of the segment after it) projects onto the vertex itself.
-  for (size_t k = 1; k + 1 < polyline.size(); ++k) {
-    const Eigen::Vector2d before = polyline[k] - polyline[k - 1], after = polyline[k + 1] - polyline[k];
-    const bool past_before = (x - polyline[k - 1]).dot(before) >= (1 - tol) * before.squaredNorm();
-    const bool ahead_of_after = (x - polyline[k]).dot(after) <= tol * after.squaredNorm();
-    if (!past_before || !ahead_of_after) continue;
-    const double dist = (x - polyline[k]).norm();
-    if (dist < best_distance * (1 - 1e-12)) {
-      best_distance = dist;
-      const Eigen::Vector2d n =
-          (outward_normal(polyline[k - 1], polyline[k]) + outward_normal(polyline[k], polyline[k + 1])).normalized();
-      best = Projection{static_cast<int>(k), 0.0, polyline[k], n};
-    }
-  }
-  return best;
-}
-
-Eigen::VectorXd PairDiscretization::pressure(const Eigen::VectorXd& g) const {
-  Eigen::VectorXd p(g.size());
+Eigen::VectorXd PairDiscretization::penalty_pressure(const Eigen::VectorXd& g) const {
+  Eigen::VectorXd z(g.size());
   const bool shifted = multiplier.size() == g.size();
-  for (Eigen::Index q = 0; q < g.size(); ++q) {
-    const double lambda = shifted ? multiplier[q] : 0.0;
-    p[q] = weight[q] > 0 ? std::max(0.0, lambda - g[q] / theta) : 0.0;
-  }
-  return p;
+  for (Eigen::Index r = 0; r < g.size(); ++r) z[r] = std::max(0.0, (shifted ? multiplier[r] : 0.0) - g[r] / theta);
+  return z;
 }
 
-Eigen::VectorXd PairDiscretization::node_pressure(const Eigen::VectorXd& g, const Eigen::VectorXd& gauss_pressure) const {
-  Eigen::VectorXd p(g.size());
-  for (Eigen::Index j = 0; j < g.size(); ++j) {
-    double v = 0.0;
-    for (const auto& [q, w] : node_from_gauss[static_cast<size_t>(j)]) v += w * gauss_pressure[q];
-    p[j] = node_has_master[j] ? std::max(0.0, v) : 0.0;
-  }
-  return p;
+void PairDiscretization::add_forces(const Eigen::VectorXd& z, Eigen::VectorXd& fs, Eigen::VectorXd& fm) const {
+  fs.noalias() -= Gs.transpose() * z;
+  fm.noalias() += Gm.transpose() * z;
 }
 
-void PairDiscretization::add_forces(const Eigen::VectorXd& p, Eigen::VectorXd& fs, Eigen::VectorXd& fm) const {
-  const Eigen::VectorXd wp = weight.cwiseProduct(p);
-  fs.noalias() += Gs.transpose() * wp;
-  fm.noalias() -= Gm.transpose() * wp;
+Eigen::VectorXd PairDiscretization::to_nodes(const Eigen::VectorXd& rows, double fill) const {
+  Eigen::VectorXd out = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(slave_nodes.size()), fill);
+  for (size_t r = 0; r < node_of_row.size(); ++r) out[node_of_row[r]] = rows[static_cast<Eigen::Index>(r)];
+  return out;
 }
 
 PenaltyChoice choose_penalty(const Problem& problem, int pair_index) {
@@ -109,7 +80,8 @@ PenaltyChoice choose_penalty(const Problem& problem, int pair_index) {
   // Mean outward normal of the master edge, weighted by segment length.
   const auto mpts = coordinates(master.mesh, master.mesh.edge_set_nodes(pair.master_edge));
   Eigen::Vector2d n = Eigen::Vector2d::Zero();
-  for (size_t i = 0; i + 1 < mpts.size(); ++i) n += (mpts[i + 1] - mpts[i]).norm() * outward_normal(mpts[i], mpts[i + 1]);
+  for (size_t i = 0; i + 1 < mpts.size(); ++i)
+    if ((mpts[i + 1] - mpts[i]).norm() > 0) n += (mpts[i + 1] - mpts[i]).norm() * outward_normal(mpts[i], mpts[i + 1]);
   if (n.norm() > 0) n.normalize();
   auto extent = [&](const mesh::Mesh& m) {
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
@@ -142,104 +114,130 @@ PairDiscretization discretize_pair(const Problem& problem, int pair_index, doubl
   d.master_body = pair.master_body;
   d.theta = theta;
   d.slave_nodes = slave.mesh.edge_set_nodes(pair.slave_edge);
-  const std::vector<int> master_nodes = master.mesh.edge_set_nodes(pair.master_edge);
+  d.master_nodes = master.mesh.edge_set_nodes(pair.master_edge);
   const auto S = coordinates(slave.mesh, d.slave_nodes);
-  const auto M = coordinates(master.mesh, master_nodes);
+  const auto Mx = coordinates(master.mesh, d.master_nodes);
+  const size_t n = S.size();
+  const SegmentMesh segments = build_segment_mesh(S, Mx);
+  const size_t n_segments = n < 2 ? 0 : n - 1;
 
-  std::vector<Eigen::Triplet<double>> ts, tm;
-  std::vector<double> weights, gaps, arcs;
-  auto add_point = [&](const Eigen::Vector2d& x, double w, double arc, int s0, double ws0, int s1, double ws1,
-                       std::vector<Eigen::Triplet<double>>& trip_s, std::vector<Eigen::Triplet<double>>& trip_m,
-                       std::vector<Eigen::Vector2d>& normals, std::vector<double>& gap_out, std::vector<double>& w_out,
-                       std::vector<double>& arc_out) {
-    const int row = static_cast<int>(w_out.size());
-    const auto proj = project(M, x);
-    if (!proj) {
-      normals.emplace_back(Eigen::Vector2d::Zero());
-      gap_out.push_back(0.0);
-      w_out.push_back(0.0);
-      arc_out.push_back(arc);
-      return false;
+  d.node_arc = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
+  for (size_t k = 1; k < n; ++k) d.node_arc[static_cast<Eigen::Index>(k)] = d.node_arc[static_cast<Eigen::Index>(k) - 1] + (S[k] - S[k - 1]).norm();
+
+  // Dual basis of every slave segment on its covered part.
+  std::vector<std::vector<const MortarSegment*>> on_segment(n_segments);
+  for (const auto& s : segments.segments) on_segment[static_cast<size_t>(s.slave)].push_back(&s);
+  std::vector<std::optional<DualBasis>> basis(n_segments);
+  for (size_t k = 0; k < n_segments; ++k) {
+    std::vector<std::pair<double, double>> covered;
+    for (const auto* s : on_segment[k]) {
+      covered.emplace_back(s->xi0, s->xi1);
+      d.covered_length += (s->xi1 - s->xi0) * segments.slave_length[k];
     }
-    const Eigen::Vector2d n = proj->normal;
-    normals.push_back(n);
-    const double geometric = pair.gap.geometric ? (x - proj->point).dot(n) : 0.0;
-    gap_out.push_back(geometric + analytic_gap(pair.gap, x));
-    w_out.push_back(w);
-    arc_out.push_back(arc);
-    add_row(trip_s, row, n, s0, ws0, s1, ws1);
-    const int j = proj->segment;
-    const int m0 = master_nodes[static_cast<size_t>(j)];
-    const int m1 = static_cast<size_t>(j) + 1 < master_nodes.size() ? master_nodes[static_cast<size_t>(j) + 1] : m0;
-    add_row(trip_m, row, n, m0, 1 - proj->t, m1, proj->t);
-    return true;
+    basis[k] = dual_basis(covered, segments.slave_length[k]);
+  }
+
+  // Which slave nodes carry a multiplier: covered enough, and not a crosspoint.
+  d.status.assign(n, NodeStatus::contact);
+  const auto prescribed = prescribed_components(slave);
+  for (size_t i = 0; i < n; ++i) {
+    double support = 0, covered = 0;
+    Eigen::Vector2d nu = Eigen::Vector2d::Zero();
+    for (size_t k : {i - 1, i}) {  // the segments before and after node i (i - 1 wraps for i = 0: skipped)
+      if (k >= n_segments) continue;
+      support += 0.5 * segments.slave_length[k];
+      if (!basis[k]) continue;
+      const double Dk = basis[k]->D[k == i ? 0 : 1];
+      covered += Dk;
+      nu += Dk * segments.slave_normal[k];
+    }
+    if (!(covered > 0)) {
+      d.status[i] = NodeStatus::uncovered;
+    } else if (covered < kDropCoverage * support) {
+      d.status[i] = NodeStatus::barely_covered;
+    } else if (auto p = prescribed.find(d.slave_nodes[i]); p != prescribed.end() && normal_is_prescribed(p->second, nu.normalized())) {
+      d.status[i] = NodeStatus::crosspoint;
+    }
+  }
+  d.row_of_node.assign(n, -1);
+  for (size_t i = 0; i < n; ++i)
+    if (d.status[i] == NodeStatus::contact) {
+      d.row_of_node[i] = static_cast<int>(d.node_of_row.size());
+      d.node_of_row.push_back(static_cast<int>(i));
+    }
+  const Eigen::Index rows = static_cast<Eigen::Index>(d.node_of_row.size());
+  d.D = Eigen::VectorXd::Zero(rows);
+  d.area = Eigen::VectorXd::Zero(rows);
+  d.gap0 = Eigen::VectorXd::Zero(rows);
+  std::vector<Eigen::Vector2d> nu(static_cast<size_t>(rows), Eigen::Vector2d::Zero());
+
+  // Integrals over every mortar segment (three-point Gauss: the integrands are at most cubic in xi).
+  std::map<std::pair<int, int>, Eigen::Vector2d> gs, gm;  // (row, node) -> vector coefficient
+  std::map<std::pair<int, int>, double> mm;              // (row, master edge position) -> scalar M
+  auto add = [](std::map<std::pair<int, int>, Eigen::Vector2d>& to, std::pair<int, int> key, const Eigen::Vector2d& v) {
+    auto it = to.emplace(key, Eigen::Vector2d::Zero()).first;  // Eigen's default constructor leaves it unset
+    it->second += v;
   };
-
-  // Gauss points: each slave segment split at the projections of the master nodes onto it.
-  const double gauss = 0.5 / std::sqrt(3.0);
-  double arc0 = 0.0;
-  d.node_from_gauss.assign(S.size(), {});
-  for (size_t k = 0; k + 1 < S.size(); ++k) {
-    const Eigen::Vector2d a = S[k], e = S[k + 1] - a;
-    const double L = e.norm();
-    std::vector<double> cuts = {0.0, 1.0};
-    for (const auto& m : M) {
-      const double t = (m - a).dot(e) / (L * L);
-      if (t > 1e-10 && t < 1 - 1e-10) cuts.push_back(t);
-    }
-    std::sort(cuts.begin(), cuts.end());
-    cuts.erase(std::unique(cuts.begin(), cuts.end(), [](double u, double v) { return v - u < 1e-10; }), cuts.end());
-    for (size_t c = 0; c + 1 < cuts.size(); ++c) {
-      const double t0 = cuts[c], t1 = cuts[c + 1], mid = 0.5 * (t0 + t1), half = t1 - t0;
-      // Linear extrapolation of the piece's two Gauss values to the segment's end nodes it touches.
-      const int qa = static_cast<int>(weights.size()), qb = qa + 1;
-      const double ta = mid - gauss * half, tb = mid + gauss * half;
-      auto extrapolate_to = [&](size_t node, double t_node) {
-        const double s_node = (t_node - ta) / (tb - ta);
-        d.node_from_gauss[node].emplace_back(qa, 1 - s_node);
-        d.node_from_gauss[node].emplace_back(qb, s_node);
-      };
-      if (c == 0) extrapolate_to(k, 0.0);
-      if (c + 2 == cuts.size()) extrapolate_to(k + 1, 1.0);
-      for (double t : {mid - gauss * half, mid + gauss * half}) {
-        const Eigen::Vector2d x = a + t * e;
-        add_point(x, 0.5 * half * L * thickness, arc0 + t * L, d.slave_nodes[k], 1 - t, d.slave_nodes[k + 1], t, ts, tm,
-                  d.normal, gaps, weights, arcs);
-        d.point.push_back(x);
+  for (size_t k = 0; k < n_segments; ++k) {
+    if (!basis[k]) continue;
+    const int r0 = d.row_of_node[k], r1 = d.row_of_node[k + 1];
+    if (r0 < 0 && r1 < 0) continue;
+    DualBasis b = *basis[k];
+    if (r0 < 0) b = drop_node(b, 0);
+    if (r1 < 0) b = drop_node(b, 1);
+    const Eigen::Vector2d nk = segments.slave_normal[k];
+    const double L = segments.slave_length[k];
+    for (const auto* s : on_segment[k]) {
+      const int m0 = d.master_nodes[static_cast<size_t>(s->master)], m1 = d.master_nodes[static_cast<size_t>(s->master) + 1];
+      for (size_t q = 0; q < kGaussX.size(); ++q) {
+        const double u = kGaussX[q];
+        const double xi = s->xi0 + u * (s->xi1 - s->xi0);
+        const double w = kGaussW[q] * (s->xi1 - s->xi0) * L * thickness;
+        const double eta = s->eta0 + u * (s->eta1 - s->eta0);
+        const double t = s->gap0 + u * (s->gap1 - s->gap0);
+        const Eigen::Vector2d x = S[k] + xi * (S[k + 1] - S[k]);
+        const double gap = (pair.gap.geometric ? t : 0.0) + analytic_gap(pair.gap, x);
+        const double Ns[2] = {1 - xi, xi}, Nm[2] = {1 - eta, eta};
+        for (int i = 0; i < 2; ++i) {
+          const int r = i == 0 ? r0 : r1;
+          if (r < 0) continue;
+          const double phi = b.phi(i, xi);
+          d.gap0[r] += w * phi * gap;
+          d.D[r] += w * phi * Ns[i];
+          d.area[r] += w * phi;
+          nu[static_cast<size_t>(r)] += w * phi * Ns[i] * nk;
+          for (int l = 0; l < 2; ++l) {
+            add(gs, {r, d.slave_nodes[k + static_cast<size_t>(l)]}, w * phi * Ns[l] * nk);
+            add(gm, {r, l == 0 ? m0 : m1}, w * phi * Nm[l] * nk);
+            mm[{r, s->master + l}] += w * phi * Nm[l];
+          }
+        }
       }
     }
-    arc0 += L;
   }
-  for (auto& entries : d.node_from_gauss)  // average over the (one or two) adjacent pieces
-    for (auto& e : entries) e.second *= entries.size() > 2 ? 0.5 : 1.0;
-  const int Q = static_cast<int>(weights.size());
-  d.weight = Eigen::Map<Eigen::VectorXd>(weights.data(), Q);
-  d.gap = Eigen::Map<Eigen::VectorXd>(gaps.data(), Q);
-  d.arc = Eigen::Map<Eigen::VectorXd>(arcs.data(), Q);
-  d.Gs.resize(Q, 2 * slave.mesh.num_nodes());
-  d.Gs.setFromTriplets(ts.begin(), ts.end());
-  d.Gm.resize(Q, 2 * master.mesh.num_nodes());
-  d.Gm.setFromTriplets(tm.begin(), tm.end());
+  for (Eigen::Index r = 0; r < rows; ++r) d.normal.push_back(nu[static_cast<size_t>(r)].normalized());
 
-  // The same at the slave nodes.
-  std::vector<Eigen::Triplet<double>> hs, hm;
-  std::vector<Eigen::Vector2d> node_normals;
-  std::vector<double> ngap, nweight, narc;
-  double arc = 0.0;
-  for (size_t k = 0; k < S.size(); ++k) {
-    if (k > 0) arc += (S[k] - S[k - 1]).norm();
-    add_point(S[k], 1.0, arc, d.slave_nodes[k], 1.0, d.slave_nodes[k], 0.0, hs, hm, node_normals, ngap, nweight, narc);
-  }
-  const int n = static_cast<int>(S.size());
-  d.node_arc = Eigen::Map<Eigen::VectorXd>(narc.data(), n);
-  d.node_gap = Eigen::Map<Eigen::VectorXd>(ngap.data(), n);
-  d.node_has_master.resize(n);
-  for (int k = 0; k < n; ++k) d.node_has_master[k] = nweight[static_cast<size_t>(k)] > 0 ? 1 : 0;
-  d.Hs.resize(n, 2 * slave.mesh.num_nodes());
-  d.Hs.setFromTriplets(hs.begin(), hs.end());
-  d.Hm.resize(n, 2 * master.mesh.num_nodes());
-  d.Hm.setFromTriplets(hm.begin(), hm.end());
+  // Sparse operators. Exact zeros (an axis-aligned normal touches one component only) are left out, which keeps
+  // each body's interface unknowns minimal; tiny off-diagonal remainders of biorthogonality are dropped too.
+  auto build = [&](const std::map<std::pair<int, int>, Eigen::Vector2d>& entries, int n_dofs) {
+    std::vector<Eigen::Triplet<double>> t;
+    for (const auto& [key, v] : entries) {
+      const double scale = d.D[key.first];
+      for (int c = 0; c < 2; ++c)
+        if (std::abs(v[c]) > 1e-14 * scale) t.emplace_back(key.first, 2 * key.second + c, v[c]);
+    }
+    SparseRows out(rows, n_dofs);
+    out.setFromTriplets(t.begin(), t.end());
+    return out;
+  };
+  d.Gs = build(gs, 2 * slave.mesh.num_nodes());
+  d.Gm = build(gm, 2 * master.mesh.num_nodes());
+  std::vector<Eigen::Triplet<double>> tm;
+  for (const auto& [key, v] : mm)
+    if (v != 0.0) tm.emplace_back(key.first, key.second, v);
+  d.M.resize(rows, static_cast<Eigen::Index>(d.master_nodes.size()));
+  d.M.setFromTriplets(tm.begin(), tm.end());
   return d;
 }
 
-}  // namespace contact::interface
+}  // namespace contact::mortar

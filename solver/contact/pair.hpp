@@ -1,90 +1,82 @@
-// One contact pair discretised on fixed meshes: the slave edge S_1 is split at the projections of the master
-// nodes (segment-to-segment), each piece carries Gauss points, and every Gauss point x is projected onto the
-// master polyline S_2 (x' the closest point, n the master's outward normal there).
+// One contact pair discretised by the dual mortar method on fixed meshes (docs/algorithm.md, "Contact").
 //
-// Linearised kinematics (paper section 2, n_1(x) ~ -n_2(x') = -n): the normal gap after deformation is
-//   g(x) = d(x) - u_1n(x) - u_2n(x') = d(x) + n . u_1(x) - n . u_2(x'),
-// with d the initial gap (geometric (x - x') . n plus the job's analytic terms). Penalty (paper (11)):
-// contact pressure p = max(0, -g) / theta, positive in compression (the paper's sigma_n = -p). The forces on
-// the bodies are f_1 = G_s^T W p (pushing the slave along +n) and f_2 = -G_m^T W p: equal and opposite, as in
-// the weak form (12). Everything here is linear algebra on these operators, so the DDM, the monolithic
-// solver and the interface methods share exactly the same discrete problem.
+// Unknowns of the contact: one multiplier per contact node (a slave node that carries one), the nodal contact
+// pressure z_r >= 0 (positive in compression, the paper's sigma_n = -pressure). The pressure field is
+// lambda = sum_r z_r Phi_r with the dual shape functions Phi_r (dual_basis.hpp), acting along the normal of the
+// slave segment it sits on.
+//
+// Linearised kinematics (paper section 2): the weighted gap of row r,
+//   g_r = integral over the slave edge of Phi_r (x' - x) . n_k   (+ Phi_r times the job's analytic gap),
+// is affine in the displacements: g = gap0 + Gm u_master - Gs u_slave, where
+//   Gs(r, slave node i)  = sum_k n_k integral_k Phi_r N_i       (= D_r nu_r at i = r; others only at dropped nodes)
+//   Gm(r, master node j) = sum_k n_k integral_k Phi_r N'_j      (n_k M_rj summed over the slave segments k),
+// and D_r = integral Phi_r N_r. The nodal gap g_r / area_r has the units of length.
+// The contact forces are  f_slave = -Gs^T z,  f_master = Gm^T z:  since the master shape functions sum to one,
+// sum_j M_rj = D_r segment by segment, so the forces balance exactly on any pair of meshes.
+// Contact conditions per row: z_r >= 0, g_r >= 0, z_r g_r = 0 (exact), or the paper's penalty in nodal form
+// z_r = max(0, -(g_r / area_r) / theta).
 #pragma once
 
 #include "../problem.hpp"
 
 #include <Eigen/SparseCore>
 
-#include <optional>
 #include <string>
 #include <vector>
 
-namespace contact::interface {
+namespace contact::mortar {
 
-// The closest point of a boundary polyline (nodes in order along the edge) to x.
-struct Projection {
-  int segment = -1;   // index of the segment (between nodes segment and segment + 1)
-  double t = 0.0;     // parameter along the segment, in [0, 1]
-  Eigen::Vector2d point = Eigen::Vector2d::Zero();
-  Eigen::Vector2d normal = Eigen::Vector2d::Zero();  // outward normal of the body owning the polyline
-};
+using SparseRows = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 
-// Nodes' coordinates in order along the edge, and whether the edge runs counter-clockwise around its body
-// (edge sets do: the body lies to the left, so the outward normal of a segment with direction e is (e_y, -e_x)).
-// Returns nullopt when the foot of the perpendicular falls outside the polyline (x has no partner).
-std::optional<Projection> project(const std::vector<Eigen::Vector2d>& polyline, const Eigen::Vector2d& x);
+// Why a slave node carries no multiplier.
+enum class NodeStatus { contact = 0, uncovered = 1, crosspoint = 2, barely_covered = 3 };
 
 struct PairDiscretization {
   std::string name;
   int slave_body = -1, master_body = -1;
-  double theta = 0.0;
+  double theta = 0.0;  // penalty parameter (used by the penalty and augmented-Lagrangian enforcement)
 
-  // Gauss points on the slave edge.
-  std::vector<Eigen::Vector2d> point;
-  std::vector<Eigen::Vector2d> normal;  // master outward normal at the projection
-  Eigen::VectorXd weight;               // quadrature weight (length x thickness); 0 where no master point
-  Eigen::VectorXd gap;                  // initial gap d
-  Eigen::VectorXd arc;                  // arc length along the slave edge
-  Eigen::SparseMatrix<double, Eigen::RowMajor> Gs;  // rows: n . u_slave(x_q)    (Q x slave dofs)
-  Eigen::SparseMatrix<double, Eigen::RowMajor> Gm;  // rows: n . u_master(x'_q)  (Q x master dofs)
-
-  // The same evaluated at the slave edge's nodes (reporting, and the paper's stopping test over FE nodes).
+  // Every slave node, in order along the slave edge.
   std::vector<int> slave_nodes;
-  Eigen::VectorXd node_arc, node_gap;
-  Eigen::VectorXi node_has_master;      // 0 where the node's projection falls outside the master edge
-  Eigen::SparseMatrix<double, Eigen::RowMajor> Hs, Hm;
+  Eigen::VectorXd node_arc;         // arc length along the slave polyline from its first node
+  std::vector<NodeStatus> status;   // per slave node
+  std::vector<int> row_of_node;     // per slave node: its row, or -1
 
-  // Augmented Lagrangian multipliers (contact pressure estimates) at the Gauss points; empty for the pure
-  // penalty method. With them the pressure is max(0, lambda - g / theta), the penalty pressure of the shifted
-  // gap d - theta lambda (effective_gap).
+  // One row per contact node.
+  std::vector<int> node_of_row;     // row -> index into slave_nodes
+  Eigen::VectorXd D;                // D_r = integral Phi_r N_r (length x thickness): the diagonal mortar matrix
+  Eigen::VectorXd area;             // integral Phi_r = sum_j M_rj: the row's share of the surface. Equal to D_r
+                                    // except next to a dropped node (Phi_r then also covers the neighbour's part)
+  Eigen::VectorXd gap0;             // weighted initial gap (geometric + analytic), length^2 x thickness
+  std::vector<Eigen::Vector2d> normal;  // unit normal of row r (direction of D_r nu_r): for reports
+  SparseRows Gs;                    // rows x slave dofs
+  SparseRows Gm;                    // rows x master dofs
+  std::vector<int> master_nodes;    // the master edge's nodes in order
+  SparseRows M;                     // rows x master edge nodes (scalar mortar matrix, summed over segments)
+  double covered_length = 0.0;      // length of the slave edge opposite the master edge
+
+  // Augmented-Lagrangian multipliers per row (empty: none). The pressure is then max(0, lambda - g / theta).
   Eigen::VectorXd multiplier;
-  // Per slave node: Gauss points and weights that extrapolate a Gauss-point field linearly to the node
-  // (averaged over the node's one or two adjacent pieces).
-  std::vector<std::vector<std::pair<int, double>>> node_from_gauss;
 
-  int n_points() const { return static_cast<int>(weight.size()); }
-  // g at the Gauss points for body displacements us (slave) and um (master), all dofs: the physical gap.
-  Eigen::VectorXd normal_gap(const Eigen::VectorXd& us, const Eigen::VectorXd& um) const { return gap + Gs * us - Gm * um; }
-  Eigen::VectorXd node_normal_gap(const Eigen::VectorXd& us, const Eigen::VectorXd& um) const {
-    return node_gap + Hs * us - Hm * um;
+  int n_rows() const { return static_cast<int>(D.size()); }
+  Eigen::VectorXd weighted_gap(const Eigen::VectorXd& us, const Eigen::VectorXd& um) const { return gap0 + Gm * um - Gs * us; }
+  // Weighted gap / area: a length (negative = penetration); the node's value for a gap linear along the slave
+  // edge, a mean with the dropped neighbour next to one, and the constant for a constant gap.
+  Eigen::VectorXd nodal_gap(const Eigen::VectorXd& us, const Eigen::VectorXd& um) const {
+    return weighted_gap(us, um).cwiseQuotient(area);
   }
-  // The gap the penalty acts on: d - theta lambda (d without multipliers).
-  Eigen::VectorXd effective_gap() const { return multiplier.size() ? Eigen::VectorXd(gap - theta * multiplier) : gap; }
-  // Contact pressure at the Gauss points from the physical gap: max(0, lambda - g / theta) (0 without master).
-  Eigen::VectorXd pressure(const Eigen::VectorXd& normal_gap_values) const;
-  // The pressure at the slave nodes (0 where a node has no master point): the Gauss-point pressures, which
-  // the force integrates, extrapolated linearly to the nodes. Not the penalty formula with the nodes' own gaps:
-  // an analytic gap is not linear between Gauss points, and with a small theta (or multipliers) the nodes of a
-  // convex gap then report no contact where the Gauss points carry it.
-  // node_normal_gap_values is used only for its size (kept for callers that have it at hand).
-  Eigen::VectorXd node_pressure(const Eigen::VectorXd& node_normal_gap_values, const Eigen::VectorXd& gauss_pressure) const;
-  // Adds the contact forces of pressures p at the Gauss points: fs += Gs^T W p, fm -= Gm^T W p.
-  void add_forces(const Eigen::VectorXd& p, Eigen::VectorXd& fs, Eigen::VectorXd& fm) const;
-  double total_force(const Eigen::VectorXd& p) const { return weight.dot(p); }
+  // The penalty pressures of nodal gaps g: max(0, lambda - g / theta).
+  Eigen::VectorXd penalty_pressure(const Eigen::VectorXd& nodal_gaps) const;
+  // Adds the contact forces of row pressures z: fs -= Gs^T z, fm += Gm^T z.
+  void add_forces(const Eigen::VectorXd& z, Eigen::VectorXd& fs, Eigen::VectorXd& fm) const;
+  // Total normal force sum_r area_r z_r (the integral of the pressure field; per unit thickness in plane strain).
+  double total_force(const Eigen::VectorXd& z) const { return area.dot(z); }
+  // Row values spread to the slave nodes (`fill` where a node has no row).
+  Eigen::VectorXd to_nodes(const Eigen::VectorXd& rows, double fill) const;
 };
 
-// theta of the pair: PenaltySpec::theta if given, else c * length / E_pair (see PenaltySpec). Also returns
-// the extents of the two bodies along the pair's mean normal (the "layer heights" of the elastic-layer model).
+// theta of the pair: PenaltySpec::theta if given, else c * length / E_pair (see PenaltySpec). Also returns the
+// extents of the two bodies along the pair's mean normal (the "layer heights" of the elastic-layer model).
 struct PenaltyChoice {
   double theta = 0.0;
   double length = 0.0;
@@ -93,7 +85,10 @@ struct PenaltyChoice {
 };
 PenaltyChoice choose_penalty(const Problem& problem, int pair_index);
 
-// Builds the discretisation of pair `pair_index` of the problem on the bodies' current meshes.
+// A slave node whose covered part of its support is below this fraction of the support carries no multiplier.
+constexpr double kDropCoverage = 1e-3;
+
+// Builds the mortar discretisation of pair `pair_index` on the bodies' current meshes.
 PairDiscretization discretize_pair(const Problem& problem, int pair_index, double theta);
 
-}  // namespace contact::interface
+}  // namespace contact::mortar

@@ -3,6 +3,8 @@
 #include "../fem/blas_threads.hpp"
 
 #include <chrono>
+#include <cmath>
+#include <limits>
 
 namespace contact::ddm {
 
@@ -11,77 +13,108 @@ double relative_change(const Eigen::VectorXd& now, const Eigen::VectorXd& before
   return scale > 0 ? (now - before).norm() / scale : 0.0;
 }
 
-ContactSystem::ContactSystem(const Problem& problem, TaskRunner& runner, bool factorize)
-    : problem_(problem), factorize_(factorize) {
+namespace {
+
+void append_error(std::string& errors, const std::string& e) { errors += (errors.empty() ? "" : "; ") + e; }
+
+}  // namespace
+
+ContactSystem::ContactSystem(const Problem& problem, TaskRunner& runner, Factorization factorization)
+    : problem_(problem), factorization_(factorization) {
   const auto t0 = std::chrono::steady_clock::now();
   fem::limit_blas_threads();
+  discretize_pairs();
   bodies_.resize(problem.bodies.size());
   runner.run(bodies_.size(), [&](size_t a) {
-    bodies_[a] = std::make_unique<fem::BodySolver>(problem.bodies[a], problem.model, factorize);
+    bodies_[a] = std::make_unique<fem::BodySolver>(problem.bodies[a], problem.model, factorization != Factorization::none,
+                                                   interface_dofs(a));
   });
   for (const auto& b : bodies_) {
-    if (!b->ok()) error_ += (error_.empty() ? "" : "; ") + b->error();
+    if (!b->ok()) append_error(error_, b->error());
     factorization_seconds_ += b->factorization_seconds();
-  }
-  if (!ok()) return;
-  for (int k = 0; k < static_cast<int>(problem.contacts.size()); ++k) {
-    penalties_.push_back(interface::choose_penalty(problem, k));
-    pairs_.push_back(interface::discretize_pair(problem, k, penalties_.back().theta));
-    if (!(penalties_.back().theta > 0))
-      error_ += (error_.empty() ? "" : "; ") + ("contact '" + pairs_.back().name + "': the penalty theta is not positive");
   }
   setup_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-void ContactSystem::rebuild(const std::vector<char>& changed, TaskRunner& runner) {
-  std::vector<size_t> todo;
-  for (size_t a = 0; a < bodies_.size(); ++a)
-    if (changed[a]) todo.push_back(a);
-  runner.run(todo.size(), [&](size_t i) {
-    const size_t a = todo[i];
-    bodies_[a] = std::make_unique<fem::BodySolver>(problem_.bodies[a], problem_.model, factorize_);
-  });
-  for (size_t a : todo) {
-    if (!bodies_[a]->ok()) error_ += (error_.empty() ? "" : "; ") + bodies_[a]->error();
-    factorization_seconds_ += bodies_[a]->factorization_seconds();
-  }
+void ContactSystem::discretize_pairs() {
   pairs_.clear();
   penalties_.clear();
   for (int k = 0; k < static_cast<int>(problem_.contacts.size()); ++k) {
-    penalties_.push_back(interface::choose_penalty(problem_, k));
-    pairs_.push_back(interface::discretize_pair(problem_, k, penalties_.back().theta));
+    penalties_.push_back(mortar::choose_penalty(problem_, k));
+    pairs_.push_back(mortar::discretize_pair(problem_, k, penalties_.back().theta));
+    if (!(penalties_.back().theta > 0))
+      append_error(error_, "contact '" + pairs_.back().name + "': the penalty theta is not positive");
   }
 }
 
-Displacements ContactSystem::loads_from_pressures(const std::vector<Eigen::VectorXd>& pressures) const {
+std::vector<int> ContactSystem::interface_dofs(size_t a) const {
+  std::vector<int> dofs;
+  if (factorization_ != Factorization::interface) return dofs;
+  auto collect = [&](const mortar::SparseRows& G) {
+    for (int r = 0; r < G.outerSize(); ++r)
+      for (mortar::SparseRows::InnerIterator it(G, r); it; ++it) dofs.push_back(static_cast<int>(it.col()));
+  };
+  for (const auto& pair : pairs_) {
+    if (static_cast<size_t>(pair.slave_body) == a) collect(pair.Gs);
+    if (static_cast<size_t>(pair.master_body) == a) collect(pair.Gm);
+  }
+  std::sort(dofs.begin(), dofs.end());
+  dofs.erase(std::unique(dofs.begin(), dofs.end()), dofs.end());
+  return dofs;
+}
+
+void ContactSystem::rebuild(const std::vector<char>& changed, TaskRunner& runner) {
+  discretize_pairs();
+  std::vector<size_t> todo;
+  for (size_t a = 0; a < bodies_.size(); ++a)
+    if (changed[a] || (factorization_ == Factorization::interface && interface_dofs(a) != bodies_[a]->interface_dofs()))
+      todo.push_back(a);
+  runner.run(todo.size(), [&](size_t i) {
+    const size_t a = todo[i];
+    bodies_[a].reset();  // free the old factorisation first
+    bodies_[a] = std::make_unique<fem::BodySolver>(problem_.bodies[a], problem_.model, factorization_ != Factorization::none,
+                                                   interface_dofs(a));
+  });
+  for (size_t a : todo) {
+    if (!bodies_[a]->ok()) append_error(error_, bodies_[a]->error());
+    factorization_seconds_ += bodies_[a]->factorization_seconds();
+  }
+}
+
+Pressures ContactSystem::penalty_pressures(const Displacements& u) const {
+  Pressures z(pairs_.size());
+  for (size_t k = 0; k < pairs_.size(); ++k) {
+    const auto& pair = pairs_[k];
+    z[k] = pair.penalty_pressure(pair.nodal_gap(u[static_cast<size_t>(pair.slave_body)], u[static_cast<size_t>(pair.master_body)]));
+  }
+  return z;
+}
+
+Displacements ContactSystem::loads_from_pressures(const Pressures& z) const {
   Displacements f(bodies_.size());
   for (size_t a = 0; a < bodies_.size(); ++a) f[a] = Eigen::VectorXd::Zero(bodies_[a]->n_dofs());
   for (size_t k = 0; k < pairs_.size(); ++k) {
     const auto& p = pairs_[k];
-    pairs_[k].add_forces(pressures[k], f[static_cast<size_t>(p.slave_body)], f[static_cast<size_t>(p.master_body)]);
+    p.add_forces(z[k], f[static_cast<size_t>(p.slave_body)], f[static_cast<size_t>(p.master_body)]);
   }
   return f;
 }
 
-Displacements ContactSystem::contact_loads(const Displacements& u, std::vector<Eigen::VectorXd>* pressures) const {
-  std::vector<Eigen::VectorXd> p(pairs_.size());
-  for (size_t k = 0; k < pairs_.size(); ++k) {
-    const auto& pair = pairs_[k];
-    p[k] = pair.pressure(pair.normal_gap(u[static_cast<size_t>(pair.slave_body)], u[static_cast<size_t>(pair.master_body)]));
-  }
-  Displacements f = loads_from_pressures(p);
-  if (pressures) *pressures = std::move(p);
+Displacements ContactSystem::contact_loads(const Displacements& u, Pressures* pressures) const {
+  Pressures z = penalty_pressures(u);
+  Displacements f = loads_from_pressures(z);
+  if (pressures) *pressures = std::move(z);
   return f;
 }
 
 Eigen::VectorXd ContactSystem::zone_normals(size_t a, const Eigen::VectorXd& u_a) const {
   std::vector<Eigen::VectorXd> parts;
-  Eigen::Index n = 0;
   for (const auto& pair : pairs_) {
-    // u_1n = -n . u_1 (slave normal ~ -n), u_2n = n . u_2 (paper's normals)
-    if (static_cast<size_t>(pair.slave_body) == a) parts.push_back(-(pair.Hs * u_a));
-    if (static_cast<size_t>(pair.master_body) == a) parts.push_back(pair.Hm * u_a);
+    // u_1n = nu . u_1 at the slave node, u_2n = -(mortar projection of u_2) . nu (the paper's normals).
+    if (static_cast<size_t>(pair.slave_body) == a) parts.push_back((pair.Gs * u_a).cwiseQuotient(pair.area));
+    if (static_cast<size_t>(pair.master_body) == a) parts.push_back(-(pair.Gm * u_a).cwiseQuotient(pair.area));
   }
+  Eigen::Index n = 0;
   for (const auto& v : parts) n += v.size();
   Eigen::VectorXd out(n);
   Eigen::Index at = 0;
@@ -109,19 +142,25 @@ Displacements ContactSystem::elastic_layer_guess(TaskRunner& runner) const {
     if (problem_.model.plane == Plane::strain) return m.E * (1 - m.nu) / ((1 + m.nu) * (1 - 2 * m.nu));
     return m.E / (1 - m.nu * m.nu);
   };
-  std::vector<Eigen::VectorXd> p(pairs_.size());
+  Pressures z(pairs_.size());
   for (size_t k = 0; k < pairs_.size(); ++k) {
     const auto& pair = pairs_[k];
     const double compliance = penalties_[k].slave_height / M(pair.slave_body) + penalties_[k].master_height / M(pair.master_body);
-    const Eigen::VectorXd g = pair.normal_gap(free_u[static_cast<size_t>(pair.slave_body)], free_u[static_cast<size_t>(pair.master_body)]);
-    p[k] = Eigen::VectorXd::Zero(g.size());
-    for (Eigen::Index q = 0; q < g.size(); ++q)
-      if (pair.weight[q] > 0) p[k][q] = std::max(0.0, -g[q]) / compliance;
+    const Eigen::VectorXd g = pair.nodal_gap(free_u[static_cast<size_t>(pair.slave_body)], free_u[static_cast<size_t>(pair.master_body)]);
+    z[k] = (-g).cwiseMax(0.0) / compliance;
   }
-  return solve_bodies(loads_from_pressures(p), runner);
+  return solve_bodies(loads_from_pressures(z), runner);
 }
 
-IterationReport ContactSystem::report(int iteration, const Displacements& u, std::vector<std::vector<char>>& previous_active) const {
+Pressures ContactSystem::nodal_gaps(const Displacements& u) const {
+  Pressures g(pairs_.size());
+  for (size_t k = 0; k < pairs_.size(); ++k)
+    g[k] = pairs_[k].nodal_gap(u[static_cast<size_t>(pairs_[k].slave_body)], u[static_cast<size_t>(pairs_[k].master_body)]);
+  return g;
+}
+
+IterationReport ContactSystem::report_gaps(int iteration, const Pressures& z, const Pressures& nodal_gaps,
+                                      std::vector<std::vector<char>>& previous_active) const {
   IterationReport r;
   r.iteration = iteration;
   for (size_t a = 0; a < bodies_.size(); ++a)
@@ -129,44 +168,43 @@ IterationReport ContactSystem::report(int iteration, const Displacements& u, std
   previous_active.resize(pairs_.size());
   for (size_t k = 0; k < pairs_.size(); ++k) {
     const auto& pair = pairs_[k];
-    const auto& us = u[static_cast<size_t>(pair.slave_body)];
-    const auto& um = u[static_cast<size_t>(pair.master_body)];
-    const Eigen::VectorXd p = pair.pressure(pair.normal_gap(us, um));
+    const Eigen::VectorXd& p = z[k];
+    const Eigen::VectorXd& g = nodal_gaps[k];
     PairReport pr;
     pr.name = pair.name;
-    pr.theta = pair.theta;
+    pr.theta = problem_.solver.enforcement == Enforcement::exact ? 0.0 : pair.theta;
     pr.force = pair.total_force(p);
     auto& prev = previous_active[k];
     const bool had_previous = prev.size() == static_cast<size_t>(p.size());
     prev.resize(static_cast<size_t>(p.size()), 0);
     bool first = true;
-    for (Eigen::Index q = 0; q < p.size(); ++q) {
-      const char active = p[q] > 0 ? 1 : 0;
-      if (had_previous && active != prev[static_cast<size_t>(q)]) ++pr.changed_points;
-      prev[static_cast<size_t>(q)] = active;
+    for (Eigen::Index row = 0; row < p.size(); ++row) {
+      pr.max_penetration = std::max(pr.max_penetration, -g[row]);
+      const char active = p[row] > 0 ? 1 : 0;
+      if (had_previous && active != prev[static_cast<size_t>(row)]) ++pr.changed_nodes;
+      prev[static_cast<size_t>(row)] = active;
       if (!active) continue;
-      ++pr.active_points;
-      if (first) pr.extent_begin = pair.arc[q];
-      pr.extent_end = pair.arc[q];
+      ++pr.active_nodes;
+      const double arc = pair.node_arc[pair.node_of_row[static_cast<size_t>(row)]];
+      if (first) pr.extent_begin = arc;
+      pr.extent_end = arc;
       first = false;
+      pr.max_pressure = std::max(pr.max_pressure, p[row]);
     }
-    const Eigen::VectorXd gn = pair.node_normal_gap(us, um);
-    const Eigen::VectorXd pn = pair.node_pressure(gn, p);
+    const Eigen::VectorXd pn = pair.to_nodes(p, 0.0);
     pr.positions.assign(pair.node_arc.data(), pair.node_arc.data() + pair.node_arc.size());
     pr.pressures.assign(pn.data(), pn.data() + pn.size());
-    for (Eigen::Index j = 0; j < pn.size(); ++j) {
-      pr.max_pressure = std::max(pr.max_pressure, pn[j]);
-      if (pair.node_has_master[j]) pr.max_penetration = std::max(pr.max_penetration, -gn[j]);
-    }
+    r.active_nodes += pr.active_nodes;
+    r.active_set_changes += pr.changed_nodes;
     r.pairs.push_back(std::move(pr));
   }
   return r;
 }
 
-Step ContactSystem::fields(const Displacements& u, int iteration) const {
+Step ContactSystem::fields(const Displacements& u, const Pressures& z, int iteration) const {
   Step step;
   step.iteration = iteration;
-  const Displacements loads = contact_loads(u);
+  const Displacements loads = loads_from_pressures(z);
   for (size_t a = 0; a < bodies_.size(); ++a) {
     const Body& body = problem_.bodies[a];
     BodyField f;
@@ -182,6 +220,10 @@ Step ContactSystem::fields(const Displacements& u, int iteration) const {
     f.reaction = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>(R.data(), n, 2);
     step.bodies.push_back(std::move(f));
   }
+  const char* enforcement = problem_.solver.enforcement == Enforcement::exact     ? "exact"
+                            : problem_.solver.enforcement == Enforcement::penalty ? "penalty"
+                                                                                   : "augmented_lagrangian";
+  const double nan = std::numeric_limits<double>::quiet_NaN();
   for (size_t k = 0; k < pairs_.size(); ++k) {
     const auto& pair = pairs_[k];
     const ContactPair& spec = problem_.contacts[k];
@@ -193,23 +235,32 @@ Step ContactSystem::fields(const Displacements& u, int iteration) const {
     f.master_body = problem_.bodies[static_cast<size_t>(spec.master_body)].name;
     f.slave_edge = spec.slave_edge;
     f.master_edge = spec.master_edge;
-    f.theta = pair.theta;
+    f.enforcement = enforcement;
+    f.theta = problem_.solver.enforcement == Enforcement::exact ? 0.0 : pair.theta;
     const auto& mesh = problem_.bodies[static_cast<size_t>(spec.slave_body)].mesh;
     const Eigen::Index n = static_cast<Eigen::Index>(pair.slave_nodes.size());
     f.position.resize(n, 2);
-    for (Eigen::Index j = 0; j < n; ++j) f.position.row(j) = mesh.nodes[static_cast<size_t>(pair.slave_nodes[static_cast<size_t>(j)])].transpose();
-    f.arc_length = pair.node_arc;
-    f.gap = pair.node_gap;
-    f.normal_gap = pair.node_normal_gap(us, um);
-    f.pressure = pair.node_pressure(f.normal_gap, pair.pressure(pair.normal_gap(us, um)));
-    f.penetration.resize(n);
-    f.active.resize(n);
+    f.node.resize(n);
     for (Eigen::Index j = 0; j < n; ++j) {
-      const bool has = pair.node_has_master[j] != 0;
-      f.penetration[j] = has ? std::max(0.0, -f.normal_gap[j]) : 0.0;
-      f.active[j] = f.pressure[j] > 0 ? 1 : 0;
+      f.node[j] = pair.slave_nodes[static_cast<size_t>(j)];
+      f.position.row(j) = mesh.nodes[static_cast<size_t>(f.node[j])].transpose();
     }
-    f.force = pair.total_force(pair.pressure(pair.normal_gap(us, um)));
+    f.normal = Eigen::MatrixX2d::Zero(n, 2);
+    for (size_t r = 0; r < pair.node_of_row.size(); ++r) f.normal.row(pair.node_of_row[r]) = pair.normal[r].transpose();
+    f.arc_length = pair.node_arc;
+    f.weight = pair.to_nodes(pair.area, 0.0);
+    f.gap = pair.to_nodes(pair.gap0.cwiseQuotient(pair.area), nan);
+    const Eigen::VectorXd g = pair.nodal_gap(us, um);
+    f.normal_gap = pair.to_nodes(g, nan);
+    f.pressure = pair.to_nodes(z[k], 0.0);
+    f.penetration = pair.to_nodes((-g).cwiseMax(0.0), 0.0);
+    f.active.resize(n);
+    f.status.resize(n);
+    for (Eigen::Index j = 0; j < n; ++j) {
+      f.active[j] = f.pressure[j] > 0 ? 1 : 0;
+      f.status[j] = static_cast<int>(pair.status[static_cast<size_t>(j)]);
+    }
+    f.force = pair.total_force(z[k]);
     step.pairs.push_back(std::move(f));
   }
   return step;

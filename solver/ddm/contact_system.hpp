@@ -1,6 +1,9 @@
-// All bodies and contact pairs of a problem on fixed meshes: each body's factorised solver and each pair's
-// discretisation, plus the evaluations every method needs (contact forces, contact-zone normal displacements,
+// All bodies and contact pairs of a problem on fixed meshes: each pair's mortar discretisation, each body's
+// factorised solver, plus the evaluations every method needs (contact forces, contact-zone normal displacements,
 // per-iteration reports, final fields). Rebuilt when a mesh changes.
+//
+// Contact pressures are per pair one value per mortar row (contact node), positive in compression
+// (contact/pair.hpp); `Pressures` holds them for all pairs.
 #pragma once
 
 #include "../contact/pair.hpp"
@@ -16,16 +19,23 @@
 namespace contact::ddm {
 
 using Displacements = std::vector<Eigen::VectorXd>;  // one full dof vector per body
+using Pressures = std::vector<Eigen::VectorXd>;      // one row vector per contact pair
 
 class ContactSystem {
  public:
-  // Assembles every body and (if `factorize`) factorises them, in parallel through `runner`; then
-  // discretises every pair. Check ok() / error().
-  ContactSystem(const Problem& problem, TaskRunner& runner, bool factorize = true);
+  enum class Factorization {
+    none,       // assembly only (the monolithic reference factorises a coupled system itself)
+    plain,      // each body factorised with the default fill-reducing ordering
+    interface,  // each body's contact unknowns ordered last: Schur complements for the interface problem
+  };
+
+  // Discretises every pair, then assembles every body and factorises them as asked, in parallel through
+  // `runner`. Check ok() / error().
+  ContactSystem(const Problem& problem, TaskRunner& runner, Factorization factorization = Factorization::plain);
 
   // After the meshes of the bodies flagged in `changed` were refined (in the Problem this system refers to):
-  // reassembles and refactorises those bodies only (an unchanged body keeps its factorisation) and rediscretises
-  // every pair. Multipliers are dropped. Check ok() afterwards.
+  // rediscretises every pair and reassembles and refactorises the changed bodies, and any other body whose
+  // interface unknowns changed (an unchanged body keeps its factorisation). Multipliers are dropped. Check ok().
   void rebuild(const std::vector<char>& changed, TaskRunner& runner);
 
   bool ok() const { return error_.empty(); }
@@ -36,22 +46,24 @@ class ContactSystem {
   const Problem& problem() const { return problem_; }
   size_t n_bodies() const { return bodies_.size(); }
   const fem::BodySolver& body(size_t a) const { return *bodies_[a]; }
-  const std::vector<interface::PairDiscretization>& pairs() const { return pairs_; }
-  const std::vector<interface::PenaltyChoice>& penalties() const { return penalties_; }
+  const std::vector<mortar::PairDiscretization>& pairs() const { return pairs_; }
+  const std::vector<mortar::PenaltyChoice>& penalties() const { return penalties_; }
   double setup_seconds() const { return setup_seconds_; }
   double factorization_seconds() const { return factorization_seconds_; }  // summed over bodies
 
-  // Augmented-Lagrangian multipliers of pair k at its Gauss points (an empty vector: none).
-  void set_multipliers(size_t k, Eigen::VectorXd gauss) { pairs_[k].multiplier = std::move(gauss); }
+  // Augmented-Lagrangian multipliers of pair k per row (an empty vector: none).
+  void set_multipliers(size_t k, Eigen::VectorXd rows) { pairs_[k].multiplier = std::move(rows); }
 
-  // Contact forces on every body from the penalty pressures of displacements u (paper (16)'s last term);
-  // the pressures at each pair's Gauss points go to *pressures if given.
-  Displacements contact_loads(const Displacements& u, std::vector<Eigen::VectorXd>* pressures = nullptr) const;
-  // Same from given Gauss-point pressures.
-  Displacements loads_from_pressures(const std::vector<Eigen::VectorXd>& pressures) const;
+  // The penalty pressures of displacements u (paper (16)'s last term, in nodal form).
+  Pressures penalty_pressures(const Displacements& u) const;
+  // Contact forces on every body from pressures: f_slave = -Gs^T z, f_master = Gm^T z.
+  Displacements loads_from_pressures(const Pressures& z) const;
+  // Contact forces from the penalty pressures of u (they go to *pressures if given).
+  Displacements contact_loads(const Displacements& u, Pressures* pressures = nullptr) const;
 
-  // Body a's normal displacements at the FE nodes of its contact zones (u_an of the paper's stopping test),
-  // stacked over the pairs it belongs to.
+  // Body a's normal displacements at its contact zones' nodes (u_an of the paper's stopping test), stacked over
+  // the pairs it belongs to: for a slave the displacement of the contact node along its normal; for a master
+  // the mortar projection of its displacement onto the slave node, along the master's normal (-n).
   Eigen::VectorXd zone_normals(size_t a, const Eigen::VectorXd& u_a) const;
 
   // Each body solved with the given loads, in parallel.
@@ -60,19 +72,35 @@ class ContactSystem {
   // The "elastic layer" initial guess (paper section 4, ALGORITHM.md section 5).
   Displacements elastic_layer_guess(TaskRunner& runner) const;
 
-  // Per-iteration report for displacements u; `previous_active` holds each pair's active flags at the Gauss
-  // points of the previous report and is updated.
-  IterationReport report(int iteration, const Displacements& u, std::vector<std::vector<char>>& previous_active) const;
+  // Per-iteration report for pressures z and nodal gaps g (per pair, per row); `previous_active` holds each
+  // pair's active flags of the previous report and is updated. The other forms take the gaps of displacements
+  // u, and (penalty) the pressures too.
+  IterationReport report_gaps(int iteration, const Pressures& z, const Pressures& nodal_gaps,
+                              std::vector<std::vector<char>>& previous_active) const;
+  IterationReport report(int iteration, const Displacements& u, const Pressures& z,
+                         std::vector<std::vector<char>>& previous_active) const {
+    return report_gaps(iteration, z, nodal_gaps(u), previous_active);
+  }
+  IterationReport report(int iteration, const Displacements& u, std::vector<std::vector<char>>& previous_active) const {
+    return report(iteration, u, penalty_pressures(u), previous_active);
+  }
+  // The nodal gaps (weighted gap / D) of displacements u.
+  Pressures nodal_gaps(const Displacements& u) const;
 
-  // Final fields (one Step).
-  Step fields(const Displacements& u, int iteration) const;
+  // Final fields (one Step) for displacements u with pressures z (the penalty form computes z from u).
+  Step fields(const Displacements& u, const Pressures& z, int iteration) const;
+  Step fields(const Displacements& u, int iteration) const { return fields(u, penalty_pressures(u), iteration); }
 
  private:
+  void discretize_pairs();
+  // Full dofs of body a that some pair's operators act on (empty unless Factorization::interface).
+  std::vector<int> interface_dofs(size_t a) const;
+
   const Problem& problem_;
-  bool factorize_ = true;
+  Factorization factorization_ = Factorization::plain;
   std::vector<std::unique_ptr<fem::BodySolver>> bodies_;
-  std::vector<interface::PairDiscretization> pairs_;
-  std::vector<interface::PenaltyChoice> penalties_;
+  std::vector<mortar::PairDiscretization> pairs_;
+  std::vector<mortar::PenaltyChoice> penalties_;
   std::string error_;
   double setup_seconds_ = 0.0, factorization_seconds_ = 0.0;
 };

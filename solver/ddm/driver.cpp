@@ -29,7 +29,7 @@ MethodOutcome MethodRunner::run(RunContext& context) {
       int setup = 0;
       if (!interface_newton_) {
         interface_newton_ = std::make_unique<InterfaceNewton>(system_, context.runner);
-        setup = interface_newton_->solves();
+        setup = 1;  // the free response of every body
       }
       MethodOutcome out = interface_newton_->solve(settings_, context);
       out.solves_per_body += setup;
@@ -55,9 +55,9 @@ MethodOutcome run_augmented_lagrangian(ContactSystem& system, const SolverSettin
   const auto& al = settings.augmented_lagrangian;
   const auto& pairs = system.pairs();
   std::vector<Eigen::Index> offset(pairs.size() + 1, 0);
-  for (size_t k = 0; k < pairs.size(); ++k) offset[k + 1] = offset[k] + pairs[k].n_points();
+  for (size_t k = 0; k < pairs.size(); ++k) offset[k + 1] = offset[k] + pairs[k].n_rows();
   Eigen::VectorXd sqrt_w(offset.back());
-  for (size_t k = 0; k < pairs.size(); ++k) sqrt_w.segment(offset[k], pairs[k].n_points()) = pairs[k].weight.cwiseSqrt();
+  for (size_t k = 0; k < pairs.size(); ++k) sqrt_w.segment(offset[k], pairs[k].n_rows()) = pairs[k].area.cwiseSqrt();
   Eigen::VectorXd lambda = Eigen::VectorXd::Zero(offset.back());
   std::deque<Eigen::VectorXd> d_lambda, d_residual, d_image;
   Eigen::VectorXd previous_lambda, previous_residual, previous_image;
@@ -78,18 +78,16 @@ MethodOutcome run_augmented_lagrangian(ContactSystem& system, const SolverSettin
     total.solves_per_body += o.solves_per_body;
     total.gamma = o.gamma;
     total.u = std::move(o.u);
+    total.z = std::move(o.z);
     if (o.reason != StopReason::converged) {
       total.reason = o.reason;
       total.message = "augmented Lagrangian update " + std::to_string(update) + ": " + o.message;
       return total;
     }
     // P(lambda): the pressures of this solve.
+    const Pressures solved = total.z.empty() ? system.penalty_pressures(total.u) : total.z;
     Eigen::VectorXd image(offset.back());
-    for (size_t k = 0; k < pairs.size(); ++k) {
-      const auto& pair = pairs[k];
-      image.segment(offset[k], pair.n_points()) = pair.pressure(
-          pair.normal_gap(total.u[static_cast<size_t>(pair.slave_body)], total.u[static_cast<size_t>(pair.master_body)]));
-    }
+    for (size_t k = 0; k < pairs.size(); ++k) image.segment(offset[k], pairs[k].n_rows()) = solved[k];
     const Eigen::VectorXd residual = sqrt_w.cwiseProduct(image - lambda);
     const double scale = sqrt_w.cwiseProduct(image).norm();
     const double change = scale > 0 ? residual.norm() / scale : 0.0;
@@ -141,7 +139,7 @@ MethodOutcome run_augmented_lagrangian(ContactSystem& system, const SolverSettin
       d_image.pop_front();
     }
     lambda = next.cwiseMax(0.0);
-    for (size_t k = 0; k < pairs.size(); ++k) system.set_multipliers(k, lambda.segment(offset[k], pairs[k].n_points()));
+    for (size_t k = 0; k < pairs.size(); ++k) system.set_multipliers(k, lambda.segment(offset[k], pairs[k].n_rows()));
     warm = total.u;
     if (update == al.max_updates) {
       total.reason = StopReason::max_iterations;
@@ -158,6 +156,15 @@ MethodOutcome run_augmented_lagrangian(ContactSystem& system, const SolverSettin
 MethodOutcome run_enforced(ContactSystem& system, const SolverSettings& settings, RunContext& context,
                            MethodRunner& runner, int& updates) {
   updates = 0;
+  if (settings.enforcement == Enforcement::exact &&
+      (settings.method == Method::neumann || settings.method == Method::robin)) {
+    MethodOutcome out;
+    out.reason = StopReason::error;
+    out.message = std::string("method ") + (settings.method == Method::neumann ? "neumann" : "robin") +
+                  " iterates on the penalty problem: enforcement exact is not available with it (use penalty, or "
+                  "augmented_lagrangian for exact contact in the limit; or method interface_newton)";
+    return out;
+  }
   if (settings.enforcement == Enforcement::augmented_lagrangian)
     return run_augmented_lagrangian(system, settings, context, runner, updates);
   return runner.run(context);

@@ -24,7 +24,7 @@ class OffsetObserver final : public Observer {
 };
 
 // Runs the chosen method once on the pairs' current (possibly multiplier-shifted) gaps. Keeps interface
-// Newton's compliance between calls; reset() forgets it (after the meshes changed).
+// Newton's interface problem between calls; reset() forgets it (after the meshes changed).
 class MethodRunner {
  public:
   MethodRunner(const ContactSystem& system, const SolverSettings& settings) : system_(system), settings_(settings) {}

@@ -44,16 +44,14 @@ std::string format(const char* fmt, double a, double b = 0, double c = 0) {
 
 }  // namespace
 
-std::vector<Eigen::VectorXd> linear_pressures(const ContactSystem& system, const Displacements& du) {
-  std::vector<Eigen::VectorXd> dp(system.pairs().size());
-  for (size_t k = 0; k < dp.size(); ++k) {
+Pressures linear_pressures(const ContactSystem& system, const Displacements& du) {
+  Pressures dz(system.pairs().size());
+  for (size_t k = 0; k < dz.size(); ++k) {
     const auto& pair = system.pairs()[k];
-    const Eigen::VectorXd dj = pair.Gs * du[static_cast<size_t>(pair.slave_body)] - pair.Gm * du[static_cast<size_t>(pair.master_body)];
-    dp[k] = Eigen::VectorXd::Zero(dj.size());
-    for (Eigen::Index q = 0; q < dj.size(); ++q)
-      if (pair.weight[q] > 0) dp[k][q] = -dj[q] / pair.theta;
+    const Eigen::VectorXd dg = pair.Gm * du[static_cast<size_t>(pair.master_body)] - pair.Gs * du[static_cast<size_t>(pair.slave_body)];
+    dz[k] = -dg.cwiseQuotient(pair.area) / pair.theta;
   }
-  return dp;
+  return dz;
 }
 
 Displacements NeumannMap::apply(const Displacements& u) { return system_.solve_bodies(system_.contact_loads(u), runner_); }
@@ -272,7 +270,7 @@ MethodOutcome run_fixed_point(const ContactSystem& system, const SolverSettings&
       out.reason = StopReason::converged;
       std::ostringstream os;
       os << (settings.criterion == Criterion::paper ? "paper's criterion " : "fixed-point residual ") << measure
-         << " <= " << settings.tolerance << " after " << k << " iterations";
+         << " <= " << settings.tolerance;
       out.message = os.str();
       break;
     }

@@ -17,7 +17,7 @@ class BodyMap {
   virtual ~BodyMap() = default;
   // u~ = F(u): one solve per body, in parallel.
   virtual Displacements apply(const Displacements& u) = 0;
-  // F's Jacobian with every Gauss point in contact, applied to du (one homogeneous solve per body). Its
+  // F's Jacobian with every contact node in contact, applied to du (one homogeneous solve per body). Its
   // spectral radius bounds the safe relaxation.
   virtual Displacements linear_response(const Displacements& du) = 0;
   // Factorisations done by the map itself (Robin refactorises when the active set changes).
@@ -49,8 +49,8 @@ class NeumannMap final : public BodyMap {
   TaskRunner& runner_;
 };
 
-// Pressures at every pair's Gauss points for an interface perturbation du with all points in contact:
-// dp = -(G_s du_s - G_m du_m) / theta (0 at points without a master).
-std::vector<Eigen::VectorXd> linear_pressures(const ContactSystem& system, const Displacements& du);
+// Pressures of every pair's contact nodes for an interface perturbation du with all nodes in contact:
+// dz = -(Gm du_m - Gs du_s) / (theta D).
+Pressures linear_pressures(const ContactSystem& system, const Displacements& du);
 
 }  // namespace contact::ddm

@@ -1,40 +1,30 @@
-// Interface Newton (see interface_newton.cpp). The object keeps what it computed of each body's contact-zone
-// compliance, so that the augmented-Lagrangian updates, which only shift the gaps, re-solve the small interface
-// problem with few or no new back-substitutions.
+// Interface Newton: the contact problem solved on the interface (interface_problem.hpp) by the primal-dual active
+// set strategy (active_set.hpp), then one solve per body for the fields.
+//   exact:   find z >= 0 with g_free + F z >= 0, complementary;
+//   penalty: the same with F + theta D (z = max(0, -g / theta) at every node), and with the augmented-Lagrangian
+//            shift g_free - theta D lambda.
+// The object keeps the interface problem, so augmented-Lagrangian updates (which only shift the gaps) cost one
+// solve per body each.
 #pragma once
 
+#include "interface_problem.hpp"
 #include "method.hpp"
+
+#include <memory>
 
 namespace contact::ddm {
 
 class InterfaceNewton {
  public:
-  // Each body's free response and contact-zone operators (bodies in parallel through `runner`). Compliance
-  // columns are computed on demand by solve().
-  InterfaceNewton(const ContactSystem& system, TaskRunner& runner);
-  // Solves the interface problem on the pairs' current effective gaps and recovers the fields (one solve per
-  // body). solves_per_body of the outcome counts the back-substitutions this call added.
+  InterfaceNewton(const ContactSystem& system, TaskRunner& runner) : system_(system), problem_(system, runner) {}
+  // Solves with the settings' enforcement on the pairs' current multipliers; reports every active-set step.
   MethodOutcome solve(const SolverSettings& settings, RunContext& context);
-  // Back-substitutions per body so far (the largest over the bodies).
-  int solves() const { return solves_; }
+  const InterfaceProblem& problem() const { return problem_; }
 
  private:
-  struct BodyZone {
-    std::vector<int> dofs;          // zone dofs (sorted)
-    Eigen::MatrixXd S;              // compliance on the zone dofs; only columns with have[j] are computed
-    std::vector<char> have;
-    Eigen::VectorXd free_zone;      // free response on the zone dofs
-    Eigen::SparseMatrix<double, Eigen::RowMajor> Q;  // n_points x zone dofs (signed contact operator rows)
-    int solves = 0;
-  };
-  // Computes the compliance columns that the loads at the candidate points need.
-  void ensure_columns(const std::vector<char>& candidate, TaskRunner& runner);
-
   const ContactSystem& system_;
-  std::vector<Eigen::Index> offset_;
-  std::vector<BodyZone> zones_;
-  Eigen::VectorXd weight_, theta_, free_jump_;
-  int solves_ = 0;
+  InterfaceProblem problem_;
+  Eigen::VectorXd last_z_;  // warm start of the next solve (augmented-Lagrangian updates)
 };
 
 }  // namespace contact::ddm

@@ -1,5 +1,5 @@
-// What every contact method (Neumann DDM, monolithic reference, and the methods still to come) takes and
-// returns, so that solve() only dispatches.
+// What every contact method (interface Newton, Neumann DDM, Robin, monolithic reference) takes and returns, so
+// that solve() only dispatches.
 #pragma once
 
 #include "../result.hpp"
@@ -22,6 +22,7 @@ struct RunContext {
 
 struct MethodOutcome {
   Displacements u;  // final displacements per body
+  Pressures z;      // final contact pressures per pair, where they are not the penalty pressures of u (exact)
   bool converged = false;
   StopReason reason = StopReason::error;
   std::string message;
@@ -38,11 +39,8 @@ MethodOutcome run_neumann(const ContactSystem& system, const SolverSettings& set
 // The Robin-type variant (ALGORITHM.md): each body's matrix carries the Robin weight on its contact zone.
 MethodOutcome run_robin(const ContactSystem& system, const SolverSettings& settings, RunContext& context);
 
-// Each body's contact-zone compliance by blocked back-substitutions (in parallel), semismooth Newton on the
-// small interface problem, one final solve per body.
-MethodOutcome run_interface_newton(const ContactSystem& system, const SolverSettings& settings, RunContext& context);
-
-// The same discrete penalty problem solved in one system by a semismooth Newton method (reference solver).
+// The same discrete problem (exact or penalty, per the settings' enforcement) solved in one system: the
+// reference solver (monolithic.cpp).
 MethodOutcome run_monolithic(const ContactSystem& system, const SolverSettings& settings, RunContext& context);
 
 }  // namespace contact::ddm

@@ -1,12 +1,22 @@
-// Reference solver: the same discrete penalty problem as the DDM, all bodies in one system.
-// Unknowns x = (x_1, ..., x_N), the free dofs of every body (u_a = T_a x_a + g_a). The energy
-//   Pi(x) = sum_a (1/2 x_a^T K_a x_a - b_a^T x_a) + sum_q w_q / (2 theta) min(0, g_q(x))^2,
-//   g(x) = d~ + B x  (B, d~ from each pair's G_s, G_m and the prescribed values),
-// is convex and piecewise quadratic; semismooth Newton (active-set) steps with a backtracking line search
-// converge to its minimiser, and the final step on the right active set is exact up to round-off.
+// Reference solver: the same discrete contact problem as the DDM, all bodies in one system. Unknowns x = every
+// body's free dofs (u_a = T_a x_a + g_a); the weighted gaps are affine, g(x) = g0 + B x (B and g0 from each
+// pair's Gs, Gm and the prescribed values).
+//  * penalty: minimise  1/2 x^T K x - b^T x + sum_r 1 / (2 theta D_r) min(0, g_r(x))^2  (convex, piecewise
+//    quadratic) by semismooth Newton steps with a backtracking line search; each step factorises
+//    K + B^T W_A B with CHOLMOD.
+//  * exact: the primal-dual active set on the whole system. On the active set A the constraints g_A(x) = 0 are
+//    eliminated: each active row r fixes one free unknown of its slave node (the component nearest the normal),
+//    x_e = (-g0_r - sum_{l != e} B_rl x_l) / B_re, with the same constraints machinery as hanging nodes, so the
+//    reduced matrix stays symmetric positive definite for CHOLMOD. The pressures follow from the residual,
+//    K x - b = B_A^T z_A (least squares on the rows of A), and A is predicted as {z - c g / D > 0}.
+// Both are independent of the interface machinery (Schur complements, dense active-set solves) that
+// interface Newton uses, which is what makes them a check on it.
 #include "method.hpp"
 
+#include "../fem/constraints.hpp"
+
 #include <Eigen/CholmodSupport>
+#include <Eigen/SparseCholesky>
 
 #include <cmath>
 #include <sstream>
@@ -15,90 +25,255 @@ namespace contact::ddm {
 
 namespace {
 
-struct GlobalPair {
-  Eigen::SparseMatrix<double> B;  // Q x n_total
-  Eigen::VectorXd d;              // d~
-  Eigen::VectorXd w_over_theta;   // w_q / theta
+using SpMat = Eigen::SparseMatrix<double>;
+
+// All bodies stacked: block-diagonal K, right-hand side b, and the contact rows in x.
+struct Stacked {
+  std::vector<Eigen::Index> offset;  // per body, into x
+  SpMat K;
+  Eigen::VectorXd b;
+  std::vector<Eigen::Index> row_offset;  // per pair, into the stacked rows
+  SpMat B;                               // rows x n
+  Eigen::VectorXd g0, D, c;              // per row: weighted gap at x = 0, D, and the active-set scaling
+  std::vector<int> row_pair, row_index;  // per row: its pair and its row in the pair
 };
 
-}  // namespace
-
-MethodOutcome run_monolithic(const ContactSystem& system, const SolverSettings& settings, RunContext& context) {
-  MethodOutcome out;
+Stacked stack(const ContactSystem& system, bool shift_by_multipliers) {
+  Stacked s;
   const size_t n_bodies = system.n_bodies();
-  std::vector<Eigen::Index> offset(n_bodies + 1, 0);
-  for (size_t a = 0; a < n_bodies; ++a) offset[a + 1] = offset[a] + system.body(a).n_free();
-  const Eigen::Index n = offset[n_bodies];
-
-  // Block-diagonal stiffness and right-hand side.
+  s.offset.assign(n_bodies + 1, 0);
+  for (size_t a = 0; a < n_bodies; ++a) s.offset[a + 1] = s.offset[a] + system.body(a).n_free();
+  const Eigen::Index n = s.offset[n_bodies];
   std::vector<Eigen::Triplet<double>> tk;
-  Eigen::VectorXd b(n);
+  s.b.resize(n);
   for (size_t a = 0; a < n_bodies; ++a) {
     const auto& K = system.body(a).reduced_stiffness();
     for (int col = 0; col < K.outerSize(); ++col)
-      for (Eigen::SparseMatrix<double>::InnerIterator it(K, col); it; ++it)
-        tk.emplace_back(offset[a] + it.row(), offset[a] + it.col(), it.value());
-    b.segment(offset[a], system.body(a).n_free()) = system.body(a).reduced_rhs();
+      for (SpMat::InnerIterator it(K, col); it; ++it) tk.emplace_back(s.offset[a] + it.row(), s.offset[a] + it.col(), it.value());
+    s.b.segment(s.offset[a], system.body(a).n_free()) = system.body(a).reduced_rhs();
   }
-  Eigen::SparseMatrix<double> K(n, n);
-  K.setFromTriplets(tk.begin(), tk.end());
+  s.K.resize(n, n);
+  s.K.setFromTriplets(tk.begin(), tk.end());
 
-  // Each pair's gap as an affine function of x.
-  std::vector<GlobalPair> gpairs;
-  for (const auto& pair : system.pairs()) {
-    const size_t s = static_cast<size_t>(pair.slave_body), m = static_cast<size_t>(pair.master_body);
-    const auto& cs = system.body(s).constraints();
-    const auto& cm = system.body(m).constraints();
-    const Eigen::SparseMatrix<double> Bs = pair.Gs * cs.T(), Bm = pair.Gm * cm.T();
-    std::vector<Eigen::Triplet<double>> tb;
-    for (int r = 0; r < Bs.outerSize(); ++r)
-      for (Eigen::SparseMatrix<double>::InnerIterator it(Bs, r); it; ++it) tb.emplace_back(it.row(), offset[s] + it.col(), it.value());
-    for (int r = 0; r < Bm.outerSize(); ++r)
-      for (Eigen::SparseMatrix<double>::InnerIterator it(Bm, r); it; ++it) tb.emplace_back(it.row(), offset[m] + it.col(), -it.value());
-    GlobalPair gp;
-    gp.B.resize(pair.n_points(), n);
-    gp.B.setFromTriplets(tb.begin(), tb.end());
-    gp.d = pair.effective_gap() + pair.Gs * cs.g() - pair.Gm * cm.g();  // shifted by theta lambda under AL
-    gp.w_over_theta = pair.weight / pair.theta;
-    gpairs.push_back(std::move(gp));
+  const auto& pairs = system.pairs();
+  s.row_offset.assign(pairs.size() + 1, 0);
+  for (size_t k = 0; k < pairs.size(); ++k) s.row_offset[k + 1] = s.row_offset[k] + pairs[k].n_rows();
+  const Eigen::Index m = s.row_offset.back();
+  s.g0.resize(m);
+  s.D.resize(m);
+  s.c.resize(m);
+  std::vector<Eigen::Triplet<double>> tb;
+  const Problem& problem = system.problem();
+  const double thickness = problem.model.plane == Plane::stress ? problem.model.thickness : 1.0;
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    const auto& pair = pairs[k];
+    const size_t sb = static_cast<size_t>(pair.slave_body), mb = static_cast<size_t>(pair.master_body);
+    const auto& cs = system.body(sb).constraints();
+    const auto& cm = system.body(mb).constraints();
+    const SpMat Bs = SpMat(pair.Gs) * cs.T(), Bm = SpMat(pair.Gm) * cm.T();
+    for (int col = 0; col < Bs.outerSize(); ++col)
+      for (SpMat::InnerIterator it(Bs, col); it; ++it) tb.emplace_back(s.row_offset[k] + it.row(), s.offset[sb] + it.col(), -it.value());
+    for (int col = 0; col < Bm.outerSize(); ++col)
+      for (SpMat::InnerIterator it(Bm, col); it; ++it) tb.emplace_back(s.row_offset[k] + it.row(), s.offset[mb] + it.col(), it.value());
+    Eigen::VectorXd g0 = pair.gap0 + pair.Gm * cm.g() - pair.Gs * cs.g();
+    if (shift_by_multipliers && pair.multiplier.size() == pair.n_rows())
+      g0 -= pair.theta * pair.area.cwiseProduct(pair.multiplier);  // the augmented Lagrangian's shifted gap
+    s.g0.segment(s.row_offset[k], pair.n_rows()) = g0;
+    s.D.segment(s.row_offset[k], pair.n_rows()) = pair.area;
+    // c = E' / h: a contact node's own stiffness scale (h its support length), for the active-set prediction.
+    const double E = system.penalties()[k].E_pair;
+    for (Eigen::Index r = 0; r < pair.n_rows(); ++r) {
+      s.c[s.row_offset[k] + r] = E / (pair.area[r] / thickness);
+      s.row_pair.push_back(static_cast<int>(k));
+      s.row_index.push_back(static_cast<int>(r));
+    }
   }
+  s.B.resize(m, n);
+  s.B.setFromTriplets(tb.begin(), tb.end());
+  return s;
+}
+
+Displacements to_bodies(const ContactSystem& system, const Stacked& s, const Eigen::VectorXd& x) {
+  Displacements u(system.n_bodies());
+  for (size_t a = 0; a < u.size(); ++a)
+    u[a] = system.body(a).constraints().expand(x.segment(s.offset[a], system.body(a).n_free()));
+  return u;
+}
+
+Pressures split_rows(const ContactSystem& system, const Stacked& s, const Eigen::VectorXd& rows) {
+  Pressures z(system.pairs().size());
+  for (size_t k = 0; k < z.size(); ++k) z[k] = rows.segment(s.row_offset[k], s.row_offset[k + 1] - s.row_offset[k]);
+  return z;
+}
+
+// The free unknown that active row r eliminates: the one of its slave node's components with the larger
+// coefficient (the component nearest the normal). -1 if both are prescribed.
+Eigen::Index eliminated_unknown(const ContactSystem& system, const Stacked& s, Eigen::Index row) {
+  const auto& pair = system.pairs()[static_cast<size_t>(s.row_pair[static_cast<size_t>(row)])];
+  const int r = s.row_index[static_cast<size_t>(row)];
+  const size_t sb = static_cast<size_t>(pair.slave_body);
+  const int node = pair.slave_nodes[static_cast<size_t>(pair.node_of_row[static_cast<size_t>(r)])];
+  const auto& free = system.body(sb).constraints();
+  Eigen::Index best = -1;
+  double best_value = 0;
+  for (int c = 0; c < 2; ++c) {
+    const int dof = 2 * node + c;
+    if (free.is_constrained(dof)) continue;
+    const double v = std::abs(pair.normal[static_cast<size_t>(r)][c]);
+    if (best < 0 || v > best_value) {
+      best_value = v;
+      const auto it = std::lower_bound(free.free_dofs().begin(), free.free_dofs().end(), dof);
+      best = s.offset[sb] + static_cast<Eigen::Index>(it - free.free_dofs().begin());
+    }
+  }
+  return best;
+}
+
+MethodOutcome run_exact(const ContactSystem& system, const SolverSettings& settings, RunContext& context) {
+  MethodOutcome out;
+  const Stacked s = stack(system, false);
+  const Eigen::Index n = s.b.size(), m = s.g0.size();
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> Brows = s.B;
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(n), z = Eigen::VectorXd::Zero(m);
+  std::vector<char> active(static_cast<size_t>(m), 0);
+  bool first = true;
+  std::vector<std::vector<char>> report_active;
+  std::vector<Eigen::VectorXd> zone(system.n_bodies());
+  const int max_steps = std::max(1, settings.max_iterations);
+  for (int k = 1; k <= max_steps; ++k) {
+    if (context.cancel.cancelled()) {
+      out.reason = StopReason::cancelled;
+      out.message = "cancelled";
+      break;
+    }
+    // Constraints x_e = ... for the active rows.
+    fem::Constraints constraints(static_cast<int>(n));
+    std::vector<Eigen::Index> A;
+    for (Eigen::Index r = 0; r < m; ++r) {
+      if (!active[static_cast<size_t>(r)]) continue;
+      const Eigen::Index e = eliminated_unknown(system, s, r);
+      if (e < 0) {
+        out.reason = StopReason::error;
+        out.message = "monolithic: a contact node has both displacement components prescribed";
+        return out;
+      }
+      double pivot = 0;
+      std::vector<std::pair<int, double>> entries;
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Brows, static_cast<int>(r)); it; ++it)
+        if (it.col() == e) pivot = it.value();
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Brows, static_cast<int>(r)); it; ++it)
+        if (it.col() != e) entries.emplace_back(static_cast<int>(it.col()), -it.value() / pivot);
+      constraints.add_line(static_cast<int>(e), std::move(entries), -s.g0[r] / pivot);
+      A.push_back(r);
+    }
+    const std::string error = constraints.close();
+    if (!error.empty()) {
+      out.reason = StopReason::error;
+      out.message = "monolithic: " + error;
+      return out;
+    }
+    const SpMat& T = constraints.T();
+    const SpMat K2 = SpMat(T.transpose() * s.K * T);
+    const Eigen::VectorXd b2 = T.transpose() * (s.b - s.K * constraints.g());
+    Eigen::CholmodDecomposition<SpMat, Eigen::Lower> factor;
+    factor.compute(K2);
+    if (factor.info() != Eigen::Success) {
+      out.reason = StopReason::error;
+      out.message = "monolithic: the constrained system could not be factorised";
+      return out;
+    }
+    x = constraints.expand(factor.solve(b2));
+    // Pressures: K x - b = B_A^T z_A, solved in the least-squares sense on the rows of A.
+    z.setZero();
+    if (!A.empty()) {
+      const Eigen::VectorXd residual = s.K * x - s.b;
+      SpMat BA(static_cast<Eigen::Index>(A.size()), n);
+      std::vector<Eigen::Triplet<double>> t;
+      for (size_t i = 0; i < A.size(); ++i)
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Brows, static_cast<int>(A[i])); it; ++it)
+          t.emplace_back(static_cast<Eigen::Index>(i), it.col(), it.value());
+      BA.setFromTriplets(t.begin(), t.end());
+      Eigen::SimplicialLDLT<SpMat> normal(SpMat(BA * BA.transpose()));
+      const Eigen::VectorXd zA = normal.solve(BA * residual);
+      for (size_t i = 0; i < A.size(); ++i) z[A[i]] = zA[static_cast<Eigen::Index>(i)];
+    }
+    const Eigen::VectorXd g = s.g0 + s.B * x;
+    std::vector<char> next(static_cast<size_t>(m), 0);
+    double c_norm = 0;
+    for (Eigen::Index r = 0; r < m; ++r) {
+      const double predicted = z[r] - s.c[r] * g[r] / s.D[r];
+      next[static_cast<size_t>(r)] = predicted > 0;
+      const double C = z[r] - std::max(0.0, predicted);
+      c_norm += C * C;
+    }
+    const Displacements u = to_bodies(system, s, x);
+    double paper = 0.0;
+    for (size_t a = 0; a < system.n_bodies(); ++a) {
+      const Eigen::VectorXd zn = system.zone_normals(a, u[a]);
+      if (!first) paper = std::max(paper, relative_change(zn, zone[a]));
+      zone[a] = zn;
+    }
+    IterationReport r = system.report(k, u, split_rows(system, s, z), report_active);
+    r.paper_criterion = paper;
+    r.measure = Measure::complementarity;
+    r.complementarity = std::sqrt(c_norm) / std::max(z.norm(), 1e-300);
+    r.active_set_changes = 0;
+    for (Eigen::Index i = 0; i < m; ++i) r.active_set_changes += next[static_cast<size_t>(i)] != active[static_cast<size_t>(i)];
+    r.elapsed_seconds = context.elapsed();
+    context.observer.on_iteration(r);
+    const bool settled = !first && (r.active_set_changes == 0 || r.complementarity <= 1e-12);
+    out.history.push_back(std::move(r));
+    out.iterations = k;
+    first = false;
+    if (settled) {
+      out.converged = true;
+      out.reason = StopReason::converged;
+      std::ostringstream os;
+      os << "monolithic active set settled (" << A.size() << " of " << m << " contact nodes in contact)";
+      out.message = os.str();
+      break;
+    }
+    active = std::move(next);
+    if (k == max_steps) {
+      out.reason = StopReason::max_iterations;
+      out.message = "monolithic: the active set did not settle within max_iterations";
+    }
+  }
+  out.u = to_bodies(system, s, x);
+  out.z = split_rows(system, s, z);
+  return out;
+}
+
+MethodOutcome run_penalty(const ContactSystem& system, const SolverSettings& settings, RunContext& context) {
+  MethodOutcome out;
+  const Stacked s = stack(system, true);
+  const Eigen::Index n = s.b.size();
+  Eigen::VectorXd w_over_theta(s.D.size());  // 1 / (theta D_r): the penalty stiffness of row r
+  for (Eigen::Index r = 0; r < s.D.size(); ++r)
+    w_over_theta[r] = 1.0 / (system.pairs()[static_cast<size_t>(s.row_pair[static_cast<size_t>(r)])].theta * s.D[r]);
 
   auto energy = [&](const Eigen::VectorXd& x) {
-    double e = 0.5 * x.dot(K * x) - b.dot(x);
-    for (const auto& gp : gpairs) {
-      const Eigen::VectorXd g = gp.d + gp.B * x;
-      for (Eigen::Index q = 0; q < g.size(); ++q)
-        if (g[q] < 0) e += 0.5 * gp.w_over_theta[q] * g[q] * g[q];
-    }
+    double e = 0.5 * x.dot(s.K * x) - s.b.dot(x);
+    const Eigen::VectorXd g = s.g0 + s.B * x;
+    for (Eigen::Index r = 0; r < g.size(); ++r)
+      if (g[r] < 0) e += 0.5 * w_over_theta[r] * g[r] * g[r];
     return e;
   };
   auto gradient = [&](const Eigen::VectorXd& x) {
-    Eigen::VectorXd grad = K * x - b;
-    for (const auto& gp : gpairs) {
-      const Eigen::VectorXd g = gp.d + gp.B * x;
-      Eigen::VectorXd f = Eigen::VectorXd::Zero(g.size());
-      for (Eigen::Index q = 0; q < g.size(); ++q)
-        if (g[q] < 0) f[q] = gp.w_over_theta[q] * g[q];
-      grad.noalias() += gp.B.transpose() * f;
-    }
-    return grad;
-  };
-  auto to_bodies = [&](const Eigen::VectorXd& x) {
-    Displacements u(n_bodies);
-    for (size_t a = 0; a < n_bodies; ++a)
-      u[a] = system.body(a).constraints().expand(x.segment(offset[a], system.body(a).n_free()));
-    return u;
+    const Eigen::VectorXd g = s.g0 + s.B * x;
+    const Eigen::VectorXd f = w_over_theta.cwiseProduct(g.cwiseMin(0.0));
+    return Eigen::VectorXd(s.K * x - s.b + s.B.transpose() * f);
   };
 
   Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
   std::vector<std::vector<char>> active_report;
-  std::vector<Eigen::VectorXd> zone(n_bodies);
+  std::vector<Eigen::VectorXd> zone(system.n_bodies());
   {
-    const Displacements u0 = to_bodies(x);
-    for (size_t a = 0; a < n_bodies; ++a) zone[a] = system.zone_normals(a, u0[a]);
+    const Displacements u0 = to_bodies(system, s, x);
+    for (size_t a = 0; a < system.n_bodies(); ++a) zone[a] = system.zone_normals(a, u0[a]);
   }
-  const double b_norm = std::max(b.norm(), 1e-300);
-  Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> factor;
+  const double b_norm = std::max(s.b.norm(), 1e-300);
+  Eigen::CholmodDecomposition<SpMat, Eigen::Lower> factor;
   const int max_newton = std::max(settings.max_iterations, 1);
   for (int k = 1; k <= max_newton; ++k) {
     if (context.cancel.cancelled()) {
@@ -106,15 +281,12 @@ MethodOutcome run_monolithic(const ContactSystem& system, const SolverSettings& 
       out.message = "cancelled";
       break;
     }
-    // Newton matrix on the current active set: K + sum B^T W_A B / theta.
-    Eigen::SparseMatrix<double> H = K;
-    for (const auto& gp : gpairs) {
-      const Eigen::VectorXd g = gp.d + gp.B * x;
-      Eigen::VectorXd w = Eigen::VectorXd::Zero(g.size());
-      for (Eigen::Index q = 0; q < g.size(); ++q)
-        if (g[q] < 0) w[q] = gp.w_over_theta[q];
-      H += Eigen::SparseMatrix<double>(gp.B.transpose() * w.asDiagonal() * gp.B);
-    }
+    // Newton matrix on the current active set: K + B^T W_A B.
+    const Eigen::VectorXd g = s.g0 + s.B * x;
+    Eigen::VectorXd wa = Eigen::VectorXd::Zero(g.size());
+    for (Eigen::Index r = 0; r < g.size(); ++r)
+      if (g[r] < 0) wa[r] = w_over_theta[r];
+    const SpMat H = s.K + SpMat(s.B.transpose() * wa.asDiagonal() * s.B);
     const Eigen::VectorXd grad = gradient(x);
     factor.compute(H);
     if (factor.info() != Eigen::Success) {
@@ -132,20 +304,20 @@ MethodOutcome run_monolithic(const ContactSystem& system, const SolverSettings& 
       x_new = x + alpha * step;
     }
     x = x_new;
-    const Displacements u = to_bodies(x);
+    const Displacements u = to_bodies(system, s, x);
     double paper = 0.0;
-    for (size_t a = 0; a < n_bodies; ++a) {
-      const Eigen::VectorXd z = system.zone_normals(a, u[a]);
-      paper = std::max(paper, relative_change(z, zone[a]));
-      zone[a] = z;
+    for (size_t a = 0; a < system.n_bodies(); ++a) {
+      const Eigen::VectorXd zn = system.zone_normals(a, u[a]);
+      paper = std::max(paper, relative_change(zn, zone[a]));
+      zone[a] = zn;
     }
     const double residual = gradient(x).norm() / b_norm;
     IterationReport r = system.report(k, u, active_report);
     r.paper_criterion = paper;
+    r.measure = Measure::gradient;
     r.fixed_point_residual = residual;  // for Newton: the relative norm of the energy gradient
     r.elapsed_seconds = context.elapsed();
-    int changed = 0;
-    for (const auto& p : r.pairs) changed += p.changed_points;
+    const int changed = r.active_set_changes;
     context.observer.on_iteration(r);
     out.history.push_back(std::move(r));
     out.iterations = k;
@@ -154,7 +326,7 @@ MethodOutcome run_monolithic(const ContactSystem& system, const SolverSettings& 
       out.converged = true;
       out.reason = StopReason::converged;
       std::ostringstream os;
-      os << "Newton converged in " << k << " steps (active set unchanged, gradient " << residual << ")";
+      os << "Newton converged (active set unchanged, gradient " << residual << ")";
       out.message = os.str();
       break;
     }
@@ -163,8 +335,15 @@ MethodOutcome run_monolithic(const ContactSystem& system, const SolverSettings& 
       out.message = "monolithic: Newton did not settle within max_iterations";
     }
   }
-  out.u = to_bodies(x);
+  out.u = to_bodies(system, s, x);
   return out;
+}
+
+}  // namespace
+
+MethodOutcome run_monolithic(const ContactSystem& system, const SolverSettings& settings, RunContext& context) {
+  if (settings.enforcement == Enforcement::exact) return run_exact(system, settings, context);
+  return run_penalty(system, settings, context);
 }
 
 }  // namespace contact::ddm

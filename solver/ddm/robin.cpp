@@ -1,7 +1,8 @@
 // The Robin-type variant (ALGORITHM.md, "Robin-type variants"; reconstructed from the authors' later papers):
 //   a_a(u~_a, v) + int psi u~_an v_n = l_a(v) + int psi u_an^k v_n + (1/theta) int (d - u_1n^k - u_2n^k)^- v_n,
 // then the same relaxation as the Neumann scheme. psi = 0 is the paper's scheme. Discretely the Robin term is
-// Psi_a = sum over the pairs of body a of G_a^T diag(psi_q w_q) G_a (G_a = G_s or G_m), added to the stiffness.
+// Psi_a = sum over the pairs of body a of G_a^T diag(psi_r / D_r) G_a (G_a = G_s or G_m: the penalty's own
+// stiffness when psi = 1/theta), added to the stiffness.
 // With a constant psi each body is factorised once; with psi = 1/theta on the current active set ("active_set")
 // a body is refactorised only when the active set of one of its pairs changes.
 #include "fixed_point.hpp"
@@ -15,7 +16,7 @@ namespace contact::ddm {
 
 namespace {
 
-using Factor = Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower>;
+using Factor = Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower>;  // refactorised often
 
 class RobinMap final : public BodyMap {
  public:
@@ -64,10 +65,10 @@ class RobinMap final : public BodyMap {
     std::vector<char> changed(system_.n_bodies(), 0);
     for (size_t k = 0; k < pairs.size(); ++k) {
       const auto& pair = pairs[k];
-      std::vector<char> now(static_cast<size_t>(pair.n_points()), 1);
+      std::vector<char> now(static_cast<size_t>(pair.n_rows()), 1);
       if (settings_.robin.active_set && !all_active) {
-        const Eigen::VectorXd p = pair.pressure(pair.normal_gap(u[static_cast<size_t>(pair.slave_body)],
-                                                               u[static_cast<size_t>(pair.master_body)]));
+        const Eigen::VectorXd p = pair.penalty_pressure(pair.nodal_gap(u[static_cast<size_t>(pair.slave_body)],
+                                                                       u[static_cast<size_t>(pair.master_body)]));
         for (Eigen::Index q = 0; q < p.size(); ++q) now[static_cast<size_t>(q)] = p[q] > 0 ? 1 : 0;
       }
       if (now != active_[k] || !factor_[static_cast<size_t>(pair.slave_body)]) {
@@ -96,10 +97,10 @@ class RobinMap final : public BodyMap {
       const auto& pair = system_.pairs()[k];
       const bool slave = static_cast<size_t>(pair.slave_body) == a, master = static_cast<size_t>(pair.master_body) == a;
       if (!slave && !master) continue;
-      Eigen::VectorXd w = Eigen::VectorXd::Zero(pair.n_points());
+      Eigen::VectorXd w = Eigen::VectorXd::Zero(pair.n_rows());
       for (Eigen::Index q = 0; q < w.size(); ++q)
         if (active_[k][static_cast<size_t>(q)])
-          w[q] = pair.weight[q] * (settings_.robin.active_set ? 1.0 / pair.theta : settings_.robin.psi);
+          w[q] = (settings_.robin.active_set ? 1.0 / pair.theta : settings_.robin.psi) / pair.area[q];
       const auto& G = slave ? pair.Gs : pair.Gm;
       Psi += Eigen::SparseMatrix<double>(G.transpose() * w.asDiagonal() * G);
     }

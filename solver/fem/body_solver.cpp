@@ -14,8 +14,11 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }
 }  // namespace
 
-BodySolver::BodySolver(const Body& body, const Model& model, bool factorize_now)
-    : body_(body), elasticity_(make_elasticity(body.material, model)), constraints_(2 * body.mesh.num_nodes()) {
+BodySolver::BodySolver(const Body& body, const Model& model, bool factorize_now, const std::vector<int>& interface_dofs)
+    : body_(body),
+      elasticity_(make_elasticity(body.material, model)),
+      constraints_(2 * body.mesh.num_nodes()),
+      interface_dofs_(interface_dofs) {
   const auto t0 = std::chrono::steady_clock::now();
   setup_constraints();
   if (!ok()) return;
@@ -104,19 +107,39 @@ void BodySolver::assemble_system() {
   rhs_base_ = T.transpose() * (f_ext_ - K_ * constraints_.g());
 }
 
+std::vector<int> BodySolver::interface_unknowns_of(const std::vector<int>& dofs) const {
+  // The free unknowns x_k with T(dof, k) != 0 for some interface dof (a prescribed dof depends on none).
+  std::vector<char> used(static_cast<size_t>(n_free()), 0);
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> rows = constraints_.T();
+  for (int dof : dofs)
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(rows, dof); it; ++it) used[static_cast<size_t>(it.col())] = 1;
+  std::vector<int> out;
+  for (int k = 0; k < n_free(); ++k)
+    if (used[static_cast<size_t>(k)]) out.push_back(k);
+  return out;
+}
+
 void BodySolver::factorize() {
   const auto t0 = std::chrono::steady_clock::now();
   if (n_free() == 0) return;  // everything prescribed: nothing to factorise
-  factor_ = std::make_unique<Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower>>();
-  factor_->compute(K_red_);
+  factor_ = std::make_unique<Cholesky>(K_red_, interface_unknowns_of(interface_dofs_));
   factorization_seconds_ = seconds_since(t0);
-  if (factor_->info() != Eigen::Success) {
+  if (!factor_->ok()) {
     std::ostringstream os;
-    os << "body '" << body_.name << "': the stiffness matrix (" << n_free()
-       << " unknowns) could not be factorised: it is singular or not positive definite"
-       << " (is the body restrained against rigid motion by its displacement conditions?)";
+    os << "body '" << body_.name << "': the stiffness matrix (" << n_free() << " unknowns) could not be factorised: "
+       << factor_->error() << " (is the body restrained against rigid motion by its displacement conditions?)";
     error_ = os.str();
   }
+}
+
+const std::vector<int>& BodySolver::interface_unknowns() const {
+  static const std::vector<int> none;
+  return factor_ ? factor_->trailing_order() : none;
+}
+
+const Eigen::MatrixXd& BodySolver::interface_factor() const {
+  static const Eigen::MatrixXd none;
+  return factor_ ? factor_->trailing_factor() : none;
 }
 
 Eigen::VectorXd BodySolver::solve_reduced(const Eigen::VectorXd& reduced_rhs) const {

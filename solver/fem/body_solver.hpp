@@ -6,10 +6,10 @@
 #pragma once
 
 #include "../problem.hpp"
+#include "cholesky.hpp"
 #include "constraints.hpp"
 #include "elasticity.hpp"
 
-#include <Eigen/CholmodSupport>
 #include <Eigen/SparseCore>
 
 #include <memory>
@@ -28,7 +28,10 @@ class BodySolver {
   // Sets up constraints, assembles and factorises. Never throws for a singular or indefinite matrix: check
   // ok() and error().
   // With factorize = false only assembly is done (for methods that factorise a coupled system instead).
-  BodySolver(const Body& body, const Model& model, bool factorize = true);
+  // interface_dofs (full dof numbers, e.g. the contact edges' dofs that contact forces act on): the free unknowns
+  // they depend on are ordered last in the factorisation, so that interface_factor() holds the Cholesky factor of
+  // the Schur complement on them (fem/cholesky.hpp).
+  BodySolver(const Body& body, const Model& model, bool factorize = true, const std::vector<int>& interface_dofs = {});
 
   bool ok() const { return error_.empty(); }
   const std::string& error() const { return error_; }
@@ -59,6 +62,15 @@ class BodySolver {
   const Eigen::VectorXd& external_load() const { return f_ext_; }               // all dofs
   const Eigen::VectorXd& reduced_rhs() const { return rhs_base_; }              // T^T (f_ext - K g)
   const Elasticity& elasticity() const { return elasticity_; }
+  // The free unknowns behind the interface dofs, in the order of the rows of interface_factor(), and the
+  // lower-triangular L_ZZ with L_ZZ L_ZZ^T = the Schur complement of the reduced stiffness on them (both empty
+  // without interface dofs). The full dofs the constructor was given are kept to tell whether a new interface
+  // needs a new factorisation.
+  const std::vector<int>& interface_unknowns() const;
+  const Eigen::MatrixXd& interface_factor() const;
+  const std::vector<int>& interface_dofs() const { return interface_dofs_; }
+  // Numbers stored in the Cholesky factor (its memory is 8 bytes each, plus the integer pattern).
+  double factor_entries() const { return factor_ ? factor_->factor_entries() : 0.0; }
   double factorization_seconds() const { return factorization_seconds_; }
   double assembly_seconds() const { return assembly_seconds_; }
 
@@ -66,13 +78,15 @@ class BodySolver {
   void setup_constraints();
   void assemble_system();
   void factorize();
+  std::vector<int> interface_unknowns_of(const std::vector<int>& dofs) const;
 
   const Body& body_;
   Elasticity elasticity_;
   Constraints constraints_;
   Eigen::SparseMatrix<double> K_, K_red_;
   Eigen::VectorXd f_ext_, rhs_base_;
-  std::unique_ptr<Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower>> factor_;
+  std::vector<int> interface_dofs_;
+  std::unique_ptr<Cholesky> factor_;
   std::string error_;
   double factorization_seconds_ = 0.0, assembly_seconds_ = 0.0;
 };

@@ -76,6 +76,7 @@ void read_input_and_provenance(hid_t file, ResultFile& r) {
   p.build_type = h5::read_string_attribute(prov, "build_type");
   p.host = h5::read_string_attribute(prov, "host");
   p.method = h5::read_string_attribute(prov, "method");
+  p.enforcement = h5::read_string_attribute(prov, "enforcement");
   p.gamma = h5::read_attribute<double>(prov, "gamma");
   p.setup_seconds = h5::read_attribute<double>(prov, "setup_seconds");
   p.factorization_seconds = h5::read_attribute<double>(prov, "factorization_seconds");
@@ -94,8 +95,13 @@ void read_history(hid_t file, ResultFile& r) {
     const auto nb = static_cast<Eigen::Index>(h.body_names.size());
     const auto np = static_cast<Eigen::Index>(h.pair_names.size());
     h.iteration = h5::read_vector<int>(g, "iteration");
+    h.update = h5::read_vector<int>(g, "update");
+    h.measure = h5::read_strings_dataset(g, "measure");
+    h.active_nodes_total = h5::read_vector<int>(g, "active_nodes_total");
+    h.active_set_changes = h5::read_vector<int>(g, "active_set_changes");
     h.paper_criterion = h5::read_vector<double>(g, "paper_criterion");
     h.fixed_point_residual = h5::read_vector<double>(g, "fixed_point_residual");
+    h.complementarity = h5::read_vector<double>(g, "complementarity");
     h.elapsed_seconds = h5::read_vector<double>(g, "elapsed_seconds");
     h.elements = read_matrix<int>(g, "elements", nb);
     h.dofs = read_matrix<int>(g, "dofs", nb);
@@ -104,9 +110,10 @@ void read_history(hid_t file, ResultFile& r) {
     h.max_pressure = read_matrix<double>(g, "max_pressure", np);
     h.extent_begin = read_matrix<double>(g, "extent_begin", np);
     h.extent_end = read_matrix<double>(g, "extent_end", np);
-    h.active_points = read_matrix<int>(g, "active_points", np);
-    h.changed_points = read_matrix<int>(g, "changed_points", np);
+    h.active_nodes = read_matrix<int>(g, "active_nodes", np);
+    h.changed_nodes = read_matrix<int>(g, "changed_nodes", np);
     h.theta = read_matrix<double>(g, "theta", np);
+    h.max_penetration = read_matrix<double>(g, "max_penetration", np);
   }
   {
     Handle g = h5::open_group(history, "steps");
@@ -147,15 +154,20 @@ PairField read_pair(hid_t contacts, const std::string& name) {
   p.slave_edge = h5::read_string_attribute(g, "slave_edge");
   p.master_body = h5::read_string_attribute(g, "master_body");
   p.master_edge = h5::read_string_attribute(g, "master_edge");
+  p.enforcement = h5::read_string_attribute(g, "enforcement");
   p.theta = h5::read_attribute<double>(g, "theta");
   p.force = h5::read_attribute<double>(g, "force");
+  p.node = read_column<int>(g, "node");
   p.position = read_matrix<double>(g, "position", 2);
+  p.normal = read_matrix<double>(g, "normal", 2);
   p.arc_length = read_column<double>(g, "arc_length");
+  p.weight = read_column<double>(g, "weight");
   p.gap = read_column<double>(g, "gap");
   p.normal_gap = read_column<double>(g, "normal_gap");
   p.pressure = read_column<double>(g, "pressure");
   p.penetration = read_column<double>(g, "penetration");
   p.active = read_column<int>(g, "active");
+  p.status = read_column<int>(g, "status");
   return p;
 }
 

@@ -21,7 +21,7 @@
 namespace contact::io {
 
 inline constexpr const char* kFormatName = "contact-ddm-result";
-inline constexpr int kFormatVersion = 1;
+inline constexpr int kFormatVersion = 2;  // 2: mortar contact (per-node multipliers, contact surfaces)
 
 struct WriteInfo {
   std::string job_id;   // "" for the CLI
@@ -50,7 +50,7 @@ std::string xdmf_path_for(const std::string& hdf_path);
 // What read_result returns: the file's contents in the solver's own types where one exists.
 
 struct Provenance {
-  std::string solver_version, compiler, build_type, host, method;
+  std::string solver_version, compiler, build_type, host, method, enforcement;
   double gamma = 0.0;
   double setup_seconds = 0.0, factorization_seconds = 0.0, wall_seconds = 0.0;
   std::vector<std::string> pair_names;  // of the final step
@@ -60,11 +60,12 @@ struct Provenance {
 // /history/iterations: one row per IterationReport. Matrices are n_iterations x n_bodies or x n_pairs.
 struct IterationHistory {
   std::vector<std::string> body_names, pair_names;
-  std::vector<int> iteration;
-  std::vector<double> paper_criterion, fixed_point_residual, elapsed_seconds;
+  std::vector<int> iteration, update, active_nodes_total, active_set_changes;
+  std::vector<std::string> measure;  // per row: "fixed_point", "complementarity" or "gradient"
+  std::vector<double> paper_criterion, fixed_point_residual, complementarity, elapsed_seconds;
   Eigen::MatrixXi elements, dofs, elements_refined;
-  Eigen::MatrixXd force, max_pressure, extent_begin, extent_end, theta;
-  Eigen::MatrixXi active_points, changed_points;
+  Eigen::MatrixXd force, max_pressure, extent_begin, extent_end, theta, max_penetration;
+  Eigen::MatrixXi active_nodes, changed_nodes;
 };
 
 // /history/steps: one row per adaptive step. dofs = 2 x nodes (see the format document).
@@ -81,7 +82,8 @@ struct StringStorage {
   std::string padding;   // "nullpad", "nullterm" or "spacepad" (fixed-length only)
 };
 
-// /VTKHDF as stored (one partition per body of the final step). `present` is false when the file has no steps.
+// /VTKHDF as stored (one partition per body, then one per contact pair, of the final step). `present` is false
+// when the file has no steps.
 struct VtkHdf {
   bool present = false;
   std::vector<std::int64_t> version;

@@ -4,6 +4,8 @@
 #include "../solve.hpp"
 #include "file_util.hpp"
 #include "h5.hpp"
+#include "h5_eigen.hpp"
+#include "vtkhdf.hpp"
 
 #include <cmath>
 #include <limits>
@@ -14,6 +16,8 @@ namespace contact::io {
 namespace {
 
 using h5::Handle;
+using h5::write_column;
+using h5::write_matrix;
 
 const char* compiler_name() {
 #if defined(__clang__)
@@ -47,34 +51,6 @@ void check_link_name(const std::string& kind, const std::string& name) {
 void check_rows(const std::string& what, Eigen::Index rows, Eigen::Index expected) {
   if (rows != expected && rows != 0)
     throw std::runtime_error(what + " has " + rows_text(rows) + " rows, expected " + rows_text(expected) + " (or 0)");
-}
-
-// Any Eigen matrix (either storage order) as a rows x cols dataset in HDF5's row-major order.
-template <class Derived>
-void write_matrix(hid_t loc, const std::string& name, const Eigen::MatrixBase<Derived>& m) {
-  using T = typename Derived::Scalar;
-  const auto rows = static_cast<size_t>(m.rows());
-  const auto cols = static_cast<size_t>(m.cols());
-  std::vector<T> data(rows * cols);
-  for (size_t r = 0; r < rows; ++r)
-    for (size_t c = 0; c < cols; ++c)
-      data[r * cols + c] = m(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c));
-  h5::write_dataset(loc, name, data, {static_cast<hsize_t>(rows), static_cast<hsize_t>(cols)});
-}
-
-template <class Derived>
-void write_column(hid_t loc, const std::string& name, const Eigen::MatrixBase<Derived>& v) {
-  using T = typename Derived::Scalar;
-  std::vector<T> data(static_cast<size_t>(v.size()));
-  for (Eigen::Index k = 0; k < v.size(); ++k) data[static_cast<size_t>(k)] = v(k);
-  h5::write_vector(loc, name, data);
-}
-
-// A row-major n x 3 copy of an n x 2 field with a zero third column (VTK's vectors are 3-D).
-Eigen::MatrixX3d with_zero_z(const Eigen::MatrixX2d& m) {
-  Eigen::MatrixX3d out = Eigen::MatrixX3d::Zero(m.rows(), 3);
-  out.leftCols<2>() = m;
-  return out;
 }
 
 // ---- root, input, provenance --------------------------------------------------------------------------
@@ -112,6 +88,7 @@ void write_provenance(hid_t file, const Result& result, const WriteInfo& info) {
   h5::write_attribute(prov, "build_type", build_type());
   h5::write_attribute(prov, "host", info.host);
   h5::write_attribute(prov, "method", result.method);
+  h5::write_attribute(prov, "enforcement", result.enforcement);
   h5::write_attribute<double>(prov, "gamma", result.gamma);
   h5::write_attribute<double>(prov, "setup_seconds", result.setup_seconds);
   h5::write_attribute<double>(prov, "factorization_seconds", result.factorization_seconds);
@@ -147,10 +124,12 @@ void write_iteration_history(hid_t history, const Problem& problem, const Result
   const auto nb = static_cast<Eigen::Index>(body_names.size());
   const auto np = static_cast<Eigen::Index>(pair_names.size());
 
-  std::vector<std::int32_t> iteration;
-  std::vector<double> paper, residual, elapsed;
+  std::vector<std::int32_t> iteration, update, active_total, changes;
+  std::vector<std::string> measure;
+  std::vector<double> paper, residual, complementarity, elapsed;
   Eigen::MatrixXi elements(n, nb), dofs(n, nb), refined(n, nb), active(n, np), changed(n, np);
-  Eigen::MatrixXd force(n, np), max_pressure(n, np), extent_begin(n, np), extent_end(n, np), theta(n, np);
+  Eigen::MatrixXd force(n, np), max_pressure(n, np), extent_begin(n, np), extent_end(n, np), theta(n, np),
+      penetration(n, np);
   for (Eigen::Index i = 0; i < n; ++i) {
     const IterationReport& r = rows[static_cast<size_t>(i)];
     if (static_cast<Eigen::Index>(r.bodies.size()) != nb || static_cast<Eigen::Index>(r.pairs.size()) != np)
@@ -159,8 +138,13 @@ void write_iteration_history(hid_t history, const Problem& problem, const Result
                                std::to_string(r.pairs.size()) + " pairs; the first row has " + rows_text(nb) +
                                " and " + rows_text(np));
     iteration.push_back(r.iteration);
+    measure.push_back(to_string(r.measure));
+    update.push_back(r.update);
+    active_total.push_back(r.active_nodes);
+    changes.push_back(r.active_set_changes);
     paper.push_back(r.paper_criterion);
     residual.push_back(r.fixed_point_residual);
+    complementarity.push_back(r.complementarity);
     elapsed.push_back(r.elapsed_seconds);
     for (Eigen::Index b = 0; b < nb; ++b) {
       const BodyReport& body = r.bodies[static_cast<size_t>(b)];
@@ -174,16 +158,22 @@ void write_iteration_history(hid_t history, const Problem& problem, const Result
       max_pressure(i, p) = pair.max_pressure;
       extent_begin(i, p) = pair.extent_begin;
       extent_end(i, p) = pair.extent_end;
-      active(i, p) = pair.active_points;
-      changed(i, p) = pair.changed_points;
+      active(i, p) = pair.active_nodes;
+      changed(i, p) = pair.changed_nodes;
       theta(i, p) = pair.theta;
+      penetration(i, p) = pair.max_penetration;
     }
   }
   h5::write_attribute(g, "body_names", body_names);
   h5::write_attribute(g, "pair_names", pair_names);
   h5::write_vector(g, "iteration", iteration);
+  h5::write_vector(g, "update", update);
+  h5::write_strings_dataset(g, "measure", measure);
   h5::write_vector(g, "paper_criterion", paper);
   h5::write_vector(g, "fixed_point_residual", residual);
+  h5::write_vector(g, "complementarity", complementarity);
+  h5::write_vector(g, "active_nodes_total", active_total);
+  h5::write_vector(g, "active_set_changes", changes);
   h5::write_vector(g, "elapsed_seconds", elapsed);
   write_matrix(g, "elements", elements);
   write_matrix(g, "dofs", dofs);
@@ -192,9 +182,10 @@ void write_iteration_history(hid_t history, const Problem& problem, const Result
   write_matrix(g, "max_pressure", max_pressure);
   write_matrix(g, "extent_begin", extent_begin);
   write_matrix(g, "extent_end", extent_end);
-  write_matrix(g, "active_points", active);
-  write_matrix(g, "changed_points", changed);
+  write_matrix(g, "active_nodes", active);
+  write_matrix(g, "changed_nodes", changed);
   write_matrix(g, "theta", theta);
+  write_matrix(g, "max_penetration", penetration);
 }
 
 std::vector<std::string> body_names_of(const Step& s) {
@@ -280,27 +271,40 @@ void write_pair(hid_t contacts, const PairField& p, const std::string& where) {
     if (rows != n)
       throw std::runtime_error(at + what + " has " + rows_text(rows) + " rows, position has " + rows_text(n));
   };
+  same("node", p.node.rows());
+  same("normal", p.normal.rows());
   same("arc_length", p.arc_length.rows());
+  same("weight", p.weight.rows());
   same("gap", p.gap.rows());
   same("normal_gap", p.normal_gap.rows());
   same("pressure", p.pressure.rows());
   same("penetration", p.penetration.rows());
   same("active", p.active.rows());
+  same("status", p.status.rows());
 
   Handle g = h5::create_group(contacts, p.name);
   h5::write_attribute(g, "slave_body", p.slave_body);
   h5::write_attribute(g, "slave_edge", p.slave_edge);
   h5::write_attribute(g, "master_body", p.master_body);
   h5::write_attribute(g, "master_edge", p.master_edge);
+  h5::write_attribute(g, "enforcement", p.enforcement);
   h5::write_attribute<double>(g, "theta", p.theta);
   h5::write_attribute<double>(g, "force", p.force);
+  write_column(g, "node", p.node.cast<std::int64_t>().eval());
   write_matrix(g, "position", p.position);
+  write_matrix(g, "normal", p.normal);
   write_column(g, "arc_length", p.arc_length);
+  write_column(g, "weight", p.weight);
   write_column(g, "gap", p.gap);
   write_column(g, "normal_gap", p.normal_gap);
   write_column(g, "pressure", p.pressure);
   write_column(g, "penetration", p.penetration);
   write_column(g, "active", p.active.cast<std::int8_t>().eval());
+  write_column(g, "status", p.status.cast<std::int8_t>().eval());
+  // The slave polyline as line cells (rows of position), for the XDMF view of the contact surface.
+  Eigen::Matrix<std::int64_t, Eigen::Dynamic, 2> segments(std::max<Eigen::Index>(n - 1, 0), 2);
+  for (Eigen::Index j = 0; j + 1 < n; ++j) segments.row(j) << j, j + 1;
+  write_matrix(g, "segments", segments);
 }
 
 void write_steps(hid_t file, const Result& result) {
@@ -318,88 +322,6 @@ void write_steps(hid_t file, const Result& result) {
     Handle contacts = h5::create_group(g, "contacts");
     for (const auto& p : s.pairs) write_pair(contacts, p, where);
   }
-}
-
-// ---- VTKHDF -------------------------------------------------------------------------------------------
-
-// The final step as a VTKHDF 1.0 UnstructuredGrid with one partition per body: the per-partition counts are
-// NumberOf*, and Points, Connectivity, Offsets, Types and the data arrays are the partitions' arrays one after
-// the other, with Connectivity holding partition-local point ids and each partition's Offsets starting at 0.
-void write_vtkhdf(hid_t file, const Step& last) {
-  Handle v = h5::create_group(file, "VTKHDF");
-  h5::write_attribute_array<std::int64_t>(v, "Version", {1, 0});
-  // ParaView 5.11 compares the whole stored string: 16 bytes, no terminator counted.
-  h5::write_fixed_string_attribute(v, "Type", "UnstructuredGrid");
-
-  std::vector<std::int64_t> n_points, n_cells, n_ids, connectivity, offsets;
-  std::vector<std::uint8_t> types;
-  std::vector<std::int32_t> body_id, level;
-  Eigen::Index total_points = 0, total_cells = 0;
-  bool all_displacement = true, all_stress_node = true, all_reaction = true, all_stress_cell = true,
-       all_von_mises = true, any_indicator = false;
-  for (const auto& b : last.bodies) {
-    total_points += b.mesh.num_nodes();
-    total_cells += b.mesh.num_cells();
-    all_displacement = all_displacement && b.displacement.rows() > 0;
-    all_stress_node = all_stress_node && b.stress_node.rows() > 0;
-    all_reaction = all_reaction && b.reaction.rows() > 0;
-    all_stress_cell = all_stress_cell && b.stress_cell.rows() > 0;
-    all_von_mises = all_von_mises && b.von_mises_cell.rows() > 0;
-    any_indicator = any_indicator || b.indicator_cell.rows() > 0;
-  }
-  Eigen::MatrixX3d points(total_points, 3), displacement(total_points, 3), reaction(total_points, 3);
-  Eigen::MatrixX4d stress_node(total_points, 4), stress_cell(total_cells, 4);
-  Eigen::VectorXd von_mises(total_cells), indicator(total_cells);
-  Eigen::Index p0 = 0, c0 = 0;
-  for (size_t id = 0; id < last.bodies.size(); ++id) {
-    const BodyField& b = last.bodies[id];
-    const mesh::Mesh& m = b.mesh;
-    const Eigen::Index n = m.num_nodes(), c = m.num_cells();
-    n_points.push_back(n);
-    n_cells.push_back(c);
-    n_ids.push_back(4 * c);
-    for (Eigen::Index i = 0; i < n; ++i)
-      points.row(p0 + i) << m.nodes[static_cast<size_t>(i)].x(), m.nodes[static_cast<size_t>(i)].y(), 0.0;
-    offsets.push_back(0);
-    for (Eigen::Index e = 0; e < c; ++e) {
-      for (int node : m.cells[static_cast<size_t>(e)]) connectivity.push_back(node);
-      offsets.push_back(4 * (e + 1));
-      types.push_back(9);  // VTK_QUAD
-      body_id.push_back(static_cast<std::int32_t>(id));
-      level.push_back(m.level.empty() ? 0 : m.level[static_cast<size_t>(e)]);
-    }
-    if (all_displacement) displacement.middleRows(p0, n) = with_zero_z(b.displacement);
-    if (all_reaction) reaction.middleRows(p0, n) = with_zero_z(b.reaction);
-    if (all_stress_node) stress_node.middleRows(p0, n) = b.stress_node;
-    if (all_stress_cell) stress_cell.middleRows(c0, c) = b.stress_cell;
-    if (all_von_mises) von_mises.segment(c0, c) = b.von_mises_cell;
-    if (any_indicator) {
-      if (b.indicator_cell.rows() > 0)
-        indicator.segment(c0, c) = b.indicator_cell;
-      else
-        indicator.segment(c0, c).setConstant(std::numeric_limits<double>::quiet_NaN());
-    }
-    p0 += n;
-    c0 += c;
-  }
-  h5::write_vector(v, "NumberOfPoints", n_points);
-  h5::write_vector(v, "NumberOfCells", n_cells);
-  h5::write_vector(v, "NumberOfConnectivityIds", n_ids);
-  write_matrix(v, "Points", points);
-  h5::write_vector(v, "Connectivity", connectivity);
-  h5::write_vector(v, "Offsets", offsets);
-  h5::write_vector(v, "Types", types);
-
-  Handle pd = h5::create_group(v, "PointData");
-  if (all_displacement) write_matrix(pd, "displacement", displacement);
-  if (all_stress_node) write_matrix(pd, "stress", stress_node);
-  if (all_reaction) write_matrix(pd, "reaction", reaction);
-  Handle cd = h5::create_group(v, "CellData");
-  if (all_stress_cell) write_matrix(cd, "stress", stress_cell);
-  if (all_von_mises) write_column(cd, "von_mises", von_mises);
-  if (any_indicator) write_column(cd, "indicator", indicator);
-  h5::write_vector(cd, "body_id", body_id);
-  h5::write_vector(cd, "level", level);
 }
 
 void write_contents(hid_t file, const Problem& problem, const Result& result, const WriteInfo& info) {

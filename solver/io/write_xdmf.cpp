@@ -1,4 +1,5 @@
-// write_xdmf: the XDMF 3 sidecar that lets ParaView step through /steps/<k> of a result file.
+// write_xdmf: the XDMF 3 sidecar that lets ParaView step through /steps/<k> of a result file: per step one grid
+// per body and one per contact pair (the slave polyline with pressure, gap and active).
 //
 // Every attribute references a stored dataset whole: XDMF has no 2-component "Vector" (it means 3), so the
 // multi-component arrays are declared "Matrix" (rows x components), which both of ParaView 5.11's XDMF readers
@@ -78,6 +79,25 @@ struct Writer {
     if (b.indicator_cell.rows() == c) attribute(in, "indicator", "Cell", base + "/indicator", c, 0);
     out << "      </Grid>\n";
   }
+
+  // The contact surface of one pair: its slave polyline with the nodal pressure, gap and active flag.
+  void pair(const std::string& step_path, const PairField& p) {
+    const Eigen::Index n = p.position.rows();
+    if (n < 2) return;
+    const std::string base = step_path + "/contacts/" + p.name;
+    const std::string in = "        ";
+    out << "      <Grid Name=\"" << xml_escape(p.name) << "\" GridType=\"Uniform\">\n";
+    out << in << "<Topology TopologyType=\"Polyline\" NodesPerElement=\"2\" NumberOfElements=\"" << n - 1 << "\">\n";
+    data_item(in + "  ", base + "/segments", n - 1, 2, "Int", 8);
+    out << in << "</Topology>\n";
+    out << in << "<Geometry GeometryType=\"XY\">\n";
+    data_item(in + "  ", base + "/position", n, 2, "Float", 8);
+    out << in << "</Geometry>\n";
+    attribute(in, "pressure", "Node", base + "/pressure", n, 0);
+    attribute(in, "gap", "Node", base + "/normal_gap", n, 0);
+    attribute(in, "active", "Node", base + "/active", n, 0, "Int", 1);
+    out << "      </Grid>\n";
+  }
 };
 
 }  // namespace
@@ -102,6 +122,7 @@ void write_xdmf(const std::string& xmf_path, const std::string& hdf_file_name, c
     out << "    <Grid Name=\"step " << k << "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n"
         << "      <Time Value=\"" << k << "\"/>\n";
     for (const auto& b : s.bodies) w.body("/steps/" + std::to_string(k), b);
+    for (const auto& p : s.pairs) w.pair("/steps/" + std::to_string(k), p);
     out << "    </Grid>\n";
   }
   out << "    </Grid>\n"

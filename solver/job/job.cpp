@@ -159,6 +159,7 @@ class JobReader {
     read_contacts(top);
     read_solver(top);
     if (const json* a = top.find("adaptivity")) read_adaptivity(*a, top.at("adaptivity"));
+    resolve_method_defaults();
     return finish();
   }
 
@@ -215,12 +216,16 @@ class JobReader {
                {"method", "penalty", "gamma", "tolerance", "criterion", "max_iterations", "initial_guess", "threads",
                 "acceleration", "anderson_depth", "robin", "enforcement", "augmented_lagrangian"},
                errors_);
-      if (const json* m = f.find("method"))
-        if (auto x = choice(*m, f.at("method"), "method", {"neumann", "monolithic", "interface_newton", "robin"}, errors_))
+      if (const json* m = f.find("method")) {
+        method_pointer_ = f.at("method");
+        if (auto x = choice(*m, f.at("method"), "method", {"neumann", "monolithic", "interface_newton", "robin"}, errors_)) {
           s.method = *x == "monolithic"         ? Method::monolithic
                      : *x == "interface_newton" ? Method::interface_newton
                      : *x == "robin"            ? Method::robin
                                                 : Method::neumann;
+          method_given_ = true;
+        }
+      }
       if (const json* p = f.find("penalty")) read_penalty(*p, f.at("penalty"), sub_object(out, "penalty"));
       if (const json* g = f.find("gamma")) {
         if (g->is_string()) {
@@ -264,12 +269,17 @@ class JobReader {
         }
       }
       if (const json* r = f.find("robin")) read_robin(*r, f.at("robin"));
-      if (const json* e = f.find("enforcement"))
-        if (auto x = choice(*e, f.at("enforcement"), "enforcement", {"penalty", "augmented_lagrangian"}, errors_))
-          s.enforcement = *x == "augmented_lagrangian" ? Enforcement::augmented_lagrangian : Enforcement::penalty;
+      if (const json* e = f.find("enforcement")) {
+        enforcement_pointer_ = f.at("enforcement");
+        if (auto x = choice(*e, f.at("enforcement"), "enforcement", {"exact", "penalty", "augmented_lagrangian"}, errors_)) {
+          s.enforcement = *x == "augmented_lagrangian" ? Enforcement::augmented_lagrangian
+                          : *x == "penalty"            ? Enforcement::penalty
+                                                       : Enforcement::exact;
+          enforcement_given_ = true;
+        }
+      }
       if (const json* a = f.find("augmented_lagrangian")) read_augmented_lagrangian(*a, f.at("augmented_lagrangian"));
     }
-    set_default(out, "method", "interface_newton");
     set_default(out, "penalty", json{{"c", 0.05}});
     set_default(out, "gamma", "auto");
     set_default(out, "tolerance", 1e-8);
@@ -280,11 +290,47 @@ class JobReader {
     set_default(out, "acceleration", "anderson");
     set_default(out, "anderson_depth", 10);
     set_default(out, "robin", json{{"psi", "active_set"}});
-    set_default(out, "enforcement", "augmented_lagrangian");
     set_default(out, "augmented_lagrangian", json{{"tolerance", 1e-9}, {"max_updates", 100}});
     json& al = out["augmented_lagrangian"];
     set_default(al, "tolerance", 1e-9);
     set_default(al, "max_updates", 100);
+  }
+
+  // The method and enforcement defaults depend on each other and on the adaptive strategy, so they are filled
+  // in after both sections are read; combinations that cannot run are errors here, never silent substitutes.
+  //  * method: interface_newton, except neumann under the paper's adaptive strategy (which is a Neumann
+  //    iteration interleaved with refinement);
+  //  * enforcement: exact for interface_newton and monolithic; penalty for neumann and robin (they iterate on the
+  //    penalty problem: exact is available to them only through augmented_lagrangian).
+  void resolve_method_defaults() {
+    SolverSettings& s = problem_.solver;
+    json& out = sub_object(normalized_, "solver");
+    const bool paper_strategy = problem_.adaptivity.enabled && problem_.adaptivity.strategy == AdaptStrategy::paper;
+    auto name = [](Method m) {
+      return m == Method::neumann ? "neumann" : m == Method::robin ? "robin" : m == Method::monolithic ? "monolithic" : "interface_newton";
+    };
+    if (!method_given_) s.method = paper_strategy ? Method::neumann : Method::interface_newton;
+    const bool fixed_point = s.method == Method::neumann || s.method == Method::robin;
+    if (!enforcement_given_) s.enforcement = fixed_point || paper_strategy ? Enforcement::penalty : Enforcement::exact;
+    if (paper_strategy && s.method != Method::neumann)
+      errors_.add(method_pointer_.empty() ? "/adaptivity/strategy" : method_pointer_,
+                  std::string("the adaptive strategy \"paper\" interleaves single Neumann iterations (paper (16)-(17)) "
+                              "with refinement: it needs method \"neumann\", not \"") +
+                      name(s.method) + "\" (or use strategy \"converge_then_refine\", which works with every method)");
+    else if (paper_strategy && s.enforcement != Enforcement::penalty)
+      errors_.add(enforcement_pointer_,
+                  "the adaptive strategy \"paper\" runs the paper's penalty iteration: enforcement must be \"penalty\" "
+                  "(use strategy \"converge_then_refine\" for exact or augmented-Lagrangian contact)");
+    else if (fixed_point && s.enforcement == Enforcement::exact)
+      errors_.add(enforcement_pointer_,
+                  std::string("method \"") + name(s.method) +
+                      "\" iterates on the penalty problem: enforcement \"exact\" is not available with it (use "
+                      "\"penalty\", or \"augmented_lagrangian\" for exact contact in the limit, or method "
+                      "\"interface_newton\")");
+    set_default(out, "method", name(s.method));
+    set_default(out, "enforcement", s.enforcement == Enforcement::exact     ? "exact"
+                                    : s.enforcement == Enforcement::penalty ? "penalty"
+                                                                            : "augmented_lagrangian");
   }
 
   void read_adaptivity(const json& value, const std::string& pointer) {
@@ -1062,6 +1108,8 @@ class JobReader {
   json discarded_;
   Errors errors_;
   Problem problem_;
+  bool method_given_ = false, enforcement_given_ = false;
+  std::string method_pointer_, enforcement_pointer_ = "/solver";
   std::vector<BodyInput> inputs_;
 };
 

@@ -48,8 +48,12 @@ with tempfile.TemporaryDirectory() as tmp:
         check("/history/steps has one row per step", hs["step"].shape[0] == len(steps), str(hs["step"].shape))
         vtk = f["VTKHDF"]
         n_final = final["quads"].shape[0] + f[f"steps/{steps[-1]}/bodies/upper/quads"].shape[0]
-        check("VTKHDF holds the final step", int(np.sum(vtk["NumberOfCells"][:])) == n_final)
-        check("VTKHDF carries the refinement level", vtk["CellData/level"].shape[0] == n_final)
+        contacts = f[f"steps/{steps[-1]}/contacts"]
+        n_lines = sum(contacts[p]["position"].shape[0] - 1 for p in contacts)
+        check("VTKHDF holds the final step's cells and contact lines",
+              list(vtk["NumberOfCells"][:]) == [f[f"steps/{steps[-1]}/bodies/upper/quads"].shape[0],
+                                                 final["quads"].shape[0], n_lines], str(vtk["NumberOfCells"][:]))
+        check("VTKHDF carries the refinement level", vtk["CellData/level"].shape[0] == n_final + n_lines)
     xmf = os.path.join(tmp, "adaptive.xmf")
     check("the XDMF sidecar is written", os.path.exists(xmf))
     if os.path.exists(xmf):

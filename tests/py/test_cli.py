@@ -32,11 +32,30 @@ with tempfile.TemporaryDirectory() as tmp:
     out = os.path.join(tmp, "patch.hdf")
     r = run(EXAMPLE, "-o", out)
     check("valid job exits 0", r.returncode == 0, r.stderr)
-    lines = [l for l in r.stdout.splitlines() if l.startswith("iter ")]
-    check("one progress line per iteration", len(lines) >= 2, r.stdout[:400])
+    # The default method is interface Newton: one line per active-set step, with the active set and the
+    # complementarity residual that decide convergence.
+    lines = [l for l in r.stdout.splitlines() if l.startswith("step ")]
+    check("one progress line per active-set step", len(lines) >= 1 and all("complementarity" in l for l in lines),
+          r.stdout[:400])
+    check("the header names the method and the enforcement",
+          "method interface_newton, enforcement exact" in r.stdout, r.stdout[:200])
     check("summary names the stop", "stop: converged" in r.stdout, r.stdout[-400:])
     check("result file written", os.path.getsize(out) > 0 if os.path.exists(out) else False)
     check("sidecar written", os.path.exists(os.path.join(tmp, "patch.xmf")))
+
+    # The paper's scheme prints one line per iteration with both stopping measures.
+    r = run(os.path.join(SRC, "api", "examples", "seed_layers.json"), "-o", os.path.join(tmp, "seed.hdf"))
+    lines = [l for l in r.stdout.splitlines() if l.startswith("iter ")]
+    check("the paper's scheme: one line per iteration", r.returncode == 0 and len(lines) >= 2 and
+          all("paper" in l and "residual" in l for l in lines), r.stdout[:400])
+    stop = [l for l in r.stdout.splitlines() if l.startswith("stop: ")]
+    check("one summary line that counts the iterations once",
+          len(stop) == 1 and stop[0].count(" after ") == 1 and stop[0].count("iterations") == 1, "\n".join(stop))
+
+    # --version
+    r = run("--version")
+    check("--version exits 0 and names the program", r.returncode == 0 and r.stdout.startswith("contact-solve "),
+          r.stdout + r.stderr)
 
     # --validate only checks.
     r = run(EXAMPLE, "--validate")

@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 """The result file layout of docs/results-format.md, checked with h5py the way a user would read it.
 
-Runs the CLI on api/examples/seed_layers.json (CONTACT_BINARY_DIR and CONTACT_SOURCE_DIR come from ctest) and
-checks the file it writes and the XDMF sidecar next to it. With a path argument, checks that file instead:
+Runs the CLI on api/examples/seed_layers.json twice, with its own settings (the paper's penalty scheme) and with
+the default solver (exact contact), (CONTACT_BINARY_DIR and CONTACT_SOURCE_DIR come from ctest) and checks the
+files it writes and the XDMF sidecars next to them. With a path argument, checks that file instead:
     python3 tests/py/test_result_layout.py some/result.hdf
 Prints one line per check and "N passed, M failed"; exits non-zero on any failure.
 """
@@ -19,6 +20,9 @@ import h5py
 import numpy as np
 
 STOP_REASONS = {"converged", "max_iterations", "stagnation", "cancelled", "error"}
+METHODS = {"interface_newton", "neumann", "robin", "monolithic"}
+ENFORCEMENTS = {"exact", "penalty", "augmented_lagrangian"}
+MEASURES = {"fixed_point", "complementarity", "gradient"}
 CHECKS = []
 
 
@@ -46,7 +50,7 @@ def expect(condition, message):
 
 
 class Context:
-    def __init__(self, path, job_path=None, bodies=("upper", "lower")):
+    def __init__(self, path, job_path=None, bodies=()):
         self.path = path
         self.job_path = job_path
         self.bodies = bodies
@@ -57,7 +61,7 @@ class Context:
 def root_attributes(c):
     a = c.f.attrs
     expect(text(a["format"]) == "contact-ddm-result", f"format is {a['format']!r}")
-    expect(int(a["format_version"]) == 1 and np.issubdtype(np.asarray(a["format_version"]).dtype, np.integer),
+    expect(int(a["format_version"]) == 2 and np.issubdtype(np.asarray(a["format_version"]).dtype, np.integer),
            f"format_version is {a['format_version']!r}")
     expect(text(a["solver_version"]) != "", "solver_version is empty")
     text(a["job_id"])  # may be empty for the CLI
@@ -69,7 +73,7 @@ def root_attributes(c):
     expect((int(a["converged"]) == 1) == (text(a["stop_reason"]) == "converged"),
            "converged and stop_reason disagree")
     expect(int(a["iterations"]) >= 0, "iterations < 0")
-    expect(text(a["method"]) in ("neumann", "monolithic"), f"method {a['method']!r}")
+    expect(text(a["method"]) in METHODS, f"method {a['method']!r}")
     text(a["message"])
     text(a["name"])
 
@@ -89,14 +93,18 @@ def input_documents(c):
 @check
 def provenance(c):
     p = c.f["provenance"]
-    for key in ("solver_version", "compiler", "build_type", "host", "method"):
+    for key in ("solver_version", "compiler", "build_type", "host", "method", "enforcement"):
         expect(isinstance(text(p.attrs[key]), str), f"provenance {key}")
+    expect(text(p.attrs["enforcement"]) in ENFORCEMENTS, f"provenance enforcement {p.attrs['enforcement']!r}")
     for key in ("gamma", "setup_seconds", "factorization_seconds", "wall_seconds"):
         expect(np.isfinite(float(p.attrs[key])), f"provenance {key} not finite")
     expect(text(p.attrs["solver_version"]) == text(c.f.attrs["solver_version"]), "two solver versions")
     theta = p["theta"][()]
     expect(len(names(p["pair_names"][()])) == len(theta), "theta and pair_names lengths differ")
-    expect(np.all(theta > 0), "theta must be positive")
+    if text(p.attrs["enforcement"]) == "exact":
+        expect(np.all(theta == 0), "theta must be 0 for exact contact")
+    else:
+        expect(np.all(theta > 0), "theta must be positive")
 
 
 @check
@@ -104,16 +112,22 @@ def iteration_history(c):
     g = c.f["history/iterations"]
     n = g["iteration"].shape[0]
     nb, npair = len(names(g.attrs["body_names"])), len(names(g.attrs["pair_names"]))
-    for col in ("iteration", "paper_criterion", "fixed_point_residual", "elapsed_seconds"):
+    for col in ("iteration", "update", "paper_criterion", "fixed_point_residual", "complementarity",
+                "active_nodes_total", "active_set_changes", "elapsed_seconds"):
         expect(g[col].shape == (n,), f"{col} has shape {g[col].shape}, expected ({n},)")
+    expect(g["measure"].shape == (n,), "measure length")
+    expect(set(names(g["measure"][()])) <= MEASURES, f"measure values {set(names(g['measure'][()]))}")
     for col in ("elements", "dofs", "elements_refined"):
         expect(g[col].shape == (n, nb), f"{col} has shape {g[col].shape}, expected ({n}, {nb})")
-    for col in ("force", "max_pressure", "extent_begin", "extent_end", "active_points", "changed_points", "theta"):
+    for col in ("force", "max_pressure", "extent_begin", "extent_end", "active_nodes", "changed_nodes", "theta",
+                "max_penetration"):
         expect(g[col].shape == (n, npair), f"{col} has shape {g[col].shape}, expected ({n}, {npair})")
     expect(np.issubdtype(g["iteration"].dtype, np.integer), "iteration is not an integer column")
     it = g["iteration"][()]
     expect(np.all(np.diff(it) > 0), "iteration numbers do not increase")
     expect(np.all(g["max_pressure"][()] >= 0), "a max_pressure is negative")
+    expect(np.all(g["active_nodes"][()].sum(axis=1) == g["active_nodes_total"][()]) if npair else True,
+           "active_nodes_total is not the sum over the pairs")
     expect(np.all(g["elapsed_seconds"][()] >= 0), "elapsed_seconds < 0")
     if text(c.f.attrs["stop_reason"]) != "error":
         expect(n >= 1, "no iteration recorded")
@@ -181,22 +195,46 @@ def steps_contacts(c):
             g = s["contacts"][pair]
             where = f"step {k} pair {pair}"
             n = g["position"].shape[0]
-            expect(g["position"].shape == (n, 2), f"{where} position shape")
-            for name in ("arc_length", "gap", "normal_gap", "pressure", "penetration", "active"):
+            for name, shape in (("position", (n, 2)), ("normal", (n, 2)), ("segments", (max(n - 1, 0), 2))):
+                expect(g[name].shape == shape, f"{where} {name} has shape {g[name].shape}, expected {shape}")
+            for name in ("node", "arc_length", "weight", "gap", "normal_gap", "pressure", "penetration", "active",
+                         "status"):
                 expect(g[name].shape == (n,), f"{where} {name} has shape {g[name].shape}, expected ({n},)")
-            expect(g["active"].dtype == np.int8, f"{where} active dtype {g['active'].dtype}")
+            for name in ("active", "status"):
+                expect(g[name].dtype == np.int8, f"{where} {name} dtype {g[name].dtype}")
             expect(set(np.unique(g["active"][()]).tolist()) <= {0, 1}, f"{where} active is not 0/1")
+            status = g["status"][()]
+            expect(set(np.unique(status).tolist()) <= {0, 1, 2, 3}, f"{where} status outside 0..3")
             pressure = g["pressure"][()]
             expect(np.all(np.isfinite(pressure)) and np.all(pressure >= 0),
                    f"{where} pressure must be >= 0 (positive in compression)")
+            expect(np.all(pressure[status != 0] == 0), f"{where} a node without multiplier carries pressure")
+            weight = g["weight"][()]
+            expect(np.all(weight[status == 0] > 0) and np.all(weight[status != 0] == 0), f"{where} weight vs status")
+            expect(abs(float(np.dot(weight, pressure)) - float(g.attrs["force"])) <= 1e-9 * max(1.0, float(g.attrs["force"])),
+                   f"{where} force is not sum(weight * pressure)")
+            # Gaps are defined (finite) exactly at the nodes that carry a multiplier.
+            for name in ("gap", "normal_gap"):
+                v = g[name][()]
+                expect(np.all(np.isfinite(v[status == 0])) and np.all(np.isnan(v[status != 0])), f"{where} {name} NaNs")
+            normal = g["normal"][()][status == 0]
+            expect(np.allclose(np.linalg.norm(normal, axis=1), 1.0), f"{where} normals are not unit vectors")
             expect(np.all(g["penetration"][()] >= 0), f"{where} penetration < 0")
             expect(np.all(np.diff(g["arc_length"][()]) > 0), f"{where} arc_length does not increase")
             for key in ("slave_body", "slave_edge", "master_body", "master_edge"):
                 expect(text(g.attrs[key]) != "", f"{where} attribute {key} empty")
+            expect(text(g.attrs["enforcement"]) in ENFORCEMENTS, f"{where} enforcement {g.attrs['enforcement']!r}")
             body_names = names(s.attrs["body_names"])
             expect(text(g.attrs["slave_body"]) in body_names and text(g.attrs["master_body"]) in body_names,
                    f"{where} names a body that is not in the step")
-            expect(float(g.attrs["theta"]) > 0, f"{where} theta <= 0")
+            slave = s["bodies"][text(g.attrs["slave_body"])]
+            node = g["node"][()]
+            expect(node.min() >= 0 and node.max() < slave["points"].shape[0], f"{where} node outside the slave mesh")
+            expect(np.array_equal(slave["points"][()][node], g["position"][()]), f"{where} position != slave points")
+            if text(g.attrs["enforcement"]) == "exact":
+                expect(float(g.attrs["theta"]) == 0, f"{where} theta != 0 for exact contact")
+            else:
+                expect(float(g.attrs["theta"]) > 0, f"{where} theta <= 0")
             expect(float(g.attrs["force"]) >= 0, f"{where} force < 0")
 
 
@@ -213,13 +251,22 @@ def vtkhdf(c):
     expect(text(v.attrs["Type"]) == "UnstructuredGrid", f"Type is {v.attrs['Type']!r}")
     npts, ncells, nids = (v[k][()] for k in ("NumberOfPoints", "NumberOfCells", "NumberOfConnectivityIds"))
     last = c.f["steps"][str(int(c.f["steps"].attrs["count"]) - 1)]
-    expect(len(npts) == len(names(last.attrs["body_names"])), "one partition per body")
+    nbody, npair = len(names(last.attrs["body_names"])), len(names(last.attrs["pair_names"]))
+    expect(len(npts) == nbody + npair, "one partition per body, then one per contact pair")
     expect(v["Points"].shape == (npts.sum(), 3), f"Points shape {v['Points'].shape}")
     expect(np.all(v["Points"][:, 2] == 0), "Points z != 0")
     expect(v["Connectivity"].shape == (nids.sum(),), "Connectivity length")
     expect(v["Offsets"].shape == (ncells.sum() + len(ncells),), "Offsets length (n_cells + 1 per partition)")
     expect(v["Types"].shape == (ncells.sum(),) and v["Types"].dtype == np.uint8, "Types shape/dtype")
-    expect(np.all(v["Types"][()] == 9), "Types are not all VTK_QUAD (9)")
+    body_cells = int(ncells[:nbody].sum())
+    expect(np.all(v["Types"][:body_cells] == 9), "body cells are not all VTK_QUAD (9)")
+    expect(np.all(v["Types"][body_cells:] == 3), "contact cells are not all VTK_LINE (3)")
+    for name in ("pressure", "gap", "active"):
+        expect(v["PointData"][name].shape == (npts.sum(),), f"PointData/{name} shape")
+    body_points = int(npts[:nbody].sum())
+    expect(np.all(np.isnan(v["PointData/pressure"][:body_points])), "body points carry a pressure")
+    expect(np.all(v["PointData/pressure"][body_points:] >= 0), "contact points have negative pressure")
+    expect(np.all(v["CellData/pair_id"][body_cells:] >= 0), "contact cells without pair_id")
     offsets, conn = v["Offsets"][()], v["Connectivity"][()]
     o = i = 0
     for p in range(len(npts)):
@@ -232,7 +279,7 @@ def vtkhdf(c):
     expect(v["PointData/displacement"].shape == (npts.sum(), 3), "PointData/displacement shape")
     for name in v["CellData"]:
         expect(v["CellData"][name].shape[0] == ncells.sum(), f"CellData/{name} rows")
-    for name in ("stress", "von_mises", "body_id", "level"):
+    for name in ("stress", "von_mises", "body_id", "pair_id", "level"):
         expect(name in v["CellData"], f"CellData/{name} missing")
 
 
@@ -253,7 +300,13 @@ def xdmf_sidecar(c):
     for k, step in enumerate(children):
         expect(step.find("Time").get("Value") == str(k), f"step {k} has Time {step.find('Time').get('Value')}")
         grids = {g.get("Name"): g for g in step.findall("Grid")}
-        expect(sorted(grids) == sorted(names(c.f["steps"][str(k)].attrs["body_names"])), f"step {k} grids")
+        st = c.f["steps"][str(k)]
+        expect(sorted(grids) == sorted(names(st.attrs["body_names"]) + names(st.attrs["pair_names"])),
+               f"step {k} grids: one per body and one per contact pair")
+        for pair in names(st.attrs["pair_names"]):
+            expect(grids[pair].find("Topology").get("TopologyType") == "Polyline", f"step {k} pair {pair} topology")
+            attributes = {a.get("Name") for a in grids[pair].findall("Attribute")}
+            expect({"pressure", "gap", "active"} <= attributes, f"step {k} pair {pair} attributes {attributes}")
         for item in step.iter("DataItem"):
             if item.get("Format") != "HDF":
                 continue
@@ -264,13 +317,21 @@ def xdmf_sidecar(c):
             expect(c.f[dataset].shape == dims, f"{dataset} is {c.f[dataset].shape}, sidecar says {dims}")
 
 
-def run_cli(tmp):
+def run_cli(tmp, name, solver="own"):
+    """contact-solve on api/examples/<name> with its own solver settings, or with the defaults (solver="default")."""
     binary = os.path.join(os.environ.get("CONTACT_BINARY_DIR", "build"), "contact-solve")
-    job = os.path.join(os.environ.get("CONTACT_SOURCE_DIR", "."), "api", "examples", "seed_layers.json")
-    out = os.path.join(tmp, "seed.hdf")
+    job = os.path.join(os.environ.get("CONTACT_SOURCE_DIR", "."), "api", "examples", name)
     for needed in (binary, job):
         if not os.path.exists(needed):
             raise RuntimeError(f"{needed} does not exist")
+    if solver == "default":
+        with open(job, encoding="utf-8") as fh:
+            document = json.load(fh)
+        document.pop("solver", None)
+        job = os.path.join(tmp, "default_" + name)
+        with open(job, "w", encoding="utf-8") as fh:
+            json.dump(document, fh)
+    out = os.path.join(tmp, f"{solver}_{os.path.splitext(name)[0]}.hdf")
     proc = subprocess.run([binary, job, "-o", out], capture_output=True, text=True, timeout=540)
     if proc.returncode != 0:
         raise RuntimeError(f"contact-solve exited {proc.returncode}:\n{proc.stdout[-2000:]}\n{proc.stderr[-2000:]}")
@@ -279,29 +340,40 @@ def run_cli(tmp):
     return out, job
 
 
+def check_file(context, label):
+    passed = failed = 0
+    for fn in CHECKS:
+        try:
+            fn(context)
+            passed += 1
+            print(f"ok   {label}{fn.__name__}")
+        except Exception as e:
+            failed += 1
+            detail = str(e) if isinstance(e, AssertionError) else traceback.format_exc(limit=2)
+            print(f"FAIL {label}{fn.__name__}: {detail}")
+    context.f.close()
+    return passed, failed
+
+
 def main():
     passed = failed = 0
     with tempfile.TemporaryDirectory() as tmp:
+        contexts = []
         try:
             if len(sys.argv) > 1:
-                context = Context(sys.argv[1])
+                contexts.append(("", Context(sys.argv[1])))
             else:
-                path, job = run_cli(tmp)
-                context = Context(path, job_path=job)
-        except Exception as e:  # the whole file is unavailable: one failure, nothing else to check
+                for name, solver in (("seed_layers.json", "own"), ("seed_layers.json", "default"), ("stack3.json", "default")):
+                    path, job = run_cli(tmp, name, solver)
+                    contexts.append((f"[{solver} {name}] ", Context(path, job_path=job)))
+        except Exception as e:  # a file is unavailable: one failure, nothing else to check
             print(f"FAIL produce a result file: {e}")
             print("0 passed, 1 failed")
             return 1
-        for fn in CHECKS:
-            try:
-                fn(context)
-                passed += 1
-                print(f"ok   {fn.__name__}")
-            except Exception as e:
-                failed += 1
-                detail = str(e) if isinstance(e, AssertionError) else traceback.format_exc(limit=2)
-                print(f"FAIL {fn.__name__}: {detail}")
-        context.f.close()
+        for label, context in contexts:
+            p, f = check_file(context, label)
+            passed += p
+            failed += f
     print(f"{passed} passed, {failed} failed")
     return 0 if failed == 0 else 1
 

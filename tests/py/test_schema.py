@@ -145,7 +145,7 @@ solver_props = schema["$defs"]["solver"]["properties"]
 check("documented defaults are the fast and exact ones",
       solver_props["method"]["default"] == "interface_newton" and solver_props["gamma"]["default"] == "auto"
       and solver_props["tolerance"]["default"] == 1e-8 and solver_props["criterion"]["default"] == "residual"
-      and solver_props["enforcement"]["default"] == "augmented_lagrangian"
+      and solver_props["enforcement"]["default"] == "exact"
       and solver_props["acceleration"]["default"] == "anderson" and solver_props["anderson_depth"]["default"] == 10
       and solver_props["max_iterations"]["default"] == 2000 and solver_props["penalty"]["default"] == {"c": 0.05})
 with open(os.path.join(SOURCE, "api", "examples", "seed_layers.json")) as f:

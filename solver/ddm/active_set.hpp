@@ -1,0 +1,52 @@
+// The contact problem on the interface, as a linear complementarity problem in the nodal pressures z:
+//
+//   h(z) = g + H z,   z >= 0,  h >= 0,  z_j h_j = 0      for every contact node j,
+//
+// with H symmetric positive definite (the interface compliance F, plus theta D for the penalty) and g the
+// weighted gaps at z = 0. Solved by the primal-dual active set strategy (Hintermueller, Ito & Kunisch 2002),
+// which is a semismooth Newton method for the complementarity function
+//   C_j(z) = z_j - max(0, z_j - c_j h_j(z) / D_j),   c_j = D_j / H_jj  (the node's own stiffness: c h / D = h / H_jj
+//   is the pressure that would close the gap h_j alone),
+// predicting the active set A = {j : z_j - c_j h_j / D_j > 0}, then solving h_A = 0 with z = 0 off A: the map
+// is piecewise linear, so the step on the right active set is exact, and the iteration stops when the set
+// repeats. Should the sets ever cycle, a primal active-set method for the equivalent convex QP
+// (min 1/2 z^T H z + g^T z over z >= 0; Lawson & Hanson's NNLS generalised) takes over: it ends in finitely
+// many steps. Pure linear algebra: nothing here knows of bodies or meshes.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <functional>
+#include <string>
+
+namespace contact::ddm {
+
+struct ActiveSetStep {
+  int step = 0;             // 1-based
+  int active = 0;           // |A|
+  int changes = 0;          // nodes that entered or left A in this step
+  double complementarity = 0.0;  // ||C(z)|| / max(||z||, tiny) after the step
+};
+
+struct ActiveSetResult {
+  Eigen::VectorXd z;
+  Eigen::VectorXd h;        // g + H z
+  bool converged = false;
+  bool cancelled = false;
+  int steps = 0;
+  bool used_fallback = false;
+  std::string message;
+};
+
+// on_step is called after every step with the current z and h; returning false cancels. `z0` (optional, same
+// size as g) gives the first active set {z0 - c h(z0) / D > 0}; without it, the nodes where g < 0. The scaling
+// c_j = D_j / H_jj makes D cancel: the prediction is z_j - h_j / H_jj > 0.
+ActiveSetResult solve_active_set(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int max_steps,
+                                 const std::function<bool(const Eigen::VectorXd& z, const Eigen::VectorXd& h,
+                                                          const ActiveSetStep&)>& on_step,
+                                 const Eigen::VectorXd* z0 = nullptr);
+
+// The QP method on its own (for the fallback and for tests): min 1/2 z^T H z + g^T z, z >= 0.
+Eigen::VectorXd solve_nonnegative_qp(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int max_steps = 0);
+
+}  // namespace contact::ddm

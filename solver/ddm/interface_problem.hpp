@@ -1,0 +1,44 @@
+// The contact problem reduced to the nodal multipliers z of all pairs (one per contact node, stacked pair by
+// pair): each body enters through its Schur complement on its contact unknowns.
+//
+// With B_a the map from body a's dofs to the weighted gaps (-Gs rows where a is the slave, +Gm where it is the
+// master), the contact forces on body a are B_a^T z, so its displacements are u_a = u_a^free + K_a^-1 B_a^T z and
+//   g(z) = g_free + F z,   F = sum_a B_a K_a^-1 B_a^T = sum_a W_a^T W_a,   W_a = L_ZZ,a^-1 B_Z,a^T,
+// where L_ZZ,a is the trailing block of body a's Cholesky factor with its contact unknowns Z ordered last
+// (fem/cholesky.hpp) and B_Z,a the columns of B_a T_a on Z. Building F costs, per body and in parallel, one
+// dense triangular solve with |Z| x (its multipliers) right-hand sides; nothing of the size of the body is
+// stored besides its factorisation. F is symmetric positive semi-definite, and definite when every contact node
+// can move (a node whose both sides are held gives a zero row: see docs/algorithm.md).
+#pragma once
+
+#include "contact_system.hpp"
+
+namespace contact::ddm {
+
+class InterfaceProblem {
+ public:
+  // Needs a system built with Factorization::interface. Free responses and Schur complements, bodies in
+  // parallel through `runner`.
+  InterfaceProblem(const ContactSystem& system, TaskRunner& runner);
+
+  Eigen::Index size() const { return F_.rows(); }
+  const Eigen::MatrixXd& compliance() const { return F_; }    // F (weighted gap per unit nodal pressure)
+  const Eigen::VectorXd& free_gap() const { return g_free_; }  // weighted gaps with no contact force
+  const Eigen::VectorXd& weights() const { return D_; }       // area of every row, stacked
+  Eigen::Index offset(size_t pair) const { return offset_[pair]; }
+
+  // Splits a stacked vector into one vector per pair, and the reverse.
+  Pressures split(const Eigen::VectorXd& stacked) const;
+  Eigen::VectorXd stack(const Pressures& per_pair) const;
+
+  // The bodies' displacements for pressures z: one solve per body, in parallel.
+  Displacements displacements(const Eigen::VectorXd& z, TaskRunner& runner) const;
+
+ private:
+  const ContactSystem& system_;
+  std::vector<Eigen::Index> offset_;
+  Eigen::MatrixXd F_;
+  Eigen::VectorXd g_free_, D_;
+};
+
+}  // namespace contact::ddm
