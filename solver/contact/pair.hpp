@@ -28,8 +28,10 @@ namespace contact::mortar {
 
 using SparseRows = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 
-// Why a slave node carries no multiplier.
-enum class NodeStatus { contact = 0, uncovered = 1, crosspoint = 2, barely_covered = 3 };
+// Whether a slave node carries a multiplier, and why not: not opposite the master, a crosspoint (its normal
+// displacement prescribed), barely covered by the master, or inside a multiplier segment (coarse-grained
+// multipliers: the slave is finer than the master there).
+enum class NodeStatus { contact = 0, uncovered = 1, crosspoint = 2, barely_covered = 3, inner = 4 };
 
 struct PairDiscretization {
   std::string name;
@@ -38,6 +40,8 @@ struct PairDiscretization {
 
   // Every slave node, in order along the slave edge.
   std::vector<int> slave_nodes;
+  std::vector<size_t> multiplier_nodes;  // positions (in slave_nodes) of the nodes that bound multiplier segments
+  std::vector<std::vector<std::pair<int, double>>> node_from_rows;  // per slave node: (row, weight) giving its value
   Eigen::VectorXd node_arc;         // arc length along the slave polyline from its first node
   std::vector<NodeStatus> status;   // per slave node
   std::vector<int> row_of_node;     // per slave node: its row, or -1
@@ -71,8 +75,11 @@ struct PairDiscretization {
   void add_forces(const Eigen::VectorXd& z, Eigen::VectorXd& fs, Eigen::VectorXd& fm) const;
   // Total normal force sum_r area_r z_r (the integral of the pressure field; per unit thickness in plane strain).
   double total_force(const Eigen::VectorXd& z) const { return area.dot(z); }
-  // Row values spread to the slave nodes (`fill` where a node has no row).
+  // Row values at every slave node: a multiplier node's own, inside a multiplier segment the linear
+  // interpolation of its ends (`fill` where no row reaches a node).
   Eigen::VectorXd to_nodes(const Eigen::VectorXd& rows, double fill) const;
+  // Row values at the multiplier nodes only (`fill` elsewhere): for per-row quantities such as the weights.
+  Eigen::VectorXd rows_at_nodes(const Eigen::VectorXd& rows, double fill) const;
 };
 
 // theta of the pair: PenaltySpec::theta if given, else c * length / E_pair (see PenaltySpec). Also returns the
@@ -87,6 +94,7 @@ PenaltyChoice choose_penalty(const Problem& problem, int pair_index);
 
 // A slave node whose covered part of its support is below this fraction of the support carries no multiplier.
 constexpr double kDropCoverage = 1e-3;
+
 
 // Builds the mortar discretisation of pair `pair_index` on the bodies' current meshes.
 PairDiscretization discretize_pair(const Problem& problem, int pair_index, double theta);

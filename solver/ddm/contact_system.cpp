@@ -1,5 +1,6 @@
 #include "contact_system.hpp"
 
+#include "../contact/segments.hpp"
 #include "../fem/blas_threads.hpp"
 
 #include <chrono>
@@ -245,10 +246,17 @@ Step ContactSystem::fields(const Displacements& u, const Pressures& z, int itera
       f.node[j] = pair.slave_nodes[static_cast<size_t>(j)];
       f.position.row(j) = mesh.nodes[static_cast<size_t>(f.node[j])].transpose();
     }
+    // Normals: a row's contact normal, elsewhere the mean of the adjacent slave segments' outward normals.
     f.normal = Eigen::MatrixX2d::Zero(n, 2);
+    for (Eigen::Index j = 0; j < n; ++j) {
+      Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+      for (Eigen::Index s : {j - 1, j})
+        if (s >= 0 && s + 1 < n) sum += mortar::outward_normal(f.position.row(s).transpose(), f.position.row(s + 1).transpose());
+      if (sum.norm() > 0) f.normal.row(j) = sum.normalized().transpose();
+    }
     for (size_t r = 0; r < pair.node_of_row.size(); ++r) f.normal.row(pair.node_of_row[r]) = pair.normal[r].transpose();
     f.arc_length = pair.node_arc;
-    f.weight = pair.to_nodes(pair.area, 0.0);
+    f.weight = pair.rows_at_nodes(pair.area, 0.0);
     f.gap = pair.to_nodes(pair.gap0.cwiseQuotient(pair.area), nan);
     const Eigen::VectorXd g = pair.nodal_gap(us, um);
     f.normal_gap = pair.to_nodes(g, nan);

@@ -4,19 +4,16 @@
 //  * penalty: minimise  1/2 x^T K x - b^T x + sum_r 1 / (2 theta D_r) min(0, g_r(x))^2  (convex, piecewise
 //    quadratic) by semismooth Newton steps with a backtracking line search; each step factorises
 //    K + B^T W_A B with CHOLMOD.
-//  * exact: the primal-dual active set on the whole system. On the active set A the constraints g_A(x) = 0 are
-//    eliminated: each active row r fixes one free unknown of its slave node (the component nearest the normal),
-//    x_e = (-g0_r - sum_{l != e} B_rl x_l) / B_re, with the same constraints machinery as hanging nodes, so the
-//    reduced matrix stays symmetric positive definite for CHOLMOD. The pressures follow from the residual,
-//    K x - b = B_A^T z_A (least squares on the rows of A), and A is predicted as {z - c g / D > 0}.
+//  * exact: the primal-dual active set on the whole system: on the active set A the saddle-point system
+//    [K  -B_A^T; B_A  0] [x; z_A] = [b; -g0_A] (equilibrium with the contact forces, and g_A = 0) is solved by a
+//    sparse LU factorisation (Eigen's SparseLU), and A is predicted as {z - c g / area > 0}. Slow for large
+//    problems (an unsymmetric factorisation per step): a reference, not a production method.
 // Both are independent of the interface machinery (Schur complements, dense active-set solves) that
 // interface Newton uses, which is what makes them a check on it.
 #include "method.hpp"
 
-#include "../fem/constraints.hpp"
-
 #include <Eigen/CholmodSupport>
-#include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
 
 #include <cmath>
 #include <sstream>
@@ -106,29 +103,6 @@ Pressures split_rows(const ContactSystem& system, const Stacked& s, const Eigen:
   return z;
 }
 
-// The free unknown that active row r eliminates: the one of its slave node's components with the larger
-// coefficient (the component nearest the normal). -1 if both are prescribed.
-Eigen::Index eliminated_unknown(const ContactSystem& system, const Stacked& s, Eigen::Index row) {
-  const auto& pair = system.pairs()[static_cast<size_t>(s.row_pair[static_cast<size_t>(row)])];
-  const int r = s.row_index[static_cast<size_t>(row)];
-  const size_t sb = static_cast<size_t>(pair.slave_body);
-  const int node = pair.slave_nodes[static_cast<size_t>(pair.node_of_row[static_cast<size_t>(r)])];
-  const auto& free = system.body(sb).constraints();
-  Eigen::Index best = -1;
-  double best_value = 0;
-  for (int c = 0; c < 2; ++c) {
-    const int dof = 2 * node + c;
-    if (free.is_constrained(dof)) continue;
-    const double v = std::abs(pair.normal[static_cast<size_t>(r)][c]);
-    if (best < 0 || v > best_value) {
-      best_value = v;
-      const auto it = std::lower_bound(free.free_dofs().begin(), free.free_dofs().end(), dof);
-      best = s.offset[sb] + static_cast<Eigen::Index>(it - free.free_dofs().begin());
-    }
-  }
-  return best;
-}
-
 MethodOutcome run_exact(const ContactSystem& system, const SolverSettings& settings, RunContext& context) {
   MethodOutcome out;
   const Stacked s = stack(system, false);
@@ -146,57 +120,38 @@ MethodOutcome run_exact(const ContactSystem& system, const SolverSettings& setti
       out.message = "cancelled";
       break;
     }
-    // Constraints x_e = ... for the active rows.
-    fem::Constraints constraints(static_cast<int>(n));
+    // The saddle-point system of the active set: [K  -B_A^T; B_A  0] [x; z_A] = [b; -g0_A].
     std::vector<Eigen::Index> A;
-    for (Eigen::Index r = 0; r < m; ++r) {
-      if (!active[static_cast<size_t>(r)]) continue;
-      const Eigen::Index e = eliminated_unknown(system, s, r);
-      if (e < 0) {
-        out.reason = StopReason::error;
-        out.message = "monolithic: a contact node has both displacement components prescribed";
-        return out;
+    for (Eigen::Index r = 0; r < m; ++r)
+      if (active[static_cast<size_t>(r)]) A.push_back(r);
+    const Eigen::Index na = static_cast<Eigen::Index>(A.size());
+    std::vector<Eigen::Triplet<double>> t;
+    t.reserve(static_cast<size_t>(s.K.nonZeros()) + 8 * static_cast<size_t>(na));
+    for (int col = 0; col < s.K.outerSize(); ++col)
+      for (SpMat::InnerIterator it(s.K, col); it; ++it) t.emplace_back(it.row(), it.col(), it.value());
+    Eigen::VectorXd rhs(n + na);
+    rhs.head(n) = s.b;
+    for (Eigen::Index i = 0; i < na; ++i) {
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Brows, static_cast<int>(A[i])); it; ++it) {
+        t.emplace_back(n + i, it.col(), it.value());
+        t.emplace_back(it.col(), n + i, -it.value());
       }
-      double pivot = 0;
-      std::vector<std::pair<int, double>> entries;
-      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Brows, static_cast<int>(r)); it; ++it)
-        if (it.col() == e) pivot = it.value();
-      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Brows, static_cast<int>(r)); it; ++it)
-        if (it.col() != e) entries.emplace_back(static_cast<int>(it.col()), -it.value() / pivot);
-      constraints.add_line(static_cast<int>(e), std::move(entries), -s.g0[r] / pivot);
-      A.push_back(r);
+      rhs[n + i] = -s.g0[A[i]];
     }
-    const std::string error = constraints.close();
-    if (!error.empty()) {
+    SpMat kkt(n + na, n + na);
+    kkt.setFromTriplets(t.begin(), t.end());
+    kkt.makeCompressed();
+    Eigen::SparseLU<SpMat> lu;
+    lu.compute(kkt);
+    if (lu.info() != Eigen::Success) {
       out.reason = StopReason::error;
-      out.message = "monolithic: " + error;
+      out.message = "monolithic: the saddle-point system of the active set could not be factorised (" + lu.lastErrorMessage() + ")";
       return out;
     }
-    const SpMat& T = constraints.T();
-    const SpMat K2 = SpMat(T.transpose() * s.K * T);
-    const Eigen::VectorXd b2 = T.transpose() * (s.b - s.K * constraints.g());
-    Eigen::CholmodDecomposition<SpMat, Eigen::Lower> factor;
-    factor.compute(K2);
-    if (factor.info() != Eigen::Success) {
-      out.reason = StopReason::error;
-      out.message = "monolithic: the constrained system could not be factorised";
-      return out;
-    }
-    x = constraints.expand(factor.solve(b2));
-    // Pressures: K x - b = B_A^T z_A, solved in the least-squares sense on the rows of A.
+    const Eigen::VectorXd solution = lu.solve(rhs);
+    x = solution.head(n);
     z.setZero();
-    if (!A.empty()) {
-      const Eigen::VectorXd residual = s.K * x - s.b;
-      SpMat BA(static_cast<Eigen::Index>(A.size()), n);
-      std::vector<Eigen::Triplet<double>> t;
-      for (size_t i = 0; i < A.size(); ++i)
-        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Brows, static_cast<int>(A[i])); it; ++it)
-          t.emplace_back(static_cast<Eigen::Index>(i), it.col(), it.value());
-      BA.setFromTriplets(t.begin(), t.end());
-      Eigen::SimplicialLDLT<SpMat> normal(SpMat(BA * BA.transpose()));
-      const Eigen::VectorXd zA = normal.solve(BA * residual);
-      for (size_t i = 0; i < A.size(); ++i) z[A[i]] = zA[static_cast<Eigen::Index>(i)];
-    }
+    for (Eigen::Index i = 0; i < na; ++i) z[A[i]] = solution[n + i];
     const Eigen::VectorXd g = s.g0 + s.B * x;
     std::vector<char> next(static_cast<size_t>(m), 0);
     double c_norm = 0;
@@ -229,7 +184,7 @@ MethodOutcome run_exact(const ContactSystem& system, const SolverSettings& setti
       out.converged = true;
       out.reason = StopReason::converged;
       std::ostringstream os;
-      os << "monolithic active set settled (" << A.size() << " of " << m << " contact nodes in contact)";
+      os << "monolithic active set settled (" << na << " of " << m << " contact nodes in contact)";
       out.message = os.str();
       break;
     }
