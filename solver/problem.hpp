@@ -99,7 +99,7 @@ struct RobinSettings {
 // Uzawa updates of the contact pressure around the penalty solve: stop when the relative change of the
 // pressures between two updates is below tolerance.
 struct AugmentedLagrangianSettings {
-  double tolerance = 1e-9;
+  double tolerance = 1e-6;  // at least ~100 times the inner solve's tolerance: the inner solves bound the attainable change
   int max_updates = 100;
 };
 

@@ -2,6 +2,8 @@
 
 #include "rigid_modes.hpp"
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <sstream>
 #include <stdexcept>
@@ -57,31 +59,33 @@ void BodySolver::setup_constraints() {
   }
 }
 
+namespace {
+
+// The element's 8 dofs (2 per corner, counter-clockwise).
+std::array<int, 8> element_dofs(const mesh::Mesh& m, int c) {
+  const auto& nodes = m.cells[static_cast<size_t>(c)];
+  std::array<int, 8> dofs{};
+  for (int k = 0; k < 4; ++k) {
+    dofs[static_cast<size_t>(2 * k)] = 2 * nodes[static_cast<size_t>(k)];
+    dofs[static_cast<size_t>(2 * k + 1)] = 2 * nodes[static_cast<size_t>(k)] + 1;
+  }
+  return dofs;
+}
+
+}  // namespace
+
 void BodySolver::assemble_system() {
+  // The reduced system T^T K T x = T^T (f - K g) is assembled directly, element by element: each element's
+  // stiffness goes through the rows of T of its dofs (a free dof: itself; a prescribed one: nothing, its value
+  // moves to the right-hand side; a hanging node: its two masters). No matrix of all dofs is stored, and the
+  // sparsity pattern is built first so that the values are summed in place (no triplet list): the memory of the
+  // assembly is that of the reduced matrix.
   const auto& m = body_.mesh;
-  const int n = 2 * m.num_nodes();
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(static_cast<size_t>(m.num_cells()) * 64);
+  const int n = 2 * m.num_nodes(), nf = n_free();
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> T = constraints_.T();
+  const Eigen::VectorXd& g = constraints_.g();
   f_ext_ = Eigen::VectorXd::Zero(n);
   const bool has_body_force = body_.body_force.squaredNorm() > 0;
-  for (int c = 0; c < m.num_cells(); ++c) {
-    const auto x = cell_coordinates(m, c);
-    const Matrix8d Ke = element_stiffness(x, elasticity_);
-    const auto& nodes = m.cells[static_cast<size_t>(c)];
-    int dofs[8];
-    for (int k = 0; k < 4; ++k) {
-      dofs[2 * k] = 2 * nodes[static_cast<size_t>(k)];
-      dofs[2 * k + 1] = 2 * nodes[static_cast<size_t>(k)] + 1;
-    }
-    for (int i = 0; i < 8; ++i)
-      for (int j = 0; j < 8; ++j) triplets.emplace_back(dofs[i], dofs[j], Ke(i, j));
-    if (has_body_force) {
-      const Vector8d fe = element_body_force(x, body_.body_force, elasticity_);
-      for (int i = 0; i < 8; ++i) f_ext_[dofs[i]] += fe[i];
-    }
-  }
-  K_.resize(n, n);
-  K_.setFromTriplets(triplets.begin(), triplets.end());
 
   // Edge tractions: constant over each straight side, so the consistent load is half the side's force at
   // each end node (exact). A normal pressure p acts as t = -p n with n the outward normal.
@@ -102,9 +106,74 @@ void BodySolver::assemble_system() {
     }
   }
 
-  const auto& T = constraints_.T();
-  K_red_ = (T.transpose() * K_ * T).pruned();
-  rhs_base_ = T.transpose() * (f_ext_ - K_ * constraints_.g());
+  // Pattern: the free unknowns each element couples, column by column.
+  std::vector<std::vector<int>> columns(static_cast<size_t>(nf));
+  std::vector<int> unknowns;
+  for (int c = 0; c < m.num_cells(); ++c) {
+    unknowns.clear();
+    for (int d : element_dofs(m, c))
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(T, d); it; ++it) unknowns.push_back(static_cast<int>(it.col()));
+    for (int k : unknowns) columns[static_cast<size_t>(k)].insert(columns[static_cast<size_t>(k)].end(), unknowns.begin(), unknowns.end());
+  }
+  std::vector<int> outer(static_cast<size_t>(nf) + 1, 0), inner;
+  for (int k = 0; k < nf; ++k) {
+    auto& col = columns[static_cast<size_t>(k)];
+    std::sort(col.begin(), col.end());
+    col.erase(std::unique(col.begin(), col.end()), col.end());
+    outer[static_cast<size_t>(k) + 1] = outer[static_cast<size_t>(k)] + static_cast<int>(col.size());
+  }
+  inner.reserve(static_cast<size_t>(outer.back()));
+  for (auto& col : columns) {
+    inner.insert(inner.end(), col.begin(), col.end());
+    std::vector<int>().swap(col);
+  }
+  std::vector<double> values(inner.size(), 0.0);
+  auto entry = [&](int row, int col) -> double& {
+    const auto first = inner.begin() + outer[static_cast<size_t>(col)], last = inner.begin() + outer[static_cast<size_t>(col) + 1];
+    return values[static_cast<size_t>(std::lower_bound(first, last, row) - inner.begin())];
+  };
+
+  // Values and the right-hand side.
+  rhs_base_ = T.transpose() * f_ext_;  // T^T f of the tractions; each element adds T^T (f_e - K_e g_e)
+  for (int c = 0; c < m.num_cells(); ++c) {
+    const auto x = cell_coordinates(m, c);
+    const Matrix8d Ke = element_stiffness(x, elasticity_);
+    const auto dofs = element_dofs(m, c);
+    Vector8d fe = Vector8d::Zero();
+    if (has_body_force) {
+      fe = element_body_force(x, body_.body_force, elasticity_);
+      for (int i = 0; i < 8; ++i) f_ext_[dofs[static_cast<size_t>(i)]] += fe[i];
+    }
+    Vector8d ge;
+    for (int i = 0; i < 8; ++i) ge[i] = g[dofs[static_cast<size_t>(i)]];
+    const Vector8d load = fe - Ke * ge;  // this element's share of f - K g
+    for (int i = 0; i < 8; ++i)
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator ii(T, dofs[static_cast<size_t>(i)]); ii; ++ii) {
+        const int ki = static_cast<int>(ii.col());
+        rhs_base_[ki] += ii.value() * load[i];
+        for (int j = 0; j < 8; ++j)
+          for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator jj(T, dofs[static_cast<size_t>(j)]); jj; ++jj)
+            entry(static_cast<int>(jj.col()), ki) += ii.value() * jj.value() * Ke(j, i);
+      }
+  }
+  K_red_ = Eigen::Map<const Eigen::SparseMatrix<double>>(nf, nf, static_cast<Eigen::Index>(values.size()), outer.data(),
+                                                         inner.data(), values.data());
+}
+
+Eigen::SparseMatrix<double> BodySolver::stiffness() const {
+  const auto& m = body_.mesh;
+  const int n = 2 * m.num_nodes();
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(static_cast<size_t>(m.num_cells()) * 64);
+  for (int c = 0; c < m.num_cells(); ++c) {
+    const Matrix8d Ke = element_stiffness(cell_coordinates(m, c), elasticity_);
+    const auto dofs = element_dofs(m, c);
+    for (int i = 0; i < 8; ++i)
+      for (int j = 0; j < 8; ++j) triplets.emplace_back(dofs[static_cast<size_t>(i)], dofs[static_cast<size_t>(j)], Ke(i, j));
+  }
+  Eigen::SparseMatrix<double> K(n, n);
+  K.setFromTriplets(triplets.begin(), triplets.end());
+  return K;
 }
 
 std::vector<int> BodySolver::interface_unknowns_of(const std::vector<int>& dofs) const {
@@ -169,7 +238,20 @@ Eigen::VectorXd BodySolver::solve(const Eigen::VectorXd& extra_load) const {
 }
 
 Eigen::VectorXd BodySolver::reactions(const Eigen::VectorXd& u, const Eigen::VectorXd& extra_load) const {
-  Eigen::VectorXd r = K_ * u - f_ext_;
+  // K u - f_ext - extra at the prescribed dofs, element by element (only elements with a prescribed dof count).
+  const auto& m = body_.mesh;
+  Eigen::VectorXd r = Eigen::VectorXd::Zero(2 * m.num_nodes());
+  for (int c = 0; c < m.num_cells(); ++c) {
+    const auto dofs = element_dofs(m, c);
+    bool prescribed = false;
+    for (int d : dofs) prescribed = prescribed || constraints_.is_dirichlet(d);
+    if (!prescribed) continue;
+    Vector8d ue;
+    for (int i = 0; i < 8; ++i) ue[i] = u[dofs[static_cast<size_t>(i)]];
+    const Vector8d fe = element_stiffness(cell_coordinates(m, c), elasticity_) * ue;
+    for (int i = 0; i < 8; ++i) r[dofs[static_cast<size_t>(i)]] += fe[i];
+  }
+  r -= f_ext_;
   if (extra_load.size() > 0) r -= extra_load;
   for (int d = 0; d < r.size(); ++d)
     if (!constraints_.is_dirichlet(d)) r[d] = 0.0;

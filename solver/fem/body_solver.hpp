@@ -57,7 +57,8 @@ class BodySolver {
   StressFields stresses(const Eigen::VectorXd& u) const;
 
   const Constraints& constraints() const { return constraints_; }
-  const Eigen::SparseMatrix<double>& stiffness() const { return K_; }           // all dofs
+  // The stiffness of all dofs, assembled on demand (not kept: the solver needs only the reduced one).
+  Eigen::SparseMatrix<double> stiffness() const;
   const Eigen::SparseMatrix<double>& reduced_stiffness() const { return K_red_; }
   const Eigen::VectorXd& external_load() const { return f_ext_; }               // all dofs
   const Eigen::VectorXd& reduced_rhs() const { return rhs_base_; }              // T^T (f_ext - K g)
@@ -83,7 +84,7 @@ class BodySolver {
   const Body& body_;
   Elasticity elasticity_;
   Constraints constraints_;
-  Eigen::SparseMatrix<double> K_, K_red_;
+  Eigen::SparseMatrix<double> K_red_;
   Eigen::VectorXd f_ext_, rhs_base_;
   std::vector<int> interface_dofs_;
   std::unique_ptr<Cholesky> factor_;

@@ -290,9 +290,9 @@ class JobReader {
     set_default(out, "acceleration", "anderson");
     set_default(out, "anderson_depth", 10);
     set_default(out, "robin", json{{"psi", "active_set"}});
-    set_default(out, "augmented_lagrangian", json{{"tolerance", 1e-9}, {"max_updates", 100}});
+    set_default(out, "augmented_lagrangian", json{{"tolerance", 1e-6}, {"max_updates", 100}});
     json& al = out["augmented_lagrangian"];
-    set_default(al, "tolerance", 1e-9);
+    set_default(al, "tolerance", 1e-6);
     set_default(al, "max_updates", 100);
   }
 
