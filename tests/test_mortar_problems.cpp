@@ -181,3 +181,18 @@ TEST(MortarExamples, EveryExampleConvergesWithItsOwnSettingsAndWithTheDefaults) 
   }
   EXPECT_GE(examples, 9);
 }
+
+TEST(MortarSteps, ActiveSetStepsDoNotGrowWithTheMesh) {
+  // The paper's problem with the defaults at 64 x 16 to 512 x 128 per body.
+  for (int nx : {64, 128, 256, 512}) {
+    json job = example("seed_layers.json");
+    job.erase("solver");
+    for (auto& b : job["bodies"]) {
+      b["mesh"]["block"]["nx"] = nx;
+      b["mesh"]["block"]["ny"] = nx / 4;
+    }
+    const Result r = run(job);
+    ASSERT_TRUE(r.converged) << r.message;
+    EXPECT_LE(r.iterations, 3) << nx;
+  }
+}

@@ -81,6 +81,50 @@ Eigen::VectorXd solve_nonnegative_qp(const Eigen::MatrixXd& H, const Eigen::Vect
   return z;
 }
 
+Eigen::VectorXd nested_initial_guess(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, const std::vector<int>& line,
+                                     const Eigen::VectorXd& position,
+                                     std::vector<std::pair<Eigen::Index, int>>* levels, Eigen::Index coarsest) {
+  const Eigen::Index n = g.size();
+  if (n <= coarsest) return Eigen::VectorXd::Zero(n);
+  // Coarse unknowns: every other one of each line, its first and last always.
+  std::vector<Eigen::Index> keep;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const bool first = j == 0 || line[static_cast<size_t>(j)] != line[static_cast<size_t>(j) - 1];
+    const bool last = j + 1 == n || line[static_cast<size_t>(j) + 1] != line[static_cast<size_t>(j)];
+    if (first || last || (!keep.empty() && j - keep.back() >= 2)) keep.push_back(j);
+  }
+  const Eigen::Index nc = static_cast<Eigen::Index>(keep.size());
+  if (nc >= n) return Eigen::VectorXd::Zero(n);
+  // P: n x nc, identity on the kept unknowns, linear interpolation between them.
+  Eigen::MatrixXd P = Eigen::MatrixXd::Zero(n, nc);
+  for (Eigen::Index c = 0; c < nc; ++c) {
+    P(keep[static_cast<size_t>(c)], c) = 1.0;
+    if (c + 1 == nc || line[static_cast<size_t>(keep[static_cast<size_t>(c) + 1])] != line[static_cast<size_t>(keep[static_cast<size_t>(c)])]) continue;
+    const Eigen::Index a = keep[static_cast<size_t>(c)], b = keep[static_cast<size_t>(c) + 1];
+    for (Eigen::Index j = a + 1; j < b; ++j) {
+      const double t = (position[j] - position[a]) / (position[b] - position[a]);
+      P(j, c) = 1 - t;
+      P(j, c + 1) = t;
+    }
+  }
+  std::vector<int> line_c(static_cast<size_t>(nc));
+  Eigen::VectorXd position_c(nc);
+  for (Eigen::Index c = 0; c < nc; ++c) {
+    line_c[static_cast<size_t>(c)] = line[static_cast<size_t>(keep[static_cast<size_t>(c)])];
+    position_c[c] = position[keep[static_cast<size_t>(c)]];
+  }
+  const Eigen::MatrixXd Hc = P.transpose() * H * P;
+  const Eigen::VectorXd gc = P.transpose() * g;
+  const size_t at = levels ? levels->size() : 0;
+  if (levels) levels->emplace_back(nc, 0);
+  const Eigen::VectorXd guess = nested_initial_guess(Hc, gc, line_c, position_c, levels, coarsest);
+  const ActiveSetResult coarse =
+      solve_active_set(Hc, gc, 50, [](const Eigen::VectorXd&, const Eigen::VectorXd&, const ActiveSetStep&) { return true; },
+                       guess.cwiseAbs().maxCoeff() > 0 ? &guess : nullptr);
+  if (levels) (*levels)[at].second = coarse.steps;
+  return P * coarse.z.cwiseMax(0.0);
+}
+
 ActiveSetResult solve_active_set(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int max_steps,
                                  const std::function<bool(const Eigen::VectorXd&, const Eigen::VectorXd&,
                                                           const ActiveSetStep&)>& on_step,

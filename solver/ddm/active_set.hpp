@@ -49,4 +49,17 @@ ActiveSetResult solve_active_set(const Eigen::MatrixXd& H, const Eigen::VectorXd
 // The QP method on its own (for the fallback and for tests): min 1/2 z^T H z + g^T z, z >= 0.
 Eigen::VectorXd solve_nonnegative_qp(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int max_steps = 0);
 
+// A first guess for the active set from the same problem on coarser multiplier spaces (nested iteration): the
+// unknowns lie on lines (line[j], consecutive and ordered by position[j] along each line, e.g. the contact nodes
+// of each pair along its slave edge); every other one is kept per line (the ends always), the rest interpolated
+// linearly in position (P), and the coarse problem z_c >= 0, P^T g + (P^T H P) z_c >= 0 is solved the same way,
+// recursively down to `coarsest` unknowns. Since P >= 0, a non-negative coarse solution prolongs to a
+// non-negative z. Returns P z_c. Where the solution's active set is a contiguous zone whose edge moves a few nodes
+// per step from the free response's guess, this keeps the number of fine steps independent of the mesh size.
+// `levels` receives the size of every coarse problem solved and its active-set steps (finest first).
+Eigen::VectorXd nested_initial_guess(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, const std::vector<int>& line,
+                                     const Eigen::VectorXd& position,
+                                     std::vector<std::pair<Eigen::Index, int>>* levels = nullptr,
+                                     Eigen::Index coarsest = 32);
+
 }  // namespace contact::ddm

@@ -26,6 +26,28 @@ MethodOutcome InterfaceNewton::solve(const SolverSettings& settings, RunContext&
     }
   }
 
+  // The first active set: from the previous solve (augmented-Lagrangian updates), else from the nested coarse
+  // solves (active_set.hpp), which keeps the number of steps independent of the mesh.
+  std::string first_note;
+  Eigen::VectorXd z0 = last_z_;
+  if (z0.size() != m) {
+    std::vector<int> line(static_cast<size_t>(m));
+    Eigen::VectorXd position(m);
+    for (size_t k = 0; k < pairs.size(); ++k)
+      for (Eigen::Index r = 0; r < pairs[k].n_rows(); ++r) {
+        line[static_cast<size_t>(ip.offset(k) + r)] = static_cast<int>(k);
+        position[ip.offset(k) + r] = pairs[k].node_arc[pairs[k].node_of_row[static_cast<size_t>(r)]];
+      }
+    std::vector<std::pair<Eigen::Index, int>> levels;
+    z0 = nested_initial_guess(H, g, line, position, &levels);
+    if (!levels.empty()) {
+      std::ostringstream os;
+      os << "first active set from coarse solves:";
+      for (const auto& [size, steps] : levels) os << " " << size << " nodes/" << steps << " steps";
+      first_note = os.str();
+    }
+  }
+
   std::vector<std::vector<char>> previous_active;
   auto on_step = [&](const Eigen::VectorXd& z, const Eigen::VectorXd& h, const ActiveSetStep& step) {
     // The reported gaps are the physical ones: h minus the penalty's theta D z, plus the shift theta D lambda.
@@ -35,13 +57,14 @@ MethodOutcome InterfaceNewton::solve(const SolverSettings& settings, RunContext&
     r.measure = Measure::complementarity;
     r.complementarity = step.complementarity;
     r.active_set_changes = step.changes;
+    if (step.step == 1) r.note = first_note;
     r.elapsed_seconds = context.elapsed();
     context.observer.on_iteration(r);
     out.history.push_back(std::move(r));
     return !context.cancel.cancelled();
   };
   const int max_steps = std::max(1, settings.max_iterations);
-  const ActiveSetResult result = solve_active_set(H, g, max_steps, on_step, last_z_.size() == m ? &last_z_ : nullptr);
+  const ActiveSetResult result = solve_active_set(H, g, max_steps, on_step, z0.size() == m && z0.cwiseAbs().maxCoeff() > 0 ? &z0 : nullptr);
   last_z_ = result.z;
   out.iterations = result.steps;
   if (result.cancelled) {
