@@ -71,6 +71,11 @@ struct BodyField {
   Eigen::VectorXd von_mises_cell;
   Eigen::VectorXd indicator_cell; // error indicator per cell (empty without adaptivity)
   Eigen::MatrixX2d reaction;      // per node: force the supports exert (zero where nothing is prescribed)
+  // A floating body (held by its contacts alone): its free rigid motions, and the rigid part of its displacement
+  // as the translation (x, y) of rigid_center (the nodes' centroid) and a rotation (radians) about it.
+  std::vector<std::string> free_motions;
+  Eigen::Vector2d rigid_center = Eigen::Vector2d::Zero();
+  Eigen::Vector3d rigid_motion = Eigen::Vector3d::Zero();
 };
 
 // Contact quantities along one pair, at the slave edge's nodes, ordered along the slave edge. The gaps are the

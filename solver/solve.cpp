@@ -88,7 +88,8 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
       result.steps = std::move(steps);
     } else if (!outcome.u.empty()) {
       result.steps.push_back(outcome.z.empty() ? system.fields(outcome.u, outcome.iterations)
-                                               : system.fields(outcome.u, outcome.z, outcome.iterations));
+                                               : system.fields(outcome.u, outcome.z, outcome.iterations,
+                                                               &outcome.rigid_amplitudes));
     }
     if (updates > 0 && !result.steps.empty()) {
       std::ostringstream os;

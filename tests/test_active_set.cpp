@@ -65,7 +65,7 @@ TEST(ActiveSet, NestedGuessIsNonNegativeAndLeavesAHandfulOfFineStepsAtEverySize)
     const std::vector<int> line(static_cast<size_t>(n), 0);
     const ActiveSetResult plain = solve_active_set(H, g, 100, always);
     std::vector<std::pair<Eigen::Index, int>> levels;
-    const Eigen::VectorXd z0 = nested_initial_guess(H, g, line, position, &levels);
+    const Eigen::VectorXd z0 = nested_initial_guess(H, g, line, position, {}, &levels);
     EXPECT_GE(z0.minCoeff(), 0.0);
     EXPECT_FALSE(levels.empty());
     const ActiveSetResult nested = solve_active_set(H, g, 100, always, &z0);

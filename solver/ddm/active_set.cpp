@@ -11,25 +11,50 @@ namespace contact::ddm {
 
 namespace {
 
-// z with h_A = 0 on the index set A and z = 0 elsewhere: H_AA z_A = -g_A.
+// z (and alpha) with h_A = 0 on the index set A, z = 0 elsewhere, and G z = e: H_AA z_A + G_A^T alpha = -g_A,
+// solved by the Schur complement S = G_A H_AA^-1 G_A^T on alpha. `ok` is false when H_AA is not positive
+// definite; `unrestrained` receives the rows of G that A leaves without support (S singular there).
 Eigen::VectorXd solve_on(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, const std::vector<Eigen::Index>& A,
-                         bool& ok) {
+                         const Equalities& eq, Eigen::VectorXd& alpha, bool& ok, std::vector<Eigen::Index>& unrestrained) {
   Eigen::VectorXd z = Eigen::VectorXd::Zero(g.size());
   ok = true;
-  if (A.empty()) return z;
-  const Eigen::Index na = static_cast<Eigen::Index>(A.size());
-  Eigen::MatrixXd HA(na, na);
+  unrestrained.clear();
+  const Eigen::Index na = static_cast<Eigen::Index>(A.size()), r = eq.G.rows();
+  alpha = Eigen::VectorXd::Zero(r);
+  if (na == 0) {
+    for (Eigen::Index i = 0; i < r; ++i) unrestrained.push_back(i);
+    return z;
+  }
+  Eigen::MatrixXd HA(na, na), GA(r, na);
   Eigen::VectorXd rhs(na);
   for (Eigen::Index i = 0; i < na; ++i) {
     for (Eigen::Index j = 0; j < na; ++j) HA(i, j) = H(A[i], A[j]);
     rhs[i] = -g[A[i]];
+    if (r > 0) GA.col(i) = eq.G.col(A[i]);
   }
   Eigen::LLT<Eigen::MatrixXd> llt(HA);
   if (llt.info() != Eigen::Success) {
     ok = false;
     return z;
   }
-  const Eigen::VectorXd zA = llt.solve(rhs);
+  Eigen::VectorXd zA = llt.solve(rhs);
+  if (r > 0) {
+    const Eigen::MatrixXd Y = llt.solve(GA.transpose());  // H_AA^-1 G_A^T
+    const Eigen::MatrixXd S = GA * Y;
+    // A row of G the active nodes do not reach has a zero diagonal in S (relative to its size elsewhere).
+    const double scale = std::max(S.diagonal().cwiseAbs().maxCoeff(), 1e-300);
+    for (Eigen::Index i = 0; i < r; ++i)
+      if (!(S(i, i) > 1e-12 * scale)) unrestrained.push_back(i);
+    Eigen::LDLT<Eigen::MatrixXd> ldlt(S);
+    if (!unrestrained.empty() || ldlt.info() != Eigen::Success || ldlt.isNegative() ||
+        ldlt.vectorD().cwiseAbs().minCoeff() <= 1e-12 * scale) {
+      if (unrestrained.empty())
+        for (Eigen::Index i = 0; i < r; ++i) unrestrained.push_back(i);
+      return z;
+    }
+    alpha = ldlt.solve(GA * zA - eq.e);
+    zA -= Y * alpha;
+  }
   for (Eigen::Index i = 0; i < na; ++i) z[A[i]] = zA[i];
   return z;
 }
@@ -58,7 +83,9 @@ Eigen::VectorXd solve_nonnegative_qp(const Eigen::MatrixXd& H, const Eigen::Vect
       for (Eigen::Index j = 0; j < n; ++j)
         if (passive[static_cast<size_t>(j)]) P.push_back(j);
       bool ok = true;
-      const Eigen::VectorXd s = solve_on(H, g, P, ok);
+      Eigen::VectorXd unused_alpha;
+      std::vector<Eigen::Index> unused_rows;
+      const Eigen::VectorXd s = solve_on(H, g, P, Equalities{}, unused_alpha, ok, unused_rows);
       if (!ok) return z;
       bool feasible = true;
       for (Eigen::Index j : P) feasible = feasible && s[j] > 0;
@@ -82,7 +109,7 @@ Eigen::VectorXd solve_nonnegative_qp(const Eigen::MatrixXd& H, const Eigen::Vect
 }
 
 Eigen::VectorXd nested_initial_guess(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, const std::vector<int>& line,
-                                     const Eigen::VectorXd& position,
+                                     const Eigen::VectorXd& position, const Equalities& equalities,
                                      std::vector<std::pair<Eigen::Index, int>>* levels, Eigen::Index coarsest) {
   const Eigen::Index n = g.size();
   if (n <= coarsest) return Eigen::VectorXd::Zero(n);
@@ -115,20 +142,21 @@ Eigen::VectorXd nested_initial_guess(const Eigen::MatrixXd& H, const Eigen::Vect
   }
   const Eigen::MatrixXd Hc = P.transpose() * H * P;
   const Eigen::VectorXd gc = P.transpose() * g;
+  Equalities coarse_eq;
+  if (!equalities.empty()) coarse_eq = Equalities{equalities.G * P, equalities.e};
   const size_t at = levels ? levels->size() : 0;
   if (levels) levels->emplace_back(nc, 0);
-  const Eigen::VectorXd guess = nested_initial_guess(Hc, gc, line_c, position_c, levels, coarsest);
+  const Eigen::VectorXd guess = nested_initial_guess(Hc, gc, line_c, position_c, coarse_eq, levels, coarsest);
   const ActiveSetResult coarse =
       solve_active_set(Hc, gc, 50, [](const Eigen::VectorXd&, const Eigen::VectorXd&, const ActiveSetStep&) { return true; },
-                       guess.cwiseAbs().maxCoeff() > 0 ? &guess : nullptr);
+                       guess.cwiseAbs().maxCoeff() > 0 ? &guess : nullptr, coarse_eq);
   if (levels) (*levels)[at].second = coarse.steps;
+  if (!coarse.converged) return Eigen::VectorXd::Zero(n);  // no guess: the fine problem starts as without one
   return P * coarse.z.cwiseMax(0.0);
 }
 
 ActiveSetResult solve_active_set(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int max_steps,
-                                 const std::function<bool(const Eigen::VectorXd&, const Eigen::VectorXd&,
-                                                          const ActiveSetStep&)>& on_step,
-                                 const Eigen::VectorXd* z0) {
+                                 const StepCallback& on_step, const Eigen::VectorXd* z0, const Equalities& eq) {
   ActiveSetResult out;
   const Eigen::Index n = g.size();
   const Eigen::VectorXd c_over_D = H.diagonal().cwiseInverse();  // c_j / D_j = 1 / H_jj
@@ -142,14 +170,22 @@ ActiveSetResult solve_active_set(const Eigen::MatrixXd& H, const Eigen::VectorXd
     for (Eigen::Index j = 0; j < n; ++j) C[j] = z[j] - std::max(0.0, z[j] - c_over_D[j] * h[j]);
     return C.norm() / std::max(z.norm(), 1e-300);
   };
+  auto gap = [&](const Eigen::VectorXd& z, const Eigen::VectorXd& alpha) {
+    Eigen::VectorXd h = g + H * z;
+    if (!eq.empty()) h.noalias() += eq.G.transpose() * alpha;
+    return h;
+  };
 
+  out.alpha = Eigen::VectorXd::Zero(eq.G.rows());
   Eigen::VectorXd z = z0 && z0->size() == n ? *z0 : Eigen::VectorXd::Zero(n);
   Eigen::VectorXd h = g + H * z;
   std::vector<char> active = predict(z, h);
+  // A floating body's position is part of the answer: without a guess, start from every node in contact.
+  if (!eq.empty() && !(z0 && z0->size() == n)) active.assign(static_cast<size_t>(n), 1);
   std::set<std::vector<char>> seen;
   out.z = z;
   out.h = h;
-  if (n == 0) {
+  if (n == 0 && eq.empty()) {
     out.converged = true;
     out.message = "no contact nodes";
     return out;
@@ -160,12 +196,17 @@ ActiveSetResult solve_active_set(const Eigen::MatrixXd& H, const Eigen::VectorXd
     for (Eigen::Index j = 0; j < n; ++j)
       if (active[static_cast<size_t>(j)]) A.push_back(j);
     bool ok = true;
-    z = solve_on(H, g, A, ok);
+    Eigen::VectorXd alpha;
+    z = solve_on(H, g, A, eq, alpha, ok, out.unrestrained);
     if (!ok) {
       out.message = "the active-set system is not positive definite";
       return out;
     }
-    h = g + H * z;
+    if (!out.unrestrained.empty()) {
+      out.message = "the contact nodes in contact do not hold every floating body";
+      return out;
+    }
+    h = gap(z, alpha);
     std::vector<char> next = predict(z, h);
     ActiveSetStep step;
     step.step = k;
@@ -173,6 +214,7 @@ ActiveSetResult solve_active_set(const Eigen::MatrixXd& H, const Eigen::VectorXd
     for (Eigen::Index j = 0; j < n; ++j) step.changes += next[static_cast<size_t>(j)] != active[static_cast<size_t>(j)];
     step.complementarity = complementarity(z, h);
     out.z = z;
+    out.alpha = alpha;
     out.h = h;
     out.steps = k;
     if (!on_step(z, h, step)) {
@@ -191,6 +233,10 @@ ActiveSetResult solve_active_set(const Eigen::MatrixXd& H, const Eigen::VectorXd
     }
     if (seen.count(next)) break;  // a cycle: hand over to the QP method
     active = std::move(next);
+  }
+  if (!eq.empty()) {
+    out.message = "the primal-dual active set cycled or did not settle with floating bodies";
+    return out;
   }
   // Cycling or max_steps: the primal active-set QP method, which terminates.
   out.used_fallback = true;

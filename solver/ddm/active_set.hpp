@@ -1,23 +1,29 @@
 // The contact problem on the interface, as a linear complementarity problem in the nodal pressures z:
 //
-//   h(z) = g + H z,   z >= 0,  h >= 0,  z_j h_j = 0      for every contact node j,
+//   h = g + H z + G^T alpha,   z >= 0,  h >= 0,  z_j h_j = 0  for every contact node j,   G z = e,
 //
-// with H symmetric positive definite (the interface compliance F, plus theta D for the penalty) and g the
-// weighted gaps at z = 0. Solved by the primal-dual active set strategy (Hintermueller, Ito & Kunisch 2002),
-// which is a semismooth Newton method for the complementarity function
-//   C_j(z) = z_j - max(0, z_j - c_j h_j(z) / D_j),   c_j = D_j / H_jj  (the node's own stiffness: c h / D = h / H_jj
+// with H symmetric positive definite (the interface compliance F, plus theta D for the penalty), g the weighted
+// gaps at z = 0, and, when some bodies float (held by their contacts alone), their rigid-mode amplitudes alpha
+// with the equilibrium of every floating body G z = e (FETI's coarse problem; G empty otherwise). It is the KKT
+// system of the convex QP  min 1/2 z^T H z + g^T z  over z >= 0 with G z = e.
+//
+// Solved by the primal-dual active set strategy (Hintermueller, Ito & Kunisch 2002), a semismooth Newton method
+// for the complementarity function
+//   C_j(z) = z_j - max(0, z_j - c_j h_j / D_j),   c_j = D_j / H_jj  (the node's own stiffness: c h / D = h / H_jj
 //   is the pressure that would close the gap h_j alone),
-// predicting the active set A = {j : z_j - c_j h_j / D_j > 0}, then solving h_A = 0 with z = 0 off A: the map
-// is piecewise linear, so the step on the right active set is exact, and the iteration stops when the set
-// repeats. Should the sets ever cycle, a primal active-set method for the equivalent convex QP
-// (min 1/2 z^T H z + g^T z over z >= 0; Lawson & Hanson's NNLS generalised) takes over: it ends in finitely
-// many steps. Pure linear algebra: nothing here knows of bodies or meshes.
+// predicting the active set A = {j : z_j - h_j / H_jj > 0}, then solving h_A = 0 with z = 0 off A (with G: the
+// saddle-point system of A, by its Schur complement on alpha): the map is piecewise linear, so the step on the
+// right active set is exact, and the iteration stops when the set repeats. Should the sets ever cycle, a primal
+// active-set method for the QP (Lawson & Hanson's NNLS generalised; without G only) takes over: it ends in
+// finitely many steps. Pure linear algebra: nothing here knows of bodies or meshes.
 #pragma once
 
 #include <Eigen/Core>
 
 #include <functional>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace contact::ddm {
 
@@ -28,23 +34,35 @@ struct ActiveSetStep {
   double complementarity = 0.0;  // ||C(z)|| / max(||z||, tiny) after the step
 };
 
+// Equality constraints G z = e with multipliers alpha (G: r x n). Empty: none.
+struct Equalities {
+  Eigen::MatrixXd G;
+  Eigen::VectorXd e;
+  bool empty() const { return G.rows() == 0; }
+};
+
 struct ActiveSetResult {
   Eigen::VectorXd z;
-  Eigen::VectorXd h;        // g + H z
+  Eigen::VectorXd alpha;    // the equalities' multipliers (empty without)
+  Eigen::VectorXd h;        // g + H z + G^T alpha
   bool converged = false;
   bool cancelled = false;
   int steps = 0;
   bool used_fallback = false;
+  // The equalities could not be met by the active nodes (a floating body held by nothing): the rows of G that
+  // the active set leaves unrestrained (empty otherwise).
+  std::vector<Eigen::Index> unrestrained;
   std::string message;
 };
 
+using StepCallback = std::function<bool(const Eigen::VectorXd& z, const Eigen::VectorXd& h, const ActiveSetStep&)>;
+
 // on_step is called after every step with the current z and h; returning false cancels. `z0` (optional, same
-// size as g) gives the first active set {z0 - c h(z0) / D > 0}; without it, the nodes where g < 0. The scaling
-// c_j = D_j / H_jj makes D cancel: the prediction is z_j - h_j / H_jj > 0.
+// size as g) gives the first active set {z0 - h(z0) / H_jj > 0}; without it, the nodes where g < 0, or every node
+// when there are equalities (a floating body's own position is not known before the solve).
 ActiveSetResult solve_active_set(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int max_steps,
-                                 const std::function<bool(const Eigen::VectorXd& z, const Eigen::VectorXd& h,
-                                                          const ActiveSetStep&)>& on_step,
-                                 const Eigen::VectorXd* z0 = nullptr);
+                                 const StepCallback& on_step, const Eigen::VectorXd* z0 = nullptr,
+                                 const Equalities& equalities = {});
 
 // The QP method on its own (for the fallback and for tests): min 1/2 z^T H z + g^T z, z >= 0.
 Eigen::VectorXd solve_nonnegative_qp(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int max_steps = 0);
@@ -52,13 +70,14 @@ Eigen::VectorXd solve_nonnegative_qp(const Eigen::MatrixXd& H, const Eigen::Vect
 // A first guess for the active set from the same problem on coarser multiplier spaces (nested iteration): the
 // unknowns lie on lines (line[j], consecutive and ordered by position[j] along each line, e.g. the contact nodes
 // of each pair along its slave edge); every other one is kept per line (the ends always), the rest interpolated
-// linearly in position (P), and the coarse problem z_c >= 0, P^T g + (P^T H P) z_c >= 0 is solved the same way,
-// recursively down to `coarsest` unknowns. Since P >= 0, a non-negative coarse solution prolongs to a
-// non-negative z. Returns P z_c. Where the solution's active set is a contiguous zone whose edge moves a few nodes
-// per step from the free response's guess, this keeps the number of fine steps independent of the mesh size.
-// `levels` receives the size of every coarse problem solved and its active-set steps (finest first).
+// linearly in position (P), and the coarse problem z_c >= 0, P^T g + (P^T H P) z_c (+ G^T alpha) >= 0,
+// (G P) z_c = e is solved the same way, recursively down to `coarsest` unknowns. Since P >= 0, a non-negative
+// coarse solution prolongs to a non-negative z. Returns P z_c. Where the solution's active set is a contiguous
+// zone whose edge moves a few nodes per step from a cruder guess, this keeps the number of fine steps
+// independent of the mesh size. `levels` receives the size of every coarse problem solved and its active-set
+// steps (finest first).
 Eigen::VectorXd nested_initial_guess(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, const std::vector<int>& line,
-                                     const Eigen::VectorXd& position,
+                                     const Eigen::VectorXd& position, const Equalities& equalities = {},
                                      std::vector<std::pair<Eigen::Index, int>>* levels = nullptr,
                                      Eigen::Index coarsest = 32);
 

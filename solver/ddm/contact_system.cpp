@@ -3,6 +3,8 @@
 #include "../contact/segments.hpp"
 #include "../fem/blas_threads.hpp"
 
+#include <Eigen/QR>
+
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -28,7 +30,7 @@ ContactSystem::ContactSystem(const Problem& problem, TaskRunner& runner, Factori
   bodies_.resize(problem.bodies.size());
   runner.run(bodies_.size(), [&](size_t a) {
     bodies_[a] = std::make_unique<fem::BodySolver>(problem.bodies[a], problem.model, factorization != Factorization::none,
-                                                   interface_dofs(a));
+                                                   interface_dofs(a), may_float(a));
   });
   for (const auto& b : bodies_) {
     if (!b->ok()) append_error(error_, b->error());
@@ -46,6 +48,13 @@ void ContactSystem::discretize_pairs() {
     if (!(penalties_.back().theta > 0))
       append_error(error_, "contact '" + pairs_.back().name + "': the penalty theta is not positive");
   }
+}
+
+bool ContactSystem::may_float(size_t a) const {
+  if (factorization_ == Factorization::plain) return false;  // the fixed-point schemes solve every body alone
+  for (const auto& c : problem_.contacts)
+    if (static_cast<size_t>(c.slave_body) == a || static_cast<size_t>(c.master_body) == a) return true;
+  return false;
 }
 
 std::vector<int> ContactSystem::interface_dofs(size_t a) const {
@@ -74,7 +83,7 @@ void ContactSystem::rebuild(const std::vector<char>& changed, TaskRunner& runner
     const size_t a = todo[i];
     bodies_[a].reset();  // free the old factorisation first
     bodies_[a] = std::make_unique<fem::BodySolver>(problem_.bodies[a], problem_.model, factorization_ != Factorization::none,
-                                                   interface_dofs(a));
+                                                   interface_dofs(a), may_float(a));
   });
   for (size_t a : todo) {
     if (!bodies_[a]->ok()) append_error(error_, bodies_[a]->error());
@@ -202,7 +211,8 @@ IterationReport ContactSystem::report_gaps(int iteration, const Pressures& z, co
   return r;
 }
 
-Step ContactSystem::fields(const Displacements& u, const Pressures& z, int iteration) const {
+Step ContactSystem::fields(const Displacements& u, const Pressures& z, int iteration,
+                           const std::vector<Eigen::VectorXd>* rigid_amplitudes) const {
   Step step;
   step.iteration = iteration;
   const Displacements loads = loads_from_pressures(z);
@@ -219,6 +229,22 @@ Step ContactSystem::fields(const Displacements& u, const Pressures& z, int itera
     f.von_mises_cell = s.von_mises_cell;
     const Eigen::VectorXd R = bodies_[a]->reactions(u[a], loads[a]);
     f.reaction = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>(R.data(), n, 2);
+    if (bodies_[a]->floating()) {
+      f.free_motions = bodies_[a]->rigid_mode_names();
+      // The rigid part R alpha as a translation of the nodes' centroid and a rotation about it (exact fit).
+      f.rigid_center = Eigen::Vector2d::Zero();
+      for (const auto& p : body.mesh.nodes) f.rigid_center += p / n;
+      if (rigid_amplitudes && a < rigid_amplitudes->size() && (*rigid_amplitudes)[a].size() == bodies_[a]->rigid_modes().cols()) {
+        const Eigen::VectorXd v = bodies_[a]->rigid_modes() * (*rigid_amplitudes)[a];
+        Eigen::MatrixXd A(2 * n, 3);
+        for (int i = 0; i < n; ++i) {
+          const Eigen::Vector2d d = body.mesh.nodes[static_cast<size_t>(i)] - f.rigid_center;
+          A.row(2 * i) << 1.0, 0.0, -d.y();
+          A.row(2 * i + 1) << 0.0, 1.0, d.x();
+        }
+        f.rigid_motion = A.colPivHouseholderQr().solve(v);
+      }
+    }
     step.bodies.push_back(std::move(f));
   }
   const char* enforcement = problem_.solver.enforcement == Enforcement::exact     ? "exact"

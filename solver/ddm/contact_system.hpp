@@ -87,14 +87,18 @@ class ContactSystem {
   // The nodal gaps (weighted gap / D) of displacements u.
   Pressures nodal_gaps(const Displacements& u) const;
 
-  // Final fields (one Step) for displacements u with pressures z (the penalty form computes z from u).
-  Step fields(const Displacements& u, const Pressures& z, int iteration) const;
+  // Final fields (one Step) for displacements u with pressures z (the penalty form computes z from u), and the
+  // floating bodies' rigid-mode amplitudes if known.
+  Step fields(const Displacements& u, const Pressures& z, int iteration,
+              const std::vector<Eigen::VectorXd>* rigid_amplitudes = nullptr) const;
   Step fields(const Displacements& u, int iteration) const { return fields(u, penalty_pressures(u), iteration); }
 
  private:
   void discretize_pairs();
   // Full dofs of body a that some pair's operators act on (empty unless Factorization::interface).
   std::vector<int> interface_dofs(size_t a) const;
+  // Whether body a may float (held by its contacts): in a pair, and a method that handles it.
+  bool may_float(size_t a) const;
 
   const Problem& problem_;
   Factorization factorization_ = Factorization::plain;

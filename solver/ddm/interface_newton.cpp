@@ -6,6 +6,35 @@
 
 namespace contact::ddm {
 
+std::string InterfaceNewton::unheld_bodies(const std::vector<Eigen::Index>& rows) const {
+  const Problem& problem = system_.problem();
+  std::string text;
+  for (const auto& f : problem_.floating()) {
+    bool named = false;
+    for (Eigen::Index row : rows) named = named || (row >= f.offset && row < f.offset + f.count);
+    if (!named) continue;
+    const auto& body = system_.body(f.body);
+    std::string motions, pairs;
+    for (const auto& m : body.rigid_mode_names()) motions += (motions.empty() ? "" : ", ") + m;
+    for (const auto& c : problem.contacts)
+      if (static_cast<size_t>(c.slave_body) == f.body || static_cast<size_t>(c.master_body) == f.body)
+        pairs += (pairs.empty() ? "'" : ", '") + c.name + "'";
+    text += (text.empty() ? "" : "; ") + ("body '" + problem.bodies[f.body].name + "' floats (" + motions +
+                                          " free) and no contact holds it: its contact" +
+                                          (pairs.find(',') != std::string::npos ? "s " : " ") + pairs +
+                                          " would have to pull (the loads move it away), or it is open at the solution;"
+                                          " give it displacement conditions that hold it, or load it towards its contacts");
+  }
+  return text.empty() ? "the contact nodes in contact do not hold the floating bodies" : text;
+}
+
+std::vector<Eigen::VectorXd> InterfaceNewton::rigid_amplitudes(const Eigen::VectorXd& alpha) const {
+  std::vector<Eigen::VectorXd> out(system_.n_bodies());
+  if (alpha.size() != problem_.equilibrium().G.rows()) return out;
+  for (const auto& f : problem_.floating()) out[f.body] = alpha.segment(f.offset, f.count);
+  return out;
+}
+
 MethodOutcome InterfaceNewton::solve(const SolverSettings& settings, RunContext& context) {
   MethodOutcome out;
   const auto& pairs = system_.pairs();
@@ -39,7 +68,7 @@ MethodOutcome InterfaceNewton::solve(const SolverSettings& settings, RunContext&
         position[ip.offset(k) + r] = pairs[k].node_arc[pairs[k].node_of_row[static_cast<size_t>(r)]];
       }
     std::vector<std::pair<Eigen::Index, int>> levels;
-    z0 = nested_initial_guess(H, g, line, position, &levels);
+    z0 = nested_initial_guess(H, g, line, position, ip.equilibrium(), &levels);
     if (!levels.empty()) {
       std::ostringstream os;
       os << "first active set from coarse solves:";
@@ -49,11 +78,12 @@ MethodOutcome InterfaceNewton::solve(const SolverSettings& settings, RunContext&
   }
 
   std::vector<std::vector<char>> previous_active;
+  const Eigen::VectorXd penalty_diagonal = H.diagonal() - ip.compliance().diagonal();  // theta area (0: exact)
+  const Eigen::VectorXd shift = g - ip.free_gap();                                      // -theta area lambda
   auto on_step = [&](const Eigen::VectorXd& z, const Eigen::VectorXd& h, const ActiveSetStep& step) {
-    // The reported gaps are the physical ones: h minus the penalty's theta D z, plus the shift theta D lambda.
-    Eigen::VectorXd gap = ip.free_gap() + ip.compliance() * z;
+    // The reported gaps are the physical ones: h without the penalty's theta area z and the multipliers' shift.
+    const Eigen::VectorXd gap = h - penalty_diagonal.cwiseProduct(z) - shift;
     IterationReport r = system_.report_gaps(step.step, ip.split(z), ip.split(gap.cwiseQuotient(ip.weights())), previous_active);
-    (void)h;
     r.measure = Measure::complementarity;
     r.complementarity = step.complementarity;
     r.active_set_changes = step.changes;
@@ -64,7 +94,9 @@ MethodOutcome InterfaceNewton::solve(const SolverSettings& settings, RunContext&
     return !context.cancel.cancelled();
   };
   const int max_steps = std::max(1, settings.max_iterations);
-  const ActiveSetResult result = solve_active_set(H, g, max_steps, on_step, z0.size() == m && z0.cwiseAbs().maxCoeff() > 0 ? &z0 : nullptr);
+  const ActiveSetResult result = solve_active_set(H, g, max_steps, on_step,
+                                                  z0.size() == m && z0.cwiseAbs().maxCoeff() > 0 ? &z0 : nullptr,
+                                                  ip.equilibrium());
   last_z_ = result.z;
   out.iterations = result.steps;
   if (result.cancelled) {
@@ -74,12 +106,17 @@ MethodOutcome InterfaceNewton::solve(const SolverSettings& settings, RunContext&
     out.converged = true;
     out.reason = StopReason::converged;
     out.message = "interface Newton: " + result.message;
+  } else if (!result.unrestrained.empty()) {
+    out.reason = StopReason::error;
+    out.message = "interface Newton: " + unheld_bodies(result.unrestrained);
+    return out;
   } else {
     out.reason = result.steps >= max_steps ? StopReason::max_iterations : StopReason::error;
     out.message = "interface Newton: " + result.message;
   }
   out.z = ip.split(result.z);
-  out.u = ip.displacements(result.z, context.runner);
+  out.u = ip.displacements(result.z, result.alpha, context.runner);
+  out.rigid_amplitudes = rigid_amplitudes(result.alpha);
   out.solves_per_body = 1;
   return out;
 }

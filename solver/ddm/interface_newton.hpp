@@ -22,6 +22,11 @@ class InterfaceNewton {
   const InterfaceProblem& problem() const { return problem_; }
 
  private:
+  // The error text for floating bodies that the active set leaves unheld (rows of G).
+  std::string unheld_bodies(const std::vector<Eigen::Index>& rows) const;
+  // Per body: its rigid-mode amplitudes (empty for a restrained body).
+  std::vector<Eigen::VectorXd> rigid_amplitudes(const Eigen::VectorXd& alpha) const;
+
   const ContactSystem& system_;
   InterfaceProblem problem_;
   Eigen::VectorXd last_z_;  // warm start of the next solve (augmented-Lagrangian updates)

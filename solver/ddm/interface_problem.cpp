@@ -46,12 +46,20 @@ InterfaceProblem::InterfaceProblem(const ContactSystem& system, TaskRunner& runn
   }
   const size_t n_bodies = system.n_bodies();
   std::vector<BodyRows> rows(n_bodies);
-  std::vector<Eigen::MatrixXd> F_body(n_bodies);
-  std::vector<Eigen::VectorXd> g_body(n_bodies);
+  std::vector<Eigen::MatrixXd> F_body(n_bodies), G_body(n_bodies);
+  std::vector<Eigen::VectorXd> g_body(n_bodies), e_body(n_bodies);
   runner.run(n_bodies, [&](size_t a) {
     rows[a] = body_rows(system, a, offset_);
     const BodyRows& R = rows[a];
     const auto& body = system.body(a);
+    if (body.floating()) {
+      // G_a = (B_a R_a)^T over this body's rows, e_a = -R_a^T f_a.
+      const Eigen::MatrixXd& modes = body.rigid_modes();
+      G_body[a] = Eigen::MatrixXd::Zero(modes.cols(), static_cast<Eigen::Index>(R.rows.size()));
+      for (size_t i = 0; i < R.rows.size(); ++i)
+        for (const auto& [dof, value] : R.entries[i]) G_body[a].col(static_cast<Eigen::Index>(i)) += value * modes.row(dof).transpose();
+      e_body[a] = -modes.transpose() * body.external_load();
+    }
     // Free response: the body under its own loads only.
     const Eigen::VectorXd u_free = body.solve(Eigen::VectorXd());
     g_body[a] = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(R.rows.size()));
@@ -80,6 +88,7 @@ InterfaceProblem::InterfaceProblem(const ContactSystem& system, TaskRunner& runn
     F_body[a] = W.transpose() * W;
   });
   F_ = Eigen::MatrixXd::Zero(m, m);
+  Eigen::Index r = 0;
   for (size_t a = 0; a < n_bodies; ++a) {
     const BodyRows& R = rows[a];
     for (size_t i = 0; i < R.rows.size(); ++i) {
@@ -87,6 +96,17 @@ InterfaceProblem::InterfaceProblem(const ContactSystem& system, TaskRunner& runn
       for (size_t j = 0; j < R.rows.size(); ++j)
         F_(R.rows[i], R.rows[j]) += F_body[a](static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j));
     }
+    if (G_body[a].rows() > 0) {
+      floating_.push_back({a, r, G_body[a].rows()});
+      r += G_body[a].rows();
+    }
+  }
+  equilibrium_.G = Eigen::MatrixXd::Zero(r, m);
+  equilibrium_.e = Eigen::VectorXd::Zero(r);
+  for (const auto& f : floating_) {
+    const BodyRows& R = rows[f.body];
+    for (size_t i = 0; i < R.rows.size(); ++i) equilibrium_.G.block(f.offset, R.rows[i], f.count, 1) = G_body[f.body].col(static_cast<Eigen::Index>(i));
+    equilibrium_.e.segment(f.offset, f.count) = e_body[f.body];
   }
 }
 
@@ -102,8 +122,12 @@ Eigen::VectorXd InterfaceProblem::stack(const Pressures& per_pair) const {
   return out;
 }
 
-Displacements InterfaceProblem::displacements(const Eigen::VectorXd& z, TaskRunner& runner) const {
-  return system_.solve_bodies(system_.loads_from_pressures(split(z)), runner);
+Displacements InterfaceProblem::displacements(const Eigen::VectorXd& z, const Eigen::VectorXd& alpha,
+                                              TaskRunner& runner) const {
+  Displacements u = system_.solve_bodies(system_.loads_from_pressures(split(z)), runner);
+  if (alpha.size() == equilibrium_.G.rows())
+    for (const auto& f : floating_) u[f.body] += system_.body(f.body).rigid_modes() * alpha.segment(f.offset, f.count);
+  return u;
 }
 
 }  // namespace contact::ddm

@@ -9,8 +9,15 @@
 // dense triangular solve with |Z| x (its multipliers) right-hand sides; nothing of the size of the body is
 // stored besides its factorisation. F is symmetric positive semi-definite, and definite when every contact node
 // can move (a node whose both sides are held gives a zero row: see docs/algorithm.md).
+//
+// Floating bodies (held by their contacts alone, FETI's case): K_a is singular with the rigid modes R_a as its
+// kernel; the factorisation with a few dofs fixed gives a generalised inverse K_a^+, and
+//   u_a = K_a^+ (f_a + B_a^T z) + R_a alpha_a,   solvable only if R_a^T (f_a + B_a^T z) = 0,
+// so the gaps gain G^T alpha and the equilibrium of every floating body G z = e joins the problem, with
+// G = [(B_a R_a)^T] and e = [-R_a^T f_a] (the coarse problem of FETI; Farhat & Roux 1991, Dostal's TFETI).
 #pragma once
 
+#include "active_set.hpp"
 #include "contact_system.hpp"
 
 namespace contact::ddm {
@@ -31,14 +38,26 @@ class InterfaceProblem {
   Pressures split(const Eigen::VectorXd& stacked) const;
   Eigen::VectorXd stack(const Pressures& per_pair) const;
 
-  // The bodies' displacements for pressures z: one solve per body, in parallel.
-  Displacements displacements(const Eigen::VectorXd& z, TaskRunner& runner) const;
+  // Floating bodies: each one's rigid-mode amplitudes alpha_a are rows [offset, offset + count) of alpha.
+  struct Floating {
+    size_t body = 0;
+    Eigen::Index offset = 0, count = 0;
+  };
+  const std::vector<Floating>& floating() const { return floating_; }
+  // The equilibrium of the floating bodies, G z = e (empty without floating bodies).
+  const Equalities& equilibrium() const { return equilibrium_; }
+
+  // The bodies' displacements for pressures z and rigid-mode amplitudes alpha (empty without floating bodies):
+  // one solve per body, in parallel.
+  Displacements displacements(const Eigen::VectorXd& z, const Eigen::VectorXd& alpha, TaskRunner& runner) const;
 
  private:
   const ContactSystem& system_;
   std::vector<Eigen::Index> offset_;
   Eigen::MatrixXd F_;
   Eigen::VectorXd g_free_, D_;
+  std::vector<Floating> floating_;
+  Equalities equilibrium_;
 };
 
 }  // namespace contact::ddm

@@ -2,6 +2,8 @@
 
 #include "rigid_modes.hpp"
 
+#include <Eigen/QR>
+
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -16,11 +18,14 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }
 }  // namespace
 
-BodySolver::BodySolver(const Body& body, const Model& model, bool factorize_now, const std::vector<int>& interface_dofs)
+BodySolver::BodySolver(const Body& body, const Model& model, bool factorize_now, const std::vector<int>& interface_dofs,
+                       bool allow_floating)
     : body_(body),
       elasticity_(make_elasticity(body.material, model)),
       constraints_(2 * body.mesh.num_nodes()),
-      interface_dofs_(interface_dofs) {
+      interface_dofs_(interface_dofs),
+      allow_floating_(allow_floating),
+      factorize_(factorize_now) {
   const auto t0 = std::chrono::steady_clock::now();
   setup_constraints();
   if (!ok()) return;
@@ -34,29 +39,58 @@ void BodySolver::setup_constraints() {
   for (const auto& [node, ends] : mesh::hanging_nodes(body_.mesh))
     for (int c = 0; c < 2; ++c)
       constraints_.add_line(2 * node + c, {{2 * ends.first + c, 0.5}, {2 * ends.second + c, 0.5}});
+  std::vector<PrescribedDof> prescribed;
   for (const auto& bc : body_.boundary) {
     if (bc.kind != BoundaryCondition::Kind::displacement) continue;
     for (int node : body_.mesh.edge_set_nodes(bc.edge)) {
-      if (bc.ux) constraints_.add_dirichlet(2 * node, *bc.ux);
-      if (bc.uy) constraints_.add_dirichlet(2 * node + 1, *bc.uy);
+      if (bc.ux) {
+        constraints_.add_dirichlet(2 * node, *bc.ux);
+        prescribed.push_back({node, 0});
+      }
+      if (bc.uy) {
+        constraints_.add_dirichlet(2 * node + 1, *bc.uy);
+        prescribed.push_back({node, 1});
+      }
     }
   }
-  const std::string err = constraints_.close();
-  if (!err.empty()) {
-    error_ = "body '" + body_.name + "': " + err;
+  // CHOLMOD factorises a singular stiffness without complaint (a tiny pivot), so check the supports first.
+  RigidModes modes = free_rigid_modes(body_.mesh, prescribed);
+  if (modes.modes.cols() > 0 && !allow_floating_) {
+    std::string list;
+    for (const auto& m : modes.names) list += (list.empty() ? "" : ", ") + m;
+    error_ = "body '" + body_.name + "' is not restrained against rigid motion (" + list +
+             " free): this method solves each body on its own, so each body needs its own displacement conditions";
     return;
   }
-  // CHOLMOD factorises a singular stiffness without complaint (a tiny pivot), so check the supports.
-  std::vector<PrescribedDof> prescribed;
-  for (int d = 0; d < constraints_.n_dofs(); ++d)
-    if (constraints_.is_dirichlet(d)) prescribed.push_back({d / 2, d % 2});
-  const auto modes = free_rigid_motions(body_.mesh, prescribed);
-  if (!modes.empty()) {
-    std::string list;
-    for (const auto& m : modes) list += (list.empty() ? "" : ", ") + m;
-    error_ = "body '" + body_.name + "' is not restrained against rigid motion (" + list +
-             " free): each body needs its own displacement conditions";
+  if (modes.modes.cols() > 0 && factorize_) {
+    // A floating body: fix as many dofs as it has free motions, chosen by QR with column pivoting among the
+    // unconstrained dofs away from the contact (if there are enough), so that the motions restricted to them are
+    // as well conditioned as possible; the factorisation then gives a generalised inverse of the stiffness.
+    std::vector<char> avoid(static_cast<size_t>(constraints_.n_dofs()), 0);
+    for (const auto& [node, c] : prescribed) avoid[static_cast<size_t>(2 * node + c)] = 1;
+    for (const auto& [node, ends] : mesh::hanging_nodes(body_.mesh)) avoid[static_cast<size_t>(2 * node)] = avoid[static_cast<size_t>(2 * node + 1)] = 1;
+    std::vector<int> candidates;
+    for (int pass = 0; pass < 2 && static_cast<Eigen::Index>(candidates.size()) < modes.modes.cols(); ++pass) {
+      candidates.clear();
+      std::vector<char> skip = avoid;
+      if (pass == 0)
+        for (int d : interface_dofs_) skip[static_cast<size_t>(d)] = 1;
+      for (int d = 0; d < constraints_.n_dofs(); ++d)
+        if (!skip[static_cast<size_t>(d)]) candidates.push_back(d);
+    }
+    Eigen::MatrixXd at(modes.modes.cols(), static_cast<Eigen::Index>(candidates.size()));
+    for (size_t j = 0; j < candidates.size(); ++j) at.col(static_cast<Eigen::Index>(j)) = modes.modes.row(candidates[j]).transpose();
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(at);
+    for (Eigen::Index i = 0; i < modes.modes.cols(); ++i) {
+      const int dof = candidates[static_cast<size_t>(qr.colsPermutation().indices()[i])];
+      fixing_dofs_.push_back(dof);
+      constraints_.add_dirichlet(dof, 0.0);
+    }
   }
+  rigid_modes_ = std::move(modes.modes);
+  rigid_mode_names_ = std::move(modes.names);
+  const std::string err = constraints_.close();
+  if (!err.empty()) error_ = "body '" + body_.name + "': " + err;
 }
 
 namespace {
@@ -255,6 +289,7 @@ Eigen::VectorXd BodySolver::reactions(const Eigen::VectorXd& u, const Eigen::Vec
   if (extra_load.size() > 0) r -= extra_load;
   for (int d = 0; d < r.size(); ++d)
     if (!constraints_.is_dirichlet(d)) r[d] = 0.0;
+  for (int d : fixing_dofs_) r[d] = 0.0;  // not a support
   return r;
 }
 

@@ -31,7 +31,11 @@ class BodySolver {
   // interface_dofs (full dof numbers, e.g. the contact edges' dofs that contact forces act on): the free unknowns
   // they depend on are ordered last in the factorisation, so that interface_factor() holds the Cholesky factor of
   // the Schur complement on them (fem/cholesky.hpp).
-  BodySolver(const Body& body, const Model& model, bool factorize = true, const std::vector<int>& interface_dofs = {});
+  // allow_floating: a body that its own displacement conditions do not restrain is accepted (it is held by its
+  // contacts): its rigid modes R are fixed at a few well-chosen dofs for the factorisation, so every solve gives
+  // a particular solution K^+ f (zero at those dofs; meaningful when R^T f = 0), and the caller adds R alpha.
+  BodySolver(const Body& body, const Model& model, bool factorize = true, const std::vector<int>& interface_dofs = {},
+             bool allow_floating = false);
 
   bool ok() const { return error_.empty(); }
   const std::string& error() const { return error_; }
@@ -70,6 +74,13 @@ class BodySolver {
   const std::vector<int>& interface_unknowns() const;
   const Eigen::MatrixXd& interface_factor() const;
   const std::vector<int>& interface_dofs() const { return interface_dofs_; }
+  // Floating bodies: the free rigid motions (all dofs x k; empty for a restrained body), their names ("translation
+  // in y", ...), and the dofs fixed to factorise (not supports: they carry no reaction; none without a
+  // factorisation, when the coupled system is factorised instead).
+  bool floating() const { return rigid_modes_.cols() > 0; }
+  const Eigen::MatrixXd& rigid_modes() const { return rigid_modes_; }
+  const std::vector<std::string>& rigid_mode_names() const { return rigid_mode_names_; }
+  const std::vector<int>& fixing_dofs() const { return fixing_dofs_; }
   // Numbers stored in the Cholesky factor (its memory is 8 bytes each, plus the integer pattern).
   double factor_entries() const { return factor_ ? factor_->factor_entries() : 0.0; }
   double factorization_seconds() const { return factorization_seconds_; }
@@ -87,6 +98,10 @@ class BodySolver {
   Eigen::SparseMatrix<double> K_red_;
   Eigen::VectorXd f_ext_, rhs_base_;
   std::vector<int> interface_dofs_;
+  bool allow_floating_ = false, factorize_ = true;
+  Eigen::MatrixXd rigid_modes_;
+  std::vector<std::string> rigid_mode_names_;
+  std::vector<int> fixing_dofs_;
   std::unique_ptr<Cholesky> factor_;
   std::string error_;
   double factorization_seconds_ = 0.0, assembly_seconds_ = 0.0;

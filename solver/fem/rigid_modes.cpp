@@ -32,6 +32,10 @@ std::string describe_translation(Eigen::Vector2d d) {
 }  // namespace
 
 std::vector<std::string> free_rigid_motions(const mesh::Mesh& mesh, const std::vector<PrescribedDof>& prescribed) {
+  return free_rigid_modes(mesh, prescribed).names;
+}
+
+RigidModes free_rigid_modes(const mesh::Mesh& mesh, const std::vector<PrescribedDof>& prescribed) {
   // Centroid of the body (area-weighted cell centres) and the distance to its farthest node, which scales the
   // rotation mode to unit size so that the three modes are comparable in the SVD.
   Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
@@ -71,6 +75,14 @@ std::vector<std::string> free_rigid_motions(const mesh::Mesh& mesh, const std::v
     null_space = svd.matrixV().rightCols(3 - rank);
   }
   if (null_space.cols() == 0) return {};
+  RigidModes out;
+  out.modes.resize(2 * mesh.num_nodes(), null_space.cols());
+  for (int node = 0; node < mesh.num_nodes(); ++node) {
+    const Eigen::Vector2d r = (mesh.nodes[static_cast<size_t>(node)] - centroid) / radius;
+    Eigen::Matrix<double, 2, 3> at;  // the three modes at this node
+    at << 1.0, 0.0, -r.y(), 0.0, 1.0, r.x();
+    out.modes.middleRows(2 * node, 2) = at * null_space;
+  }
 
   // Describe the null space in a canonical basis (the SVD's own basis mixes modes arbitrarily): its part with
   // no rotation is spanned by translations, and at most one further direction rotates.
@@ -102,7 +114,8 @@ std::vector<std::string> free_rigid_motions(const mesh::Mesh& mesh, const std::v
     free.push_back(describe_translation(tsvd.matrixU().col(0)));
   }
   if (!rotation_text.empty()) free.push_back(rotation_text);
-  return free;
+  out.names = std::move(free);
+  return out;
 }
 
 }  // namespace contact::fem

@@ -12,6 +12,8 @@
 
 #include "../mesh/mesh.hpp"
 
+#include <Eigen/Core>
+
 namespace contact::fem {
 
 // One prescribed displacement component: node index and component (0 = x, 1 = y).
@@ -23,5 +25,15 @@ using PrescribedDof = std::array<int, 2>;
 // centroid (two unit translations and a rotation scaled to unit size at the farthest node) evaluated at the
 // prescribed components; their null space, by SVD with a relative tolerance of 1e-10, holds the free motions.
 std::vector<std::string> free_rigid_motions(const mesh::Mesh& mesh, const std::vector<PrescribedDof>& prescribed);
+
+// The same free motions as vectors: `modes` is n_dofs x k (dof = 2 node + component), its columns an orthonormal
+// basis (in the coefficients of the three modes about the centroid, the rotation scaled to unit size at the
+// farthest node) of the rigid motions that vanish at every prescribed component; `names` describes them as above.
+// k = 0 for a restrained body. Each column vanishes, to round-off, at the prescribed components.
+struct RigidModes {
+  Eigen::MatrixXd modes;
+  std::vector<std::string> names;
+};
+RigidModes free_rigid_modes(const mesh::Mesh& mesh, const std::vector<PrescribedDof>& prescribed);
 
 }  // namespace contact::fem
