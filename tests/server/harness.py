@@ -49,7 +49,7 @@ def flat_patch(displacement=-0.001, name="flat_patch"):
     return job
 
 
-def long_job(max_iterations=200000, name="long"):
+def long_job(max_iterations=100000, name="long"):
     """The paper's two layers on a tall mesh (32 x 256 per body, about 2 ms per iteration) with a tolerance the
     iteration does not reach before max_iterations: a job that runs until cancelled, or for a bounded time."""
     job = example("seed_layers.json")
