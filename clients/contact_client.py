@@ -170,7 +170,8 @@ class Client:
         return cls(self._host, self._port, timeout=timeout)
 
     def _headers(self, extra=None):
-        h = {"User-Agent": "contact_client/1", "Accept": "application/json"}
+        # X-Requested-With: contactd refuses a body-less POST or a DELETE without it (its cross-site rule).
+        h = {"User-Agent": "contact_client/1", "Accept": "application/json", "X-Requested-With": "contact_client"}
         if self.token:
             h["Authorization"] = "Bearer " + self.token
         h.update(extra or {})
