@@ -100,6 +100,7 @@ std::int64_t EventLog::load() {
   // One pass in chunks of 1 MiB: each complete line is indexed by its prefix; the lines are never all in memory.
   constexpr std::size_t kChunk = 1 << 20;
   constexpr std::size_t kLongestLine = 64u << 20;  // no event is this long: a file without newlines is damage
+  constexpr std::int64_t kMaxGap = 1'000'000;
   std::vector<char> chunk(kChunk);
   std::string line;  // the current line, possibly spanning chunks
   std::uint64_t read_at = 0, line_start = 0;
@@ -124,10 +125,16 @@ std::int64_t EventLog::load() {
       ++from;  // the newline
       std::int64_t seq = 0;
       std::string type;
-      if (!parse_prefix(line, seq, type) || seq != static_cast<std::int64_t>(offsets_.size()) + 1 ||
-          line.back() != '}') {
+      const auto next = static_cast<std::int64_t>(offsets_.size()) + 1;
+      // A gap is events lost to write errors (a full disk): they stay missing. A seq that goes back, or a jump no
+      // write error explains, is not this log's.
+      if (!parse_prefix(line, seq, type) || seq < next || seq > next + kMaxGap || line.back() != '}') {
         damaged = true;
         break;
+      }
+      while (static_cast<std::int64_t>(offsets_.size()) + 1 < seq) {
+        offsets_.push_back(kUnwritten);
+        types_.push_back(0);
       }
       offsets_.push_back(line_start);
       types_.push_back(type_index(type));
@@ -145,9 +152,15 @@ std::int64_t EventLog::load() {
                std::to_string(line_start) + "); the file is kept as " + aside.substr(aside.rfind('/') + 1) +
                " and the events before the damage are served";
     log_line("events: " + path_ + ": " + problem_);
-    if (::rename(path_.c_str(), aside.c_str()) != 0 || !copy_prefix(fd, path_, line_start)) {
-      log_line("events: cannot set " + path_ + " aside: " + std::strerror(errno));
-      file_ok_ = false;  // never appended to or cut: it stays as found
+    const std::string copy = path_ + ".tmp";
+    ::unlink(copy.c_str());
+    if (!copy_prefix(fd, copy, line_start) || ::rename(path_.c_str(), aside.c_str()) != 0 ||
+        ::rename(copy.c_str(), path_.c_str()) != 0) {
+      log_line("events: cannot set " + path_ + " aside (" + std::strerror(errno) +
+               "); it is served up to the damage and never written to");
+      ::unlink(copy.c_str());
+      if (::access(path_.c_str(), F_OK) != 0) ::rename(aside.c_str(), path_.c_str());
+      frozen_ = true;
     }
   } else if (torn) {
     log_line("events: cut " + std::to_string(read_at - line_start) + " bytes of a torn last line from " + path_);
@@ -181,7 +194,7 @@ void EventLog::damaged_locked(std::int64_t seq, const std::string& problem) cons
 }
 
 void EventLog::open_for_append_locked() {
-  if (fd_ >= 0 || discarded_) return;
+  if (fd_ >= 0 || discarded_ || frozen_) return;
   fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_NOFOLLOW | O_CLOEXEC, 0644);
   if (fd_ < 0) {
     if (file_ok_) log_line("events: cannot open " + path_ + ": " + std::strerror(errno));

@@ -94,6 +94,7 @@ class EventLog {
   std::deque<std::string> recent_;      // the last events; recent_.back() is seq == offsets_.size()
   bool discarded_ = false;
   bool file_ok_ = true;  // false after a write error: older events may be missing from the file
+  bool frozen_ = false;  // damaged and could not be set aside: never written to (appends reach streams only)
   std::int64_t dropped_ = 0;
   mutable std::int64_t unreadable_from_ = 0;  // > 0: the first seq whose line is damaged (never served)
   mutable std::string problem_;

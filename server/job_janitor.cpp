@@ -18,8 +18,9 @@ void JobQueue::watchdog_loop() {
     if (stopping_) break;
     const auto now = Clock::now();
     watch_running_locked(now);
-    if (now >= next_janitor) {
+    if (now >= next_janitor || retention_due_) {  // due after every job that finishes (retention by size)
       next_janitor = now + interval;
+      retention_due_ = false;
       lock.unlock();
       apply_retention();
       if (store_.reserve_used()) store_.restore_reserve();

@@ -30,6 +30,18 @@ std::string format_seconds(double s) {
   return text;
 }
 
+// What a client is told about a failed write of the result file: HDF5's error stack names the system's reason
+// ("error message = 'No space left on device'") among addresses and paths; only the reason is public.
+std::string write_error_summary(const std::string& what, const std::string& data_dir) {
+  static const std::string marker = "error message = '";
+  const auto at = what.find(marker);
+  if (at != std::string::npos) {
+    const auto end = what.find('\'', at + marker.size());
+    if (end != std::string::npos) return what.substr(at + marker.size(), end - at - marker.size());
+  }
+  return public_message(what, data_dir);
+}
+
 // Appends one `iteration` event per solver iteration and keeps the job's progress summary current.
 // Runs on the worker's thread; it only takes short locks and never waits for a client.
 class EventObserver final : public contact::Observer {
@@ -314,7 +326,7 @@ void JobQueue::run(const std::shared_ptr<Job>& job) {
       store_.remove_result(id);  // also frees the space a full disk needs for the state change below
       outcome.state = JobState::failed;
       outcome.stop_reason = "error";
-      outcome.message = "cannot write the result file: " + public_message(e.what(), store_.data_dir());
+      outcome.message = "cannot write the result file: " + write_error_summary(e.what(), store_.data_dir());
     }
   }
   for (const auto& step : result.steps) job->events.append("step", step_event(step));
@@ -326,8 +338,10 @@ void JobQueue::mark_settled(const std::shared_ptr<Job>& job) {
     std::lock_guard<std::mutex> lock(mutex_);
     job->settled = true;
     note_finished_locked(job);
+    retention_due_ = true;
   }
   settled_.notify_all();
+  watchdog_.notify_all();
 }
 
 void JobQueue::finish(const std::shared_ptr<Job>& job, JobRecord outcome) {

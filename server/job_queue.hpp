@@ -176,6 +176,7 @@ class JobQueue {
   std::int64_t finished_bytes_ = 0;                          // their disk_bytes, summed
   std::vector<std::string> stuck_;
   std::int64_t expired_total_ = 0;
+  bool retention_due_ = false;  // a job was settled: the janitor checks retention at once
   std::int64_t events_dropped_total_ = 0;
   std::deque<std::shared_ptr<Job>> queue_;
   std::vector<std::shared_ptr<Job>> running_;

@@ -5,6 +5,7 @@
 #include <fcntl.h>
 #include <sys/file.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -62,7 +63,10 @@ JobStore::JobStore(const std::string& data_dir)
   fs::create_directories(jobs_dir_, ec);
   if (ec) throw std::runtime_error("cannot create the data directory '" + jobs_dir_ + "': " + ec.message());
   lock_fd_ = lock_data_dir(data_dir_);
-  if (!restore_reserve()) log_line("store: cannot set the disk reserve aside in " + data_dir_ + " (disk full?)");
+  if (!restore_reserve()) {
+    reserve_used_ = true;  // as good as used: readiness says the disk is (nearly) full
+    log_line("store: cannot set the disk reserve aside in " + data_dir_ + " (less than 2 MiB free?)");
+  }
 }
 
 JobStore::~JobStore() {
@@ -122,6 +126,11 @@ bool JobStore::restore_reserve() {
     reserve_used_ = false;
     return true;
   }
+  // Only with room to spare: taking back the last free megabyte would leave the disk as full as before.
+  struct statvfs fs {};
+  if (::statvfs(data_dir_.c_str(), &fs) == 0 &&
+      static_cast<unsigned long long>(fs.f_bavail) * fs.f_frsize < 2ull * kReserveBytes)
+    return false;
   const std::string tmp = reserve_path_ + ".tmp";
   ::unlink(tmp.c_str());
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0600);

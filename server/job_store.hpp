@@ -82,7 +82,7 @@ class JobStore {
   bool writable() const;
   // The reserve was given up to store a state change on a full disk (readiness says so until it is back).
   bool reserve_used() const { return reserve_used_.load(); }
-  // Sets the reserve aside again if there is room; true if it is in place.
+  // Sets the reserve aside again if there is room for it and as much again; true if it is in place.
   bool restore_reserve();
 
  private:
