@@ -260,11 +260,11 @@ class Server:
     def wait_done(self, job_id, timeout=60):
         return self.wait_for(job_id, lambda j: j.get("done"), timeout)
 
-    def rss_kb(self):
-        """The server's resident memory (VmRSS, kB)."""
+    def rss_kb(self, field="VmRSS"):
+        """The server's resident memory (kB): VmRSS now, or VmHWM for its peak so far."""
         with open(f"/proc/{self.proc.pid}/status") as f:
             for line in f:
-                if line.startswith("VmRSS:"):
+                if line.startswith(field + ":"):
                     return int(line.split()[1])
         return None
 
