@@ -161,6 +161,8 @@ with Server(token=TOKEN, args=["--workers", "1"]) as server:
           (r.json() or {}).get("type") == "/problems/host-not-allowed", r)
     r = server.get("/metrics", headers={"Host": "rebind.example"})
     check("the Host check covers /metrics too", r.status == 421, r.status)
+    r = server.get("/healthz", headers={"Host": "10.1.2.3:8080"})
+    check("probes are exempt (an orchestrator probes by address)", r.status == 200, r.status)
     for host in ("localhost:1234", "127.0.0.1", "LOCALHOST"):
         check(f"Host {host}: allowed", server.get("/healthz", headers={"Host": host}).status == 200)
     running = server.submit_id(flat_patch(name="cross-site"))
