@@ -272,7 +272,15 @@ void ConnectionGate::accept_all() {
     const int fd = ::accept4(listen_fd_, reinterpret_cast<sockaddr*>(&address), &length, SOCK_NONBLOCK | SOCK_CLOEXEC);
     if (fd < 0) {
       if (errno == EINTR || errno == ECONNABORTED) continue;
-      if (errno == EMFILE || errno == ENFILE) log_line("gate: out of file descriptors; not accepting for now");
+      if (errno == EMFILE || errno == ENFILE) {
+        // The pending connections stay in the backlog; a pause keeps this loop from spinning on them.
+        static auto last_note = Clock::time_point{};
+        if (Clock::now() - last_note > std::chrono::seconds(10)) {
+          last_note = Clock::now();
+          log_line("gate: out of file descriptors; accepting again as connections close");
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      }
       return;  // EAGAIN: none left
     }
     std::string ip;
