@@ -11,6 +11,7 @@ BUILD_PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev
   libcpp-httplib-dev
   python3 python3-h5py python3-numpy python3-jsonschema python3-matplotlib
+  iproute2  # ss: tests/server/test_connections.py reads the listen backlog
 )
 RUNTIME_PACKAGES=(
   libcholmod3 libopenblas0-pthread libhdf5-103-1 libcpp-httplib0.11 ca-certificates curl python3

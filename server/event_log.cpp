@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <algorithm>
 #include <cstring>
 #include <string_view>
 
@@ -45,11 +46,40 @@ bool parse_prefix(std::string_view line, std::int64_t& seq, std::string& type) {
 
 }  // namespace
 
-EventLog::EventLog(std::string path) : path_(std::move(path)) {}
+EventLog::EventLog(std::string path, std::uint64_t max_bytes) : path_(std::move(path)), max_bytes_(max_bytes) {}
 
 EventLog::~EventLog() {
   if (fd_ >= 0) ::close(fd_);
 }
+
+namespace {
+
+// Copies the first `bytes` of `from` into a new file `to` (never through a link), fsync'ed.
+bool copy_prefix(int from, const std::string& to, std::uint64_t bytes) {
+  const int out = ::open(to.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+  if (out < 0) return false;
+  std::vector<char> buffer(1 << 20);
+  std::uint64_t done = 0;
+  bool ok = true;
+  while (ok && done < bytes) {
+    const ssize_t n = ::pread(from, buffer.data(), std::min<std::uint64_t>(buffer.size(), bytes - done),
+                              static_cast<off_t>(done));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    for (ssize_t w = 0; ok && w < n;) {
+      const ssize_t m = ::write(out, buffer.data() + w, static_cast<std::size_t>(n - w));
+      if (m < 0 && errno == EINTR) continue;
+      ok = m > 0;
+      w += m > 0 ? m : 0;
+    }
+    done += static_cast<std::uint64_t>(n);
+  }
+  ok = ok && done == bytes && ::fsync(out) == 0;
+  ::close(out);
+  return ok;
+}
+
+}  // namespace
 
 std::int64_t EventLog::load() {
   std::lock_guard<std::mutex> lock(mutex_);
@@ -57,40 +87,115 @@ std::int64_t EventLog::load() {
   types_.clear();
   recent_.clear();
   file_size_ = 0;
-  std::string content;
-  try {
-    content = read_whole_file(path_);
-  } catch (const std::exception&) {
+  const int fd = ::open(path_.c_str(), O_RDWR | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0) {
+    if (errno == ELOOP) {  // a symbolic link planted in the store: moved aside (the link, not its target)
+      const std::string aside = path_ + ".damaged-" + std::to_string(now_unix_us() / 1000000);
+      problem_ = "events.ndjson was a symbolic link (moved to " + aside.substr(aside.rfind('/') + 1) + ")";
+      if (::rename(path_.c_str(), aside.c_str()) != 0) problem_ += "; cannot move it: " + std::string(std::strerror(errno));
+      log_line("events: " + path_ + ": " + problem_);
+    }
     return 0;  // no events yet
   }
-  std::uint64_t position = 0;
-  const std::string_view view(content);
-  while (position < content.size()) {
-    const std::size_t newline = content.find('\n', position);
-    if (newline == std::string::npos) break;  // torn last line: the crash hit the one write() of a line
-    const std::string_view line = view.substr(position, newline - position);
-    std::int64_t seq = 0;
-    std::string type;
-    if (!parse_prefix(line, seq, type) || seq != static_cast<std::int64_t>(offsets_.size()) + 1) break;
-    // Every line is written whole by one write(), so only the last one can be damaged: check it fully.
-    if (newline + 1 >= content.size() && !nlohmann::json::accept(line)) break;
-    offsets_.push_back(position);
-    types_.push_back(type_index(type));
-    position = newline + 1;  // events read back stay on disk only: a finished job costs no memory
+  // One pass in chunks of 1 MiB: each complete line is indexed by its prefix; the lines are never all in memory.
+  constexpr std::size_t kChunk = 1 << 20;
+  constexpr std::size_t kLongestLine = 64u << 20;  // no event is this long: a file without newlines is damage
+  constexpr std::int64_t kMaxGap = 1'000'000;
+  std::vector<char> chunk(kChunk);
+  std::string line;  // the current line, possibly spanning chunks
+  std::uint64_t read_at = 0, line_start = 0;
+  bool damaged = false, torn = false;
+  while (!damaged) {
+    const ssize_t n = ::pread(fd, chunk.data(), chunk.size(), static_cast<off_t>(read_at));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      torn = !line.empty();  // the crash hit the one write() of the last line
+      break;
+    }
+    read_at += static_cast<std::uint64_t>(n);
+    std::size_t from = 0;
+    while (from < static_cast<std::size_t>(n)) {
+      const char* begin = chunk.data() + from;
+      const void* nl = std::memchr(begin, '\n', static_cast<std::size_t>(n) - from);
+      const std::size_t take = nl ? static_cast<std::size_t>(static_cast<const char*>(nl) - begin)
+                                  : static_cast<std::size_t>(n) - from;
+      line.append(begin, take);
+      from += take;
+      if (!nl) break;
+      ++from;  // the newline
+      std::int64_t seq = 0;
+      std::string type;
+      const auto next = static_cast<std::int64_t>(offsets_.size()) + 1;
+      // A gap is events lost to write errors (a full disk): they stay missing. A seq that goes back, or a jump no
+      // write error explains, is not this log's.
+      if (!parse_prefix(line, seq, type) || seq < next || seq > next + kMaxGap || line.back() != '}') {
+        damaged = true;
+        break;
+      }
+      while (static_cast<std::int64_t>(offsets_.size()) + 1 < seq) {
+        offsets_.push_back(kUnwritten);
+        types_.push_back(0);
+      }
+      offsets_.push_back(line_start);
+      types_.push_back(type_index(type));
+      line_start += line.size() + 1;  // events read back stay on disk only: a finished job costs no memory
+      line.clear();
+    }
+    if (line.size() > kLongestLine) damaged = true;
   }
-  file_size_ = position;
-  if (position < content.size()) {
-    log_line("events: cut " + std::to_string(content.size() - position) + " bytes of a torn or foreign tail from " +
-             path_);
-    if (::truncate(path_.c_str(), static_cast<off_t>(position)) != 0)
+  file_size_ = line_start;
+  if (damaged) {
+    // Not a crash artefact (every line is written whole by one write()): keep the file as it is, continue on a
+    // copy of the good part.
+    const std::string aside = path_ + ".damaged-" + std::to_string(now_unix_us() / 1000000);
+    problem_ = "events.ndjson is damaged after event " + std::to_string(offsets_.size()) + " (byte " +
+               std::to_string(line_start) + "); the file is kept as " + aside.substr(aside.rfind('/') + 1) +
+               " and the events before the damage are served";
+    log_line("events: " + path_ + ": " + problem_);
+    const std::string copy = path_ + ".tmp";
+    ::unlink(copy.c_str());
+    if (!copy_prefix(fd, copy, line_start) || ::rename(path_.c_str(), aside.c_str()) != 0 ||
+        ::rename(copy.c_str(), path_.c_str()) != 0) {
+      log_line("events: cannot set " + path_ + " aside (" + std::strerror(errno) +
+               "); it is served up to the damage and never written to");
+      ::unlink(copy.c_str());
+      if (::access(path_.c_str(), F_OK) != 0) ::rename(aside.c_str(), path_.c_str());
+      frozen_ = true;
+    }
+  } else if (torn) {
+    log_line("events: cut " + std::to_string(read_at - line_start) + " bytes of a torn last line from " + path_);
+    if (::ftruncate(fd, static_cast<off_t>(line_start)) != 0)
       log_line("events: cannot truncate " + path_ + ": " + std::strerror(errno));
   }
+  ::close(fd);
   return static_cast<std::int64_t>(offsets_.size());
 }
 
+std::string EventLog::problem() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return problem_;
+}
+
+std::int64_t EventLog::dropped() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return dropped_;
+}
+
+bool EventLog::unreadable_after(std::int64_t after) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return unreadable_from_ > 0 && after + 1 >= unreadable_from_;
+}
+
+void EventLog::damaged_locked(std::int64_t seq, const std::string& problem) const {
+  if (unreadable_from_ > 0 && unreadable_from_ <= seq) return;
+  unreadable_from_ = seq;
+  problem_ = problem;
+  log_line("events: " + path_ + ": " + problem);
+}
+
 void EventLog::open_for_append_locked() {
-  if (fd_ >= 0 || discarded_) return;
-  fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  if (fd_ >= 0 || discarded_ || frozen_) return;
+  fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_NOFOLLOW | O_CLOEXEC, 0644);
   if (fd_ < 0) {
     if (file_ok_) log_line("events: cannot open " + path_ + ": " + std::strerror(errno));
     file_ok_ = false;
@@ -112,6 +217,12 @@ std::int64_t EventLog::append(const std::string& type, const nlohmann::json& fie
     const std::string rest =
         fields.is_object() ? fields.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) : std::string("{}");
     line += rest.size() > 2 ? "," + rest.substr(1) : std::string("}");
+    if (type == "iteration" && file_size_ + line.size() + 1 > max_bytes_) {
+      if (dropped_++ == 0)
+        log_line("events: " + path_ + " has reached its cap of " + std::to_string(max_bytes_) +
+                 " bytes; further iteration events are not recorded");
+      return 0;
+    }
     open_for_append_locked();
     std::uint64_t offset = kUnwritten;
     if (fd_ >= 0) {
@@ -149,7 +260,8 @@ std::vector<Event> EventLog::read_after(std::int64_t after, std::size_t max_coun
   std::vector<Event> events;
   if (after < 0) after = 0;
   std::unique_lock<std::mutex> lock(mutex_);
-  const std::int64_t last = static_cast<std::int64_t>(offsets_.size());
+  std::int64_t last = static_cast<std::int64_t>(offsets_.size());
+  if (unreadable_from_ > 0) last = std::min(last, unreadable_from_ - 1);
   if (discarded_ || after >= last || max_count == 0) return events;
   const std::int64_t until = std::min<std::int64_t>(last, after + static_cast<std::int64_t>(max_count));
   const std::int64_t first_recent = last - static_cast<std::int64_t>(recent_.size()) + 1;
@@ -175,7 +287,7 @@ std::vector<Event> EventLog::read_after(std::int64_t after, std::size_t max_coun
     lock.unlock();  // the file part is read without the lock: the worker keeps appending meanwhile
     if (begin != kUnwritten && end > begin) {
       std::string bytes(end - begin, '\0');
-      const int fd = ::open(path_.c_str(), O_RDONLY | O_CLOEXEC);
+      const int fd = ::open(path_.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
       std::size_t got = 0;
       if (fd >= 0) {
         while (got < bytes.size()) {
@@ -193,7 +305,23 @@ std::vector<Event> EventLog::read_after(std::int64_t after, std::size_t max_coun
         if (from >= bytes.size()) break;
         const std::size_t newline = bytes.find('\n', from);
         if (newline == std::string::npos) break;
-        events.push_back({seq + static_cast<std::int64_t>(k), kTypes[types[k]], bytes.substr(from, newline - from)});
+        const std::int64_t event_seq = seq + static_cast<std::int64_t>(k);
+        std::string line = bytes.substr(from, newline - from);
+        // Only whole events are served: a line changed on disk since it was written is reported, not sent.
+        std::int64_t line_seq = 0;
+        std::string line_type;
+        if (!parse_prefix(line, line_seq, line_type) || line_seq != event_seq || !nlohmann::json::accept(line)) {
+          std::function<void(const std::string&)> report;
+          {
+            std::lock_guard<std::mutex> relock(mutex_);
+            damaged_locked(event_seq, "events.ndjson: the line of event " + std::to_string(event_seq) +
+                                          " is not a valid event; the stream stops before it");
+            report = on_damage_;
+          }
+          if (report) report(problem());
+          return events;
+        }
+        events.push_back({event_seq, kTypes[types[k]], std::move(line)});
       }
     }
     seq = file_until + 1;

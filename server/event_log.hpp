@@ -5,6 +5,10 @@
 // Last-Event-ID stays meaningful. Each line is a complete JSON object that starts
 // {"seq":N,"type":"...","time":"...", followed by the type's own fields (see docs/server.md).
 //
+// Bounded: once the file has `max_bytes`, further `iteration` events are dropped (counted by dropped()); the few
+// state, step and end events are always written. Damage is never served: a line that is not a whole event is
+// not sent to any client, and the log's problem() says where it is (the job store reports it).
+//
 // Thread safety: every member may be called from any thread. append() (the worker) never waits for readers: it
 // holds the lock only to write one line and to notify.
 #pragma once
@@ -15,6 +19,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -30,15 +35,26 @@ struct Event {
 class EventLog {
  public:
   // `path` is the job's events.ndjson; it is created on the first append.
-  explicit EventLog(std::string path);
+  EventLog(std::string path, std::uint64_t max_bytes);
   ~EventLog();
   EventLog(const EventLog&) = delete;
   EventLog& operator=(const EventLog&) = delete;
 
-  // Reads an existing file back (start-up): indexes every complete line and cuts off a torn last line (a crash
-  // in the middle of a write) or anything after the first line that is not the next event. Returns the number of
-  // events kept.
+  // Reads an existing file back (start-up), as a stream (only the index is kept: 9 bytes per event): indexes
+  // every complete line and cuts off a torn last line (a crash in the middle of its one write). A damaged line
+  // before the end (not the next event, or not an object), or a file that is a symbolic link, is not cut: the
+  // file is renamed to events.ndjson.damaged-<time> (kept for inspection) and the events before the damage are
+  // copied into a new events.ndjson; problem() says what was found. Returns the number of events kept.
   std::int64_t load();
+
+  // What is wrong with the log ("" when nothing): found by load() or by a read (a line that is not JSON).
+  std::string problem() const;
+  // Called (once) when a read finds damage, with the problem; set before the log is used.
+  void on_damage(std::function<void(const std::string&)> callback) { on_damage_ = std::move(callback); }
+  // Iteration events not recorded because the log reached max_bytes.
+  std::int64_t dropped() const;
+  // True when the event after `after` exists but cannot be read (damaged): a stream ends there.
+  bool unreadable_after(std::int64_t after) const;
 
   // Appends one event of `type` with `fields` (a JSON object; seq, type and time are added) and wakes waiters.
   // Returns the event's seq. An I/O error is logged, not thrown: the event still reaches live subscribers.
@@ -62,10 +78,13 @@ class EventLog {
 
  private:
   void open_for_append_locked();
+  void damaged_locked(std::int64_t seq, const std::string& problem) const;  // found by a read: mutable state
 
   static constexpr std::size_t kRecent = 512;  // events kept in memory per job
 
   const std::string path_;
+  const std::uint64_t max_bytes_;
+  std::function<void(const std::string&)> on_damage_;
   mutable std::mutex mutex_;
   mutable std::condition_variable changed_;
   int fd_ = -1;
@@ -75,6 +94,10 @@ class EventLog {
   std::deque<std::string> recent_;      // the last events; recent_.back() is seq == offsets_.size()
   bool discarded_ = false;
   bool file_ok_ = true;  // false after a write error: older events may be missing from the file
+  bool frozen_ = false;  // damaged and could not be set aside: never written to (appends reach streams only)
+  std::int64_t dropped_ = 0;
+  mutable std::int64_t unreadable_from_ = 0;  // > 0: the first seq whose line is damaged (never served)
+  mutable std::string problem_;
 };
 
 }  // namespace contactd

@@ -1,13 +1,21 @@
-// The HTTP face of contactd: one class owns the httplib::Server; the routes are registered in one place
-// (register_routes) and each handler is short: parse the request, call the JobQueue, map the outcome to a response.
-// Cross-cutting rules live in the pre-routing handler (bearer token, Content-Encoding, body size, "not ready"),
-// the error handler (JSON problem documents for every 4xx/5xx, 405 with Allow) and the exception handler (500).
-// The API is specified in api/openapi.yaml and explained in docs/server.md.
+// The HTTP face of contactd: one class owns the transport (connection gate, HTTP threads, httplib's request
+// processing: http_transport.hpp); the routes are registered in one place (register_routes) and each handler is
+// short: parse the request, call the JobQueue, map the outcome to a response (http_handlers.cpp).
+// Cross-cutting rules live in the pre-routing handler (framing, Host allow-list, cross-site rules, bearer token,
+// Content-Encoding and media type, body size, "not ready"), the error handler (JSON problem documents for every
+// 4xx/5xx, 405 with Allow) and the exception handler (500). The API is specified in api/openapi.yaml and explained
+// in docs/server.md.
 #pragma once
 
+// The solver's headers (Eigen) before httplib's: <resolv.h>, which httplib includes, defines a macro `_res`
+// that Eigen uses as a parameter name.
 #include "job_queue.hpp"
 #include "job_store.hpp"
 #include "metrics.hpp"
+
+#include "body_budget.hpp"
+#include "http_transport.hpp"
+#include "request_guard.hpp"
 
 #include <httplib.h>
 
@@ -30,14 +38,28 @@ struct HttpSettings {
   int max_streams = 64;                      // concurrent progress streams; more get 503
   int http_threads = 0;                      // 0 = max_streams + 32
   bool access_log = false;                   // one stderr line per request
+  std::vector<std::string> allowed_hosts;    // Host header allow-list; empty = loopback names and `host`
+  // Connections (connection_gate.hpp).
+  std::size_t max_connections = 1024;
+  std::size_t max_connections_per_client = 512;
+  int listen_backlog = 1024;
+  double head_timeout_seconds = 10.0;
+  double idle_timeout_seconds = 5.0;
+  double body_timeout_seconds = 60.0;
+  std::size_t max_header_bytes = 16 * 1024;
+  std::size_t max_header_fields = 64;
+  // Job bodies (body_budget.hpp).
+  std::size_t max_large_bodies = 4;  // bodies over 256 KiB read at once
+  std::size_t max_validations = 0;   // jobs parsed and validated at once; 0 = the number of cores (at least 2)
 };
 
 class HttpServer {
  public:
   HttpServer(HttpSettings settings, JobQueue& queue, JobStore& store, Metrics& metrics);
+  ~HttpServer();
 
-  // Binds the listening socket. Returns the port, or -1 if it cannot bind.
-  int bind();
+  // Binds the listening socket. Returns the port, or -1 if it cannot bind (`error` says why).
+  int bind(std::string& error);
   // Serves until stop(); blocks the calling thread.
   void listen();
 
@@ -50,7 +72,7 @@ class HttpServer {
   // Waits (at most `timeout`) until every stream has sent its last bytes and closed.
   void wait_for_streams(std::chrono::milliseconds timeout);
   // Last step: stops listening and waits for the connections to finish.
-  void stop() { server_.stop(); }
+  void stop() { transport_->stop(); }
 
  private:
   using Request = httplib::Request;
@@ -89,17 +111,22 @@ class HttpServer {
 
   // Helpers.
   bool authorized(const Request& req) const;
-  bool read_json_body(const Request& req, Response& res, const ContentReader& reader, std::string& body);
+  // Reads a JSON job body within the body budget; on failure the response is set and the result is false.
+  bool read_json_body(const Request& req, Response& res, const ContentReader& reader, std::string& body,
+                      BodyBudget::Slot& slot);
   std::shared_ptr<Job> find_job(const Request& req, Response& res);
   nlohmann::json job_resource(const JobRecord& record, int queue_position) const;
   bool pump_stream(Stream& stream, httplib::DataSink& sink);
   void method_not_allowed_or_not_found(const Request& req, Response& res);
 
   HttpSettings settings_;
+  GuardSettings guard_;
   JobQueue& queue_;
   JobStore& store_;
   Metrics& metrics_;
-  httplib::Server server_;
+  BodyBudget budget_;
+  HttplibCore core_;
+  std::unique_ptr<Transport> transport_;
   std::vector<Route> routes_;
   std::atomic<bool> ready_{false};
   std::atomic<bool> stopping_{false};

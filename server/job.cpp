@@ -40,6 +40,7 @@ nlohmann::json to_state_json(const JobRecord& r) {
                       {"started_us", r.started_us},
                       {"finished_us", r.finished_us},
                       {"attempts", r.attempts},
+                      {"interruptions", r.interruptions},
                       {"idempotency_key", r.idempotency_key},
                       {"body_bytes", r.body_bytes},
                       {"stop_reason", r.stop_reason},
@@ -47,6 +48,8 @@ nlohmann::json to_state_json(const JobRecord& r) {
                       {"iterations", r.iterations},
                       {"solve_seconds", r.solve_seconds},
                       {"result_available", r.result_available},
+                      {"result_bytes", r.result_bytes},
+                      {"events_dropped", r.events_dropped},
                       {"progress", r.progress}};
   j["converged"] = r.converged ? nlohmann::json(*r.converged) : nlohmann::json(nullptr);
   return j;
@@ -66,6 +69,7 @@ JobRecord from_state_json(const nlohmann::json& j) {
   r.started_us = j.value("started_us", std::int64_t{0});
   r.finished_us = j.value("finished_us", std::int64_t{0});
   r.attempts = j.value("attempts", 0);
+  r.interruptions = j.value("interruptions", 0);
   r.idempotency_key = j.value("idempotency_key", "");
   r.body_bytes = j.value("body_bytes", std::int64_t{0});
   r.stop_reason = j.value("stop_reason", "");
@@ -73,6 +77,8 @@ JobRecord from_state_json(const nlohmann::json& j) {
   r.iterations = j.value("iterations", 0);
   r.solve_seconds = j.value("solve_seconds", 0.0);
   r.result_available = j.value("result_available", false);
+  r.result_bytes = j.value("result_bytes", std::int64_t{0});
+  r.events_dropped = j.value("events_dropped", std::int64_t{0});
   if (j.contains("converged") && j["converged"].is_boolean()) r.converged = j["converged"].get<bool>();
   if (j.contains("progress")) r.progress = j["progress"];
   return r;

@@ -1,15 +1,12 @@
+// The queue's life cycle: submission, cancellation, deletion, listing, and the state changes (commit) they all
+// go through. The workers and a run's outcome are in job_worker.cpp; start-up recovery and the store's health in
+// job_recovery.cpp; the watchdog (time limits, stuck jobs, retention) in job_janitor.cpp.
 #include "job_queue.hpp"
 
 #include "events.hpp"
 #include "util.hpp"
 
-#include "io/result_file.hpp"
-#include "solve.hpp"
-
 #include <algorithm>
-#include <cstdio>
-#include <functional>
-#include <new>
 #include <string_view>
 
 namespace contactd {
@@ -17,36 +14,6 @@ namespace contactd {
 namespace {
 
 std::size_t hash_body(const std::string& body) { return std::hash<std::string_view>{}(body); }
-
-std::string format_seconds(double s) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", s);
-  return text;
-}
-
-// Appends one `iteration` event per solver iteration and keeps the job's progress summary current.
-// Runs on the worker's thread; it only takes short locks and never waits for a client.
-class EventObserver final : public contact::Observer {
- public:
-  EventObserver(Job& job, std::mutex& records_mutex, Metrics& metrics)
-      : job_(job), records_mutex_(records_mutex), metrics_(metrics) {}
-
-  void on_iteration(const contact::IterationReport& report) override {
-    job_.events.append("iteration", iteration_event(report));
-    nlohmann::json summary = progress_summary(report);
-    {
-      std::lock_guard<std::mutex> lock(records_mutex_);
-      job_.record.iterations = report.iteration;
-      job_.record.progress = std::move(summary);
-    }
-    metrics_.iteration_done();
-  }
-
- private:
-  Job& job_;
-  std::mutex& records_mutex_;
-  Metrics& metrics_;
-};
 
 }  // namespace
 
@@ -58,6 +25,13 @@ JobQueue::~JobQueue() {
   for (auto& t : threads_)
     if (t.joinable()) t.detach();  // shutdown() gave up on it; the process is exiting
   if (watchdog_thread_.joinable()) watchdog_thread_.join();
+}
+
+std::shared_ptr<Job> JobQueue::make_job(const JobRecord& record) {
+  auto job = std::make_shared<Job>(record, store_.events_path(record.id), settings_.max_event_log_bytes);
+  const std::string id = record.id;
+  job->events.on_damage([this, id](const std::string& problem) { report_damage(id, problem); });
+  return job;
 }
 
 void JobQueue::set_state_locked(Job& job, JobState state) {
@@ -79,69 +53,49 @@ void JobQueue::unregister_locked(const std::shared_ptr<Job>& job) {
   const JobRecord& r = job->record;
   jobs_.erase(r.id);
   by_time_.erase({r.created_us, r.id});
+  if (by_finished_.erase({r.finished_us, r.id}) > 0) finished_bytes_ -= job->disk_bytes;
   const auto key = by_key_.find(r.idempotency_key);
   if (key != by_key_.end() && key->second == r.id) by_key_.erase(key);
   body_hash_.erase(r.id);
   --state_counts_[static_cast<std::size_t>(r.state)];
 }
 
-void JobQueue::persist(const std::shared_ptr<Job>& job, bool durable) {
-  std::lock_guard<std::mutex> persist_lock(job->persist_mutex);
-  JobRecord copy;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    copy = job->record;
-  }
-  try {
-    store_.save_state(copy, durable);
-  } catch (const std::exception& e) {
-    log_line("job " + copy.id + ": " + e.what());
-  }
+void JobQueue::note_finished_locked(const std::shared_ptr<Job>& job) {
+  if (by_finished_.emplace(TimeKey{job->record.finished_us, job->record.id}, job).second)
+    finished_bytes_ += job->disk_bytes;
 }
 
-void JobQueue::recover() {
-  const std::vector<JobRecord> records = store_.load_all();
-  int requeued = 0;
-  for (const JobRecord& loaded : records) {
-    auto job = std::make_shared<Job>(loaded, store_.events_path(loaded.id));
-    job->events.load();
-    JobRecord& r = job->record;
-    if (!r.idempotency_key.empty()) {
-      try {
-        body_hash_[r.id] = hash_body(store_.read_job(r.id));
-      } catch (const std::exception& e) {
-        log_line("job " + r.id + ": " + e.what());
-      }
-    }
-    if (is_terminal(r.state)) {
-      if (job->events.last_type() != "end") {  // crashed between storing the outcome and announcing it
-        job->events.append("end", end_event(r));
-        job->events.sync_and_close();
-      }
-      job->settled = true;
-      std::lock_guard<std::mutex> lock(mutex_);
-      register_locked(job);
-      continue;
-    }
-    const bool interrupted = r.state == JobState::running;
-    r.state = JobState::queued;
-    r.started_us = 0;
-    r.iterations = 0;
-    r.progress = nullptr;
-    if (interrupted) {
-      store_.remove_result(r.id);  // of the interrupted run, if it got that far
-      r.message = "re-queued: its run was interrupted (the server stopped)";
-      persist(job);
-      job->events.append("state", state_event(JobState::queued, r.message, r.attempts));
-      job->events.sync_and_close();
-    }
+bool JobQueue::commit(const std::shared_ptr<Job>& job, const Change& change, bool durable, std::string* error) {
+  std::lock_guard<std::mutex> persist_lock(job->persist_mutex);
+  JobRecord next;
+  {
     std::lock_guard<std::mutex> lock(mutex_);
-    register_locked(job);
-    queue_.push_back(job);
-    ++requeued;
+    next = job->record;
   }
-  log_line("store: " + std::to_string(records.size()) + " jobs read back from " + store_.data_dir() + ", " +
-           std::to_string(requeued) + " queued to run");
+  change(next);
+  try {
+    store_.save_state(next, durable);
+  } catch (const std::exception& e) {
+    log_line("job " + next.id + ": cannot store its state " + to_string(next.state) + ": " + e.what());
+    if (error) *error = public_message(e.what(), store_.data_dir());
+    return false;
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  set_state_locked(*job, next.state);
+  change(job->record);  // the same change on the live record (the observer may have moved its progress on)
+  return true;
+}
+
+bool JobQueue::commit_patiently(const std::shared_ptr<Job>& job, const Change& change) {
+  for (int attempt = 0;; ++attempt) {
+    if (commit(job, change, /*durable=*/true)) return true;
+    if (attempt == 0) log_line("job " + job->record.id + ": retrying every second until its outcome can be stored");
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      if (watchdog_.wait_for(lock, std::chrono::seconds(1), [this] { return stopping_; })) return false;
+    }
+    store_.restore_reserve();
+  }
 }
 
 void JobQueue::start() {
@@ -178,203 +132,15 @@ bool JobQueue::stopping() const {
   return stopping_;
 }
 
-void JobQueue::worker_loop() {
-  while (true) {
-    std::shared_ptr<Job> job;
-    {
-      std::unique_lock<std::mutex> lock(mutex_);
-      work_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
-      if (stopping_) break;
-      job = queue_.front();
-      queue_.pop_front();
-      if (job->record.state != JobState::queued) continue;  // cancelled while waiting
-      set_state_locked(*job, JobState::running);
-      job->record.started_us = now_unix_us();
-      job->record.attempts += 1;
-      job->record.iterations = 0;
-      job->record.progress = nullptr;
-      job->record.message.clear();
-      job->deadline = settings_.time_limit_seconds > 0
-                          ? std::chrono::steady_clock::now() +
-                                std::chrono::microseconds(static_cast<std::int64_t>(settings_.time_limit_seconds * 1e6))
-                          : std::chrono::steady_clock::time_point::max();
-      running_.push_back(job);
-    }
-    try {
-      run(job);
-    } catch (const std::exception& e) {  // run() handles the solver's failures; this is a bug or no memory
-      log_line("job " + job->record.id + ": unexpected error: " + e.what());
-    }
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      running_.erase(std::remove(running_.begin(), running_.end(), job), running_.end());
-    }
-    idle_.notify_all();
-  }
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    --workers_alive_;
-  }
-  idle_.notify_all();
-}
-
-void JobQueue::watchdog_loop() {
-  std::unique_lock<std::mutex> lock(mutex_);
-  while (!stopping_) {
-    watchdog_.wait_for(lock, std::chrono::milliseconds(100));
-    const auto now = std::chrono::steady_clock::now();
-    for (const auto& job : running_) {
-      if (now >= job->deadline && job->cancel_reason.load() == static_cast<int>(CancelReason::none)) {
-        job->request_cancel(CancelReason::time_limit);
-        log_line("job " + job->record.id + ": time limit of " + format_seconds(settings_.time_limit_seconds) +
-                 " s reached; stopping it");
-      }
-    }
-  }
-}
-
-void JobQueue::run(const std::shared_ptr<Job>& job) {
-  const std::string id = job->record.id;
-  int attempt = 0;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    attempt = job->record.attempts;
-  }
-  // Not fsync'ed: whether a crash leaves QUEUED or RUNNING on disk, the job is queued again at start-up.
-  persist(job, /*durable=*/false);
-  job->events.append("state", state_event(JobState::running, "a worker started the job", attempt));
-  log_line("job " + id + ": started (attempt " + std::to_string(attempt) + ")");
-
-  JobRecord outcome;
-  outcome.converged = false;
-  contact::Result result;
-  std::optional<contact::Problem> problem;
-  try {
-    contact::job::Limits limits;
-    limits.max_dofs = settings_.max_dofs;
-    auto parsed = contact::job::parse_text(store_.read_job(id), limits);
-    if (!parsed.ok()) {
-      // Valid when submitted; invalid now (a smaller --max-dofs since, or another solver version).
-      result.stop_reason = contact::StopReason::error;
-      result.message = "the job is no longer valid: " + contact::job::format_errors(parsed.errors);
-    } else {
-      problem = std::move(parsed.problem);
-      EventObserver observer(*job, mutex_, metrics_);
-      result = contact::solve(*problem, observer, job->cancel);
-    }
-  } catch (const std::bad_alloc&) {
-    result = contact::Result{};
-    result.stop_reason = contact::StopReason::error;
-    result.message = "out of memory";
-  } catch (const std::exception& e) {
-    result = contact::Result{};
-    result.stop_reason = contact::StopReason::error;
-    result.message = std::string("internal error: ") + e.what();
-  }
-  metrics_.solve_finished(result.wall_seconds);
-
-  const auto reason = static_cast<CancelReason>(job->cancel_reason.load());
-  if (result.stop_reason == contact::StopReason::cancelled && reason == CancelReason::shutdown) {
-    requeue_after_shutdown(job);
-    return;
-  }
-
-  outcome.iterations = result.iterations;
-  outcome.solve_seconds = result.wall_seconds;
-  outcome.message = result.message;
-  outcome.stop_reason = contact::to_string(result.stop_reason);
-  switch (result.stop_reason) {
-    case contact::StopReason::converged:
-      outcome.state = JobState::succeeded;
-      outcome.converged = true;
-      break;
-    case contact::StopReason::max_iterations:
-    case contact::StopReason::stagnation:
-      outcome.state = JobState::succeeded;
-      break;
-    case contact::StopReason::error:
-      outcome.state = JobState::failed;
-      break;
-    case contact::StopReason::cancelled:
-      if (reason == CancelReason::time_limit) {
-        outcome.state = JobState::failed;
-        outcome.stop_reason = "time_limit";
-        outcome.message = "stopped by the time limit of " + format_seconds(settings_.time_limit_seconds) + " s after " +
-                          std::to_string(result.iterations) + " iterations";
-      } else {
-        outcome.state = JobState::cancelled;
-        outcome.message = "cancelled after " + std::to_string(result.iterations) + " iterations";
-      }
-      break;
-  }
-
-  // The result file: written before the job is marked done, so that `end` means "downloadable now".
-  if (problem && !result.steps.empty() && result.stop_reason != contact::StopReason::error) {
-    try {
-      contact::io::WriteInfo info;
-      info.job_id = id;
-      contact::io::write_result(store_.result_path(id), *problem, result, info);
-      contact::io::write_xdmf(store_.xmf_path(id), "result.hdf", result);
-      outcome.result_available = true;
-    } catch (const std::exception& e) {
-      store_.remove_result(id);
-      outcome.state = JobState::failed;
-      outcome.stop_reason = "error";
-      outcome.message = std::string("cannot write the result file: ") + e.what();
-    }
-  }
-  for (const auto& step : result.steps) job->events.append("step", step_event(step));
-  finish(job, std::move(outcome));
-}
-
 void JobQueue::mark_settled(const std::shared_ptr<Job>& job) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     job->settled = true;
+    note_finished_locked(job);
+    retention_due_ = true;
   }
   settled_.notify_all();
-}
-
-void JobQueue::finish(const std::shared_ptr<Job>& job, JobRecord outcome) {
-  JobRecord after;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    JobRecord& r = job->record;
-    set_state_locked(*job, outcome.state);
-    r.finished_us = now_unix_us();
-    r.stop_reason = outcome.stop_reason;
-    r.message = outcome.message;
-    r.converged = outcome.converged;
-    r.iterations = outcome.iterations;
-    r.solve_seconds = outcome.solve_seconds;
-    r.result_available = outcome.result_available;
-    after = r;
-  }
-  persist(job);
-  job->events.append("end", end_event(after));
-  job->events.sync_and_close();
-  mark_settled(job);
-  log_line("job " + after.id + ": " + to_string(after.state) + " (" + after.stop_reason + ", " +
-           std::to_string(after.iterations) + " iterations, " + format_seconds(after.solve_seconds) + " s)");
-}
-
-void JobQueue::requeue_after_shutdown(const std::shared_ptr<Job>& job) {
-  JobRecord after;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    JobRecord& r = job->record;
-    set_state_locked(*job, JobState::queued);
-    r.started_us = 0;
-    r.iterations = 0;
-    r.progress = nullptr;
-    r.message = "interrupted by a shutdown; it runs again when the server restarts";
-    after = r;
-  }
-  store_.remove_result(after.id);
-  persist(job);
-  job->events.append("state", state_event(JobState::queued, after.message, after.attempts));
-  job->events.sync_and_close();
-  log_line("job " + after.id + ": interrupted by the shutdown, stored as QUEUED");
+  watchdog_.notify_all();
 }
 
 contact::job::ParseResult JobQueue::validate(const std::string& body) const {
@@ -383,9 +149,9 @@ contact::job::ParseResult JobQueue::validate(const std::string& body) const {
   return contact::job::parse_text(body, limits);
 }
 
-JobQueue::Submission JobQueue::submit(const std::string& body, const std::string& idempotency_key) {
+JobQueue::Submission JobQueue::submit(const std::string& body, contact::job::ParseResult parsed,
+                                      const std::string& idempotency_key) {
   Submission submission;
-  auto parsed = validate(body);
   if (!parsed.ok()) {
     submission.outcome = Submission::Outcome::invalid;
     submission.errors = std::move(parsed.errors);
@@ -397,10 +163,26 @@ JobQueue::Submission JobQueue::submit(const std::string& body, const std::string
   if (!idempotency_key.empty()) {
     const auto known = by_key_.find(idempotency_key);
     if (known != by_key_.end()) {
-      const auto job = jobs_.at(known->second);
+      const auto found = jobs_.find(known->second);
+      if (found == jobs_.end()) {  // the job of this key is damaged (its state.json cannot be read)
+        submission.outcome = Submission::Outcome::key_damaged;
+        submission.detail = known->second;
+        return submission;
+      }
+      const auto job = found->second;
       const auto h = body_hash_.find(known->second);
       const bool same = h != body_hash_.end() && h->second == hash &&
                         job->record.body_bytes == static_cast<std::int64_t>(body.size());
+      lock.unlock();
+      if (same && !job->stored) {
+        // Another request with this key is storing it now: wait for it (it holds the job's persist lock).
+        std::lock_guard<std::mutex> wait(job->persist_mutex);
+        if (!job->stored) {
+          submission.outcome = Submission::Outcome::store_error;
+          submission.detail = "the job could not be stored";
+          return submission;
+        }
+      }
       submission.outcome = same ? Submission::Outcome::replayed : Submission::Outcome::key_conflict;
       submission.job = job;
       return submission;
@@ -421,8 +203,9 @@ JobQueue::Submission JobQueue::submit(const std::string& body, const std::string
   record.created_us = std::max(now_unix_us(), last_created_us_ + 1);  // strictly increasing: a total order
   record.idempotency_key = idempotency_key;
   record.body_bytes = static_cast<std::int64_t>(body.size());
-  auto job = std::make_shared<Job>(record, store_.events_path(record.id));
-  // Held until the files exist: anyone persisting this job (a cancel) waits for them.
+  auto job = make_job(record);
+  // Held until the files exist: anyone persisting this job (a cancel) waits for them. Registered (for the key)
+  // but invisible to the API (find, list) until stored.
   std::unique_lock<std::mutex> persist_lock(job->persist_mutex);
   register_locked(job);
   if (!idempotency_key.empty()) body_hash_[record.id] = hash;
@@ -435,9 +218,10 @@ JobQueue::Submission JobQueue::submit(const std::string& body, const std::string
     lock.lock();
     unregister_locked(job);
     submission.outcome = Submission::Outcome::store_error;
-    submission.detail = e.what();
+    submission.detail = public_message(e.what(), store_.data_dir());
     return submission;
   }
+  job->stored = true;
   job->events.append("state", state_event(JobState::queued, "accepted", 0));
   persist_lock.unlock();
   metrics_.job_submitted();
@@ -455,7 +239,7 @@ JobQueue::Submission JobQueue::submit(const std::string& body, const std::string
 std::shared_ptr<Job> JobQueue::find(const std::string& id) const {
   std::lock_guard<std::mutex> lock(mutex_);
   const auto it = jobs_.find(id);
-  return it == jobs_.end() ? nullptr : it->second;
+  return it == jobs_.end() || !it->second->stored ? nullptr : it->second;
 }
 
 JobRecord JobQueue::snapshot(const Job& job, int* queue_position) const {
@@ -476,12 +260,12 @@ JobRecord JobQueue::snapshot(const Job& job, int* queue_position) const {
 
 JobQueue::CancelOutcome JobQueue::cancel(const std::string& id) {
   std::shared_ptr<Job> job;
-  JobRecord after;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     const auto it = jobs_.find(id);
-    if (it == jobs_.end()) return CancelOutcome::not_found;
+    if (it == jobs_.end() || !it->second->stored) return CancelOutcome::not_found;
     job = it->second;
+    const bool taken = std::find(running_.begin(), running_.end(), job) != running_.end();
     switch (job->record.state) {
       case JobState::running:
         job->request_cancel(CancelReason::user);  // the solver stops within one iteration
@@ -492,21 +276,42 @@ JobQueue::CancelOutcome JobQueue::cancel(const std::string& id) {
       case JobState::failed:
         return CancelOutcome::already_done;
       case JobState::queued:
+        if (taken) {  // a worker is storing it as RUNNING: stopped as soon as it starts
+          job->request_cancel(CancelReason::user);
+          return CancelOutcome::cancelling;
+        }
         break;
     }
-    // Queued: it never starts. (A worker only starts a job it finds QUEUED under this same lock.)
+    // Queued: it never starts. (A worker only takes a job it finds QUEUED under this same lock.)
     queue_.erase(std::remove(queue_.begin(), queue_.end(), job), queue_.end());
-    set_state_locked(*job, JobState::cancelled);
-    JobRecord& r = job->record;
-    r.finished_us = now_unix_us();
+  }
+  const std::int64_t now = now_unix_us();
+  const bool stored = commit(job, [now](JobRecord& r) {
+    r.state = JobState::cancelled;
+    r.finished_us = now;
     r.stop_reason = "cancelled";
     r.message = "cancelled before it started";
     r.converged = false;
-    after = r;
+  }, /*durable=*/true);
+  if (!stored) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (job->record.state == JobState::queued && !stopping_) {  // still queued, in its place by creation time
+      const auto later = std::find_if(queue_.begin(), queue_.end(), [&](const std::shared_ptr<Job>& other) {
+        return other->record.created_us > job->record.created_us;
+      });
+      queue_.insert(later, job);
+      work_.notify_one();
+    }
+    return CancelOutcome::store_error;
   }
-  persist(job);
+  JobRecord after = snapshot(*job);
   job->events.append("end", end_event(after));
   job->events.sync_and_close();
+  const std::int64_t bytes = store_.disk_usage(id);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    job->disk_bytes = bytes;
+  }
   mark_settled(job);
   log_line("job " + id + ": cancelled while queued");
   return CancelOutcome::cancelled;
@@ -516,8 +321,25 @@ JobQueue::RemoveOutcome JobQueue::remove(const std::string& id, std::string& det
   std::shared_ptr<Job> job;
   {
     std::unique_lock<std::mutex> lock(mutex_);
+    const auto damaged = damaged_.find(id);
+    if (damaged != damaged_.end() && jobs_.count(id) == 0) {
+      // A job whose state cannot be read: deleting it is the way to clear it.
+      lock.unlock();
+      try {
+        store_.remove(id);
+      } catch (const std::exception& e) {
+        detail = public_message(e.what(), store_.data_dir());
+        return RemoveOutcome::store_error;
+      }
+      lock.lock();
+      damaged_.erase(id);
+      for (auto it = by_key_.begin(); it != by_key_.end();)
+        it = it->second == id ? by_key_.erase(it) : std::next(it);
+      log_line("job " + id + ": deleted (it was damaged)");
+      return RemoveOutcome::removed;
+    }
     const auto it = jobs_.find(id);
-    if (it == jobs_.end()) return RemoveOutcome::not_found;
+    if (it == jobs_.end() || !it->second->stored) return RemoveOutcome::not_found;
     job = it->second;
     if (!is_terminal(job->record.state)) return RemoveOutcome::not_done;
     // A terminal job whose `end` event is still being written (a client that saw `end` may delete at once):
@@ -525,14 +347,15 @@ JobQueue::RemoveOutcome JobQueue::remove(const std::string& id, std::string& det
     if (!settled_.wait_for(lock, std::chrono::seconds(5), [&] { return job->settled.load(); }))
       return RemoveOutcome::not_done;
     unregister_locked(job);
+    damaged_.erase(id);
   }
   job->events.discard();  // open streams end
   std::lock_guard<std::mutex> persist_lock(job->persist_mutex);
   try {
     store_.remove(id);
   } catch (const std::exception& e) {
-    detail = e.what();
-    log_line("job " + id + ": " + detail);
+    detail = public_message(e.what(), store_.data_dir());
+    log_line("job " + id + ": " + e.what());
     return RemoveOutcome::store_error;
   }
   log_line("job " + id + ": deleted");
@@ -547,7 +370,7 @@ JobQueue::Page JobQueue::list(std::optional<JobState> state, std::size_t page_si
   while (it != by_time_.begin()) {
     --it;
     const JobRecord& r = it->second->record;
-    if (state && r.state != *state) continue;
+    if (!it->second->stored || (state && r.state != *state)) continue;
     if (page.jobs.size() == page_size) {  // one more exists: this page is full and another follows
       const JobRecord& last = page.jobs.back();
       page.next = Cursor{last.created_us, last.id};

@@ -10,6 +10,16 @@
 //                                 returned one)
 //   cancelled by the time limit-> FAILED with stop_reason "time_limit" (result file as for CANCELLED)
 //   cancelled by shutdown      -> back to QUEUED on disk: it runs again, from the start, at the next start-up.
+//   server died while running  -> QUEUED again at the next start-up, or FAILED with stop_reason "interrupted"
+//                                 once that has happened max_attempts times (a job that kills the server).
+//
+// Every state change the API reports is on disk first: the new record is written to state.json, and only then
+// does the job in memory change (commit()). A write that fails leaves the job as it was (the caller reports the
+// store error), and a worker whose job cannot be stored as finished keeps trying until it can.
+//
+// Damage found in the store (a state.json that cannot be read, an event log or result file changed on disk) is
+// kept in a registry: such jobs are never served from their files nor deleted by retention, and health() lists
+// them for /readyz and /metrics.
 //
 // Thread safety: every public member may be called from any thread. One mutex guards the registry and every
 // job's record; it is never held while solving, writing result files or waiting for a client.
@@ -25,6 +35,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -38,10 +49,24 @@
 namespace contactd {
 
 struct QueueSettings {
-  int workers = 1;                  // jobs solved at once
-  std::size_t max_queued = 100;     // QUEUED jobs beyond which submissions are refused (503)
-  long max_dofs = 2'000'000;        // job::Limits::max_dofs
-  double time_limit_seconds = 0.0;  // per run; 0 = none
+  int workers = 1;                     // jobs solved at once
+  std::size_t max_queued = 100;        // QUEUED jobs beyond which submissions are refused (503)
+  long max_dofs = 2'000'000;           // job::Limits::max_dofs
+  double time_limit_seconds = 3600.0;  // per run; 0 = none
+  int max_attempts = 3;                // runs cut short by the server dying, after which a job ends FAILED
+  std::uint64_t max_event_log_bytes = 256u << 20;  // per job; iteration events beyond are not recorded
+  double stuck_after_seconds = 60.0;   // a job still running this long after it was told to stop is "stuck"
+  double retention_seconds = 7 * 86400.0;          // finished jobs older than this are deleted; 0 = kept
+  std::uint64_t retention_bytes = 10ull << 30;     // finished jobs beyond this total are deleted, oldest first
+  double janitor_interval_seconds = 10.0;          // how often retention runs
+};
+
+// What /readyz and /metrics report about the jobs.
+struct QueueHealth {
+  std::vector<std::pair<std::string, std::string>> damaged;  // (id, problem)
+  std::vector<std::string> stuck;                            // ids of jobs that do not stop
+  std::int64_t expired_total = 0;                            // jobs deleted by retention since start-up
+  std::int64_t events_dropped_total = 0;                     // iteration events not recorded (log caps)
 };
 
 class JobQueue {
@@ -61,24 +86,30 @@ class JobQueue {
   bool shutdown(std::chrono::milliseconds grace);
 
   struct Submission {
-    enum class Outcome { accepted, replayed, invalid, key_conflict, queue_full, unavailable, store_error };
+    enum class Outcome { accepted, replayed, invalid, key_conflict, key_damaged, queue_full, unavailable, store_error };
     Outcome outcome = Outcome::invalid;
     std::shared_ptr<Job> job;
     std::vector<contact::job::ValidationError> errors;  // invalid
-    std::string detail;                                 // store_error
+    std::string detail;                                 // store_error; key_damaged: the job's id
   };
-  // Validates and queues a job. With a non-empty idempotency key already used: the same body returns the
-  // existing job (replayed), another body is a key_conflict.
-  Submission submit(const std::string& body, const std::string& idempotency_key);
+  // Queues a job validated by validate(). With a non-empty idempotency key already used: the same body returns
+  // the existing job (replayed), another body is a key_conflict (key_damaged: that job's files are damaged).
+  Submission submit(const std::string& body, contact::job::ParseResult parsed, const std::string& idempotency_key);
 
   // Validates only.
   contact::job::ParseResult validate(const std::string& body) const;
 
+  // A stored job (nullptr when unknown, damaged, or still being stored).
   std::shared_ptr<Job> find(const std::string& id) const;
+  // What is wrong with a job's files, if the store found damage.
+  std::optional<std::string> damage(const std::string& id) const;
+  // Records damage found while serving a job (a result file that is not what was written).
+  void report_damage(const std::string& id, const std::string& problem);
+  QueueHealth health() const;
   // A consistent copy of the job's record, and its place in the queue (1 = next; 0 when not waiting).
   JobRecord snapshot(const Job& job, int* queue_position = nullptr) const;
 
-  enum class CancelOutcome { cancelled, cancelling, already_cancelled, already_done, not_found };
+  enum class CancelOutcome { cancelled, cancelling, already_cancelled, already_done, not_found, store_error };
   CancelOutcome cancel(const std::string& id);
 
   enum class RemoveOutcome { removed, not_found, not_done, store_error };
@@ -104,17 +135,28 @@ class JobQueue {
  private:
   using TimeKey = std::pair<std::int64_t, std::string>;
 
+  using Change = std::function<void(JobRecord&)>;
+
   void worker_loop();
   void watchdog_loop();
+  void watch_running_locked(std::chrono::steady_clock::time_point now);
+  void apply_retention();
   void run(const std::shared_ptr<Job>& job);
   // Sets job->settled under the queue lock and wakes remove() calls waiting for it.
   void mark_settled(const std::shared_ptr<Job>& job);
   void finish(const std::shared_ptr<Job>& job, JobRecord outcome);
   void requeue_after_shutdown(const std::shared_ptr<Job>& job);
-  void persist(const std::shared_ptr<Job>& job, bool durable = true);
+  // Applies `change` to a copy of the job's record, writes it to state.json, and only then to the job in memory.
+  // False (the job unchanged, `error` set) if the write fails.
+  bool commit(const std::shared_ptr<Job>& job, const Change& change, bool durable, std::string* error = nullptr);
+  // commit() until it succeeds or the queue stops (a worker finishing a job on a full disk); false if stopped.
+  bool commit_patiently(const std::shared_ptr<Job>& job, const Change& change);
+  std::shared_ptr<Job> make_job(const JobRecord& record);
+  void recover_job(const std::shared_ptr<Job>& job, int& requeued);
   void set_state_locked(Job& job, JobState state);
   void register_locked(const std::shared_ptr<Job>& job);
   void unregister_locked(const std::shared_ptr<Job>& job);
+  void note_finished_locked(const std::shared_ptr<Job>& job);
 
   JobStore& store_;
   Metrics& metrics_;
@@ -129,6 +171,13 @@ class JobQueue {
   std::map<TimeKey, std::shared_ptr<Job>> by_time_;         // (created_us, id), oldest first
   std::unordered_map<std::string, std::string> by_key_;     // idempotency key -> id
   std::unordered_map<std::string, std::size_t> body_hash_;  // id -> hash of job.json (jobs with a key)
+  std::map<std::string, std::string> damaged_;              // id -> problem (see damage())
+  std::map<TimeKey, std::shared_ptr<Job>> by_finished_;     // settled jobs by (finished_us, id): retention
+  std::int64_t finished_bytes_ = 0;                          // their disk_bytes, summed
+  std::vector<std::string> stuck_;
+  std::int64_t expired_total_ = 0;
+  bool retention_due_ = false;  // a job was settled: the janitor checks retention at once
+  std::int64_t events_dropped_total_ = 0;
   std::deque<std::shared_ptr<Job>> queue_;
   std::vector<std::shared_ptr<Job>> running_;
   std::array<std::int64_t, 5> state_counts_{};

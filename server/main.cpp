@@ -2,20 +2,23 @@
 //   contactd [--host H] [--port P] [--data-dir D] [--workers N] ...   (every flag also has a CONTACTD_* variable)
 // With no configuration it serves http://127.0.0.1:8080 and keeps its jobs in ./contactd-data.
 // SIGTERM or SIGINT: graceful shutdown (docs/server.md, "Shutdown"), exit status 0.
+#include "body_budget.hpp"
 #include "http_server.hpp"
 #include "job_queue.hpp"
 #include "job_store.hpp"
 #include "metrics.hpp"
 #include "util.hpp"
 
-#include "job/job.hpp"
 #include "solve.hpp"
 
 #include <CLI/CLI.hpp>
 
+#include <fcntl.h>
 #include <pthread.h>
 #include <signal.h>
+#include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -23,67 +26,164 @@
 
 namespace {
 
+// The flags bind directly to the settings they set (their defaults are the structs' own).
 struct Config {
-  std::string host = "127.0.0.1";
-  int port = 8080;
   std::string data_dir = "./contactd-data";
-  int workers = 0;  // 0 = the number of cores
-  std::size_t max_queued = 100;
-  std::size_t max_request_bytes = 8u << 20;
-  long max_dofs = contact::job::Limits{}.max_dofs;
-  double time_limit_seconds = 0.0;
-  std::string token;
-  int heartbeat_seconds = 15;
-  int max_streams = 64;
-  int http_threads = 0;
-  bool access_log = false;
+  std::string allowed_hosts;  // parsed into http.allowed_hosts
+  contactd::QueueSettings queue = [] {
+    contactd::QueueSettings q;
+    q.workers = 0;  // the number of cores
+    return q;
+  }();
+  contactd::HttpSettings http;
 };
 
 // Every flag has an environment variable; a flag given on the command line wins.
 void add_flags(CLI::App& app, Config& c) {
-  app.add_option("--host", c.host, "address to listen on")->envname("CONTACTD_HOST")->capture_default_str();
-  app.add_option("--port", c.port, "TCP port (0: any free port, printed at start-up)")
+  app.add_option("--host", c.http.host, "address to listen on")->envname("CONTACTD_HOST")->capture_default_str();
+  app.add_option("--port", c.http.port, "TCP port (0: any free port, printed at start-up)")
       ->envname("CONTACTD_PORT")
       ->check(CLI::Range(0, 65535))
       ->capture_default_str();
   app.add_option("--data-dir", c.data_dir, "job store directory (created if missing)")
       ->envname("CONTACTD_DATA_DIR")
       ->capture_default_str();
-  app.add_option("--workers", c.workers, "jobs solved at once (0: one per core)")
+  app.add_option("--workers", c.queue.workers, "jobs solved at once (0: one per core)")
       ->envname("CONTACTD_WORKERS")
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();
-  app.add_option("--max-queued", c.max_queued, "queued jobs beyond which submissions get 503")
+  app.add_option("--max-queued", c.queue.max_queued, "queued jobs beyond which submissions get 503")
       ->envname("CONTACTD_MAX_QUEUED")
       ->check(CLI::Range(1, 1000000))
       ->capture_default_str();
-  app.add_option("--max-request-bytes", c.max_request_bytes, "largest request body accepted (413 beyond)")
+  app.add_option("--max-request-bytes", c.http.max_request_bytes, "largest request body accepted (413 beyond)")
       ->envname("CONTACTD_MAX_REQUEST_BYTES")
       ->check(CLI::Range(1024, 1 << 30))
       ->capture_default_str();
-  app.add_option("--max-dofs", c.max_dofs, "largest job accepted, in degrees of freedom over all bodies")
+  app.add_option("--max-dofs", c.queue.max_dofs, "largest job accepted, in degrees of freedom over all bodies")
       ->envname("CONTACTD_MAX_DOFS")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  app.add_option("--time-limit-seconds", c.time_limit_seconds, "wall-time limit per run (0: none)")
+  app.add_option("--time-limit-seconds", c.queue.time_limit_seconds, "wall-time limit per run (0: none)")
       ->envname("CONTACTD_TIME_LIMIT_SECONDS")
       ->check(CLI::Range(0.0, 1e9))
       ->capture_default_str();
-  app.add_option("--token", c.token, "bearer token every /v1 request must carry (prefer the variable)")
+  app.add_option("--max-attempts", c.queue.max_attempts,
+                 "runs cut short by the server dying after which a job ends FAILED (interrupted)")
+      ->envname("CONTACTD_MAX_ATTEMPTS")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  app.add_option("--max-event-log-bytes", c.queue.max_event_log_bytes,
+                 "size of a job's event log beyond which iteration events are not recorded")
+      ->envname("CONTACTD_MAX_EVENT_LOG_BYTES")
+      ->check(CLI::Range(std::uint64_t{64} << 10, std::uint64_t{1} << 40))
+      ->capture_default_str();
+  app.add_option("--retention-seconds", c.queue.retention_seconds, "finished jobs older than this are deleted (0: kept)")
+      ->envname("CONTACTD_RETENTION_SECONDS")
+      ->check(CLI::Range(0.0, 1e10))
+      ->capture_default_str();
+  app.add_option("--retention-bytes", c.queue.retention_bytes,
+                 "finished jobs beyond this total size are deleted, oldest first (0: no limit)")
+      ->envname("CONTACTD_RETENTION_BYTES")
+      ->capture_default_str();
+  app.add_option("--token", c.http.token, "bearer token every /v1 request must carry (prefer the variable)")
       ->envname("CONTACTD_TOKEN");
-  app.add_option("--heartbeat-seconds", c.heartbeat_seconds, "progress-stream heartbeat period")
+  app.add_option("--heartbeat-seconds", c.http.heartbeat_seconds, "progress-stream heartbeat period")
       ->envname("CONTACTD_HEARTBEAT_SECONDS")
       ->check(CLI::Range(1, 3600))
       ->capture_default_str();
-  app.add_option("--max-streams", c.max_streams, "concurrent progress streams (503 beyond)")
+  app.add_option("--max-streams", c.http.max_streams, "concurrent progress streams (503 beyond)")
       ->envname("CONTACTD_MAX_STREAMS")
       ->check(CLI::Range(1, 10000))
       ->capture_default_str();
-  app.add_option("--http-threads", c.http_threads, "HTTP connection threads (0: max-streams + 32)")
+  app.add_option("--http-threads", c.http.http_threads, "HTTP connection threads (0: max-streams + 32)")
       ->envname("CONTACTD_HTTP_THREADS")
       ->check(CLI::Range(0, 20000))
       ->capture_default_str();
-  app.add_flag("--access-log", c.access_log, "log every request to stderr")->envname("CONTACTD_ACCESS_LOG");
+  app.add_flag("--access-log", c.http.access_log, "log every request to stderr")->envname("CONTACTD_ACCESS_LOG");
+  app.add_option("--allowed-hosts", c.allowed_hosts,
+                 "host names the Host header may give, comma-separated ('*': any; default: localhost, 127.0.0.1, "
+                 "[::1] and --host)")
+      ->envname("CONTACTD_ALLOWED_HOSTS");
+  app.add_option("--max-connections", c.http.max_connections, "open connections in total (503 beyond)")
+      ->envname("CONTACTD_MAX_CONNECTIONS")
+      ->check(CLI::Range(8, 100000))
+      ->capture_default_str();
+  app.add_option("--max-connections-per-client", c.http.max_connections_per_client,
+                 "open connections per client address (503 beyond; 0: no limit)")
+      ->envname("CONTACTD_MAX_CONNECTIONS_PER_CLIENT")
+      ->check(CLI::Range(0, 100000))
+      ->capture_default_str();
+  app.add_option("--listen-backlog", c.http.listen_backlog, "connections the kernel queues before they are accepted")
+      ->envname("CONTACTD_LISTEN_BACKLOG")
+      ->check(CLI::Range(16, 65535))
+      ->capture_default_str();
+  app.add_option("--request-head-timeout-seconds", c.http.head_timeout_seconds,
+                 "a request's line and headers must arrive within this (408 beyond)")
+      ->envname("CONTACTD_REQUEST_HEAD_TIMEOUT_SECONDS")
+      ->check(CLI::Range(0.1, 3600.0))
+      ->capture_default_str();
+  app.add_option("--idle-timeout-seconds", c.http.idle_timeout_seconds,
+                 "a kept-alive connection must start its next request within this")
+      ->envname("CONTACTD_IDLE_TIMEOUT_SECONDS")
+      ->check(CLI::Range(0.1, 3600.0))
+      ->capture_default_str();
+  app.add_option("--request-body-timeout-seconds", c.http.body_timeout_seconds,
+                 "a request's body must arrive within this (408 beyond)")
+      ->envname("CONTACTD_REQUEST_BODY_TIMEOUT_SECONDS")
+      ->check(CLI::Range(1.0, 3600.0))
+      ->capture_default_str();
+  app.add_option("--max-header-bytes", c.http.max_header_bytes, "size of a request's line and headers (431 beyond)")
+      ->envname("CONTACTD_MAX_HEADER_BYTES")
+      ->check(CLI::Range(1024, 1 << 20))
+      ->capture_default_str();
+  app.add_option("--max-header-fields", c.http.max_header_fields, "header fields in a request (431 beyond)")
+      ->envname("CONTACTD_MAX_HEADER_FIELDS")
+      ->check(CLI::Range(8, 1000))
+      ->capture_default_str();
+  app.add_option("--max-large-bodies", c.http.max_large_bodies,
+                 "request bodies over 256 KiB read and validated at once (others wait, then 503)")
+      ->envname("CONTACTD_MAX_LARGE_BODIES")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  app.add_option("--max-validations", c.http.max_validations, "jobs validated at once (0: one per core, at least 2)")
+      ->envname("CONTACTD_MAX_VALIDATIONS")
+      ->check(CLI::Range(0, 1000))
+      ->capture_default_str();
+}
+
+// From here on, what any library prints on standard output (CHOLMOD's warnings, for one) goes to the log as
+// "solver output: ..." lines instead of the server's stdout (a detached thread forwards it).
+void capture_stdout() {
+  int pipe_fds[2];
+  if (::pipe2(pipe_fds, O_CLOEXEC) != 0) return;
+  std::fflush(stdout);
+  if (::dup2(pipe_fds[1], STDOUT_FILENO) < 0) {
+    ::close(pipe_fds[0]);
+    ::close(pipe_fds[1]);
+    return;
+  }
+  ::close(pipe_fds[1]);
+  std::thread([fd = pipe_fds[0]] {
+    std::string pending;
+    char buffer[4096];
+    while (true) {
+      const ssize_t n = ::read(fd, buffer, sizeof buffer);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) break;
+      pending.append(buffer, static_cast<std::size_t>(n));
+      std::size_t newline;
+      while ((newline = pending.find('\n')) != std::string::npos) {
+        const std::string line = pending.substr(0, newline);
+        pending.erase(0, newline + 1);
+        if (!line.empty()) contactd::log_line("solver output: " + line.substr(0, 1000));
+      }
+      if (pending.size() > 4096) {
+        contactd::log_line("solver output: " + pending.substr(0, 1000));
+        pending.clear();
+      }
+    }
+  }).detach();
 }
 
 }  // namespace
@@ -93,7 +193,13 @@ int main(int argc, char** argv) {
   Config config;
   add_flags(app, config);
   CLI11_PARSE(app, argc, argv);
-  if (config.workers == 0) config.workers = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  if (config.queue.workers == 0)
+    config.queue.workers = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  config.http.allowed_hosts = contactd::parse_host_list(config.allowed_hosts);
+  // Retention is checked a few times per retention period (at most every 10 s).
+  config.queue.janitor_interval_seconds =
+      config.queue.retention_seconds > 0 ? std::min(10.0, std::max(0.2, config.queue.retention_seconds / 4)) : 10.0;
+  contactd::BodyBudget::configure_allocator();
 
   // Signals: blocked in every thread (the mask is inherited) and taken by one sigwait thread, which starts the
   // shutdown outside any signal handler. SIGPIPE is ignored: a vanished client is a failed write, not a death.
@@ -108,27 +214,13 @@ int main(int argc, char** argv) {
   try {
     JobStore store(config.data_dir);
     Metrics metrics;
-    QueueSettings queue_settings;
-    queue_settings.workers = config.workers;
-    queue_settings.max_queued = config.max_queued;
-    queue_settings.max_dofs = config.max_dofs;
-    queue_settings.time_limit_seconds = config.time_limit_seconds;
-    JobQueue queue(store, metrics, queue_settings);
+    JobQueue queue(store, metrics, config.queue);
+    HttpServer server(config.http, queue, store, metrics);
 
-    HttpSettings http;
-    http.host = config.host;
-    http.port = config.port;
-    http.max_request_bytes = config.max_request_bytes;
-    http.token = config.token;
-    http.heartbeat_seconds = config.heartbeat_seconds;
-    http.max_streams = config.max_streams;
-    http.http_threads = config.http_threads;
-    http.access_log = config.access_log;
-    HttpServer server(http, queue, store, metrics);
-
-    const int port = server.bind();
+    std::string error;
+    const int port = server.bind(error);
     if (port < 0) {
-      log_line("cannot listen on " + config.host + ":" + std::to_string(config.port));
+      log_line("cannot listen on " + config.http.host + ":" + std::to_string(config.http.port) + ": " + error);
       return 1;
     }
     // Serve at once (the /v1 routes answer 503 "starting" and /readyz 503 until the store is read back).
@@ -143,9 +235,10 @@ int main(int argc, char** argv) {
     }
     server.set_ready();
     std::printf("contactd %s listening on http://%s:%d (data dir %s, %d workers%s)\n", contact::solver_version(),
-                config.host.c_str(), port, config.data_dir.c_str(), config.workers,
-                config.token.empty() ? "" : ", bearer token required");
+                config.http.host.c_str(), port, config.data_dir.c_str(), config.queue.workers,
+                config.http.token.empty() ? "" : ", bearer token required");
     std::fflush(stdout);
+    capture_stdout();
 
     int received = 0;
     sigwait(&signals, &received);

@@ -26,7 +26,16 @@ class Metrics {
   void stream_closed() { --stream_clients_; }
   std::int64_t stream_clients() const { return stream_clients_.load(); }
 
-  std::string render(const JobCounts& counts, int workers_busy, int workers) const;
+  // What is sampled from the queue, the store and the transport when rendering.
+  struct Gauges {
+    JobCounts jobs;
+    int workers = 0, workers_busy = 0;
+    std::int64_t damaged_jobs = 0, stuck_jobs = 0;
+    std::int64_t jobs_expired_total = 0, events_dropped_total = 0;
+    bool disk_reserve_used = false;
+    std::int64_t connections = 0;
+  };
+  std::string render(const Gauges& gauges) const;
 
  private:
   std::atomic<std::int64_t> jobs_submitted_{0};

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
@@ -124,13 +125,15 @@ bool constant_time_equal(std::string_view a, std::string_view b) {
 
 namespace {
 [[noreturn]] void fail(const std::string& path, const char* step) {
-  throw std::runtime_error("cannot " + std::string(step) + " '" + path + "': " + std::strerror(errno));
+  const int code = errno;
+  throw FileError("cannot " + std::string(step) + " '" + path + "': " + std::strerror(code), code);
 }
 }  // namespace
 
 void write_file_atomically(const std::string& path, std::string_view content, bool durable) {
   const std::string tmp = path + ".tmp";
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  ::unlink(tmp.c_str());  // a leftover (or a planted link) is never written through
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
   if (fd < 0) fail(tmp, "create");
   std::size_t written = 0;
   while (written < content.size()) {
@@ -165,7 +168,7 @@ void write_file_atomically(const std::string& path, std::string_view content, bo
 }
 
 std::string read_whole_file(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
   if (fd < 0) fail(path, "open");
   std::string content;
   char buffer[65536];
@@ -186,7 +189,7 @@ std::string read_whole_file(const std::string& path) {
 }
 
 void sync_file(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
   if (fd < 0) fail(path, "open");
   if (::fsync(fd) != 0) {
     const int saved = errno;
@@ -202,6 +205,28 @@ void sync_directory(const std::string& path) {
   if (fd < 0) return;
   ::fsync(fd);
   ::close(fd);
+}
+
+std::string public_message(const std::string& text, const std::string& data_dir) {
+  std::string out;
+  for (std::size_t k = 0; k < text.size();) {
+    if (!data_dir.empty() && text.compare(k, data_dir.size(), data_dir) == 0) {
+      out += "<data-dir>";
+      k += data_dir.size();
+      continue;
+    }
+    if (text[k] == '0' && k + 1 < text.size() && (text[k + 1] == 'x' || text[k + 1] == 'X')) {
+      std::size_t e = k + 2;
+      while (e < text.size() && std::isxdigit(static_cast<unsigned char>(text[e]))) ++e;
+      if (e - k - 2 >= 6) {  // an address, not a small constant
+        out += "0x...";
+        k = e;
+        continue;
+      }
+    }
+    out += text[k++];
+  }
+  return out;
 }
 
 void log_line(const std::string& text) {

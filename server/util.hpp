@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 
@@ -28,12 +29,29 @@ bool base64url_decode(std::string_view text, std::string& bytes);
 // Compares in time independent of where the strings differ (the token check).
 bool constant_time_equal(std::string_view a, std::string_view b);
 
+// A failed system call on a file: the message names the path and the step; `code` is the errno (ENOSPC...).
+class FileError : public std::runtime_error {
+ public:
+  FileError(const std::string& message, int code) : std::runtime_error(message), code_(code) {}
+  int code() const { return code_; }
+
+ private:
+  int code_;
+};
+
+// The file functions below never follow a symbolic link in the last component of a path (O_NOFOLLOW): the data
+// directory holds only files the server wrote, and a link planted there must not make it read or overwrite
+// another file. Errors are FileError.
+
 // Writes `content` to `path` atomically: "<path>.tmp" is written and renamed over `path`, so a crash leaves
 // either the old or the new file, never a partial one under `path`. With `durable` the file is fsync'ed before
 // the rename and the directory after it (the new content survives a power failure too); without, the rename
-// still makes the change atomic for a crash of the process. Throws std::runtime_error naming the path and the
-// failed step.
+// still makes the change atomic for a crash of the process. Throws FileError naming the path and the failed step.
 void write_file_atomically(const std::string& path, std::string_view content, bool durable = true);
+
+// A public version of an error message: hexadecimal addresses (HDF5 prints "buf = 0x7fb8...") are masked and
+// `data_dir` is written "<data-dir>". The full text goes to the log only.
+std::string public_message(const std::string& text, const std::string& data_dir);
 
 // The whole file; throws std::runtime_error if it cannot be read.
 std::string read_whole_file(const std::string& path);

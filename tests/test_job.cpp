@@ -717,3 +717,127 @@ TEST(BadJobs, HugeButFiniteNumberIsRejectedAtItsPointer) {
   EXPECT_EQ(r.errors[0].pointer, "/bodies/0/material/E");
   EXPECT_NE(r.errors[0].message.find("too large"), std::string::npos);
 }
+
+// ---- limits on every field that sets the work or the resources of a job (docs/job-format.md, "Limits") -----
+
+TEST(JobLimits, AThirtyThousandCharacterNameIsAnErrorNotAStackOverflow) {
+  // std::regex_match recursed once per character: names of ~30 000 characters crashed the parser.
+  const std::string long_name(30000, 'a');
+  for (const char* where : {"body", "edge", "contact"}) {
+    json job = small_job();
+    std::string pointer;
+    if (std::string(where) == "body") {
+      job["bodies"][0]["name"] = long_name;
+      pointer = "/bodies/0/name";
+    } else if (std::string(where) == "edge") {
+      job["bodies"][0]["mesh"] = explicit_mesh();
+      job["bodies"][0]["mesh"]["edges"][long_name] = {{0, 1}};
+      pointer = "/bodies/0/mesh/edges/" + long_name.substr(0, 1000);
+    } else {
+      job["contacts"][0]["name"] = long_name + "!";
+      pointer = "/contacts/0/name";
+    }
+    const ParseResult r = parse_text(job.dump());
+    ASSERT_FALSE(r.ok()) << where;
+    bool found = false;
+    for (const auto& e : r.errors)
+      if (e.pointer.rfind(pointer, 0) == 0 && e.message.find("too long: at most") != std::string::npos) {
+        found = true;
+        EXPECT_LT(e.message.size(), 200u) << "the message must not echo the whole name";
+      }
+    EXPECT_TRUE(found) << where << ":\n" << listing(r).substr(0, 2000);
+  }
+  // A name of a million invalid characters is answered quickly too (no recursion, no quadratic work).
+  json job = small_job();
+  job["bodies"][1]["name"] = std::string(1000000, '*');
+  const ParseResult r = parse(job);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.errors[0].pointer, "/bodies/1/name") << listing(r).substr(0, 2000);
+}
+
+TEST(JobLimits, NamesAtTheLimitAreAcceptedAndCharactersAreStillChecked) {
+  json job = small_job();
+  const std::string name(64, 'u');  // the documented limit
+  job["bodies"][0]["name"] = name;
+  job["contacts"][0]["slave"] = name + ".bottom";
+  const ParseResult ok = parse(job);
+  EXPECT_TRUE(ok.ok()) << listing(ok);
+  job = small_job();
+  job["bodies"][0]["name"] = "up per";
+  job["contacts"] = json::array();
+  expect_only_error(parse(job), "/bodies/0/name", "must consist of letters, digits, '_' and '-' only");
+  job = small_job();
+  job["contacts"][0]["name"] = "upper.bottom-lower.top";  // '.' is allowed in contact names
+  EXPECT_TRUE(parse(job).ok());
+  job["contacts"][0]["name"] = "a/b";
+  expect_only_error(parse(job), "/contacts/0/name", "'_', '-' and '.' only");
+  job = small_job();
+  job["name"] = std::string(300, 'j');
+  expect_only_error(parse(job), "/name", "too long: at most 256 characters");
+}
+
+TEST(JobLimits, ThreadsAboveTheBoundAreRejected) {
+  // solver.threads = 1000000 exhausted the host's process ids and hung the worker.
+  json job = small_job();
+  job["solver"] = {{"threads", 1000000}};
+  expect_only_error(parse(job), "/solver/threads", "threads = 1000000 is too large (at most 64)");
+  job["solver"] = {{"threads", 64}};
+  EXPECT_TRUE(parse(job).ok());
+}
+
+TEST(JobLimits, IterationAndUpdateCountsHaveUpperBounds) {
+  json job = small_job();
+  job["solver"] = {{"max_iterations", 100001}};
+  expect_only_error(parse(job), "/solver/max_iterations", "at most 100000");
+  job["solver"] = {{"max_iterations", 100000}};
+  EXPECT_TRUE(parse(job).ok());
+  job["solver"] = {{"augmented_lagrangian", {{"max_updates", 1000000}}}};
+  expect_only_error(parse(job), "/solver/augmented_lagrangian/max_updates", "at most 1000");
+  job = small_job();
+  job["adaptivity"] = {{"max_steps", 101}};
+  expect_only_error(parse(job), "/adaptivity/max_steps", "at most 100");
+  job["adaptivity"] = {{"max_dofs", 2000001}};
+  expect_only_error(parse(job), "/adaptivity/max_dofs", "at most 2000000");
+}
+
+TEST(JobLimits, TooManyBodiesOrContactsAreRefusedBeforeAnyIsRead) {
+  json job = small_job();
+  json bodies = json::array();
+  for (int k = 0; k < 20000; ++k) bodies.push_back({{"name", "b" + std::to_string(k)}});  // each one invalid
+  job["bodies"] = bodies;
+  job["contacts"] = json::array();
+  const ParseResult r = parse(job);
+  ASSERT_EQ(r.errors.size(), 1u) << listing(r).substr(0, 2000);
+  EXPECT_EQ(r.errors[0].pointer, "/bodies");
+  EXPECT_NE(r.errors[0].message.find("20000 bodies; at most 64"), std::string::npos) << listing(r);
+
+  job = small_job();
+  job["contacts"] = json::array();
+  for (int k = 0; k < 257; ++k) job["contacts"].push_back({{"slave", "upper.bottom"}, {"master", "lower.top"}});
+  expect_only_error(parse(job), "/contacts", "257 contact pairs; at most 256");
+}
+
+TEST(JobLimits, AnEdgeSideListedTwiceIsAnErrorNotADoubleLoad) {
+  json job = small_job();
+  job["bodies"][0]["mesh"] = explicit_mesh();
+  job["bodies"][0]["mesh"]["edges"]["cap"] = {{5, 4}, {4, 3}, {4, 5}};  // [4, 5] is [5, 4] again
+  job["bodies"][0]["boundary"] = {{{"edge", "wall"}, {"displacement", {{"x", 0}, {"y", 0}}}},
+                                  {{"edge", "cap"}, {"traction", {0, -1}}}};
+  job["contacts"][0]["slave"] = "upper.base";
+  expect_only_error(parse(job), "/bodies/0/mesh/edges/cap/2",
+                    "the side [4, 5] of edge 'cap' is already listed at /bodies/0/mesh/edges/cap/0");
+}
+
+TEST(JobLimits, ErrorListsAreBoundedWhateverTheDocument) {
+  // 5000 unknown fields with long names: at most Errors::kMaxErrors entries, each message and pointer cut.
+  json job = small_job();
+  for (int k = 0; k < 5000; ++k) job["x" + std::to_string(k) + std::string(5000, 'k')] = k;
+  const ParseResult r = parse(job);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.errors.size(), 201u);
+  EXPECT_NE(r.errors.back().message.find("and 4800 more errors"), std::string::npos) << r.errors.back().message;
+  for (const auto& e : r.errors) {
+    EXPECT_LE(e.pointer.size(), 1030u);
+    EXPECT_LE(e.message.size(), 1030u);
+  }
+}

@@ -15,7 +15,6 @@
 #include <cmath>
 #include <limits>
 #include <map>
-#include <regex>
 #include <set>
 #include <sstream>
 
@@ -42,19 +41,32 @@ void set_default(json& object, const std::string& key, json value) {
   if (object.is_object() && !object.contains(key)) object[key] = std::move(value);
 }
 
-bool is_identifier(const std::string& s) {
-  static const std::regex pattern("^[A-Za-z0-9_-]+$");
-  return std::regex_match(s, pattern);
+// Letters, digits, '_' and '-' (and '.' when `dot`), at least one. A plain loop: std::regex_match recurses once
+// per character and overflows the stack on a long name.
+bool is_identifier(const std::string& s, bool dot = false) {
+  return !s.empty() && std::all_of(s.begin(), s.end(), [dot](char c) {
+    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-' ||
+           (dot && c == '.');
+  });
+}
+
+// Why `s` is not a name of at most `max_length` characters of the allowed set (the pattern quoted), or nullopt.
+std::optional<std::string> name_problem(const std::string& s, const std::string& what, size_t max_length, bool dot) {
+  const char* allowed = dot ? "letters, digits, '_', '-' and '.' only (pattern ^[A-Za-z0-9_.-]+$)"
+                            : "letters, digits, '_' and '-' only (pattern ^[A-Za-z0-9_-]+$)";
+  if (s.size() > max_length)
+    return what + " '" + read::shown(s) + "' is too long: at most " + std::to_string(max_length) + " characters";
+  if (!is_identifier(s, dot)) return what + " '" + read::shown(s) + "' must consist of " + allowed;
+  return std::nullopt;
 }
 
 // Reads a name that other parts of the job refer to ("body.edge"), so it must be an identifier.
 std::optional<std::string> identifier(const json& value, const std::string& pointer, const std::string& what,
-                                      Errors& errors) {
+                                      size_t max_length, Errors& errors) {
   auto s = read::string(value, pointer, what, errors);
   if (!s) return std::nullopt;
-  if (!is_identifier(*s)) {
-    errors.add(pointer,
-               what + " '" + *s + "' must consist of letters, digits, '_' and '-' only (pattern ^[A-Za-z0-9_-]+$)");
+  if (auto problem = name_problem(*s, what, max_length, false)) {
+    errors.add(pointer, *problem);
     return std::nullopt;
   }
   return s;
@@ -78,7 +90,7 @@ std::optional<std::string> choice(const json& value, const std::string& pointer,
   if (std::find(options.begin(), options.end(), *s) == options.end()) {
     std::vector<std::string> quoted;
     for (const auto& o : options) quoted.push_back("\"" + o + "\"");
-    errors.add(pointer, what + " \"" + *s + "\" is not one of " + join_names(quoted));
+    errors.add(pointer, what + " \"" + read::shown(*s) + "\" is not one of " + join_names(quoted));
     return std::nullopt;
   }
   return s;
@@ -160,10 +172,35 @@ class JobReader {
     read_solver(top);
     if (const json* a = top.find("adaptivity")) read_adaptivity(*a, top.at("adaptivity"));
     resolve_method_defaults();
+    check_work_limits();
     return finish();
   }
 
  private:
+  // The upper bounds of Limits on the values read (a default is always within them). Separate from the readers so
+  // that each bound is stated once, next to the others.
+  void check_work_limits() {
+    const SolverSettings& s = problem_.solver;
+    auto over = [&](const std::string& pointer, const std::string& what, long long value, long long max,
+                    const std::string& why) {
+      if (value > max)
+        errors_.add(pointer, what + " = " + std::to_string(value) + " is too large (at most " + std::to_string(max) +
+                                 "): " + why);
+    };
+    over("/solver/threads", "threads", s.threads, limits_.max_threads,
+         "each thread solves one body; 0 means one per body up to the cores");
+    over("/solver/max_iterations", "max_iterations", s.max_iterations, limits_.max_iterations,
+         "a job that needs more is not converging");
+    over("/solver/augmented_lagrangian/max_updates", "max_updates", s.augmented_lagrangian.max_updates,
+         limits_.max_updates, "each update runs a whole inner solve");
+    if (problem_.adaptivity.enabled) {
+      over("/adaptivity/max_steps", "max_steps", problem_.adaptivity.max_steps, limits_.max_adaptive_steps,
+           "each step solves the whole problem again");
+      over("/adaptivity/max_dofs", "max_dofs", problem_.adaptivity.max_dofs, limits_.max_dofs,
+           "refinement may not exceed the server's limit on degrees of freedom");
+    }
+  }
+
   ParseResult finish() {
     ParseResult result;
     result.errors = errors_.take();
@@ -178,7 +215,13 @@ class JobReader {
 
   void read_header(const Fields& top) {
     if (const json* v = top.find("name")) {
-      if (auto s = read::string(*v, top.at("name"), "name", errors_)) problem_.name = *s;
+      if (auto s = read::string(*v, top.at("name"), "name", errors_)) {
+        if (s->size() > limits_.max_job_name_length)
+          errors_.add(top.at("name"), "name '" + read::shown(*s) + "' is too long: at most " +
+                                          std::to_string(limits_.max_job_name_length) + " characters");
+        else
+          problem_.name = *s;
+      }
     } else {
       problem_.name = "job";
     }
@@ -382,7 +425,7 @@ class JobReader {
             if (inputs_[k].has_name) known += (known.empty() ? "" : ", ") + inputs_[k].body.name;
           }
           if (found < 0)
-            errors_.add(ip, "unknown body '" + name + "'; the bodies are " + known);
+            errors_.add(ip, "unknown body '" + read::shown(name) + "'; the bodies are " + known);
           else if (std::find(a.bodies.begin(), a.bodies.end(), found) == a.bodies.end())
             a.bodies.push_back(found);
         }
@@ -459,6 +502,11 @@ class JobReader {
       errors_.add("/bodies", "at least one body is required");
       return;
     }
+    if (list->size() > static_cast<size_t>(limits_.max_bodies)) {  // refused before any body is read
+      errors_.add("/bodies", "the job has " + std::to_string(list->size()) + " bodies; at most " +
+                                 std::to_string(limits_.max_bodies) + " are accepted");
+      return;
+    }
     json& out_list = normalized_["bodies"];
     std::map<std::string, std::string> first_pointer_of_name;
     for (size_t i = 0; i < list->size(); ++i) {
@@ -501,7 +549,7 @@ class JobReader {
     Fields f(value, in.pointer, "a body", {"name", "material", "mesh", "boundary", "body_force"}, errors_);
     if (!f.ok()) return;
     if (const json* n = f.require("name", "a name of letters, digits, '_' and '-', unique among the bodies"))
-      if (auto s = identifier(*n, f.at("name"), "body name", errors_)) {
+      if (auto s = identifier(*n, f.at("name"), "body name", limits_.max_name_length, errors_)) {
         in.body.name = *s;
         in.has_name = true;
       }
@@ -789,12 +837,29 @@ class JobReader {
     m.valid = errors_.size() == before && nodes_ok && !m.quads.empty();
   }
 
+  // A side listed twice in one edge set (in either direction) would carry its load twice: an error at the
+  // second listing, naming the first.
+  bool no_side_twice(const std::string& name, const std::vector<std::array<int, 2>>& pairs,
+                     const std::string& pointer) {
+    std::map<std::pair<int, int>, size_t> first;
+    bool ok = true;
+    for (size_t k = 0; k < pairs.size(); ++k) {
+      const auto [i, j] = pairs[k];
+      auto [it, inserted] = first.emplace(std::make_pair(std::min(i, j), std::max(i, j)), k);
+      if (inserted) continue;
+      errors_.add(child(pointer, k), "the side [" + std::to_string(i) + ", " + std::to_string(j) + "] of edge '" +
+                                         name + "' is already listed at " + child(pointer, it->second) +
+                                         " (a side listed twice would carry its load twice)");
+      ok = false;
+    }
+    return ok;
+  }
+
   template <typename Index>
   void read_edge_set(const std::string& name, const json& value, const std::string& pointer, bool nodes_ok,
                      const Index& index, MeshInput& m) {
-    if (!is_identifier(name)) {
-      errors_.add(pointer, "edge name '" + name +
-                               "' must consist of letters, digits, '_' and '-' only (pattern ^[A-Za-z0-9_-]+$)");
+    if (auto problem = name_problem(name, "edge name", limits_.max_name_length, false)) {
+      errors_.add(pointer, *problem);
       return;
     }
     m.edge_names.push_back(name);
@@ -820,6 +885,7 @@ class JobReader {
       else
         ok = false;
     }
+    if (ok) ok = no_side_twice(name, pairs, pointer);
     if (ok) m.edge_pairs.emplace_back(name, std::move(pairs));
   }
 
@@ -839,8 +905,8 @@ class JobReader {
         if (auto s = read::string(*e, f.at("edge"), "edge", errors_)) {
           bc.edge = *s;
           if (in.mesh.edges_known && !has_edge(in.mesh, *s)) {
-            errors_.add(f.at("edge"),
-                        "the body has no edge '" + *s + "'; its edges are " + join_names(in.mesh.edge_names));
+            errors_.add(f.at("edge"), "the body has no edge '" + read::shown(*s) + "'; its edges are " +
+                                          join_names(in.mesh.edge_names));
           } else {
             auto [it, inserted] = first_pointer_of_edge.emplace(*s, bp);
             if (!inserted)
@@ -980,7 +1046,7 @@ class JobReader {
     if (!s) return std::nullopt;
     const size_t dot = s->find('.');
     if (dot == std::string::npos || dot == 0 || dot + 1 == s->size() || s->find('.', dot + 1) != std::string::npos) {
-      errors_.add(pointer, what + " must be \"body.edge\" (e.g. \"upper.bottom\"), got \"" + *s + "\"");
+      errors_.add(pointer, what + " must be \"body.edge\" (e.g. \"upper.bottom\"), got \"" + read::shown(*s) + "\"");
       return std::nullopt;
     }
     const std::string body = s->substr(0, dot), edge = s->substr(dot + 1);
@@ -990,14 +1056,14 @@ class JobReader {
       if (inputs_[b].has_name && inputs_[b].body.name == body) {
         const MeshInput& m = inputs_[b].mesh;
         if (m.edges_known && !has_edge(m, edge)) {
-          errors_.add(pointer,
-                      "body '" + body + "' has no edge '" + edge + "'; its edges are " + join_names(m.edge_names));
+          errors_.add(pointer, "body '" + body + "' has no edge '" + read::shown(edge) + "'; its edges are " +
+                                   join_names(m.edge_names));
           return std::nullopt;
         }
         return EdgeRef{static_cast<int>(b), edge};
       }
     }
-    errors_.add(pointer, "there is no body named '" + body + "'; the bodies are " + join_names(names));
+    errors_.add(pointer, "there is no body named '" + read::shown(body) + "'; the bodies are " + join_names(names));
     return std::nullopt;
   }
 
@@ -1010,6 +1076,11 @@ class JobReader {
     }
     if (!list->is_array()) {
       errors_.add("/contacts", "contacts must be an array, got " + read::type_name(*list));
+      return;
+    }
+    if (list->size() > static_cast<size_t>(limits_.max_contacts)) {  // refused before any pair is read
+      errors_.add("/contacts", "the job has " + std::to_string(list->size()) + " contact pairs; at most " +
+                                   std::to_string(limits_.max_contacts) + " are accepted");
       return;
     }
     std::map<std::string, std::string> pointer_of_name;
@@ -1046,11 +1117,10 @@ class JobReader {
       }
       if (const json* n = f.find("name")) {
         auto s = read::string(*n, f.at("name"), "contact name", errors_);
-        static const std::regex pattern("^[A-Za-z0-9_.-]+$");
-        if (s && !std::regex_match(*s, pattern))
-          errors_.add(f.at("name"),
-                      "contact name '" + *s +
-                          "' must consist of letters, digits, '_', '-' and '.' only (pattern ^[A-Za-z0-9_.-]+$)");
+        // Room for the default name, "body.edge-body.edge" (four identifiers).
+        auto problem = s ? name_problem(*s, "contact name", 4 * limits_.max_name_length + 3, true) : std::nullopt;
+        if (problem)
+          errors_.add(f.at("name"), *problem);
         else if (s)
           pair.name = *s;
       }
@@ -1162,7 +1232,7 @@ class TextPath {
           f.key = parsed.get<std::string>();
           if (!f.keys.insert(f.key).second)
             errors_.add(pending_pointer(),
-                        "duplicate key '" + f.key + "' in one object (a JSON reader keeps only one of them)");
+                        "duplicate key '" + read::shown(f.key) + "' in one object (a JSON reader keeps only one of them)");
         }
         break;
       case json::parse_event_t::value:

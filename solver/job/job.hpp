@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstddef>
 #include <optional>
 #include <string>
 #include <vector>
@@ -17,8 +18,18 @@ struct ValidationError {
   std::string message;  // e.g. "nu = 0.5 is outside (-1, 0.5)"
 };
 
+// Upper bounds on every field that sets the work or the resources a job takes (docs/job-format.md, "Limits").
+// A job over any of them is rejected with an error at the field's pointer, before anything is built.
 struct Limits {
   long max_dofs = 2'000'000;  // total over all bodies; larger jobs are rejected, not attempted
+  int max_bodies = 64;
+  int max_contacts = 256;
+  int max_threads = 64;                // solver.threads
+  int max_iterations = 100'000;        // solver.max_iterations
+  int max_updates = 1'000;             // solver.augmented_lagrangian.max_updates
+  int max_adaptive_steps = 100;        // adaptivity.max_steps
+  std::size_t max_name_length = 64;    // body, edge and contact names (identifiers)
+  std::size_t max_job_name_length = 256;
 };
 
 struct ParseResult {

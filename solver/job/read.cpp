@@ -47,10 +47,44 @@ std::string join_names(const std::vector<std::string>& names) {
 
 std::string type_name(const json& value) { return value.type_name(); }
 
+namespace {
+// The first `max` bytes of `text`, cut back to a UTF-8 character boundary.
+std::string utf8_prefix(const std::string& text, size_t max) {
+  if (text.size() <= max) return text;
+  size_t end = max;
+  while (end > 0 && (static_cast<unsigned char>(text[end]) & 0xC0) == 0x80) --end;
+  return text.substr(0, end);
+}
+}  // namespace
+
+std::string shown(const std::string& text, size_t max) {
+  if (text.size() <= max) return text;
+  return utf8_prefix(text, max) + "... (" + std::to_string(text.size()) + " bytes)";
+}
+
+void Errors::add(std::string pointer, std::string message) {
+  ++total_;
+  if (list_.size() >= kMaxErrors) return;
+  if (pointer.size() > kMaxErrorText) pointer = utf8_prefix(pointer, kMaxErrorText) + "...";
+  if (message.size() > kMaxErrorText) message = utf8_prefix(message, kMaxErrorText) + "...";
+  list_.push_back({std::move(pointer), std::move(message)});
+}
+
+std::vector<ValidationError> Errors::take() {
+  std::vector<ValidationError> out = std::move(list_);
+  if (total_ > out.size())
+    out.push_back({"", "and " + std::to_string(total_ - out.size()) + " more errors (only the first " +
+                           std::to_string(out.size()) + " are listed)"});
+  list_.clear();
+  total_ = 0;
+  return out;
+}
+
 size_t Errors::count_under(const std::string& pointer) const {
-  return static_cast<size_t>(std::count_if(list_.begin(), list_.end(), [&](const ValidationError& e) {
+  const auto n = static_cast<size_t>(std::count_if(list_.begin(), list_.end(), [&](const ValidationError& e) {
     return e.pointer == pointer || e.pointer.rfind(pointer + "/", 0) == 0;
   }));
+  return total_ > list_.size() ? std::max<size_t>(n, 1) : n;
 }
 
 std::optional<double> number(const json& value, const std::string& pointer, const std::string& what, Errors& errors) {
@@ -156,10 +190,13 @@ Fields::Fields(const json& value, std::string pointer, std::string what, std::ve
   object_ = &value;
   for (const auto& item : value.items()) {
     if (std::find(allowed.begin(), allowed.end(), item.key()) != allowed.end()) continue;
-    std::string message = "unknown field '" + item.key() + "' in " + what;
+    std::string message = "unknown field '" + shown(item.key()) + "' in " + what;
     std::string closest;
     size_t best = 3;  // suggest only close misspellings
     for (const auto& name : allowed) {
+      // Lengths 3 or more apart are never a close misspelling (and a huge key costs nothing).
+      const size_t longer = std::max(item.key().size(), name.size()), shorter = std::min(item.key().size(), name.size());
+      if (longer - shorter >= best) continue;
       const size_t d = edit_distance(item.key(), name);
       if (d < best) {
         best = d;

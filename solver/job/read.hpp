@@ -30,18 +30,29 @@ std::string join_names(const std::vector<std::string>& names);
 // nlohmann's type name: "object", "array", "string", "boolean", "number", "null".
 std::string type_name(const json& value);
 
-// The errors found so far, in the order found.
+// A value from the job for a message: itself when short, else its first `max` bytes (whole UTF-8 characters)
+// and how long it is, so that an error never echoes a huge input back.
+std::string shown(const std::string& text, size_t max = 64);
+
+// The errors found so far, in the order found. Each message and pointer is cut to kMaxErrorText bytes, and only
+// the first kMaxErrors are kept (take() then adds one line saying how many more were found): a hostile document
+// cannot make the error list larger than its own size.
 class Errors {
  public:
-  void add(std::string pointer, std::string message) { list_.push_back({std::move(pointer), std::move(message)}); }
-  size_t size() const { return list_.size(); }
-  // How many errors point at `pointer` or inside it.
+  static constexpr size_t kMaxErrors = 200;
+  static constexpr size_t kMaxErrorText = 1024;
+
+  void add(std::string pointer, std::string message);
+  // Every error found, kept or not.
+  size_t size() const { return total_; }
+  // How many errors point at `pointer` or inside it (at least 1 once errors were dropped: unknown, so assume some).
   size_t count_under(const std::string& pointer) const;
   const std::vector<ValidationError>& list() const { return list_; }
-  std::vector<ValidationError> take() { return std::move(list_); }
+  std::vector<ValidationError> take();
 
  private:
   std::vector<ValidationError> list_;
+  size_t total_ = 0;
 };
 
 // Typed views of one value. `what` names the value in messages ("nu", "corner 2"). Each returns nullopt after

@@ -17,7 +17,8 @@ import time
 
 SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
 BIN = os.environ.get("CONTACT_BINARY_DIR", os.path.join(SRC, "build"))
-CONTACTD = os.path.join(BIN, "server", "contactd")
+# CONTACTD_BIN runs the tests against another build (e.g. an older one, to see a regression test fail).
+CONTACTD = os.environ.get("CONTACTD_BIN") or os.path.join(BIN, "server", "contactd")
 CONTACT_SOLVE = os.path.join(BIN, "contact-solve")
 EXAMPLES = os.path.join(SRC, "api", "examples")
 HOST = "127.0.0.1"  # the tests only ever contact the loopback address
@@ -49,7 +50,7 @@ def flat_patch(displacement=-0.001, name="flat_patch"):
     return job
 
 
-def long_job(max_iterations=200000, name="long"):
+def long_job(max_iterations=100000, name="long"):
     """The paper's two layers on a tall mesh (32 x 256 per body, about 2 ms per iteration) with a tolerance the
     iteration does not reach before max_iterations: a job that runs until cancelled, or for a bounded time."""
     job = example("seed_layers.json")
@@ -115,7 +116,8 @@ class Response:
 class Server:
     """A contactd process on a free port. Use as a context manager, or call stop()/kill()."""
 
-    def __init__(self, data_dir=None, args=(), env=None, token=None):
+    def __init__(self, data_dir=None, args=(), env=None, token=None, prefix=()):
+        self.prefix = list(prefix)  # a command to run contactd through (e.g. nsenter ... --)
         self.owns_dir = data_dir is None
         self.data_dir = data_dir or tempfile.mkdtemp(prefix="contactd-test-")
         self.args = list(args)
@@ -128,10 +130,11 @@ class Server:
         self.port = None
         self.log_path = None
 
-    def start(self, timeout=20):
+    def start(self, timeout=20, ready=True):
+        """Starts contactd and waits until /readyz says 200 (with ready=False: until /healthz answers)."""
         fd, self.log_path = tempfile.mkstemp(prefix="contactd-log-", suffix=".txt")
         self.log = os.fdopen(fd, "w")
-        cmd = [CONTACTD, "--host", HOST, "--port", "0", "--data-dir", self.data_dir, "--heartbeat-seconds", "1",
+        cmd = [*self.prefix, CONTACTD, "--host", HOST, "--port", "0", "--data-dir", self.data_dir, "--heartbeat-seconds", "1",
                *self.args]
         self.proc = subprocess.Popen(cmd, stdout=self.log, stderr=subprocess.STDOUT, env=self.env)
         _started.append(self)
@@ -152,7 +155,7 @@ class Server:
         deadline = time.time() + timeout
         while time.time() < deadline:
             try:
-                if self.request("GET", "/readyz", timeout=5).status == 200:
+                if self.request("GET", "/readyz" if ready else "/healthz", timeout=5).status == 200:
                     return self
             except OSError:
                 pass
@@ -216,6 +219,9 @@ class Server:
         if isinstance(body, str):
             body = body.encode()
         h = self.auth_headers(headers) if auth else dict(headers or {})
+        if method in ("POST", "DELETE") and "Content-Type" not in h:
+            # What every client of the API sends with a body-less POST or a DELETE (the cross-site rule).
+            h.setdefault("X-Requested-With", "contactd-tests")
         conn = self.connection(timeout)
         try:
             conn.request(method, path, body=body, headers=h)
@@ -253,6 +259,14 @@ class Server:
 
     def wait_done(self, job_id, timeout=60):
         return self.wait_for(job_id, lambda j: j.get("done"), timeout)
+
+    def rss_kb(self, field="VmRSS"):
+        """The server's resident memory (kB): VmRSS now, or VmHWM for its peak so far."""
+        with open(f"/proc/{self.proc.pid}/status") as f:
+            for line in f:
+                if line.startswith(field + ":"):
+                    return int(line.split()[1])
+        return None
 
     def metric(self, name):
         """The value of one sample of /metrics, e.g. metric('contactd_jobs{state="SUCCEEDED"}')."""

@@ -84,11 +84,11 @@ with Server(token=TOKEN, args=["--workers", "1", "--max-dofs", "100000"]) as ser
     from harness import Response
     expect("10 MB chunked body", Response(resp.status, {k.lower(): v for k, v in resp.getheaders()}, resp.read()), 413)
     conn.close()
-    raw = server.raw(b"POST /v1/jobs HTTP/1.1\r\nHost: x\r\nAuthorization: Bearer " + TOKEN.encode() +
+    raw = server.raw(b"POST /v1/jobs HTTP/1.1\r\nHost: 127.0.0.1\r\nAuthorization: Bearer " + TOKEN.encode() +
                      b"\r\nContent-Type: application/json\r\nContent-Length: 1000000000000\r\n\r\n{")
     count += 1
     check("Content-Length of 1 TB -> 413 at once", raw.startswith(b"HTTP/1.1 413") and b"problem+json" in raw, raw[:200])
-    raw = server.raw(b"POST /v1/jobs HTTP/1.1\r\nHost: x\r\nAuthorization: Bearer " + TOKEN.encode() +
+    raw = server.raw(b"POST /v1/jobs HTTP/1.1\r\nHost: 127.0.0.1\r\nAuthorization: Bearer " + TOKEN.encode() +
                      b"\r\nContent-Type: application/json\r\n\r\n", timeout=5)
     count += 1
     check("POST without a length -> 411 at once", raw.startswith(b"HTTP/1.1 411") and b"problem+json" in raw, raw[:200])

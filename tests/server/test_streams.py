@@ -129,7 +129,7 @@ with Server(args=["--workers", "1", "--max-streams", "24"]) as server:
     # --- a client that stops reading never blocks the worker or other clients --------------------------------
     raw = socket.create_connection((HOST, server.port), timeout=10)
     raw.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
-    raw.sendall(f"GET /v1/jobs/{job_id}/events HTTP/1.1\r\nHost: x\r\n\r\n".encode())
+    raw.sendall(f"GET /v1/jobs/{job_id}/events HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n".encode())
     time.sleep(1.5)  # the job appends ~700 events (about 1 MB) meanwhile; this client reads none of them
     a = server.job(job_id)["iterations"]
     time.sleep(0.5)

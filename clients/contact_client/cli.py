@@ -1,0 +1,257 @@
+"""The command line: contact_client.py COMMAND ... (see the package's docstring). Whatever a server or a proxy
+sends, a command ends with one "error: ..." line per problem and an exit code, never a traceback."""
+import argparse
+import json
+import os
+import sys
+import traceback
+
+from .client import DEFAULT_TIMEOUT, DEFAULT_URL, Client
+from .display import Progress, dicts, num, print_job, word
+from .errors import EXIT_ERROR, EXIT_JOB, EXIT_OK, EXIT_USAGE, BadInput, ClientError, one_line
+from .plot import plot_result
+from .results import read_events, read_result
+
+
+def _cmd_submit(c, a):
+    if (a.output or a.events_out or a.xmf) and not a.wait:
+        raise BadInput("-o, --xmf and --events-out need --wait")
+    job = c.submit(a.file, idempotency_key=a.idempotency_key)
+    print(job["id"], flush=True)  # submit() checked that it is there
+    if not a.wait:
+        return EXIT_OK
+    return _follow(c, job["id"], a)
+
+
+def _follow(c, job_id, a):
+    out = None
+    try:
+        if a.events_out:
+            try:
+                out = open(a.events_out, "w", encoding="utf-8")
+            except OSError as exc:
+                raise BadInput(f"cannot write {a.events_out}: {exc.strerror}") from None
+        progress = Progress(quiet=a.quiet, events_out=out)
+        c.log = progress.note
+        end = None
+        # --timeout, when given, is how long the stream may stay silent before it is resumed.
+        for e in c.events(job_id, max_retries=a.retries, read_timeout=getattr(a, "timeout", None)):
+            progress(e)
+            if e.get("type") == "end":
+                end = e
+    finally:
+        if out:
+            out.close()
+    state = word(end.get("state")) if end else None
+    if getattr(a, "output", None):
+        if end and end.get("result_available") is True:
+            c.download(job_id, a.output, xmf=getattr(a, "xmf", False))
+            sys.stderr.write(f"wrote {a.output} ({os.path.getsize(a.output)} bytes)\n")
+        else:
+            sys.stderr.write(f"no result to download (job {state})\n")
+    if state != "SUCCEEDED":
+        sys.stderr.write(f"job {job_id} ended {state}\n")
+        return EXIT_JOB
+    return EXIT_OK
+
+
+def _cmd_watch(c, a):
+    return _follow(c, a.id, a)
+
+
+def _cmd_status(c, a):
+    job = c.status(a.id)
+    if a.json:
+        print(json.dumps(job, indent=2))
+    else:
+        print_job(job, sys.stdout)
+    return EXIT_OK
+
+
+def _cmd_list(c, a):
+    page = c.list(state=a.state, page_size=a.page_size, page_token=a.page_token, all_pages=a.all)
+    if a.json:
+        print(json.dumps(page, indent=2))
+        return EXIT_OK
+    jobs = page["jobs"]
+    if not jobs:
+        print("no jobs")
+    for j in jobs:
+        outcome = word(j.get("stop_reason")) or (f"queue {num(j['queue_position'], 'd')}"
+                                                 if j.get("queue_position") else "")
+        print(f"{word(j.get('id'), 40)}  {word(j.get('state')):9}  {num(j.get('iterations', 0), 'd'):>7}  "
+              f"{outcome:14}  {word(j.get('created'), 40)}  {word(j.get('name'), 200)}")
+    if page.get("next_page_token"):
+        print(f"more: --page-token {word(page['next_page_token'], 300)}")
+    return EXIT_OK
+
+
+def _cmd_cancel(c, a):
+    job = c.cancel(a.id)
+    job_id = word(job.get("id")) or a.id
+    if job.get("state") == "CANCELLED":
+        print(f"{job_id} CANCELLED")
+    else:
+        print(f"{job_id} {word(job.get('state'))}: cancellation requested (stops within one iteration)")
+    return EXIT_OK
+
+
+def _cmd_delete(c, a):
+    c.delete(a.id)
+    print(f"{a.id} deleted")
+    return EXIT_OK
+
+
+def _cmd_download(c, a):
+    c.download(a.id, a.output, xmf=a.xmf)
+    print(f"wrote {a.output} ({os.path.getsize(a.output)} bytes)"
+          + (f" and {os.path.splitext(a.output)[0] + '.xmf'}" if a.xmf else ""))
+    return EXIT_OK
+
+
+def _cmd_validate(c, a):
+    r = c.validate(a.file)
+    bodies = ", ".join(f"{word(b.get('name'))} {num(b.get('elements'), 'd')} cells {num(b.get('nodes'), 'd')} nodes"
+                       for b in dicts(r.get("bodies")))
+    print(f"valid: {word(r.get('name'), 300)}: {num(r.get('dofs'), 'd')} dofs ({bodies}), "
+          f"{num(r.get('contacts'), 'd')} contact pair(s)")
+    if a.normalized:
+        print(json.dumps(r.get("normalized"), indent=2))
+    return EXIT_OK
+
+
+def _cmd_plot(c, a):
+    if not os.path.exists(a.file):
+        raise BadInput(f"cannot read {a.file}: no such file")
+    try:
+        import h5py  # noqa: F401
+        import matplotlib  # noqa: F401
+        import numpy  # noqa: F401
+    except ImportError as exc:
+        raise ClientError(f"plot needs {exc.name}, which {sys.executable} cannot import (Debian's "
+                          "/usr/bin/python3 with apt-get install python3-h5py python3-numpy python3-matplotlib)"
+                          ) from None
+    try:
+        result = read_result(a.file)
+    except (OSError, KeyError, ValueError) as exc:
+        raise BadInput(f"cannot read {a.file}: {one_line(exc)}") from None
+    events = None
+    if a.events:
+        try:
+            events = read_events(a.events)
+        except (OSError, ValueError) as exc:
+            raise BadInput(f"cannot read events from {a.events}: {one_line(exc)}") from None
+    plot_result(result, a.output, events=events, warp=a.warp, title=a.title)
+    print(f"wrote {a.output} (1000 x 800 px)")
+    return EXIT_OK
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):
+        self.print_usage(sys.stderr)
+        sys.stderr.write(f"error: {message}\n")
+        sys.exit(EXIT_USAGE)
+
+
+def build_parser():
+    common = argparse.ArgumentParser(add_help=False)
+    common.add_argument("--url", default=argparse.SUPPRESS,
+                        help=f"server URL (default: $CONTACT_URL or {DEFAULT_URL})")
+    common.add_argument("--token", default=argparse.SUPPRESS, help="bearer token (default: $CONTACT_TOKEN)")
+    common.add_argument("--timeout", type=float, default=argparse.SUPPRESS,
+                        help=f"seconds to wait for an answer (default {DEFAULT_TIMEOUT:g}); for watch and "
+                             "submit --wait, how long the progress stream may stay silent before it is resumed")
+    p = _Parser(prog="contact_client.py", parents=[common],
+                description="Client of contactd, the contact solver service. Exit codes: 0 ok, 1 server or job "
+                            "error, 2 usage or invalid job, 3 job ended but not SUCCEEDED.")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    sub.required = True
+
+    def follow_opts(sp):
+        sp.add_argument("-q", "--quiet", action="store_true",
+                        help="no iteration lines when not on a terminal (state changes and the end only)")
+        sp.add_argument("--events-out", metavar="FILE", help="also save every event as NDJSON (for plot --events)")
+        sp.add_argument("--retries", type=int, default=5, help="reconnections in a row before giving up (5)")
+
+    s = sub.add_parser("submit", parents=[common], help="submit a job; prints its id")
+    s.add_argument("file", metavar="FILE|-", help="the job JSON ('-' for standard input)")
+    s.add_argument("--wait", action="store_true", help="follow the job to its end (exit 3 unless SUCCEEDED)")
+    s.add_argument("-o", "--output", metavar="FILE", help="with --wait: download the result to FILE")
+    s.add_argument("--xmf", action="store_true", help="with -o: also save the XDMF sidecar next to it")
+    s.add_argument("--idempotency-key", metavar="KEY", help="retry-safe submission key")
+    follow_opts(s)
+    s.set_defaults(func=_cmd_submit)
+
+    s = sub.add_parser("watch", parents=[common], help="follow a job's progress to its end")
+    s.add_argument("id")
+    follow_opts(s)
+    s.set_defaults(func=_cmd_watch)
+
+    s = sub.add_parser("status", parents=[common], help="a job's state, progress and outcome")
+    s.add_argument("id")
+    s.add_argument("--json", action="store_true", help="the job resource as JSON")
+    s.set_defaults(func=_cmd_status)
+
+    s = sub.add_parser("list", parents=[common], help="jobs, newest first")
+    s.add_argument("--state", choices=["QUEUED", "RUNNING", "SUCCEEDED", "FAILED", "CANCELLED"],
+                   type=str.upper)
+    s.add_argument("--page-size", type=int)
+    s.add_argument("--page-token")
+    s.add_argument("--all", action="store_true", help="follow next_page_token to the last page")
+    s.add_argument("--json", action="store_true")
+    s.set_defaults(func=_cmd_list)
+
+    for name, func, text in (("cancel", _cmd_cancel, "cancel a queued or running job"),
+                             ("delete", _cmd_delete, "delete a finished job and its files")):
+        s = sub.add_parser(name, parents=[common], help=text)
+        s.add_argument("id")
+        s.set_defaults(func=func)
+
+    s = sub.add_parser("download", parents=[common], help="download a job's HDF5 result")
+    s.add_argument("id")
+    s.add_argument("-o", "--output", required=True, metavar="FILE")
+    s.add_argument("--xmf", action="store_true", help="also save the XDMF sidecar (FILE with .xmf) for ParaView")
+    s.set_defaults(func=_cmd_download)
+
+    s = sub.add_parser("validate", parents=[common], help="validate a job on the server without running it")
+    s.add_argument("file", metavar="FILE|-")
+    s.add_argument("--normalized", action="store_true", help="print the job with every default filled in")
+    s.set_defaults(func=_cmd_validate)
+
+    s = sub.add_parser("plot", parents=[common],
+                       help="plot a result: pressure along each pair, final mesh by von Mises stress")
+    s.add_argument("file", metavar="FILE.hdf")
+    s.add_argument("-o", "--output", required=True, metavar="PNG")
+    s.add_argument("--events", metavar="FILE",
+                   help="the job's saved events (--events-out, or NDJSON/SSE from curl): one curve per iteration")
+    s.add_argument("--warp", type=float, default=0.0, help="draw the mesh displaced by this factor")
+    s.add_argument("--title")
+    s.set_defaults(func=_cmd_plot)
+    return p
+
+
+def main(argv=None):
+    a = build_parser().parse_args(argv)
+    try:
+        if a.command == "plot":
+            return a.func(None, a)
+        c = Client(getattr(a, "url", None), getattr(a, "token", None),
+                   getattr(a, "timeout", DEFAULT_TIMEOUT))
+        return a.func(c, a)
+    except ClientError as exc:
+        sys.stdout.flush()
+        for line in exc.lines:
+            sys.stderr.write(f"error: {line}\n")
+        return exc.exit_code
+    except KeyboardInterrupt:
+        sys.stderr.write("\ninterrupted (the job goes on on the server; cancel it with: cancel ID)\n")
+        return 130
+    except BrokenPipeError:
+        return EXIT_ERROR
+    except Exception as exc:  # a bug of the client: one line, the details only on request
+        sys.stdout.flush()
+        if os.environ.get("CONTACT_CLIENT_DEBUG"):
+            traceback.print_exc()
+        sys.stderr.write(f"error: internal error of the client: {type(exc).__name__}: {one_line(exc)[:300]} "
+                         "(CONTACT_CLIENT_DEBUG=1 shows where)\n")
+        return EXIT_ERROR

@@ -1,0 +1,150 @@
+"""The figure of a result: contact pressure along each pair, the final mesh coloured by von Mises stress."""
+import os
+
+from .errors import BadInput
+from .results import read_events, read_result
+
+
+def _spread(n, k):
+    """At most k indices of range(n), evenly spread, the first and the last included."""
+    if n <= k:
+        return list(range(n))
+    return sorted({round(i * (n - 1) / (k - 1)) for i in range(k)})
+
+
+def plot_result(result, png, events=None, warp=0.0, title=None, max_curves=12):
+    """Draws one figure of 1000 x 800 pixels (10 x 8 inches at 100 dpi) into png:
+
+    top: the contact pressure against x along each pair (one panel per pair), one curve per adaptive step;
+         with a single step, the pressure profile of each iteration when `events` (the job's events, a list of
+         dicts or a path to saved events) are given (at most max_curves of them, spread over the run), and the
+         final profile from the file;
+    bottom: each body's final mesh, cells coloured by von Mises stress, edges drawn (refinement shows as
+         smaller cells), one colour bar. warp > 0 draws the mesh displaced by warp x displacement.
+
+    result is a path or the dict of read_result(). Returns png."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.cm
+    import matplotlib.colors
+    import matplotlib.pyplot as plt
+    import numpy as np
+    from matplotlib.collections import PolyCollection
+
+    if not isinstance(result, dict):
+        result = read_result(result)
+    if isinstance(events, (str, os.PathLike)):
+        events = read_events(events)
+    steps = result["steps"]
+    if not steps:
+        raise BadInput(f"{result.get('path', 'the result')}: no step in the file (the solve failed before its "
+                       "first iteration)")
+    final = steps[-1]
+    pair_names = final["pair_names"]
+    attrs = result["attrs"]
+
+    fig = plt.figure(figsize=(10, 8), dpi=100)
+    npairs = max(1, len(pair_names))
+    gs = fig.add_gridspec(2, npairs, height_ratios=[1.0, 1.25], left=0.08, right=0.92, top=0.92, bottom=0.07,
+                          hspace=0.32, wspace=0.4)
+    name = attrs.get("name") or os.path.basename(result.get("path", ""))
+    stop = attrs.get("stop_reason", "")
+    fig.suptitle(title or f"{name}: {attrs.get('iterations', '?')} iterations, {stop}, "
+                 f"{len(steps)} step{'s' if len(steps) != 1 else ''}", fontsize=12)
+
+    iteration_profiles = {}
+    if len(steps) == 1 and events:
+        for e in events:
+            if e.get("type") == "iteration":
+                for p in e.get("pairs", []):
+                    if p.get("positions") and p.get("pressures"):
+                        iteration_profiles.setdefault(p["name"], []).append(
+                            (e["iteration"], np.asarray(p["positions"], float), np.asarray(p["pressures"], float)))
+
+    for j, pair in enumerate(pair_names or [None]):
+        ax = fig.add_subplot(gs[0, j])
+        if pair is None:
+            ax.text(0.5, 0.5, "no contact pair", ha="center", va="center", transform=ax.transAxes)
+            continue
+        c_final = final["contacts"][pair]
+        cmap = plt.get_cmap("viridis")
+        # (number, x, pressure, extra label) per curve, coloured by its place in the run.
+        curves, what = [], "step"
+        if len(steps) > 1:
+            for k in _spread(len(steps), max_curves):
+                c = steps[k]["contacts"].get(pair)
+                if c is not None and "x" in c:
+                    curves.append((k, c["x"], c["pressure"], f" (iter {steps[k]['iteration']}, {len(c['x'])} nodes)"))
+            span = (0, len(steps) - 1)
+        else:
+            profiles = iteration_profiles.get(pair, [])
+            what = "iteration"
+            arc, xs = c_final.get("arc_length"), c_final.get("x")
+            if xs is None or arc is None or len(arc) < 2:
+                arc = None
+            for i in _spread(len(profiles), max_curves):
+                it, sv, pv = profiles[i]
+                curves.append((it, np.interp(sv, arc, xs) if arc is not None else sv, pv, ""))
+            span = (profiles[0][0], profiles[-1][0]) if profiles else (0, 1)
+        norm = matplotlib.colors.Normalize(vmin=span[0], vmax=max(span[1], span[0] + 1))
+        labelled = len(curves) <= 6
+        for number, x, pv, extra in curves:
+            ax.plot(x, pv, color=cmap(norm(number)), lw=1.0, marker="." if len(x) < 80 else None, ms=2.5,
+                    label=f"{what} {number}{extra}" if labelled else None)
+        if len(curves) > 1 and not labelled:
+            sm = matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap)
+            fig.colorbar(sm, ax=ax, fraction=0.05, pad=0.02).set_label(what, fontsize=8)
+        if "x" in c_final:
+            ax.plot(c_final["x"], c_final["pressure"], color="black", lw=1.5, ls=(0, (5, 3)) if curves else "-",
+                    label=f"final (iter {final['iteration']}, from the file)", zorder=5)
+        ax.set_xlabel("x of the slave edge node")
+        ax.set_ylabel("contact pressure")
+        total = len(steps) if what == "step" else len(iteration_profiles.get(pair, []))
+        shown = f"{len(curves)} of {total}" if len(curves) < total else f"all {total}"
+        ax.set_title(pair + (f" ({shown} {what}s)" if len(curves) > 1 else ""), fontsize=10)
+        ax.grid(True, alpha=0.3)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=7, loc="best", framealpha=0.8)
+
+    ax = fig.add_subplot(gs[1, :])
+    polys, values, levels = [], [], []
+    for body in final["body_names"]:
+        b = final["bodies"][body]
+        xy = b["points"]
+        if warp and "displacement" in b and len(b["displacement"]) == len(xy):
+            xy = xy + warp * b["displacement"]
+        quads = b["quads"]
+        polys.append(xy[quads])
+        vm = b.get("von_mises")
+        values.append(vm if vm is not None and len(vm) == len(quads) else np.full(len(quads), np.nan))
+        lv = b.get("level")
+        levels.append((body, len(quads), int(lv.max()) if lv is not None and len(lv) else 0))
+    for body, xy in zip(final["body_names"], polys):
+        if len(xy):
+            flat = xy.reshape(-1, 2)
+            centre = (flat.min(axis=0) + flat.max(axis=0)) / 2
+            ax.text(centre[0], centre[1], body, ha="center", va="center", fontsize=9, zorder=5,
+                    bbox=dict(boxstyle="round,pad=0.2", facecolor="white", alpha=0.75, edgecolor="none"))
+    verts = np.concatenate(polys) if polys else np.zeros((0, 4, 2))
+    vals = np.concatenate(values) if values else np.zeros(0)
+    # Edges thin out on fine meshes so that the colours still show.
+    lw = float(np.clip(0.3 * np.sqrt(1000.0 / max(1, len(verts))), 0.05, 0.3))
+    pc = PolyCollection(verts, array=vals, cmap="viridis", edgecolors=(0, 0, 0, 0.8), linewidths=lw)
+    ax.add_collection(pc)
+    if len(verts):
+        lo, hi = verts.reshape(-1, 2).min(axis=0), verts.reshape(-1, 2).max(axis=0)
+        pad = 0.02 * max(hi - lo)
+        ax.set_xlim(lo[0] - pad, hi[0] + pad)
+        ax.set_ylim(lo[1] - pad, hi[1] + pad)
+    ax.set_aspect("equal", adjustable="datalim")  # the panel keeps its size; the shorter side's range grows
+    ax.set_xlabel("x")
+    ax.set_ylabel("y")
+    ax.set_title("final mesh" + (f" (displacement x {warp:g})" if warp else "") + ": "
+                 + ", ".join(f"{b} {m} cells" + (f", refinement level <= {lv}" if lv else "")
+                             for b, m, lv in levels), fontsize=10)
+    cb = fig.colorbar(pc, ax=ax, fraction=0.04, pad=0.02)
+    cb.set_label("von Mises stress")
+    os.makedirs(os.path.dirname(os.path.abspath(png)), exist_ok=True)
+    fig.savefig(png, dpi=100)
+    plt.close(fig)
+    return png

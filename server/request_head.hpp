@@ -1,0 +1,34 @@
+// The request head (request line and header fields, RFC 9112 section 2) as the connection gate sees it before
+// any HTTP thread does: is it complete, within the limits, and free of what a request head must never contain?
+// A pure function of the bytes received so far, so it can be asked again after every read.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <string_view>
+
+namespace contactd {
+
+struct HeadLimits {
+  std::size_t max_head_bytes = 16 * 1024;  // request line + header fields + the empty line (431 beyond)
+  std::size_t max_request_line = 4096;     // (414 beyond)
+  std::size_t max_header_fields = 64;      // (431 beyond)
+};
+
+struct HeadCheck {
+  enum class Verdict { incomplete, complete, refused };
+  Verdict verdict = Verdict::incomplete;
+  std::size_t skip = 0;      // empty lines before the request line (RFC 9112 2.2: ignored)
+  std::size_t head_end = 0;  // complete: bytes of the head from the start of the buffer, skip and "\r\n\r\n" included
+  bool probe = false;        // complete: GET or HEAD of /healthz or /readyz (served by the probe threads)
+  int status = 0;            // refused: 400, 414 or 431
+  std::string detail;        // refused: what is wrong, for the problem document
+};
+
+// Checks `received` (the bytes read so far on a connection, starting at a request). Refuses: a bare CR or LF (every
+// line must end in CRLF), a control character or DEL in the request line or a field (NUL included; HTAB is allowed
+// in field values), obs-fold (a line starting with a space), a field line without a name and colon or with a
+// space before the colon, and anything over the limits. Says `incomplete` until the empty line arrives.
+HeadCheck check_head(std::string_view received, const HeadLimits& limits);
+
+}  // namespace contactd

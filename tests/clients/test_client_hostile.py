@@ -1,0 +1,248 @@
+#!/usr/bin/env python3
+"""The client against a broken server or proxy (issue 10, item 14): every command, for every kind of bad answer,
+ends with "error: ..." lines and exit code 1 (or 2, 3), never a traceback; a redirect is not success (delete does
+not say "deleted", download writes no file); a download must be an HDF5 file (an HTML page or garbage is not
+saved); watch honours --timeout on a silent stream.
+
+A fake server on a loopback port answers every request with the raw bytes of the scenario under test. The
+commands run in this process (contact_client.main with stdout and stderr captured; an exception escaping main
+is what would print a traceback) and a few as subprocesses. Standard library only."""
+import contextlib
+import io
+import json
+import os
+import socket
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(HERE, "..", ".."))
+sys.path.insert(0, os.path.join(SRC, "tests", "server"))
+sys.path.insert(0, os.path.join(SRC, "clients"))
+
+import contact_client as cc  # noqa: E402
+from harness import Checks  # noqa: E402
+
+CLIENT = os.path.join(SRC, "clients", "contact_client.py")
+JOB_ID = "00000000-0000-4000-8000-000000000000"
+HOST = "127.0.0.1"
+
+t = Checks()
+check = t.check
+
+
+def http(status, body=b"", content_type="application/json", extra=b"", length=None):
+    if isinstance(body, str):
+        body = body.encode()
+    head = b"HTTP/1.1 %d X\r\n" % status
+    if content_type:
+        head += b"Content-Type: " + content_type.encode() + b"\r\n"
+    head += b"Content-Length: " + (str(len(body)) if length is None else length).encode() + b"\r\n"
+    return head + extra + b"Connection: close\r\n\r\n" + body
+
+
+def sse(*data_lines):
+    body = b"".join(b"data: " + d.encode() + b"\n\n" for d in data_lines)
+    return (b"HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nConnection: close\r\n\r\n" + body)
+
+
+class Silent:
+    """Sends the head of an event stream, then nothing for `seconds`."""
+
+    def __init__(self, seconds):
+        self.seconds = seconds
+
+    def __call__(self, sock):
+        sock.sendall(b"HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nTransfer-Encoding: chunked\r\n\r\n")
+        time.sleep(self.seconds)
+
+
+# Every kind of bad answer (the same for every path asked).
+SCENARIOS = {
+    "problem with non-string fields": http(400, json.dumps({"type": 42, "title": ["x"], "status": "400",
+                                                             "detail": {"a": 1}, "errors": "nope",
+                                                             "state": [1]}), "application/problem+json"),
+    "problem with odd errors": http(400, json.dumps({"type": "/problems/invalid-job", "errors": [
+        1, None, {"pointer": 5, "message": ["m"]}]}), "application/problem+json"),
+    "JSON null": http(200, "null"),
+    "JSON list": http(200, "[1, 2]"),
+    "no id": http(202, json.dumps({"state": "QUEUED", "jobs": 5, "bodies": 3})),
+    "odd field types": http(200, json.dumps({"id": JOB_ID, "state": ["x"], "jobs": [1, {"id": 3, "state": None}],
+                                             "next_page_token": 7, "progress": [1], "timings": "t",
+                                             "error": "e", "bodies": [1], "iterations": "many"})),
+    "HTML page (a proxy)": http(200, "<html><body>Sign in to the portal</body></html>", "text/html"),
+    "HTML error page": http(502, "<html>Bad Gateway</html>", "text/html"),
+    "redirect": http(302, "", None, extra=b"Location: http://elsewhere.example/\r\n"),
+    "moved permanently": http(301, "", None, extra=b"Location: /login\r\n"),
+    "Content-Length abc": http(200, "{}", length="abc"),
+    "short body": http(200, '{"id": "x"}', length="500"),
+    "bad chunked encoding": (b"HTTP/1.1 200 OK\r\nContent-Type: application/json\r\nTransfer-Encoding: chunked\r\n\r\n"
+                             b"zz\r\n{}\r\n0\r\n\r\n"),
+    "not HTTP": b"SSH-2.0-OpenSSH_9.2\r\n",
+    "garbage status line": b"HTTP/1.1 abc def\r\n\r\n",
+    "nothing": b"",
+    "deep JSON": http(200, "[" * 100000 + "]" * 100000),
+    "deep problem": http(400, "[" * 100000 + "]" * 100000, "application/problem+json"),
+    "SSE data not JSON": sse("this is not json"),
+    "SSE list": sse("[1, 2, 3]"),
+    "SSE odd iteration": sse(json.dumps({"seq": 1, "type": "iteration", "iteration": "x", "paper_criterion": "p",
+                                         "bodies": "b", "pairs": [1, {"name": 3, "force": "f"}],
+                                         "elapsed_seconds": [1]}),
+                             json.dumps({"seq": "2", "type": "step", "bodies": [{"elements": "e"}]}),
+                             json.dumps({"seq": 3, "type": "end", "state": ["S"], "iterations": "i",
+                                         "solve_seconds": "s", "result_available": "yes"})),
+    "HDF5 of the wrong size": http(200, b"\x89HDF\r\n\x1a\nrest", "application/x-hdf5", length="999"),
+    "garbage as HDF5": http(200, b"GIF89a" + b"\x00" * 100, "application/x-hdf5"),
+}
+
+
+class FakeServer:
+    def __init__(self):
+        self.sock = socket.socket()
+        self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        self.sock.bind((HOST, 0))
+        self.sock.listen(16)
+        self.url = f"http://{HOST}:{self.sock.getsockname()[1]}"
+        self.answer = b""
+        threading.Thread(target=self._accept, daemon=True).start()
+
+    def _accept(self):
+        while True:
+            try:
+                conn, _ = self.sock.accept()
+            except OSError:
+                return
+            threading.Thread(target=self._serve, args=(conn,), daemon=True).start()
+
+    def _serve(self, conn):
+        try:
+            conn.settimeout(5)
+            data = b""
+            while b"\r\n\r\n" not in data:
+                chunk = conn.recv(65536)
+                if not chunk:
+                    break
+                data += chunk
+            answer = self.answer
+            if callable(answer):
+                answer(conn)
+            else:
+                conn.sendall(answer)
+        except OSError:
+            pass
+        finally:
+            try:
+                conn.shutdown(socket.SHUT_RDWR)
+            except OSError:
+                pass
+            conn.close()
+
+
+def run_main(args):
+    """(exit code, stdout, stderr, escaped exception) of contact_client.main(args)."""
+    out, err = io.StringIO(), io.StringIO()
+    escaped = None
+    code = None
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            code = cc.main(args)
+        except SystemExit as exc:
+            code = exc.code
+        except BaseException as exc:  # what would be a traceback
+            escaped = exc
+    return code, out.getvalue(), err.getvalue(), escaped
+
+
+server = FakeServer()
+tmp = tempfile.mkdtemp(prefix="client-hostile-")
+job_file = os.path.join(tmp, "job.json")
+with open(job_file, "w") as f:
+    json.dump({"name": "x", "bodies": []}, f)
+download_to = os.path.join(tmp, "result.hdf")
+
+COMMANDS = [
+    ["submit", job_file],
+    ["submit", job_file, "--wait", "--retries", "0"],
+    ["status", JOB_ID],
+    ["status", JOB_ID, "--json"],
+    ["list"],
+    ["list", "--all"],
+    ["cancel", JOB_ID],
+    ["delete", JOB_ID],
+    ["download", JOB_ID, "-o", download_to],
+    ["download", JOB_ID, "-o", download_to, "--xmf"],
+    ["validate", job_file],
+    ["watch", JOB_ID, "--retries", "0"],
+]
+
+runs = tracebacks = 0
+start = time.time()
+for name, answer in SCENARIOS.items():
+    server.answer = answer
+    for command in COMMANDS:
+        args = command + ["--url", server.url, "--timeout", "2"]
+        if os.path.exists(download_to):
+            os.remove(download_to)
+        code, out, err, escaped = run_main(args)
+        runs += 1
+        label = f"{name}: {' '.join(command[:2])}"
+        if escaped is not None:
+            tracebacks += 1
+            check(f"{label}: no traceback", False, repr(escaped))
+            continue
+        check(f"{label}: an exit code, not a crash", code in (0, 1, 2, 3), (code, err[-300:]))
+        if code != 0:
+            check(f"{label}: says what is wrong on stderr", err.strip() != "" and ("error: " in err or "ended" in err),
+                  err[-300:])
+        check(f"{label}: handled, not caught by the last-resort handler", "internal error of the client" not in err,
+              err[-300:])
+        if command[0] == "download":
+            check(f"{label}: no file written unless it is HDF5", not os.path.exists(download_to) or code == 0,
+                  code)
+        if command[0] == "delete":
+            check(f"{label}: nothing but 204 is 'deleted'", code != 0 and "deleted" not in out, (code, out))
+print(f"{runs} runs of {len(COMMANDS)} commands against {len(SCENARIOS)} bad answers in {time.time() - start:.1f} s, "
+      f"{tracebacks} tracebacks", flush=True)
+
+# The cases of the issue, by name.
+server.answer = SCENARIOS["HTML page (a proxy)"]
+code, out, err, _ = run_main(["download", JOB_ID, "-o", download_to, "--url", server.url])
+check("a proxy's HTML page is not saved as .hdf", code == 1 and not os.path.exists(download_to) and
+      "not an HDF5 file" in err, err)
+server.answer = SCENARIOS["garbage as HDF5"]
+code, out, err, _ = run_main(["download", JOB_ID, "-o", download_to, "--url", server.url])
+check("a download without the HDF5 signature is not saved", code == 1 and not os.path.exists(download_to) and
+      "HDF5 signature" in err, err)
+server.answer = SCENARIOS["redirect"]
+code, out, err, _ = run_main(["delete", JOB_ID, "--url", server.url])
+check("delete answered 302: exit 1, a line naming the redirect", code == 1 and "302" in err and "redirect" in err and
+      out == "", (code, out, err))
+code, out, err, _ = run_main(["download", JOB_ID, "-o", download_to, "--url", server.url])
+check("download answered 302: no 0-byte file", code == 1 and not os.path.exists(download_to), (code, err))
+
+# watch honours --timeout on a stream that goes silent (it used to wait 60 s per attempt).
+server.answer = Silent(30)
+begin = time.time()
+code, out, err, _ = run_main(["watch", JOB_ID, "--url", server.url, "--timeout", "1", "--retries", "1"])
+took = time.time() - begin
+check("watch --timeout 1 on a silent stream: gives up within seconds", code == 1 and took < 6 and
+      "no event or heartbeat for 1 s" in err, (code, took, err))
+
+# As commands: the same answers print no traceback.
+for name in ("problem with non-string fields", "JSON null", "SSE data not JSON", "Content-Length abc",
+             "bad chunked encoding", "deep JSON"):
+    server.answer = SCENARIOS[name]
+    command = ["watch", JOB_ID, "--retries", "0"] if name.startswith("SSE") else ["status", JOB_ID]
+    r = subprocess.run([sys.executable, CLIENT, *command, "--url", server.url, "--timeout", "2"],
+                       capture_output=True, text=True, timeout=60)
+    check(f"as a command, {name}: exit 1 and no traceback", r.returncode == 1 and "Traceback" not in r.stderr and
+          r.stderr.startswith("error: "), (r.returncode, r.stderr[-400:]))
+
+check("python3 -m contact_client works", subprocess.run(
+    [sys.executable, "-m", "contact_client", "--help"], capture_output=True, text=True,
+    cwd=os.path.join(SRC, "clients")).returncode == 0)
+server.sock.close()
+t.finish()
