@@ -1,6 +1,7 @@
 // FEM layer: Q1 element properties and patch tests (linear fields reproduced exactly on distorted meshes).
 #include "fem/body_solver.hpp"
 #include "fem/elasticity.hpp"
+#include "element_checks.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
@@ -45,24 +46,7 @@ TEST(Q1Element, StiffnessIsSymmetricWithExactlyThreeRigidModesInItsNullSpace) {
   x << 0.1, 0.0, 1.3, 0.2, 1.1, 0.9, -0.1, 1.2;  // a general convex quadrilateral
   for (Plane plane : {Plane::strain, Plane::stress}) {
     const Elasticity el = make_elasticity({2.1e5, 0.3}, Model{plane, 0.5});
-    const Matrix8d K = element_stiffness(x, el);
-    EXPECT_LE((K - K.transpose()).cwiseAbs().maxCoeff(), 1e-12 * K.cwiseAbs().maxCoeff());
-    Eigen::SelfAdjointEigenSolver<Matrix8d> eig(K);
-    const auto& ev = eig.eigenvalues();
-    const double largest = ev.maxCoeff();
-    int zero = 0;
-    for (int i = 0; i < 8; ++i) {
-      EXPECT_GT(ev[i], -1e-10 * largest);
-      if (std::abs(ev[i]) < 1e-10 * largest) ++zero;
-    }
-    EXPECT_EQ(zero, 3);
-    // ... and the three are the rigid motions: translations and the infinitesimal rotation.
-    Eigen::Matrix<double, 8, 3> rigid;
-    for (int k = 0; k < 4; ++k) {
-      rigid.row(2 * k) << 1, 0, -x(k, 1);
-      rigid.row(2 * k + 1) << 0, 1, x(k, 0);
-    }
-    EXPECT_LE((K * rigid).cwiseAbs().maxCoeff(), 1e-10 * largest);
+    contact::testing::expect_symmetric_with_rigid_null_space<4>(element_stiffness(x, el), x);
   }
 }
 

@@ -1,5 +1,6 @@
 // Refinement with hanging nodes: 1-irregularity, curved boundaries, constraints, patch test and convergence.
 #include "fem/body_solver.hpp"
+#include "lame_ring.hpp"
 #include "mesh/mesh.hpp"
 
 #include <gtest/gtest.h>
@@ -188,36 +189,10 @@ TEST(HangingNodes, UniformStressUnderTractionsOnANonConformingMesh) {
 }
 
 TEST(HangingNodes, LameRingConvergesAtTheOptimalRateUnderUniformRefinement) {
-  // Quarter of a thick ring a = 1 <= r <= b = 2 under internal pressure P, plane strain, symmetry on both
-  // straight edges: u_r = A r + B / r with A = (1+nu)(1-2nu) P a^2 / (E (b^2 - a^2)),
-  // B = (1+nu) P a^2 b^2 / (E (b^2 - a^2)). Q1 on the curved mesh: nodal displacement error O(h^2).
-  const double E = 1000.0, nu = 0.3, P = 1.0, a = 1.0, b = 2.0;
-  const double A = (1 + nu) * (1 - 2 * nu) * P * a * a / (E * (b * b - a * a));
-  const double Bc = (1 + nu) * P * a * a * b * b / (E * (b * b - a * a));
-  Body body;
-  body.name = "ring";
-  body.material = {E, nu};
-  mesh::BlockSpec s;
-  s.corners = {mesh::Point(a, 0), mesh::Point(b, 0), mesh::Point(0, b), mesh::Point(0, a)};
-  s.nx = 4;
-  s.ny = 4;
-  mesh::Curve outer, inner;
-  outer.kind = inner.kind = mesh::Curve::Kind::arc;
-  outer.radius = b;
-  inner.radius = a;
-  mesh::fit_curve(outer, s.corners[1], s.corners[2]);
-  mesh::fit_curve(inner, s.corners[0], s.corners[3]);
-  s.curves["right"] = outer;
-  s.curves["left"] = inner;
-  body.mesh = mesh::make_block(s);
-  BoundaryCondition sym_x{"bottom", BoundaryCondition::Kind::displacement};  // y = 0 line: u_y = 0
-  sym_x.uy = 0.0;
-  BoundaryCondition sym_y{"top", BoundaryCondition::Kind::displacement};     // x = 0 line: u_x = 0
-  sym_y.ux = 0.0;
-  BoundaryCondition pressure{"left", BoundaryCondition::Kind::traction};     // inner arc
-  pressure.normal_pressure = true;
-  pressure.pressure = P;
-  body.boundary = {sym_x, sym_y, pressure};
+  // The quarter ring under internal pressure (lame_ring.hpp). Q1 on the curved mesh: nodal displacement error
+  // O(h^2).
+  const contact::testing::LameRing ring;
+  Body body = ring.body(ring.block(4, 4));
   std::vector<double> errors;
   for (int level = 0; level < 3; ++level) {
     if (level > 0) mesh::refine_uniform(body.mesh);
@@ -225,13 +200,9 @@ TEST(HangingNodes, LameRingConvergesAtTheOptimalRateUnderUniformRefinement) {
     ASSERT_TRUE(solver.ok()) << solver.error();
     const Eigen::VectorXd u = solver.solve(Eigen::VectorXd());
     double err = 0;
-    for (int n = 0; n < body.mesh.num_nodes(); ++n) {
-      const Eigen::Vector2d x = body.mesh.nodes[static_cast<size_t>(n)];
-      const double r = x.norm();
-      const Eigen::Vector2d exact = (A * r + Bc / r) * x / r;
-      err = std::max(err, (u.segment<2>(2 * n) - exact).norm());
-    }
-    errors.push_back(err / (A * b + Bc / a));
+    for (int n = 0; n < body.mesh.num_nodes(); ++n)
+      err = std::max(err, (u.segment<2>(2 * n) - ring.exact(body.mesh.nodes[static_cast<size_t>(n)])).norm());
+    errors.push_back(err / (ring.A() * ring.b + ring.B() / ring.a));
   }
   for (size_t k = 1; k < errors.size(); ++k) {
     const double rate = std::log2(errors[k - 1] / errors[k]);

@@ -1,7 +1,7 @@
 #include "indicator.hpp"
 
 #include "../bem/bem.hpp"
-#include "../fem/elasticity.hpp"
+#include "../fem/element.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -18,22 +18,27 @@ std::pair<int, int> key(int a, int b) { return {std::min(a, b), std::max(a, b)};
 
 double squared_norm(const Eigen::Vector3d& s) { return s[0] * s[0] + s[1] * s[1] + 2 * s[2] * s[2]; }
 
-// eta from FE and reference stresses at the 2x2 Gauss points of every cell (3 x 4 per cell).
-Eigen::VectorXd normalised(const mesh::Mesh& m, const std::vector<Eigen::Matrix<double, 3, 4>>& fe,
-                           const std::vector<Eigen::Matrix<double, 3, 4>>& ref, Normalization normalization) {
+// Stresses at the quadrature points of every cell (fem/element.hpp: 2x2 Gauss on a quadrilateral, 3 points on a
+// triangle), one 3 x points block per cell.
+using CellStresses = std::vector<fem::PointStresses>;
+
+// eta from FE and reference stresses at the quadrature points of every cell.
+Eigen::VectorXd normalised(const mesh::Mesh& m, const CellStresses& fe, const CellStresses& ref,
+                           Normalization normalization) {
   const int n = m.num_cells();
   Eigen::VectorXd diff2(n), area(n);
   double ref2 = 0.0, total_area = 0.0;
   for (int c = 0; c < n; ++c) {
-    const auto x = fem::cell_coordinates(m, c);
+    const fem::CellQuadrature q = fem::cell_quadrature(m, c);
+    const auto& f = fe[static_cast<size_t>(c)];
+    const auto& r = ref[static_cast<size_t>(c)];
     diff2[c] = 0.0;
     area[c] = 0.0;
-    for (int q = 0; q < 4; ++q) {
-      double det = 0;
-      fem::strain_matrix(x, fem::kGaussPoints[static_cast<size_t>(q)].x(), fem::kGaussPoints[static_cast<size_t>(q)].y(), det);
-      diff2[c] += det * squared_norm(ref[static_cast<size_t>(c)].col(q) - fe[static_cast<size_t>(c)].col(q));
-      ref2 += det * squared_norm(ref[static_cast<size_t>(c)].col(q));
-      area[c] += det;
+    for (int p = 0; p < q.size; ++p) {
+      const double w = q.weight[static_cast<size_t>(p)];
+      diff2[c] += w * squared_norm(r.col(p) - f.col(p));
+      ref2 += w * squared_norm(r.col(p));
+      area[c] += w;
     }
     total_area += area[c];
   }
@@ -45,24 +50,12 @@ Eigen::VectorXd normalised(const mesh::Mesh& m, const std::vector<Eigen::Matrix<
   return eta;
 }
 
-std::vector<Eigen::Matrix<double, 3, 4>> fe_gauss_stresses(const Body& body, const fem::BodySolver& solver,
-                                                          const Eigen::VectorXd& u) {
+CellStresses fe_point_stresses(const Body& body, const fem::BodySolver& solver, const Eigen::VectorXd& u) {
   const auto& m = body.mesh;
-  std::vector<Eigen::Matrix<double, 3, 4>> out(static_cast<size_t>(m.num_cells()));
-  for (int c = 0; c < m.num_cells(); ++c) {
-    fem::Vector8d ue;
-    for (int k = 0; k < 4; ++k) ue.segment<2>(2 * k) = u.segment<2>(2 * m.cells[static_cast<size_t>(c)][static_cast<size_t>(k)]);
-    out[static_cast<size_t>(c)] = fem::gauss_stresses(fem::cell_coordinates(m, c), ue, solver.elasticity());
-  }
+  CellStresses out(static_cast<size_t>(m.num_cells()));
+  for (int c = 0; c < m.num_cells(); ++c)
+    out[static_cast<size_t>(c)] = fem::cell_point_stresses(m, c, fem::cell_values(m, c, u), solver.elasticity());
   return out;
-}
-
-// Physical position of a reference point of a cell.
-Eigen::Vector2d map_point(const Eigen::Matrix<double, 4, 2>& x, double xi, double eta) {
-  static const double xs[4] = {-1, 1, 1, -1}, es[4] = {-1, -1, 1, 1};
-  Eigen::Vector2d p = Eigen::Vector2d::Zero();
-  for (int k = 0; k < 4; ++k) p += 0.25 * (1 + xs[k] * xi) * (1 + es[k] * eta) * x.row(k).transpose();
-  return p;
 }
 
 }  // namespace
@@ -72,7 +65,7 @@ std::vector<int> boundary_loop(const mesh::Mesh& m) {
   // itself (both are interior: the neighbour is refined).
   std::map<std::pair<int, int>, int> count;
   for (int c = 0; c < m.num_cells(); ++c)
-    for (int s = 0; s < 4; ++s) {
+    for (int s = 0; s < m.cells[static_cast<size_t>(c)].size(); ++s) {
       const auto n = m.edge_nodes({c, s});
       count[key(n[0], n[1])]++;
     }
@@ -85,7 +78,7 @@ std::vector<int> boundary_loop(const mesh::Mesh& m) {
   std::map<int, int> next;  // boundary side a -> b in the cells' counter-clockwise direction
   size_t sides = 0;
   for (int c = 0; c < m.num_cells(); ++c)
-    for (int s = 0; s < 4; ++s) {
+    for (int s = 0; s < m.cells[static_cast<size_t>(c)].size(); ++s) {
       const auto n = m.edge_nodes({c, s});
       if (count[key(n[0], n[1])] != 1 || interior.count(key(n[0], n[1]))) continue;
       if (next.count(n[0])) return {};  // a node starting two boundary sides: not a simple loop
@@ -109,19 +102,17 @@ IndicatorResult zz_indicator(const Body& body, const fem::BodySolver& solver, co
                              Normalization normalization) {
   const auto t0 = std::chrono::steady_clock::now();
   const auto& m = body.mesh;
-  const auto fe = fe_gauss_stresses(body, solver, u);
-  const auto recovered = solver.stresses(u).node;  // nodal averages of the extrapolated Gauss values
-  std::vector<Eigen::Matrix<double, 3, 4>> ref(fe.size());
-  static const double xs[4] = {-1, 1, 1, -1}, es[4] = {-1, -1, 1, 1};
+  const CellStresses fe = fe_point_stresses(body, solver, u);
+  const auto recovered = solver.stresses(u).node;  // nodal averages of the cells' values at their nodes
+  CellStresses ref(fe.size());
   for (int c = 0; c < m.num_cells(); ++c) {
     const auto& cell = m.cells[static_cast<size_t>(c)];
-    for (int q = 0; q < 4; ++q) {
-      const auto& gp = fem::kGaussPoints[static_cast<size_t>(q)];
-      Eigen::Vector3d s = Eigen::Vector3d::Zero();
-      for (int k = 0; k < 4; ++k)
-        s += 0.25 * (1 + xs[k] * gp.x()) * (1 + es[k] * gp.y()) * recovered.row(cell[static_cast<size_t>(k)]).head<3>().transpose();
-      ref[static_cast<size_t>(c)].col(q) = s;
-    }
+    const fem::CellQuadrature q = fem::cell_quadrature(m, c);
+    auto& r = ref[static_cast<size_t>(c)];
+    r = fem::PointStresses::Zero(3, q.size);
+    for (int p = 0; p < q.size; ++p)
+      for (int k = 0; k < cell.size(); ++k)
+        r.col(p) += q.shape(p, k) * recovered.row(cell[static_cast<size_t>(k)]).head<3>().transpose();
   }
   IndicatorResult r;
   r.eta = normalised(m, fe, ref, normalization);
@@ -192,16 +183,21 @@ IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fe
   try {
     const bem::BoundarySolution sol = bem::solve(bp);
     std::vector<Eigen::Vector2d> points;
+    std::vector<size_t> first(static_cast<size_t>(m.num_cells()) + 1, 0);  // cell c's points start at first[c]
     points.reserve(static_cast<size_t>(m.num_cells()) * 4);
     for (int c = 0; c < m.num_cells(); ++c) {
-      const auto x = fem::cell_coordinates(m, c);
-      for (const auto& gp : fem::kGaussPoints) points.push_back(map_point(x, gp.x(), gp.y()));
+      const fem::CellQuadrature q = fem::cell_quadrature(m, c);
+      for (int p = 0; p < q.size; ++p) points.push_back(q.point[static_cast<size_t>(p)]);
+      first[static_cast<size_t>(c) + 1] = points.size();
     }
     const Eigen::MatrixX3d sb = bem::interior_stresses(bp, sol, points);
-    std::vector<Eigen::Matrix<double, 3, 4>> ref(static_cast<size_t>(m.num_cells()));
-    for (int c = 0; c < m.num_cells(); ++c)
-      for (int q = 0; q < 4; ++q) ref[static_cast<size_t>(c)].col(q) = sb.row(4 * c + q).transpose();
-    r.eta = normalised(m, fe_gauss_stresses(body, solver, u), ref, normalization);
+    CellStresses ref(static_cast<size_t>(m.num_cells()));
+    for (size_t c = 0; c < ref.size(); ++c) {
+      ref[c].resize(3, static_cast<Eigen::Index>(first[c + 1] - first[c]));
+      for (size_t p = first[c]; p < first[c + 1]; ++p)
+        ref[c].col(static_cast<Eigen::Index>(p - first[c])) = sb.row(static_cast<Eigen::Index>(p)).transpose();
+    }
+    r.eta = normalised(m, fe_point_stresses(body, solver, u), ref, normalization);
   } catch (const std::exception& e) {
     r = zz_indicator(body, solver, u, normalization);
     r.note = "body '" + body.name + "': the boundary-element solve failed (" + e.what() + "); zz indicator used";
@@ -222,7 +218,7 @@ Marking mark(const mesh::Mesh& mesh, const Eigen::VectorXd& eta, double delta, i
     candidates.push_back(c);
   }
   std::sort(candidates.begin(), candidates.end(), [&](int a, int b) { return eta[a] > eta[b]; });
-  // A split adds at most 5 nodes (4 midpoints, 1 centre), 10 dofs; the 1-irregularity closure can add more,
+  // A split adds at most 5 nodes (a quadrilateral's 4 midpoints and centre; a triangle's 3 midpoints), 10 dofs; the 1-irregularity closure can add more,
   // so keep a margin of one extra split per marked cell.
   const long dofs = 2L * mesh.num_nodes();
   const long room = (max_dofs - dofs) / 20;

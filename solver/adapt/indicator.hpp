@@ -1,10 +1,11 @@
 // Error indicators per cell and marking (paper section 3; ALGORITHM.md section 3).
 //
 // Both indicators compare the FE stresses sigma_F with a reference field sigma_R, ||s||_D = sqrt(int_D s_ij s_ij)
-// (in-plane components: sxx^2 + syy^2 + 2 sxy^2, the 2x2 Gauss rule of each element), normalised
+// (in-plane components: sxx^2 + syy^2 + 2 sxy^2; the 2x2 Gauss rule of a quadrilateral, the three-point rule of
+// degree 2 of a triangle: fem/element.hpp), normalised
 //   rms:  eta(e) = ( ||sigma_R - sigma_F||_e / sqrt|e| ) / ( ||sigma_R||_Omega / sqrt|Omega| )   (default)
 //   area: eta(e) = ( ||sigma_R - sigma_F||_e / |e| ) / ( ||sigma_R||_Omega / |Omega| )   (the paper, as printed)
-// The printed form divides an L2 norm by an area, so it scales like 1/sqrt|e|: for Q1 (stress error O(h)) it
+// The printed form divides an L2 norm by an area, so it scales like 1/sqrt|e|: for Q1 and P1 (stress error O(h)) it
 // does not fall under refinement, and on seed_layers it marks almost every cell at every step. The rms form
 // is the same comparison made scale-consistent (RMS error over the cell against RMS stress over the body).
 //  * fem_bem: sigma_R = sigma_B, the boundary-element stresses of the same body problem (same prescribed

@@ -1,5 +1,6 @@
 #include "body_solver.hpp"
 
+#include "element.hpp"
 #include "rigid_modes.hpp"
 
 #include <Eigen/QR>
@@ -93,21 +94,6 @@ void BodySolver::setup_constraints() {
   if (!err.empty()) error_ = "body '" + body_.name + "': " + err;
 }
 
-namespace {
-
-// The element's 8 dofs (2 per corner, counter-clockwise).
-std::array<int, 8> element_dofs(const mesh::Mesh& m, int c) {
-  const auto& nodes = m.cells[static_cast<size_t>(c)];
-  std::array<int, 8> dofs{};
-  for (int k = 0; k < 4; ++k) {
-    dofs[static_cast<size_t>(2 * k)] = 2 * nodes[static_cast<size_t>(k)];
-    dofs[static_cast<size_t>(2 * k + 1)] = 2 * nodes[static_cast<size_t>(k)] + 1;
-  }
-  return dofs;
-}
-
-}  // namespace
-
 void BodySolver::assemble_system() {
   // The reduced system T^T K T x = T^T (f - K g) is assembled directly, element by element: each element's
   // stiffness goes through the rows of T of its dofs (a free dof: itself; a prescribed one: nothing, its value
@@ -145,7 +131,7 @@ void BodySolver::assemble_system() {
   std::vector<int> unknowns;
   for (int c = 0; c < m.num_cells(); ++c) {
     unknowns.clear();
-    for (int d : element_dofs(m, c))
+    for (int d : cell_dofs(m.cells[static_cast<size_t>(c)]))
       for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(T, d); it; ++it) unknowns.push_back(static_cast<int>(it.col()));
     for (int k : unknowns) columns[static_cast<size_t>(k)].insert(columns[static_cast<size_t>(k)].end(), unknowns.begin(), unknowns.end());
   }
@@ -170,23 +156,21 @@ void BodySolver::assemble_system() {
   // Values and the right-hand side.
   rhs_base_ = T.transpose() * f_ext_;  // T^T f of the tractions; each element adds T^T (f_e - K_e g_e)
   for (int c = 0; c < m.num_cells(); ++c) {
-    const auto x = cell_coordinates(m, c);
-    const Matrix8d Ke = element_stiffness(x, elasticity_);
-    const auto dofs = element_dofs(m, c);
-    Vector8d fe = Vector8d::Zero();
+    const CellMatrix Ke = cell_stiffness(m, c, elasticity_);
+    const CellDofs dofs = cell_dofs(m.cells[static_cast<size_t>(c)]);
+    const Eigen::Index nd = dofs.size();
+    CellVector fe = CellVector::Zero(nd);
     if (has_body_force) {
-      fe = element_body_force(x, body_.body_force, elasticity_);
-      for (int i = 0; i < 8; ++i) f_ext_[dofs[static_cast<size_t>(i)]] += fe[i];
+      fe = cell_body_force(m, c, body_.body_force, elasticity_);
+      for (Eigen::Index i = 0; i < nd; ++i) f_ext_[dofs[i]] += fe[i];
     }
-    Vector8d ge;
-    for (int i = 0; i < 8; ++i) ge[i] = g[dofs[static_cast<size_t>(i)]];
-    const Vector8d load = fe - Ke * ge;  // this element's share of f - K g
-    for (int i = 0; i < 8; ++i)
-      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator ii(T, dofs[static_cast<size_t>(i)]); ii; ++ii) {
+    const CellVector load = fe - Ke * cell_values(m, c, g);  // this element's share of f - K g
+    for (Eigen::Index i = 0; i < nd; ++i)
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator ii(T, dofs[i]); ii; ++ii) {
         const int ki = static_cast<int>(ii.col());
         rhs_base_[ki] += ii.value() * load[i];
-        for (int j = 0; j < 8; ++j)
-          for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator jj(T, dofs[static_cast<size_t>(j)]); jj; ++jj)
+        for (Eigen::Index j = 0; j < nd; ++j)
+          for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator jj(T, dofs[j]); jj; ++jj)
             entry(static_cast<int>(jj.col()), ki) += ii.value() * jj.value() * Ke(j, i);
       }
   }
@@ -200,10 +184,10 @@ Eigen::SparseMatrix<double> BodySolver::stiffness() const {
   std::vector<Eigen::Triplet<double>> triplets;
   triplets.reserve(static_cast<size_t>(m.num_cells()) * 64);
   for (int c = 0; c < m.num_cells(); ++c) {
-    const Matrix8d Ke = element_stiffness(cell_coordinates(m, c), elasticity_);
-    const auto dofs = element_dofs(m, c);
-    for (int i = 0; i < 8; ++i)
-      for (int j = 0; j < 8; ++j) triplets.emplace_back(dofs[static_cast<size_t>(i)], dofs[static_cast<size_t>(j)], Ke(i, j));
+    const CellMatrix Ke = cell_stiffness(m, c, elasticity_);
+    const CellDofs dofs = cell_dofs(m.cells[static_cast<size_t>(c)]);
+    for (Eigen::Index i = 0; i < dofs.size(); ++i)
+      for (Eigen::Index j = 0; j < dofs.size(); ++j) triplets.emplace_back(dofs[i], dofs[j], Ke(i, j));
   }
   Eigen::SparseMatrix<double> K(n, n);
   K.setFromTriplets(triplets.begin(), triplets.end());
@@ -276,14 +260,12 @@ Eigen::VectorXd BodySolver::reactions(const Eigen::VectorXd& u, const Eigen::Vec
   const auto& m = body_.mesh;
   Eigen::VectorXd r = Eigen::VectorXd::Zero(2 * m.num_nodes());
   for (int c = 0; c < m.num_cells(); ++c) {
-    const auto dofs = element_dofs(m, c);
+    const CellDofs dofs = cell_dofs(m.cells[static_cast<size_t>(c)]);
     bool prescribed = false;
-    for (int d : dofs) prescribed = prescribed || constraints_.is_dirichlet(d);
+    for (Eigen::Index i = 0; i < dofs.size(); ++i) prescribed = prescribed || constraints_.is_dirichlet(dofs[i]);
     if (!prescribed) continue;
-    Vector8d ue;
-    for (int i = 0; i < 8; ++i) ue[i] = u[dofs[static_cast<size_t>(i)]];
-    const Vector8d fe = element_stiffness(cell_coordinates(m, c), elasticity_) * ue;
-    for (int i = 0; i < 8; ++i) r[dofs[static_cast<size_t>(i)]] += fe[i];
+    const CellVector fe = cell_stiffness(m, c, elasticity_) * cell_values(m, c, u);
+    for (Eigen::Index i = 0; i < dofs.size(); ++i) r[dofs[i]] += fe[i];
   }
   r -= f_ext_;
   if (extra_load.size() > 0) r -= extra_load;
@@ -302,15 +284,13 @@ StressFields BodySolver::stresses(const Eigen::VectorXd& u) const {
   Eigen::VectorXi count = Eigen::VectorXi::Zero(m.num_nodes());
   for (int c = 0; c < m.num_cells(); ++c) {
     const auto& nodes = m.cells[static_cast<size_t>(c)];
-    Vector8d ue;
-    for (int k = 0; k < 4; ++k) ue.segment<2>(2 * k) = u.segment<2>(2 * nodes[static_cast<size_t>(k)]);
-    const auto gs = gauss_stresses(cell_coordinates(m, c), ue, elasticity_);
-    const Eigen::Vector3d mean = gs.rowwise().mean();
+    const PointStresses ps = cell_point_stresses(m, c, cell_values(m, c, u), elasticity_);
+    const Eigen::Vector3d mean = ps.rowwise().mean();
     const double szz = elasticity_.nu_zz * (mean[0] + mean[1]);
     s.cell.row(c) << mean[0], mean[1], mean[2], szz;
     s.von_mises_cell[c] = von_mises(mean[0], mean[1], mean[2], szz);
-    const auto corners = extrapolate_to_corners(gs);
-    for (int k = 0; k < 4; ++k) {
+    const NodeStresses corners = cell_node_stresses(nodes, ps);
+    for (int k = 0; k < nodes.size(); ++k) {
       const int node = nodes[static_cast<size_t>(k)];
       s.node.row(node).head<3>() += corners.row(k);
       count[node]++;

@@ -18,8 +18,8 @@
 namespace contact::fem {
 
 struct StressFields {
-  Eigen::MatrixX4d cell;  // mean over the Gauss points: sxx, syy, sxy, szz
-  Eigen::MatrixX4d node;  // Gauss values extrapolated to the corners, averaged over the cells at a node
+  Eigen::MatrixX4d cell;  // mean over the quadrature points: sxx, syy, sxy, szz (a triangle's: its constant)
+  Eigen::MatrixX4d node;  // the cells' values carried to their nodes (element.hpp), averaged over the cells at a node
   Eigen::VectorXd von_mises_cell;
 };
 

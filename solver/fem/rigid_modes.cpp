@@ -42,7 +42,8 @@ RigidModes free_rigid_modes(const mesh::Mesh& mesh, const std::vector<Prescribed
   double area = 0.0;
   for (int c = 0; c < mesh.num_cells(); ++c) {
     Eigen::Vector2d centre = Eigen::Vector2d::Zero();
-    for (int node : mesh.cells[static_cast<size_t>(c)]) centre += mesh.nodes[static_cast<size_t>(node)] / 4.0;
+    const auto& cell = mesh.cells[static_cast<size_t>(c)];
+    for (int node : cell) centre += mesh.nodes[static_cast<size_t>(node)] / cell.size();
     const double a = std::abs(mesh.cell_area(c));
     centroid += a * centre;
     area += a;

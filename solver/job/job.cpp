@@ -142,7 +142,7 @@ struct MeshInput {
   std::map<std::string, std::string> curve_pointers;  // edge name -> pointer of its curve object
   // explicit arrays
   std::vector<Point> nodes;
-  std::vector<std::array<int, 4>> quads;
+  std::vector<mesh::Cell> quads;
   std::vector<std::pair<std::string, std::vector<std::array<int, 2>>>> edge_pairs;
 };
 
@@ -800,7 +800,7 @@ class JobReader {
             errors_.add(qp, "quad " + std::to_string(q) + " must be an array of four node indices [i, j, k, l]");
             continue;
           }
-          std::array<int, 4> cell{};
+          mesh::Cell cell(-1, -1, -1, -1);
           bool ok = true;
           for (size_t k = 0; k < 4; ++k) {
             auto n = index(quad[k], child(qp, k), "node index");
@@ -960,9 +960,11 @@ class JobReader {
       mesh.nodes = std::move(m.nodes);
       mesh.cells = std::move(m.quads);
       mesh.level.assign(mesh.cells.size(), 0);
-      for (const auto& [name, pairs] : m.edge_pairs)
-        if (auto message = mesh::add_edge_set(mesh, name, pairs))
-          errors_.add(child(child(mp, "edges"), name), "edge '" + name + "': " + *message);
+      // An edge's order follows its cells' sides: only for valid cells (an inverted cell is the error to report).
+      if (mesh::check_cells(mesh).empty())
+        for (const auto& [name, pairs] : m.edge_pairs)
+          if (auto message = mesh::add_edge_set(mesh, name, pairs))
+            errors_.add(child(child(mp, "edges"), name), "edge '" + name + "': " + *message);
       check_arrays(mesh, mp);
     }
     // A bad curve can invert every cell of a block: report a few, then how many more, not thousands of lines.
@@ -987,23 +989,9 @@ class JobReader {
       errors_.add(child(pointer, "nodes"),
                   "nodes not used by any quad: " + join_names(unused) + " (each node must belong to a quad)");
     }
-    // Union-find over quads sharing a side.
-    std::vector<int> parent(mesh.cells.size());
-    for (size_t c = 0; c < parent.size(); ++c) parent[c] = static_cast<int>(c);
-    auto root = [&](int c) {
-      while (parent[static_cast<size_t>(c)] != c)
-        c = parent[static_cast<size_t>(c)] = parent[static_cast<size_t>(parent[static_cast<size_t>(c)])];
-      return c;
-    };
-    std::map<std::pair<int, int>, int> side_owner;
-    for (int c = 0; c < mesh.num_cells(); ++c)
-      for (int s = 0; s < 4; ++s) {
-        auto n = mesh.edge_nodes({c, s});
-        auto [it, inserted] = side_owner.emplace(std::make_pair(std::min(n[0], n[1]), std::max(n[0], n[1])), c);
-        if (!inserted) parent[static_cast<size_t>(root(c))] = root(it->second);
-      }
+    const std::vector<int> piece = mesh::pieces(mesh);
     for (int c = 1; c < mesh.num_cells(); ++c)
-      if (root(c) != root(0)) {
+      if (piece[static_cast<size_t>(c)] != 0) {
         errors_.add(child(pointer, "quads"), "quad " + std::to_string(c) +
                                                  " is not connected to quad 0 through shared sides: a body must be one "
                                                  "piece (use one body per piece)");

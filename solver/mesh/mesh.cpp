@@ -89,9 +89,14 @@ std::vector<int> Mesh::edge_set_nodes(const std::string& name) const {
 
 double Mesh::cell_area(int cell) const {
   const auto& c = cells[static_cast<size_t>(cell)];
+  const auto n = static_cast<size_t>(c.size());
   double a = 0.0;
-  for (size_t k = 0; k < 4; ++k) a += cross(nodes[static_cast<size_t>(c[k])], nodes[static_cast<size_t>(c[(k + 1) % 4])]);
+  for (size_t k = 0; k < n; ++k) a += cross(nodes[static_cast<size_t>(c[k])], nodes[static_cast<size_t>(c[(k + 1) % n])]);
   return 0.5 * a;
+}
+
+bool Mesh::has_triangles() const {
+  return std::any_of(cells.begin(), cells.end(), [](const Cell& c) { return c.is_triangle(); });
 }
 
 Eigen::Vector2d Mesh::bbox_min() const {
@@ -162,11 +167,64 @@ Mesh make_block(const BlockSpec& spec) {
   return m;
 }
 
+namespace {
+
+std::string point_text(const Point& p) {
+  std::ostringstream os;
+  os << '(' << p.x() << ", " << p.y() << ')';
+  return os.str();
+}
+
+// Orders boundary sides (each in its cell's counter-clockwise direction) into one open chain; an error message
+// when they are several pieces or a closed loop.
+std::optional<std::string> order_chain(const Mesh& m, std::vector<EdgeRef>& refs) {
+  std::unordered_map<int, size_t> by_first;
+  std::unordered_map<int, int> second_count;
+  for (size_t k = 0; k < refs.size(); ++k) {
+    const auto n = m.edge_nodes(refs[k]);
+    by_first[n[0]] = k;
+    second_count[n[1]]++;
+  }
+  std::vector<int> starts;
+  for (size_t k = 0; k < refs.size(); ++k) {
+    const int first = m.edge_nodes(refs[k])[0];
+    if (!second_count.count(first)) starts.push_back(first);
+  }
+  if (starts.empty())
+    return "its " + std::to_string(refs.size()) +
+           " sides form a closed loop around the body or a hole; an edge must be an open chain with two ends (split "
+           "it into two edges)";
+  std::vector<EdgeRef> chain;
+  if (starts.size() == 1 && by_first.size() == refs.size()) {
+    int cur = starts.front();
+    while (chain.size() < refs.size()) {
+      auto it = by_first.find(cur);
+      if (it == by_first.end()) break;
+      chain.push_back(refs[it->second]);
+      cur = m.edge_nodes(refs[it->second])[1];
+    }
+  }
+  if (chain.size() != refs.size()) {
+    std::sort(starts.begin(), starts.end());
+    std::string where;
+    for (size_t k = 0; k < starts.size() && k < 4; ++k)
+      where += (k ? ", " : "") + point_text(m.nodes[static_cast<size_t>(starts[k])]);
+    if (starts.size() > 4) where += ", ...";
+    return "its " + std::to_string(refs.size()) + " sides are not one chain along the boundary: they form " +
+           std::to_string(std::max<size_t>(starts.size(), 2)) + " separate pieces (starting at " + where +
+           "); an edge must be one connected piece (make each piece its own edge)";
+  }
+  refs = std::move(chain);
+  return std::nullopt;
+}
+
+}  // namespace
+
 std::optional<std::string> add_edge_set(Mesh& m, const std::string& name, const std::vector<std::array<int, 2>>& pairs) {
   // Sides of all cells by their unordered node pair.
   std::map<std::pair<int, int>, std::vector<EdgeRef>> sides;
   for (int c = 0; c < m.num_cells(); ++c)
-    for (int s = 0; s < 4; ++s) {
+    for (int s = 0; s < m.cells[static_cast<size_t>(c)].size(); ++s) {
       auto n = m.edge_nodes({c, s});
       sides[{std::min(n[0], n[1]), std::max(n[0], n[1])}].push_back({c, s});
     }
@@ -176,40 +234,17 @@ std::optional<std::string> add_edge_set(Mesh& m, const std::string& name, const 
     auto it = sides.find({std::min(i, j), std::max(i, j)});
     std::ostringstream os;
     if (it == sides.end()) {
-      os << "pair " << k << " [" << i << ", " << j << "] is not a side of any quad";
+      os << "pair " << k << " [" << i << ", " << j << "] is not a side of any cell";
       return os.str();
     }
     if (it->second.size() != 1) {
-      os << "pair " << k << " [" << i << ", " << j << "] is an interior side shared by two quads, not a boundary edge";
+      os << "pair " << k << " [" << i << ", " << j << "] is an interior side shared by two cells, not a boundary edge";
       return os.str();
     }
     refs.push_back(it->second.front());
   }
-  // Order into a chain along the boundary direction when the set is one open chain.
-  std::unordered_map<int, size_t> by_first;
-  std::unordered_map<int, int> second_count;
-  for (size_t k = 0; k < refs.size(); ++k) {
-    auto n = m.edge_nodes(refs[k]);
-    by_first[n[0]] = k;
-    second_count[n[1]]++;
-  }
-  int start = -1, starts = 0;
-  for (const auto& [first, k] : by_first)
-    if (!second_count.count(first)) {
-      start = first;
-      ++starts;
-    }
-  if (starts == 1 && by_first.size() == refs.size()) {
-    std::vector<EdgeRef> chain;
-    int cur = start;
-    while (chain.size() < refs.size()) {
-      auto it = by_first.find(cur);
-      if (it == by_first.end()) break;
-      chain.push_back(refs[it->second]);
-      cur = m.edge_nodes(refs[it->second])[1];
-    }
-    if (chain.size() == refs.size()) refs = std::move(chain);
-  }
+  if (refs.empty()) return "it has no sides";
+  if (auto problem = order_chain(m, refs)) return problem;
   m.edge_sets[name] = std::move(refs);
   return std::nullopt;
 }
@@ -218,20 +253,25 @@ std::vector<std::string> check_cells(const Mesh& m) {
   std::vector<std::string> problems;
   for (int c = 0; c < m.num_cells(); ++c) {
     const auto& q = m.cells[static_cast<size_t>(c)];
+    const int n = q.size();
     std::ostringstream os;
+    if (n != 3 && n != 4) {
+      os << "cell " << c << " has " << n << " nodes (a cell is a triangle or a quadrilateral)";
+      problems.push_back(os.str());
+      continue;
+    }
     bool bad_index = false;
-    for (int k = 0; k < 4; ++k)
-      if (q[static_cast<size_t>(k)] < 0 || q[static_cast<size_t>(k)] >= m.num_nodes()) bad_index = true;
+    for (int node : q)
+      if (node < 0 || node >= m.num_nodes()) bad_index = true;
     if (bad_index) {
       os << "cell " << c << " refers to a node index outside 0.." << m.num_nodes() - 1;
       problems.push_back(os.str());
       continue;
     }
+    auto at = [&](int k) -> const Point& { return m.nodes[static_cast<size_t>(q[static_cast<size_t>(k % n)])]; };
     const double area = m.cell_area(c);
     double scale = 0.0;
-    for (int k = 0; k < 4; ++k)
-      scale = std::max(scale, (m.nodes[static_cast<size_t>(q[static_cast<size_t>((k + 1) % 4)])] -
-                               m.nodes[static_cast<size_t>(q[static_cast<size_t>(k)])]).squaredNorm());
+    for (int k = 0; k < n; ++k) scale = std::max(scale, (at(k + 1) - at(k)).squaredNorm());
     if (!(scale > 0) || std::abs(area) <= 1e-12 * scale) {
       os << "cell " << c << " is degenerate (zero area)";
       problems.push_back(os.str());
@@ -242,20 +282,40 @@ std::vector<std::string> check_cells(const Mesh& m) {
       problems.push_back(os.str());
       continue;
     }
-    // The bilinear map's Jacobian is positive everywhere iff it is positive at the four corners.
-    for (int k = 0; k < 4; ++k) {
-      const Point& x = m.nodes[static_cast<size_t>(q[static_cast<size_t>(k)])];
-      const Point& next = m.nodes[static_cast<size_t>(q[static_cast<size_t>((k + 1) % 4)])];
-      const Point& prev = m.nodes[static_cast<size_t>(q[static_cast<size_t>((k + 3) % 4)])];
-      if (cross(next - x, prev - x) <= 1e-12 * scale) {
-        os << "cell " << c << " is degenerate or not convex at its local node " << k << " (node " << q[static_cast<size_t>(k)]
-           << ")";
+    // A triangle of positive area is valid. The bilinear map's Jacobian is positive everywhere iff it is positive
+    // at the four corners; at a triangle's corners that is its area, already checked.
+    for (int k = 0; k < n; ++k) {
+      if (cross(at(k + 1) - at(k), at(k + n - 1) - at(k)) <= 1e-12 * scale) {
+        os << "cell " << c << " is degenerate or not convex at its local node " << k << " (node "
+           << q[static_cast<size_t>(k)] << ")";
         problems.push_back(os.str());
         break;
       }
     }
   }
   return problems;
+}
+
+std::vector<int> pieces(const Mesh& m) {
+  std::vector<int> parent(m.cells.size());
+  for (size_t c = 0; c < parent.size(); ++c) parent[c] = static_cast<int>(c);
+  auto root = [&](int c) {
+    while (parent[static_cast<size_t>(c)] != c)
+      c = parent[static_cast<size_t>(c)] = parent[static_cast<size_t>(parent[static_cast<size_t>(c)])];
+    return c;
+  };
+  std::map<std::pair<int, int>, int> side_owner;
+  for (int c = 0; c < m.num_cells(); ++c)
+    for (int s = 0; s < m.cells[static_cast<size_t>(c)].size(); ++s) {
+      const auto n = m.edge_nodes({c, s});
+      auto [it, inserted] = side_owner.emplace(std::make_pair(std::min(n[0], n[1]), std::max(n[0], n[1])), c);
+      if (!inserted) parent[static_cast<size_t>(root(c))] = root(it->second);
+    }
+  std::vector<int> piece(m.cells.size(), -1);
+  std::map<int, int> number;  // root -> piece
+  for (int c = 0; c < m.num_cells(); ++c)
+    piece[static_cast<size_t>(c)] = number.emplace(root(c), static_cast<int>(number.size())).first->second;
+  return piece;
 }
 
 }  // namespace contact::mesh

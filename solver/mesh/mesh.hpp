@@ -1,4 +1,5 @@
-// Quadrilateral meshes of one body: plain arrays plus named boundary edge sets.
+// Meshes of one body: quadrilaterals and triangles (mixed meshes allowed), plain arrays plus named boundary edge
+// sets.
 //
 // Layering: this module knows nothing of finite elements or contact. A Mesh is a value type; copies are
 // independent. Node coordinates are in the user's length unit.
@@ -6,6 +7,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <array>
 #include <map>
 #include <optional>
@@ -16,8 +18,39 @@ namespace contact::mesh {
 
 using Point = Eigen::Vector2d;
 
-// One side of a cell: side s joins the cell's local nodes s and (s + 1) % 4, so with counter-clockwise cells
-// the body lies to the left of the side's direction and its outward normal points to the right.
+// One cell: a triangle (3 nodes) or a quadrilateral (4 nodes), counter-clockwise. Iterating a cell visits its
+// nodes only (3 or 4); cell[k] is local node k.
+class Cell {
+ public:
+  using value_type = int;
+  using iterator = int*;
+  using const_iterator = const int*;
+
+  Cell() = default;
+  Cell(int a, int b, int c) : nodes_{a, b, c, -1}, size_(3) {}
+  Cell(int a, int b, int c, int d) : nodes_{a, b, c, d}, size_(4) {}
+
+  int size() const { return size_; }  // the number of nodes, which is also the number of sides
+  bool is_triangle() const { return size_ == 3; }
+  int& operator[](size_t k) { return nodes_[k]; }
+  int operator[](size_t k) const { return nodes_[k]; }
+  int* begin() { return nodes_.data(); }
+  int* end() { return nodes_.data() + size_; }
+  const int* begin() const { return nodes_.data(); }
+  const int* end() const { return nodes_.data() + size_; }
+  bool operator==(const Cell& o) const {
+    return size_ == o.size_ && std::equal(begin(), end(), o.begin());
+  }
+  bool operator!=(const Cell& o) const { return !(*this == o); }
+
+ private:
+  std::array<int, 4> nodes_{{-1, -1, -1, -1}};
+  int size_ = 0;
+};
+
+// One side of a cell: side s joins the cell's local nodes s and (s + 1) % n (n = 3 or 4), so with
+// counter-clockwise cells the body lies to the left of the side's direction and its outward normal points to the
+// right.
 struct EdgeRef {
   int cell = -1;
   int side = -1;
@@ -42,22 +75,27 @@ struct Curve {
 
 struct Mesh {
   std::vector<Point> nodes;
-  std::vector<std::array<int, 4>> cells;  // node indices, counter-clockwise
+  std::vector<Cell> cells;                 // node indices, counter-clockwise
   std::vector<int> level;                  // refinement level per cell (0 = initial mesh)
   // Boundary edge sets by name, each ordered along the edge (consecutive entries share a node).
   std::map<std::string, std::vector<EdgeRef>> edge_sets;
   // True geometry of named edges that are curved (block edges); absent means straight.
   std::map<std::string, Curve> edge_curves;
+  // True geometry of single boundary sides, by (smaller node, larger node): the arcs of a Gmsh mesh's curves.
+  // Refinement puts a split side's midpoint on its curve and passes the curve on to the two halves.
+  std::map<std::pair<int, int>, Curve> side_curves;
   // Edges split by refinement: (smaller node, larger node) -> midpoint node. A cell side (a, b) whose edge is
   // split carries a hanging node (the neighbour across it is refined); see hanging_nodes().
   std::map<std::pair<int, int>, int> edge_midpoint;
 
   int num_nodes() const { return static_cast<int>(nodes.size()); }
   int num_cells() const { return static_cast<int>(cells.size()); }
+  // True when some cell is a triangle (false for an all-quadrilateral mesh).
+  bool has_triangles() const;
   // The two node indices of a side, in the cell's counter-clockwise direction.
   std::array<int, 2> edge_nodes(EdgeRef e) const {
     const auto& c = cells[static_cast<size_t>(e.cell)];
-    return {c[static_cast<size_t>(e.side)], c[static_cast<size_t>((e.side + 1) % 4)]};
+    return {c[static_cast<size_t>(e.side)], c[static_cast<size_t>((e.side + 1) % c.size())]};
   }
   // Nodes of an edge set in order along the set (n_edges + 1 nodes for an open chain). Empty if unknown.
   std::vector<int> edge_set_nodes(const std::string& name) const;
@@ -90,16 +128,21 @@ Mesh make_block(const BlockSpec& spec);
 std::optional<std::string> fit_curve(Curve& curve, const Point& p, const Point& q);
 
 // Adds a named edge set from node pairs (either orientation) of an explicit mesh: each pair must be a
-// boundary side of exactly one cell. The set is ordered into a chain when it is one. Returns an error message
-// naming the offending pair (by its index in `pairs`) if a pair is not a boundary side.
+// boundary side of exactly one cell, and the pairs must form one open chain along the boundary (a set of several
+// pieces, or a closed loop, has no one order: it is an error). The set is stored in chain order, counter-clockwise
+// along the boundary (the body on the left). Returns an error message naming the offending pair (by its index in
+// `pairs`), or saying why the set is not one chain.
 std::optional<std::string> add_edge_set(Mesh& m, const std::string& name,
                                         const std::vector<std::array<int, 2>>& pairs);
 
 // ---------------------------------------------------------------------------------------------------------
-// Refinement (quadtree): a marked cell splits into four; the mesh is kept 1-irregular (at most one hanging node
-// per side) by also refining coarser neighbours where needed. New nodes on a curved named edge lie on its curve.
+// Refinement (quadtree): a marked cell splits into four (a quadrilateral by its side midpoints and its centre, a
+// triangle by its side midpoints); the mesh is kept 1-irregular (at most one hanging node per side) by also
+// refining coarser neighbours where needed, across quadrilaterals and triangles alike. New nodes on a curved named
+// edge lie on its curve.
 
-// Rule for a node created by refinement: its value of any bilinear field is sum weight * value(parent node).
+// Rule for a node created by refinement: its value of the finite-element field (bilinear on a quadrilateral,
+// linear on a triangle) is sum weight * value(parent node).
 struct NewNode {
   int node = -1;
   std::vector<std::pair<int, double>> parents;
@@ -119,7 +162,7 @@ RefinementResult refine(Mesh& m, const std::vector<int>& marked, int max_level =
 RefinementResult refine_uniform(Mesh& m);
 
 // Hanging nodes of the current mesh: node -> the two end nodes of the cell side it hangs on (its value is the
-// mean of theirs for Q1).
+// mean of theirs: Q1 and P1 are linear along a side).
 std::map<int, std::pair<int, int>> hanging_nodes(const Mesh& m);
 
 // Values of a nodal field (rows = nodes) extended to the nodes created by a refinement.
@@ -127,5 +170,9 @@ Eigen::MatrixXd transfer(const Eigen::MatrixXd& old_values, const RefinementResu
 
 // Mesh sanity checks used by validation. Each problem is a message naming the cell or edge.
 std::vector<std::string> check_cells(const Mesh& m);
+
+// The pieces of a mesh (cells joined through shared sides are in one piece): each cell's piece, numbered from 0
+// in the order of their first cells, so a mesh in one piece has all zeros.
+std::vector<int> pieces(const Mesh& m);
 
 }  // namespace contact::mesh

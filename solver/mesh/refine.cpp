@@ -25,7 +25,7 @@ std::map<std::pair<int, int>, std::string> boundary_side_names(const Mesh& m) {
 std::map<std::pair<int, int>, std::vector<int>> sides_of(const Mesh& m) {
   std::map<std::pair<int, int>, std::vector<int>> out;
   for (int c = 0; c < m.num_cells(); ++c)
-    for (int s = 0; s < 4; ++s) {
+    for (int s = 0; s < m.cells[static_cast<size_t>(c)].size(); ++s) {
       const auto n = m.edge_nodes({c, s});
       out[key(n[0], n[1])].push_back(c);
     }
@@ -37,7 +37,7 @@ std::map<std::pair<int, int>, std::vector<int>> sides_of(const Mesh& m) {
 std::map<int, std::pair<int, int>> hanging_nodes(const Mesh& m) {
   std::map<int, std::pair<int, int>> out;
   for (int c = 0; c < m.num_cells(); ++c)
-    for (int s = 0; s < 4; ++s) {
+    for (int s = 0; s < m.cells[static_cast<size_t>(c)].size(); ++s) {
       const auto n = m.edge_nodes({c, s});
       auto it = m.edge_midpoint.find(key(n[0], n[1]));
       // The side is active on this (coarser) cell but split on the other side: its midpoint hangs.
@@ -63,7 +63,7 @@ RefinementResult refine(Mesh& m, const std::vector<int>& marked_in, int max_leve
   while (!queue.empty()) {
     const int c = queue.back();
     queue.pop_back();
-    for (int s = 0; s < 4; ++s) {
+    for (int s = 0; s < m.cells[static_cast<size_t>(c)].size(); ++s) {
       const auto n = m.edge_nodes({c, s});
       for (int end = 0; end < 2; ++end) {
         auto pe = parent_edge.find(n[static_cast<size_t>(end)]);
@@ -101,38 +101,52 @@ RefinementResult refine(Mesh& m, const std::vector<int>& marked_in, int max_leve
       auto curve = m.edge_curves.find(named->second);
       if (curve != m.edge_curves.end()) x = curve->second.between(pa, pb, 0.5);  // on the true curve
     }
+    auto side = m.side_curves.find(key(a, b));
+    if (side != m.side_curves.end()) x = side->second.between(pa, pb, 0.5);
     const int id = add_node(x, {{a, 0.5}, {b, 0.5}});
     m.edge_midpoint[key(a, b)] = id;
+    if (side != m.side_curves.end()) {  // the halves lie on the same curve
+      const Curve curve = side->second;
+      m.side_curves.erase(side);
+      m.side_curves[key(a, id)] = curve;
+      m.side_curves[key(id, b)] = curve;
+    }
     return id;
   };
 
-  // Edge-set entries of refined cells, replaced by their two halves afterwards.
+  // Child k of a refined cell holds its corner k at local node k (the fourth child of a triangle is the middle
+  // one), so side s of the parent is side s of children s and (s + 1) % n. The first child keeps the parent's
+  // index; the others are appended.
   const int n_before = m.num_cells();
   std::vector<std::array<int, 4>> children(static_cast<size_t>(n_before), {-1, -1, -1, -1});
   for (int c = 0; c < n_before; ++c) {
     if (!marked[static_cast<size_t>(c)]) continue;
-    const auto q = m.cells[static_cast<size_t>(c)];
-    const int m01 = midpoint(q[0], q[1]), m12 = midpoint(q[1], q[2]), m23 = midpoint(q[2], q[3]), m30 = midpoint(q[3], q[0]);
-    // Centre: the bilinear centre corrected for curved sides (equal to the corner mean for straight ones).
-    const Point centre = 0.5 * (m.nodes[static_cast<size_t>(m01)] + m.nodes[static_cast<size_t>(m12)] +
-                                m.nodes[static_cast<size_t>(m23)] + m.nodes[static_cast<size_t>(m30)]) -
-                         0.25 * (m.nodes[static_cast<size_t>(q[0])] + m.nodes[static_cast<size_t>(q[1])] +
-                                 m.nodes[static_cast<size_t>(q[2])] + m.nodes[static_cast<size_t>(q[3])]);
-    const int ctr = add_node(centre, {{q[0], 0.25}, {q[1], 0.25}, {q[2], 0.25}, {q[3], 0.25}});
+    const Cell q = m.cells[static_cast<size_t>(c)];
     const int level = m.level[static_cast<size_t>(c)] + 1;
-    m.cells[static_cast<size_t>(c)] = {q[0], m01, ctr, m30};
+    std::vector<Cell> split;
+    if (q.is_triangle()) {
+      const int m01 = midpoint(q[0], q[1]), m12 = midpoint(q[1], q[2]), m20 = midpoint(q[2], q[0]);
+      split = {{q[0], m01, m20}, {m01, q[1], m12}, {m20, m12, q[2]}, {m01, m12, m20}};
+    } else {
+      const int m01 = midpoint(q[0], q[1]), m12 = midpoint(q[1], q[2]), m23 = midpoint(q[2], q[3]), m30 = midpoint(q[3], q[0]);
+      // Centre: the bilinear centre corrected for curved sides (equal to the corner mean for straight ones).
+      const Point centre = 0.5 * (m.nodes[static_cast<size_t>(m01)] + m.nodes[static_cast<size_t>(m12)] +
+                                  m.nodes[static_cast<size_t>(m23)] + m.nodes[static_cast<size_t>(m30)]) -
+                           0.25 * (m.nodes[static_cast<size_t>(q[0])] + m.nodes[static_cast<size_t>(q[1])] +
+                                   m.nodes[static_cast<size_t>(q[2])] + m.nodes[static_cast<size_t>(q[3])]);
+      const int ctr = add_node(centre, {{q[0], 0.25}, {q[1], 0.25}, {q[2], 0.25}, {q[3], 0.25}});
+      split = {{q[0], m01, ctr, m30}, {m01, q[1], m12, ctr}, {ctr, m12, q[2], m23}, {m30, ctr, m23, q[3]}};
+    }
+    m.cells[static_cast<size_t>(c)] = split[0];
     m.level[static_cast<size_t>(c)] = level;
     children[static_cast<size_t>(c)][0] = c;
-    const std::array<std::array<int, 4>, 3> others = {{{m01, q[1], m12, ctr}, {ctr, m12, q[2], m23}, {m30, ctr, m23, q[3]}}};
-    for (int k = 0; k < 3; ++k) {
-      children[static_cast<size_t>(c)][static_cast<size_t>(k) + 1] = m.num_cells();
-      m.cells.push_back(others[static_cast<size_t>(k)]);
+    for (size_t k = 1; k < 4; ++k) {
+      children[static_cast<size_t>(c)][k] = m.num_cells();
+      m.cells.push_back(split[k]);
       m.level.push_back(level);
     }
     ++result.refined_cells;
   }
-  // Side s of a refined cell = side s of two children: (0: child 0, 1), (1: 1, 2), (2: 2, 3), (3: 3, 0).
-  static const int first_child[4] = {0, 1, 2, 3}, second_child[4] = {1, 2, 3, 0};
   for (auto& [name, refs] : m.edge_sets) {
     std::vector<EdgeRef> out;
     out.reserve(refs.size() * 2);
@@ -142,8 +156,9 @@ RefinementResult refine(Mesh& m, const std::vector<int>& marked_in, int max_leve
         continue;
       }
       const auto& ch = children[static_cast<size_t>(e.cell)];
-      out.push_back({ch[static_cast<size_t>(first_child[e.side])], e.side});
-      out.push_back({ch[static_cast<size_t>(second_child[e.side])], e.side});
+      const int n_sides = m.cells[static_cast<size_t>(e.cell)].size();
+      out.push_back({ch[static_cast<size_t>(e.side)], e.side});
+      out.push_back({ch[static_cast<size_t>((e.side + 1) % n_sides)], e.side});
     }
     refs = std::move(out);
   }
@@ -151,7 +166,7 @@ RefinementResult refine(Mesh& m, const std::vector<int>& marked_in, int max_leve
   // are still active on some cell (it is also how the next refinement finds coarser neighbours).
   std::set<std::pair<int, int>> active;
   for (int c = 0; c < m.num_cells(); ++c)
-    for (int s = 0; s < 4; ++s) {
+    for (int s = 0; s < m.cells[static_cast<size_t>(c)].size(); ++s) {
       const auto n = m.edge_nodes({c, s});
       active.insert(key(n[0], n[1]));
     }
