@@ -1,6 +1,7 @@
 // Result file I/O: what write_result writes, read_result reads back bit for bit; the VTKHDF partition sizes
 // agree; failures name the path and leave no file; the XDMF sidecar names every step and body.
 #include "io/result_file.hpp"
+#include "triangle_meshes.hpp"
 
 #include <gtest/gtest.h>
 
@@ -8,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <numeric>
 #include <regex>
 #include <sstream>
 #include <thread>
@@ -479,9 +481,9 @@ TEST(ResultFile, VtkHdfPartitionsOneBodyEachThenOnePairEachAndSizesAgree) {
   ASSERT_EQ(u.cols(), 3);
   EXPECT_EQ(u.col(2).cwiseAbs().maxCoeff(), 0.0);
   EXPECT_EQ(u(0, 0), last.bodies[0].displacement(0, 0));
-  EXPECT_EQ(v.point_data.at("stress").cols(), 4);
+  EXPECT_EQ(v.point_data.at("stress").cols(), 6);  // VTK's symmetric tensor: ParaView names its components
   EXPECT_EQ(v.cell_data.at("stress").rows(), cells);
-  EXPECT_EQ(v.cell_data.at("stress").cols(), 4);
+  EXPECT_EQ(v.cell_data.at("stress").cols(), 6);
   EXPECT_EQ(v.cell_data.at("von_mises").rows(), cells);
   const Eigen::MatrixXd& level = v.cell_data.at("level");
   EXPECT_EQ(level(body_cells - 1, 0), 1.0);  // the refined lower body is the last body
@@ -634,4 +636,71 @@ TEST(Xdmf, SidecarIsWellFormedAndNamesEveryStepBodyAndContactSurface) {
   EXPECT_EQ(count(text, "<Grid Name=\"lower\""), f.result.steps.size());
   EXPECT_EQ(count(text, "/indicator</DataItem>"), f.result.steps.size());  // lower body only
   EXPECT_EQ(io::xdmf_path_for("a/b.h5"), "a/b.h5.xmf");
+}
+
+TEST(ResultFile, TriangleAndMixedMeshesRoundTripAndTheViewsTypeEveryCell) {
+  // The fixture with the upper body all triangles and the refined lower body mixed: `cells` and `cell_types`
+  // for every body, `quads` only for an all-quadrilateral mesh, VTK_TRIANGLE (5) and VTK_QUAD (9) in /VTKHDF,
+  // XDMF's Mixed topology in the sidecar, and the meshes read back cell for cell.
+  Fixture f = make_fixture();
+  for (auto& s : f.result.steps) {
+    s.bodies[0] = body_field("upper", contact::testing::split_into_triangles(s.bodies[0].mesh), false);
+    s.bodies[1] = body_field("lower", contact::testing::split_into_triangles(s.bodies[1].mesh, [](int c) { return c % 3 == 0; }),
+                             true);
+    s.pairs[0] = pair_field(s.bodies[0], 0.04);
+  }
+  f.result.history = {report(1, f.result.steps[0]), report(2, f.result.steps[1])};
+  const fs::path path = output_dir() / "triangles.hdf";
+  io::write_result(path.string(), f.problem, f.result);
+  const io::ResultFile r = io::read_result(path.string());
+  ASSERT_EQ(r.steps.size(), 2u);
+  for (size_t k = 0; k < 2; ++k)
+    for (size_t b = 0; b < 2; ++b)
+      expect_same_mesh(r.steps[k].bodies[b].mesh, f.result.steps[k].bodies[b].mesh, "step " + std::to_string(k));
+  const Step& last = f.result.steps.back();
+  const io::VtkHdf& v = r.vtkhdf;
+  size_t cell = 0, id = 0;
+  for (size_t b = 0; b < 2; ++b) {
+    const mesh::Mesh& m = last.bodies[b].mesh;
+    std::int64_t ids = 0;
+    for (const auto& c : m.cells) {
+      EXPECT_EQ(v.types[cell], c.is_triangle() ? 5 : 9) << "body " << b;
+      for (int node : c) EXPECT_EQ(v.connectivity[id++], node);
+      ids += c.size();
+      ++cell;
+    }
+    EXPECT_EQ(v.number_of_connectivity_ids[b], ids);
+  }
+  EXPECT_EQ(std::count(v.types.begin(), v.types.end(), 5),
+            std::count_if(last.bodies[0].mesh.cells.begin(), last.bodies[0].mesh.cells.end(), [](const mesh::Cell& c) { return c.is_triangle(); }) +
+                std::count_if(last.bodies[1].mesh.cells.begin(), last.bodies[1].mesh.cells.end(), [](const mesh::Cell& c) { return c.is_triangle(); }));
+  // Stresses in the views: VTK's symmetric tensor (xx, yy, zz, xy, yz, xz) of (sxx, syy, sxy, szz).
+  const Eigen::MatrixXd& s = v.cell_data.at("stress");
+  const Eigen::MatrixX4d& upper = last.bodies[0].stress_cell;
+  for (Eigen::Index e = 0; e < upper.rows(); ++e) {
+    EXPECT_EQ(s(e, 0), upper(e, 0));
+    EXPECT_EQ(s(e, 1), upper(e, 1));
+    EXPECT_EQ(s(e, 2), upper(e, 3));
+    EXPECT_EQ(s(e, 3), upper(e, 2));
+    EXPECT_EQ(s(e, 4), 0.0);
+    EXPECT_EQ(s(e, 5), 0.0);
+  }
+  // The sidecar: Mixed topologies of 1 + nodes numbers per cell, on xdmf_topology; the stresses as tensors.
+  const std::string xmf = io::xdmf_path_for(path.string());
+  io::write_xdmf(xmf, path.filename().string(), f.result);
+  const std::string text = read_text(xmf);
+  std::string problem;
+  EXPECT_TRUE(xml_tags_balance(text, problem)) << problem;
+  EXPECT_EQ(count(text, "TopologyType=\"Mixed\""), 4u);
+  EXPECT_EQ(count(text, "TopologyType=\"Quadrilateral\""), 0u);
+  for (size_t b = 0; b < 2; ++b) {
+    const mesh::Mesh& m = last.bodies[b].mesh;
+    const size_t length = m.cells.size() + static_cast<size_t>(std::accumulate(
+                                                m.cells.begin(), m.cells.end(), 0, [](int n, const mesh::Cell& c) { return n + c.size(); }));
+    EXPECT_NE(text.find("<DataItem Dimensions=\"" + std::to_string(length) + "\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">"
+                        "triangles.hdf:/steps/1/bodies/" + last.bodies[b].name + "/xdmf_topology</DataItem>"),
+              std::string::npos)
+        << last.bodies[b].name;
+    EXPECT_NE(text.find("/steps/1/bodies/" + last.bodies[b].name + "/stress_node_tensor</DataItem>"), std::string::npos);
+  }
 }

@@ -170,9 +170,12 @@ int main(int argc, char** argv) {
   }
   try {
     contact::io::write_result(output, problem, result);
-    const std::filesystem::path xmf = std::filesystem::path(output).replace_extension(".xmf");
+    std::filesystem::path xmf = std::filesystem::path(output).replace_extension(".xmf");
     contact::io::write_xdmf(xmf.string(), std::filesystem::path(output).filename().string(), result);
-    std::printf("wrote %s and %s\n", output.c_str(), xmf.string().c_str());
+    // ParaView's Xdmf3 readers abort on a bare file name (they join it with the data file's name): "./x.xmf".
+    if (!xmf.has_parent_path()) xmf = std::filesystem::path(".") / xmf;
+    std::printf("wrote %s and %s (in ParaView, open %s with the Xdmf3 Reader)\n", output.c_str(), xmf.string().c_str(),
+                xmf.string().c_str());
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
     return 1;

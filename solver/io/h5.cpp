@@ -186,6 +186,11 @@ bool has_link(hid_t loc, const std::string& name) {
   return r > 0;
 }
 
+void hard_link(hid_t loc, const std::string& existing, const std::string& name) {
+  if (H5Lcreate_hard(loc, existing.c_str(), loc, name.c_str(), H5P_DEFAULT, H5P_DEFAULT) < 0)
+    fail("link '" + join_path(loc, name) + "' to '" + existing + "'");
+}
+
 bool has_attribute(hid_t obj, const std::string& name) {
   const htri_t r = H5Aexists(obj, name.c_str());
   if (r < 0) fail("look up attribute '" + name + "' of '" + object_name(obj) + "'");

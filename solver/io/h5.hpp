@@ -113,6 +113,8 @@ Handle open_file(const std::string& path);    // read-only
 Handle create_group(hid_t loc, const std::string& name);
 Handle open_group(hid_t loc, const std::string& name);
 bool has_link(hid_t loc, const std::string& name);  // one path component
+// A second name for an existing object in the same group (an HDF5 hard link: one object, two names).
+void hard_link(hid_t loc, const std::string& existing, const std::string& name);
 bool has_attribute(hid_t obj, const std::string& name);
 std::string object_name(hid_t obj);  // full path inside the file, for messages
 std::vector<std::string> link_names(hid_t group);  // members of a group, in name order

@@ -132,10 +132,15 @@ BodyField read_body(hid_t bodies, const std::string& name) {
   BodyField b;
   b.name = name;
   const Eigen::MatrixXd points = read_matrix<double>(g, "points", 2);
-  const Eigen::MatrixXi quads = read_matrix<int>(g, "quads", 4);
+  // `cells` (a triangle's last column -1); files written before triangles existed have only `quads`.
+  const Eigen::MatrixXi cells = read_matrix<int>(g, h5::has_link(g, "cells") ? "cells" : "quads", 4);
   for (Eigen::Index i = 0; i < points.rows(); ++i) b.mesh.nodes.emplace_back(points(i, 0), points(i, 1));
-  for (Eigen::Index e = 0; e < quads.rows(); ++e)
-    b.mesh.cells.push_back({quads(e, 0), quads(e, 1), quads(e, 2), quads(e, 3)});
+  for (Eigen::Index e = 0; e < cells.rows(); ++e) {
+    if (cells(e, 3) < 0)
+      b.mesh.cells.emplace_back(cells(e, 0), cells(e, 1), cells(e, 2));
+    else
+      b.mesh.cells.emplace_back(cells(e, 0), cells(e, 1), cells(e, 2), cells(e, 3));
+  }
   b.mesh.level = h5::read_vector<int>(g, "level");
   b.displacement = read_matrix<double>(g, "displacement", 2);
   b.stress_cell = read_matrix<double>(g, "stress_cell", 4);

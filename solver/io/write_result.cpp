@@ -2,6 +2,7 @@
 #include "result_file.hpp"
 
 #include "../solve.hpp"
+#include "view_layout.hpp"
 #include "file_util.hpp"
 #include "h5.hpp"
 #include "h5_eigen.hpp"
@@ -246,18 +247,34 @@ void write_body(hid_t bodies, const BodyField& b, const std::string& where) {
   Handle g = h5::create_group(bodies, b.name);
   Eigen::MatrixX2d points(n, 2);
   for (Eigen::Index i = 0; i < n; ++i) points.row(i) = m.nodes[static_cast<size_t>(i)].transpose();
-  Eigen::Matrix<std::int64_t, Eigen::Dynamic, 4> quads(c, 4);
+  // cells: 4 node indices per row, -1 in the last column of a triangle; cell_types: VTK's type per cell. An
+  // all-quadrilateral mesh also has them as `quads` (a second name of the same dataset, as in format version 2
+  // before triangles); a mesh with triangles has `xdmf_topology` for the sidecar's Mixed topology instead.
+  Eigen::Matrix<std::int64_t, Eigen::Dynamic, 4> cells(c, 4);
+  std::vector<std::uint8_t> types(static_cast<size_t>(c));
+  std::vector<std::int64_t> mixed;
   std::vector<std::int32_t> level(static_cast<size_t>(c), 0);
   for (Eigen::Index e = 0; e < c; ++e) {
-    for (int j = 0; j < 4; ++j) quads(e, j) = m.cells[static_cast<size_t>(e)][static_cast<size_t>(j)];
+    const mesh::Cell& cell = m.cells[static_cast<size_t>(e)];
+    for (int j = 0; j < 4; ++j) cells(e, j) = j < cell.size() ? cell[static_cast<size_t>(j)] : -1;
+    types[static_cast<size_t>(e)] = vtk_cell_type(cell);
+    mixed.push_back(xdmf_cell_type(cell));
+    mixed.insert(mixed.end(), cell.begin(), cell.end());
     if (!m.level.empty()) level[static_cast<size_t>(e)] = m.level[static_cast<size_t>(e)];
   }
   write_matrix(g, "points", points);
-  write_matrix(g, "quads", quads);
+  write_matrix(g, "cells", cells);
+  h5::write_vector(g, "cell_types", types);
+  if (m.has_triangles())
+    h5::write_vector(g, "xdmf_topology", mixed);
+  else
+    h5::hard_link(g, "cells", "quads");
   h5::write_vector(g, "level", level);
   write_matrix(g, "displacement", b.displacement);
   write_matrix(g, "stress_cell", b.stress_cell);
   write_matrix(g, "stress_node", b.stress_node);
+  write_matrix(g, "stress_cell_tensor", stress_tensor(b.stress_cell));  // the sidecar's (view_layout.hpp)
+  write_matrix(g, "stress_node_tensor", stress_tensor(b.stress_node));
   write_column(g, "von_mises", b.von_mises_cell);
   if (b.indicator_cell.size() > 0) write_column(g, "indicator", b.indicator_cell);
   write_matrix(g, "reaction", b.reaction);

@@ -1,6 +1,6 @@
 // write_vtkhdf: the final step as a VTKHDF 1.0 UnstructuredGrid (docs/results-format.md, "/VTKHDF").
 //
-// Partitions: every body (VTK_QUAD cells), then every contact pair (its slave polyline, VTK_LINE cells). The
+// Partitions: every body (VTK_QUAD and VTK_TRIANGLE cells), then every contact pair (its slave polyline, VTK_LINE cells). The
 // per-partition counts are NumberOf*, and Points, Connectivity, Offsets, Types and the data arrays are the
 // partitions' arrays one after the other, with Connectivity holding partition-local point ids and each
 // partition's Offsets starting at 0. VTKHDF 1.0 needs every array on every partition, so:
@@ -10,6 +10,7 @@
 //    cells), so that a Threshold on pair_id >= 0 shows the contact surfaces alone.
 #include "vtkhdf.hpp"
 
+#include "view_layout.hpp"
 #include "h5.hpp"
 #include "h5_eigen.hpp"
 
@@ -23,8 +24,6 @@ using h5::Handle;
 using h5::with_zero_z;
 using h5::write_column;
 using h5::write_matrix;
-
-constexpr std::uint8_t kVtkLine = 3, kVtkQuad = 9;
 
 }  // namespace
 
@@ -62,7 +61,7 @@ void write_vtkhdf(hid_t file, const Step& last) {
   }
 
   Eigen::MatrixX3d points(total_points, 3), displacement(total_points, 3), reaction(total_points, 3);
-  Eigen::MatrixX4d stress_node(total_points, 4), stress_cell(total_cells, 4);
+  StressTensor stress_node(total_points, 6), stress_cell(total_cells, 6);  // ParaView names these components
   Eigen::VectorXd von_mises(total_cells), indicator(total_cells);
   Eigen::VectorXd pressure = Eigen::VectorXd::Constant(total_points, nan), gap = pressure;
   Eigen::Matrix<std::int8_t, Eigen::Dynamic, 1> active = Eigen::Matrix<std::int8_t, Eigen::Dynamic, 1>::Constant(total_points, -1);
@@ -73,22 +72,25 @@ void write_vtkhdf(hid_t file, const Step& last) {
     const Eigen::Index n = m.num_nodes(), c = m.num_cells();
     n_points.push_back(n);
     n_cells.push_back(c);
-    n_ids.push_back(4 * c);
     for (Eigen::Index i = 0; i < n; ++i)
       points.row(p0 + i) << m.nodes[static_cast<size_t>(i)].x(), m.nodes[static_cast<size_t>(i)].y(), 0.0;
     offsets.push_back(0);
+    std::int64_t ids = 0;
     for (Eigen::Index e = 0; e < c; ++e) {
-      for (int node : m.cells[static_cast<size_t>(e)]) connectivity.push_back(node);
-      offsets.push_back(4 * (e + 1));
-      types.push_back(kVtkQuad);
+      const mesh::Cell& cell = m.cells[static_cast<size_t>(e)];
+      for (int node : cell) connectivity.push_back(node);
+      ids += cell.size();
+      offsets.push_back(ids);
+      types.push_back(vtk_cell_type(cell));
       body_id.push_back(static_cast<std::int32_t>(id));
       pair_id.push_back(-1);
       level.push_back(m.level.empty() ? 0 : m.level[static_cast<size_t>(e)]);
     }
+    n_ids.push_back(ids);
     if (all_displacement) displacement.middleRows(p0, n) = with_zero_z(b.displacement);
     if (all_reaction) reaction.middleRows(p0, n) = with_zero_z(b.reaction);
-    if (all_stress_node) stress_node.middleRows(p0, n) = b.stress_node;
-    if (all_stress_cell) stress_cell.middleRows(c0, c) = b.stress_cell;
+    if (all_stress_node) stress_node.middleRows(p0, n) = stress_tensor(b.stress_node);
+    if (all_stress_cell) stress_cell.middleRows(c0, c) = stress_tensor(b.stress_cell);
     if (all_von_mises) von_mises.segment(c0, c) = b.von_mises_cell;
     if (any_indicator) {
       if (b.indicator_cell.rows() > 0)
@@ -123,7 +125,10 @@ void write_vtkhdf(hid_t file, const Step& last) {
       const Eigen::RowVector3d none3 = Eigen::RowVector3d::Constant(nan);
       displacement.row(p0 + j) = known && all_displacement ? Eigen::RowVector3d(b->displacement(node, 0), b->displacement(node, 1), 0.0) : none3;
       reaction.row(p0 + j) = known && all_reaction ? Eigen::RowVector3d(b->reaction(node, 0), b->reaction(node, 1), 0.0) : none3;
-      stress_node.row(p0 + j) = known && all_stress_node ? Eigen::RowVector4d(b->stress_node.row(node)) : Eigen::RowVector4d::Constant(nan);
+      if (known && all_stress_node)
+        stress_node.row(p0 + j) = stress_tensor(b->stress_node.row(node)).row(0);
+      else
+        stress_node.row(p0 + j).setConstant(nan);
       pressure[p0 + j] = p.pressure[j];
       gap[p0 + j] = p.normal_gap[j];
       active[p0 + j] = static_cast<std::int8_t>(p.active[j]);

@@ -64,16 +64,25 @@ struct Writer {
     const std::string base = step_path + "/bodies/" + b.name;
     const std::string in = "        ";
     out << "      <Grid Name=\"" << xml_escape(b.name) << "\" GridType=\"Uniform\">\n";
-    out << in << "<Topology TopologyType=\"Quadrilateral\" NumberOfElements=\"" << c << "\">\n";
-    data_item(in + "  ", base + "/quads", c, 4, "Int", 8);
+    if (b.mesh.has_triangles()) {
+      // XDMF's Mixed topology: per cell its type code (4 triangle, 5 quadrilateral) and its nodes.
+      Eigen::Index length = 0;
+      for (const auto& cell : b.mesh.cells) length += 1 + cell.size();
+      out << in << "<Topology TopologyType=\"Mixed\" NumberOfElements=\"" << c << "\">\n";
+      data_item(in + "  ", base + "/xdmf_topology", length, 0, "Int", 8);
+    } else {
+      out << in << "<Topology TopologyType=\"Quadrilateral\" NumberOfElements=\"" << c << "\">\n";
+      data_item(in + "  ", base + "/quads", c, 4, "Int", 8);
+    }
     out << in << "</Topology>\n";
     out << in << "<Geometry GeometryType=\"XY\">\n";
     data_item(in + "  ", base + "/points", n, 2, "Float", 8);
     out << in << "</Geometry>\n";
     if (b.displacement.rows() == n) attribute(in, "displacement", "Node", base + "/displacement", n, 2);
-    if (b.stress_node.rows() == n) attribute(in, "stress_node", "Node", base + "/stress_node", n, 4);
+    // The stresses as 6-component symmetric tensors: ParaView names their components XX, YY, ZZ, XY, YZ, XZ.
+    if (b.stress_node.rows() == n) attribute(in, "stress_node", "Node", base + "/stress_node_tensor", n, 6);
     if (b.reaction.rows() == n) attribute(in, "reaction", "Node", base + "/reaction", n, 2);
-    if (b.stress_cell.rows() == c) attribute(in, "stress_cell", "Cell", base + "/stress_cell", c, 4);
+    if (b.stress_cell.rows() == c) attribute(in, "stress_cell", "Cell", base + "/stress_cell_tensor", c, 6);
     if (b.von_mises_cell.rows() == c) attribute(in, "von_mises", "Cell", base + "/von_mises", c, 0);
     attribute(in, "level", "Cell", base + "/level", c, 0, "Int", 4);
     if (b.indicator_cell.rows() == c) attribute(in, "indicator", "Cell", base + "/indicator", c, 0);

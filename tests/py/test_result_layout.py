@@ -160,22 +160,32 @@ def steps_bodies(c):
         for body in body_names:
             b = s["bodies"][body]
             where = f"step {k} body {body}"
-            n, m = b["points"].shape[0], b["quads"].shape[0]
+            n, m = b["points"].shape[0], b["cells"].shape[0]
             expect(n > 0 and m > 0, f"{where} is empty")
-            shapes = {"points": (n, 2), "quads": (m, 4), "displacement": (n, 2), "stress_cell": (m, 4),
-                      "stress_node": (n, 4), "von_mises": (m,), "level": (m,), "reaction": (n, 2)}
+            shapes = {"points": (n, 2), "cells": (m, 4), "cell_types": (m,), "displacement": (n, 2),
+                      "stress_cell": (m, 4), "stress_node": (n, 4), "stress_cell_tensor": (m, 6),
+                      "stress_node_tensor": (n, 6), "von_mises": (m,), "level": (m,), "reaction": (n, 2)}
             if "indicator" in b:
                 shapes["indicator"] = (m,)
             for name, shape in shapes.items():
                 expect(b[name].shape == shape, f"{where} {name} has shape {b[name].shape}, expected {shape}")
             expect(b["points"].dtype == np.float64, f"{where} points dtype {b['points'].dtype}")
-            expect(b["quads"].dtype == np.int64, f"{where} quads dtype {b['quads'].dtype}")
+            expect(b["cells"].dtype == np.int64, f"{where} cells dtype {b['cells'].dtype}")
+            expect(b["cell_types"].dtype == np.uint8, f"{where} cell_types dtype {b['cell_types'].dtype}")
             expect(np.issubdtype(b["level"].dtype, np.integer), f"{where} level dtype")
-            q = b["quads"][()]
-            expect(q.min() >= 0 and q.max() < n, f"{where} quads index outside 0..{n - 1}")
+            cells, types = b["cells"][()], b["cell_types"][()]
+            expect(np.all((types == 5) | (types == 9)), f"{where} cell_types other than 5 and 9")
+            expect(np.all((cells[:, 3] == -1) == (types == 5)), f"{where} triangles are not the rows ending in -1")
+            if np.all(types == 9):  # all quadrilaterals: `quads` is the same dataset
+                expect("quads" in b and np.array_equal(b["quads"][()], cells), f"{where} quads differs from cells")
+            else:
+                expect("quads" not in b and "xdmf_topology" in b, f"{where} with triangles: quads or xdmf_topology")
+            expect(cells[:, :3].min() >= 0 and cells.max() < n, f"{where} cells index outside 0..{n - 1}")
             expect(np.all(np.isfinite(b["displacement"][()])), f"{where} displacement not finite")
             expect(np.all(b["von_mises"][()] >= 0), f"{where} von Mises < 0")
-            # counter-clockwise cells (positive shoelace area), as mesh.hpp promises
+            # counter-clockwise cells (positive shoelace area), as mesh.hpp promises; a triangle's last node is
+            # its first again (zero-length side)
+            q = np.where(cells >= 0, cells, cells[:, :1])
             p = b["points"][()][q]
             area = 0.5 * np.sum(p[:, :, 0] * np.roll(p[:, :, 1], -1, axis=1)
                                 - np.roll(p[:, :, 0], -1, axis=1) * p[:, :, 1], axis=1)
@@ -260,7 +270,8 @@ def vtkhdf(c):
     expect(v["Offsets"].shape == (ncells.sum() + len(ncells),), "Offsets length (n_cells + 1 per partition)")
     expect(v["Types"].shape == (ncells.sum(),) and v["Types"].dtype == np.uint8, "Types shape/dtype")
     body_cells = int(ncells[:nbody].sum())
-    expect(np.all(v["Types"][:body_cells] == 9), "body cells are not all VTK_QUAD (9)")
+    expect(np.all((v["Types"][:body_cells] == 9) | (v["Types"][:body_cells] == 5)),
+           "body cells are not all VTK_QUAD (9) or VTK_TRIANGLE (5)")
     expect(np.all(v["Types"][body_cells:] == 3), "contact cells are not all VTK_LINE (3)")
     for name in ("pressure", "gap", "active"):
         expect(v["PointData"][name].shape == (npts.sum(),), f"PointData/{name} shape")
