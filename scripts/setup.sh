@@ -12,6 +12,7 @@ BUILD_PACKAGES=(
   libcpp-httplib-dev
   python3 python3-h5py python3-numpy python3-jsonschema python3-matplotlib
   iproute2  # ss: tests/server/test_connections.py reads the listen backlog
+  gmsh libgmsh-dev  # meshing api/examples/*.geo (scripts/make_gmsh_examples.sh); the MSH reader's cross-check
 )
 RUNTIME_PACKAGES=(
   libcholmod3 libopenblas0-pthread libhdf5-103-1 libcpp-httplib0.11 ca-certificates curl python3

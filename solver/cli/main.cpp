@@ -12,9 +12,7 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
-#include <sstream>
 
 namespace {
 
@@ -74,14 +72,6 @@ class ProgressPrinter final : public contact::Observer {
   bool quiet_;
 };
 
-std::string read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error("cannot open job file '" + path + "'");
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -104,16 +94,10 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   CLI11_PARSE(app, argc, argv);
 
-  std::string text;
-  try {
-    text = read_file(job_path);
-  } catch (const std::exception& e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return 2;
-  }
   contact::job::Limits limits;
   limits.max_dofs = max_dofs;
-  auto parsed = contact::job::parse_text(text, limits);
+  // Gmsh mesh files are read relative to the job file's directory.
+  auto parsed = contact::job::parse_file(job_path, limits);
   if (!parsed.ok()) {
     std::cerr << job_path << ": the job is invalid (" << parsed.errors.size() << " error"
               << (parsed.errors.size() == 1 ? "" : "s") << "):\n"

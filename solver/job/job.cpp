@@ -2,7 +2,8 @@
 //
 // Validation runs in phases so that every problem is reported at once and nothing expensive happens for a job
 // that is already known to be bad:
-//   1. read every field (types, ranges, unknown fields) without generating any mesh;
+//   1. read every field (types, ranges, unknown fields) without generating any mesh (a Gmsh mesh is read here,
+//      its size bounded by the limit on degrees of freedom, since its edge names come from the file);
 //   2. count the degrees of freedom from the mesh sizes alone and refuse the job if over the limit;
 //   3. generate the meshes and check their cells;
 //   4. check that each body is restrained against rigid motion (needs the mesh; only for bodies with no
@@ -12,12 +13,17 @@
 #include "job.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <set>
 #include <sstream>
 
+#include "gmsh_input.hpp"
 #include "read.hpp"
 #include "../fem/rigid_modes.hpp"
 
@@ -131,7 +137,7 @@ int depth_of(const json& document) {
 // Phase 1 records: what was read of a body before any mesh exists.
 
 struct MeshInput {
-  enum class Kind { unknown, block, arrays };
+  enum class Kind { unknown, block, arrays, gmsh };
   Kind kind = Kind::unknown;
   bool valid = false;        // every field read without error: the mesh can be built
   double dofs = -1.0;        // 2 * nodes, known from the sizes alone; < 0 if unknown
@@ -144,6 +150,8 @@ struct MeshInput {
   std::vector<Point> nodes;
   std::vector<mesh::Cell> quads;
   std::vector<std::pair<std::string, std::vector<std::array<int, 2>>>> edge_pairs;
+  // gmsh: the surface's mesh, built while reading (gmsh_input.hpp)
+  std::optional<GmshBody> gmsh;
 };
 
 struct BodyInput {
@@ -157,9 +165,17 @@ bool has_edge(const MeshInput& m, const std::string& name) {
   return std::find(m.edge_names.begin(), m.edge_names.end(), name) != m.edge_names.end();
 }
 
+// For a Gmsh body: why `edge`, a physical curve of the file, is not one of its edges; nullopt otherwise.
+std::optional<std::string> curve_elsewhere(const MeshInput& m, const std::string& edge) {
+  if (!m.gmsh || std::find(m.gmsh->elsewhere.begin(), m.gmsh->elsewhere.end(), edge) == m.gmsh->elsewhere.end())
+    return std::nullopt;
+  return "physical curve '" + edge + "' is not on the boundary of surface '" + m.gmsh->surface +
+         "'; the physical curves on its boundary are " + join_names(m.edge_names);
+}
+
 class JobReader {
  public:
-  JobReader(const json& job, const Limits& limits) : job_(job), limits_(limits), normalized_(job) {}
+  JobReader(const json& job, const Limits& limits) : job_(job), limits_(limits), normalized_(job), gmsh_(limits) {}
 
   ParseResult run() {
     Fields top(job_, "", "the job", {"name", "version", "model", "bodies", "contacts", "solver", "adaptivity"},
@@ -555,8 +571,8 @@ class JobReader {
       }
     if (const json* m = f.require("material", "an object {\"E\": Young's modulus, \"nu\": Poisson's ratio}"))
       read_material(*m, f.at("material"), in.body.material);
-    if (const json* m =
-            f.require("mesh", "either {\"block\": {...}} or {\"nodes\": ..., \"quads\": ..., \"edges\": ...}"))
+    if (const json* m = f.require("mesh", "one of {\"block\": {...}}, {\"nodes\": ..., \"quads\": ..., \"edges\": ...} "
+                                          "or {\"gmsh\": {...}}"))
       read_mesh(*m, f.at("mesh"), in.mesh, sub_object(out, "mesh"));
     if (const json* b = f.find("boundary")) read_boundary(*b, f.at("boundary"), in);
     set_default(out, "boundary", json::array());
@@ -591,9 +607,13 @@ class JobReader {
       return;
     }
     if (value.contains("gmsh")) {
-      errors_.add(
-          child(pointer, "gmsh"),
-          "gmsh meshes are not available in this version of the solver; use a block or explicit nodes and quads");
+      const size_t before = errors_.size();
+      Fields f(value, pointer, "mesh", {"gmsh"}, errors_);
+      if (errors_.size() != before) {
+        errors_.add(pointer, "give either a gmsh mesh, a block or explicit nodes and quads, not several");
+        return;
+      }
+      read_gmsh(value.at("gmsh"), child(pointer, "gmsh"), m);
       return;
     }
     const bool block = value.contains("block");
@@ -706,6 +726,22 @@ class JobReader {
         if (auto message = mesh::fit_curve(curve, p, q)) errors_.add(m.curve_pointers.at(name), *message);
       }
     }
+    m.valid = errors_.size() == before;
+  }
+
+  // {"gmsh": {...}}: the file (or data) is read and the surface's mesh built here, so that its edge names are
+  // known to the boundary conditions and contacts; its size counts in the limit like any other mesh's.
+  void read_gmsh(const json& value, const std::string& pointer, MeshInput& m) {
+    m.kind = MeshInput::Kind::gmsh;
+    const size_t before = errors_.size();
+    m.gmsh = gmsh_.read(value, pointer, errors_);
+    if (!m.gmsh) return;
+    for (const auto& name : m.gmsh->edges)
+      if (auto problem = name_problem(name, "physical curve name", limits_.max_name_length, false))
+        errors_.add(pointer, "surface '" + m.gmsh->surface + "': " + *problem + " to be used as an edge name");
+    m.edges_known = true;
+    m.edge_names = m.gmsh->edges;
+    m.dofs = 2.0 * m.gmsh->mesh.num_nodes();
     m.valid = errors_.size() == before;
   }
 
@@ -905,8 +941,9 @@ class JobReader {
         if (auto s = read::string(*e, f.at("edge"), "edge", errors_)) {
           bc.edge = *s;
           if (in.mesh.edges_known && !has_edge(in.mesh, *s)) {
-            errors_.add(f.at("edge"), "the body has no edge '" + read::shown(*s) + "'; its edges are " +
-                                          join_names(in.mesh.edge_names));
+            errors_.add(f.at("edge"), curve_elsewhere(in.mesh, *s).value_or(
+                                          "the body has no edge '" + read::shown(*s) + "'; its edges are " +
+                                          join_names(in.mesh.edge_names)));
           } else {
             auto [it, inserted] = first_pointer_of_edge.emplace(*s, bp);
             if (!inserted)
@@ -956,6 +993,8 @@ class JobReader {
     mesh::Mesh& mesh = in.body.mesh;
     if (m.kind == MeshInput::Kind::block) {
       mesh = mesh::make_block(m.block);
+    } else if (m.kind == MeshInput::Kind::gmsh) {
+      mesh = std::move(m.gmsh->mesh);  // checked while reading (cells and edges, with Gmsh's element tags)
     } else {
       mesh.nodes = std::move(m.nodes);
       mesh.cells = std::move(m.quads);
@@ -1044,8 +1083,8 @@ class JobReader {
       if (inputs_[b].has_name && inputs_[b].body.name == body) {
         const MeshInput& m = inputs_[b].mesh;
         if (m.edges_known && !has_edge(m, edge)) {
-          errors_.add(pointer, "body '" + body + "' has no edge '" + read::shown(edge) + "'; its edges are " +
-                                   join_names(m.edge_names));
+          errors_.add(pointer, curve_elsewhere(m, edge).value_or("body '" + body + "' has no edge '" + read::shown(edge) +
+                                                                 "'; its edges are " + join_names(m.edge_names)));
           return std::nullopt;
         }
         return EdgeRef{static_cast<int>(b), edge};
@@ -1169,6 +1208,7 @@ class JobReader {
   bool method_given_ = false, enforcement_given_ = false;
   std::string method_pointer_, enforcement_pointer_ = "/solver";
   std::vector<BodyInput> inputs_;
+  GmshMeshes gmsh_;
 };
 
 // Nesting depth of JSON text, found by scanning brackets outside strings, so that a hostile document is refused
@@ -1321,6 +1361,16 @@ ParseResult parse_text(const std::string& text, const Limits& limits) {
   } catch (...) {
     return failure("", "internal error while reading the job");
   }
+}
+
+ParseResult parse_file(const std::string& path, Limits limits) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  if (!in) return failure("", "cannot open the job file '" + path + "': " + std::strerror(errno));
+  text << in.rdbuf();  // an empty file leaves the text empty: malformed JSON, said by parse_text
+  const std::filesystem::path directory = std::filesystem::path(path).parent_path();
+  limits.mesh_directory = directory.empty() ? std::string(".") : directory.string();
+  return parse_text(text.str(), limits);
 }
 
 std::string format_errors(const std::vector<ValidationError>& errors) {

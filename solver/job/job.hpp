@@ -30,6 +30,10 @@ struct Limits {
   int max_adaptive_steps = 100;        // adaptivity.max_steps
   std::size_t max_name_length = 64;    // body, edge and contact names (identifiers)
   std::size_t max_job_name_length = 256;
+  // Gmsh meshes given as {"file": ...} are read relative to this directory (the job file's: parse_file sets it).
+  // Unset, a job may not name a file (the server: a job sends the .msh text as "data").
+  std::optional<std::string> mesh_directory;
+  std::size_t max_mesh_file_bytes = 256u << 20;  // a .msh file read from disk
 };
 
 struct ParseResult {
@@ -44,6 +48,10 @@ ParseResult parse(const nlohmann::json& job, const Limits& limits = {});
 
 // Same from text; malformed JSON gives one error with pointer "" naming the byte offset.
 ParseResult parse_text(const std::string& text, const Limits& limits = {});
+
+// Same from a job file: its Gmsh mesh files are read relative to its directory (limits.mesh_directory is set to
+// it). A job file that cannot be read gives one error with pointer "".
+ParseResult parse_file(const std::string& path, Limits limits = {});
 
 // One line per error: "<pointer>: <message>".
 std::string format_errors(const std::vector<ValidationError>& errors);

@@ -1,0 +1,434 @@
+// Gmsh meshes: the MSH 4.1 reader, a physical surface as a body (edges, orientation, arcs), every kind of bad file
+// with its message, and the job's gmsh meshes (file, data, the server's refusal of files, references to curves).
+#include "job/job.hpp"
+#include "mesh/gmsh.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+using namespace contact;
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kExamples = std::string(CONTACT_SOURCE_DIR) + "/api/examples/";
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
+}
+
+// A small MSH 4.1 file built in the test: nodes (tag = index + 1), element blocks, physical groups.
+struct Msh {
+  struct Block {
+    int dim, entity, type;
+    std::vector<std::vector<std::size_t>> elements;  // node tags; element tags are numbered in order
+  };
+  std::string header = "4.1 0 8";
+  std::vector<std::array<double, 3>> nodes;
+  std::vector<Block> blocks;
+  std::vector<std::tuple<int, int, std::string>> names;  // dim, physical tag, name
+  std::map<std::pair<int, int>, std::vector<int>> groups;  // (dim, entity) -> physical tags
+
+  std::string text() const {
+    std::ostringstream os;
+    os.precision(17);
+    os << "$MeshFormat\n" << header << "\n$EndMeshFormat\n$PhysicalNames\n" << names.size() << "\n";
+    for (const auto& [dim, tag, name] : names) os << dim << ' ' << tag << " \"" << name << "\"\n";
+    os << "$EndPhysicalNames\n$Entities\n";
+    std::map<int, std::vector<int>> entities;
+    for (const auto& b : blocks) entities[b.dim].push_back(b.entity);
+    for (int d = 0; d < 4; ++d) {
+      std::sort(entities[d].begin(), entities[d].end());
+      entities[d].erase(std::unique(entities[d].begin(), entities[d].end()), entities[d].end());
+    }
+    os << entities[0].size() << ' ' << entities[1].size() << ' ' << entities[2].size() << " 0\n";
+    for (int d = 0; d < 3; ++d)
+      for (int e : entities[d]) {
+        os << e << (d == 0 ? " 0 0 0 " : " 0 0 0 1 1 0 ");
+        auto it = groups.find({d, e});
+        const std::vector<int> g = it == groups.end() ? std::vector<int>{} : it->second;
+        os << g.size();
+        for (int t : g) os << ' ' << t;
+        os << (d == 0 ? "\n" : " 0\n");
+      }
+    os << "$EndEntities\n$Nodes\n1 " << nodes.size() << " 1 " << nodes.size() << "\n2 1 0 " << nodes.size() << "\n";
+    for (size_t k = 0; k < nodes.size(); ++k) os << k + 1 << "\n";
+    for (const auto& x : nodes) os << x[0] << ' ' << x[1] << ' ' << x[2] << "\n";
+    size_t count = 0;
+    for (const auto& b : blocks) count += b.elements.size();
+    os << "$EndNodes\n$Elements\n" << blocks.size() << ' ' << count << " 1 " << count << "\n";
+    size_t tag = 0;
+    for (const auto& b : blocks) {
+      os << b.dim << ' ' << b.entity << ' ' << b.type << ' ' << b.elements.size() << "\n";
+      for (const auto& e : b.elements) {
+        os << ++tag;
+        for (auto n : e) os << ' ' << n;
+        os << "\n";
+      }
+    }
+    os << "$EndElements\n";
+    return os.str();
+  }
+};
+
+// The unit square [0, 2] x [0, 1] as four triangles around its centre (node 5), counter-clockwise, with its
+// bottom (a physical curve of two lines), top and left as physical curves; elements 1..4 are the triangles.
+Msh square() {
+  Msh m;
+  m.nodes = {{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {0, 1, 0}, {1, 0.5, 0}, {1, 0, 0}};
+  m.blocks.push_back({2, 1, 2, {{1, 6, 5}, {6, 2, 5}, {2, 3, 5}, {3, 4, 5}, {4, 1, 5}}});
+  m.blocks.push_back({1, 1, 1, {{1, 6}, {6, 2}}});
+  m.blocks.push_back({1, 2, 1, {{3, 4}}});
+  m.blocks.push_back({1, 3, 1, {{4, 1}}});
+  m.names = {{2, 10, "sq"}, {1, 11, "bottom"}, {1, 12, "top"}, {1, 13, "left"}};
+  m.groups = {{{2, 1}, {10}}, {{1, 1}, {11}}, {{1, 2}, {12}}, {{1, 3}, {13}}};
+  return m;
+}
+
+mesh::gmsh::Surface surface_of(const Msh& m, const std::string& name) {
+  return mesh::gmsh::surface(mesh::gmsh::parse(m.text(), 1000), name);
+}
+
+// The only error of `s` contains `phrase`.
+void expect_error(const mesh::gmsh::Surface& s, const std::string& phrase) {
+  ASSERT_EQ(s.errors.size(), 1u) << (s.errors.empty() ? "no error" : s.errors[0]);
+  EXPECT_NE(s.errors[0].find(phrase), std::string::npos) << "missing '" << phrase << "' in: " << s.errors[0];
+}
+
+void expect_parse_error(const std::string& text, const std::string& phrase) {
+  try {
+    mesh::gmsh::parse(text, 1000);
+    ADD_FAILURE() << "no error; expected '" << phrase << "'";
+  } catch (const mesh::gmsh::ParseError& e) {
+    EXPECT_NE(std::string(e.what()).find(phrase), std::string::npos) << "missing '" << phrase << "' in: " << e.what();
+  }
+}
+
+double area(const mesh::Mesh& m) {
+  double a = 0;
+  for (int c = 0; c < m.num_cells(); ++c) a += m.cell_area(c);
+  return a;
+}
+
+}  // namespace
+
+TEST(GmshReader, ReadsAPhysicalSurfaceWithItsCurvesAsOrderedCounterClockwiseEdges) {
+  const auto s = surface_of(square(), "sq");
+  ASSERT_TRUE(s.errors.empty()) << s.errors[0];
+  EXPECT_EQ(s.mesh.num_nodes(), 6);
+  EXPECT_EQ(s.mesh.num_cells(), 5);
+  EXPECT_TRUE(mesh::check_cells(s.mesh).empty());
+  EXPECT_NEAR(area(s.mesh), 2.0, 1e-15);
+  EXPECT_EQ(s.edges, (std::vector<std::string>{"bottom", "top", "left"}));
+  // The bottom's two lines in order along the boundary, body on the left: x increasing.
+  const auto bottom = s.mesh.edge_set_nodes("bottom");
+  ASSERT_EQ(bottom.size(), 3u);
+  for (size_t k = 0; k + 1 < bottom.size(); ++k) EXPECT_LT(s.mesh.nodes[bottom[k]].x(), s.mesh.nodes[bottom[k + 1]].x());
+  const auto left = s.mesh.edge_set_nodes("left");  // the line is stored 4 -> 1 (downwards), as the boundary runs
+  ASSERT_EQ(left.size(), 2u);
+  EXPECT_GT(s.mesh.nodes[left[0]].y(), s.mesh.nodes[left[1]].y());
+}
+
+TEST(GmshReader, ReadsTheExamplesWithTheirCurvesOnEachSurface) {
+  const auto file = mesh::gmsh::parse(read_text(kExamples + "flat_patch_gmsh.msh"), 1'000'000);
+  for (const char* body : {"lower", "upper"}) {
+    const auto s = mesh::gmsh::surface(file, body);
+    ASSERT_TRUE(s.errors.empty()) << s.errors[0];
+    EXPECT_NEAR(area(s.mesh), 2.0, 1e-12) << body;
+    EXPECT_TRUE(mesh::check_cells(s.mesh).empty()) << body;
+    EXPECT_TRUE(s.mesh.side_curves.empty()) << body;  // straight sides only
+    // "left" is one curve on both bodies: each has its own piece of it, the other curves are elsewhere.
+    const std::string own = std::string(body) + "_top", other = std::string(body == std::string("lower") ? "upper" : "lower") + "_top";
+    EXPECT_TRUE(s.mesh.edge_sets.count("left") && s.mesh.edge_sets.count(own)) << body;
+    EXPECT_NE(std::find(s.elsewhere.begin(), s.elsewhere.end(), other), s.elsewhere.end()) << body;
+    for (int n : s.mesh.edge_set_nodes("left")) EXPECT_EQ(s.mesh.nodes[static_cast<size_t>(n)].x(), 0.0) << body;
+  }
+}
+
+TEST(GmshReader, ArcsAreRecognisedAndRefinementPutsNewNodesOnThem) {
+  const auto file = mesh::gmsh::parse(read_text(kExamples + "hertz_cylinder_gmsh.msh"), 1'000'000);
+  auto s = mesh::gmsh::surface(file, "upper");
+  ASSERT_TRUE(s.errors.empty()) << s.errors[0];
+  const auto arc = s.mesh.edge_set_nodes("upper_bottom");
+  ASSERT_GT(arc.size(), 20u);
+  EXPECT_EQ(s.mesh.side_curves.size(), arc.size() - 1);  // every side of the arc, nothing else
+  const mesh::Point centre(0, 10);
+  mesh::refine_uniform(s.mesh);
+  const auto refined = s.mesh.edge_set_nodes("upper_bottom");
+  EXPECT_EQ(refined.size(), 2 * (arc.size() - 1) + 1);
+  for (int n : refined) EXPECT_NEAR((s.mesh.nodes[static_cast<size_t>(n)] - centre).norm(), 10.0, 1e-12);
+  EXPECT_TRUE(mesh::check_cells(s.mesh).empty());
+}
+
+TEST(GmshReader, ASurfaceMeshedClockwiseIsReversed) {
+  Msh m = square();
+  for (auto& e : m.blocks[0].elements) std::reverse(e.begin(), e.end());
+  const auto s = surface_of(m, "sq");
+  ASSERT_TRUE(s.errors.empty()) << s.errors[0];
+  for (int c = 0; c < s.mesh.num_cells(); ++c) EXPECT_GT(s.mesh.cell_area(c), 0.0);
+  EXPECT_NEAR(area(s.mesh), 2.0, 1e-15);
+  EXPECT_EQ(s.mesh.edge_set_nodes("bottom").size(), 3u);
+}
+
+TEST(GmshReader, QuadrangleAndMixedSurfaces) {
+  Msh m = square();
+  // Replace the triangles by a quadrangle (1, 6, 5, 4) and two triangles.
+  m.blocks[0].elements = {{6, 2, 5}, {2, 3, 5}, {3, 4, 5}};
+  m.blocks.insert(m.blocks.begin(), Msh::Block{2, 1, 3, {{1, 6, 5, 4}}});
+  const auto s = surface_of(m, "sq");
+  ASSERT_TRUE(s.errors.empty()) << s.errors[0];
+  EXPECT_TRUE(s.mesh.has_triangles());
+  EXPECT_EQ(s.mesh.num_cells(), 4);
+  EXPECT_NEAR(area(s.mesh), 2.0, 1e-15);
+}
+
+TEST(GmshErrors, FilesThatAreNotMsh41AsciiAreRefusedSayingWhat) {
+  Msh m = square();
+  m.header = "2.2 0 8";
+  expect_parse_error(m.text(), "MSH format version 2.2 is not supported");
+  m.header = "4.0 0 8";
+  expect_parse_error(m.text(), "gmsh old.msh -save -format msh41");
+  m.header = "4.1 1 8";
+  expect_parse_error(m.text(), "binary MSH files are not supported");
+  expect_parse_error("", "the file is empty");
+  expect_parse_error("SetFactory(\"OpenCASCADE\");\nPoint(1) = {0, 0, 0};\n", "not a Gmsh MSH file");
+  const std::string text = square().text();
+  expect_parse_error(text.substr(0, text.find("$EndNodes") - 8), "the file ends where");
+  std::string bad = text;
+  bad.replace(bad.find("\n1 1 6 5\n"), 9, "\n1 1 6 99\n");
+  expect_parse_error(bad, "element 1 refers to node 99");
+  std::string bad_number = text;
+  bad_number.replace(bad_number.find("2 0 0\n"), 6, "2 zero 0\n");
+  expect_parse_error(bad_number, "line ");
+  expect_parse_error(bad_number, "a node's y must be a finite number, got 'zero'");
+  std::string crowded = text;  // the $Elements header: 4 blocks, 9 elements, tags 1..9
+  crowded.replace(crowded.find("$Elements\n4 9 1 9\n"), 18, "$Elements\n4 100000 1 9\n");
+  expect_parse_error(crowded, "the file has 100000 elements, more than the 4016 that a plane mesh within the limit");
+  std::string overfull = text;
+  overfull.replace(overfull.find("$Elements\n4 9 1 9\n"), 18, "$Elements\n4 8 1 9\n");
+  expect_parse_error(overfull, "the element blocks hold more elements than the section's header says");
+  try {
+    mesh::gmsh::parse(text, 5);
+    ADD_FAILURE() << "no error for too many nodes";
+  } catch (const mesh::gmsh::ParseError& e) {
+    EXPECT_NE(std::string(e.what()).find("6 nodes, more than the 5"), std::string::npos) << e.what();
+  }
+}
+
+TEST(GmshErrors, UnknownNamesListTheKnownSurfaces) {
+  expect_error(surface_of(square(), "punch"), "the file has no physical surface 'punch'; its physical surfaces are 'sq'");
+  expect_error(surface_of(square(), "top"), "'top' is a physical curve, not a physical surface");
+  EXPECT_FALSE(surface_of(square(), "punch").found);
+}
+
+TEST(GmshErrors, UnsupportedElementsAreNamedByTheirTagsAndType) {
+  Msh m = square();
+  m.blocks[0].type = 9;  // 6-node triangles (the mid-side nodes do not matter: the type is refused first)
+  for (auto& e : m.blocks[0].elements) e.insert(e.end(), {1, 2, 3});
+  expect_error(surface_of(m, "sq"), "elements 1, 2, 3, 4 and 5 of surface 'sq' are 6-node second-order triangles");
+  m = square();
+  m.blocks[0].elements[2] = {2, 3, 5, 6};  // a triangle block with a four-node element: the parser says where
+  expect_parse_error(m.text(), "element 3 has 4 nodes, but its block's type is the 3-node triangle (3 nodes)");
+  m = square();
+  m.blocks[1].elements[0] = {1};  // a line with one node
+  expect_parse_error(m.text(), "element 6 has 1 nodes, but its block's type is the 2-node line (2 nodes)");
+  m = square();
+  m.blocks[0].elements[1] = {6, 2, 6};
+  expect_error(surface_of(m, "sq"), "element 2 of surface 'sq' repeats a node");
+}
+
+TEST(GmshErrors, InvertedDegenerateAndNonConvexCellsAreNamed) {
+  Msh m = square();
+  std::reverse(m.blocks[0].elements[3].begin(), m.blocks[0].elements[3].end());  // one clockwise among four
+  expect_error(surface_of(m, "sq"), "element 4 of surface 'sq' is inverted: its nodes run clockwise while the other 4");
+  m = square();
+  m.nodes[4] = {1, 0, 0};  // the centre moved onto the bottom: triangles 1 and 2 become flat
+  m.nodes[5] = {1.5, 0, 0};
+  const auto s = surface_of(m, "sq");
+  ASSERT_FALSE(s.errors.empty());
+  EXPECT_NE(s.errors[0].find("degenerate (zero area)"), std::string::npos) << s.errors[0];
+  m = square();
+  m.blocks[0].elements = {{6, 2, 5}, {2, 3, 5}, {3, 4, 5}};
+  m.blocks.insert(m.blocks.begin(), Msh::Block{2, 1, 3, {{1, 6, 5, 4}}});
+  m.nodes[4] = {0.3, 0.3, 0};  // the quadrangle's corner 5 pulled inwards: non-convex at 5? (1, 6, 5, 4) stays convex
+  m.nodes[0] = {0.5, 0.45, 0};  // corner 1 pushed past the diagonal 6-4: the quadrangle is not convex at 1
+  const auto q = surface_of(m, "sq");
+  ASSERT_FALSE(q.errors.empty());
+  bool named = false;
+  for (const auto& e : q.errors) named = named || e.find("element 1 of surface 'sq'") != std::string::npos;
+  EXPECT_TRUE(named) << q.errors[0];
+}
+
+TEST(GmshErrors, CurvesOffTheBoundaryOrNotOneChainAndBodiesInPiecesAreRefused) {
+  Msh m = square();
+  m.blocks.push_back({1, 4, 1, {{1, 5}}});  // from a corner to the centre: through the interior
+  m.names.push_back({1, 14, "crack"});
+  m.groups[{1, 4}] = {14};
+  expect_error(surface_of(m, "sq"), "physical curve 'crack' on surface 'sq' runs through the surface's interior (element");
+  m = square();
+  m.blocks[2].elements.push_back({1, 6});  // top = the top line and half of the bottom: two pieces
+  expect_error(surface_of(m, "sq"), "physical curve 'top' on surface 'sq': its 2 sides are not one chain");
+  m = square();
+  m.blocks[1].elements = {{1, 6}, {6, 2}, {2, 3}, {3, 4}, {4, 1}};  // "bottom" all around
+  expect_error(surface_of(m, "sq"), "closed loop");
+  m = square();
+  m.nodes.push_back({5, 0, 0});
+  m.nodes.push_back({6, 0, 0});
+  m.nodes.push_back({5, 1, 0});
+  m.blocks[0].elements.push_back({7, 8, 9});  // a separate triangle
+  expect_error(surface_of(m, "sq"), "surface 'sq' is not one piece: element 6 is");
+  m = square();
+  m.nodes[4][2] = 0.1;  // the centre out of the plane
+  expect_error(surface_of(m, "sq"), "is not in a plane z = const");
+  m = square();
+  for (auto& x : m.nodes) x[2] = 3.0;  // a plane z = 3 is fine
+  EXPECT_TRUE(surface_of(m, "sq").errors.empty());
+}
+
+// ---- the job format -------------------------------------------------------------------------------------
+
+namespace {
+
+// flat_patch_gmsh.json with its meshes as the file's text (data) or by file name.
+json flat_patch_gmsh() {
+  std::ifstream in(kExamples + "flat_patch_gmsh.json");
+  return json::parse(in);
+}
+
+job::Limits in_examples() {
+  job::Limits limits;
+  limits.mesh_directory = kExamples;
+  return limits;
+}
+
+void expect_only_error(const job::ParseResult& r, const std::string& pointer, const std::string& phrase) {
+  ASSERT_EQ(r.errors.size(), 1u) << job::format_errors(r.errors);
+  EXPECT_EQ(r.errors[0].pointer, pointer) << job::format_errors(r.errors);
+  EXPECT_NE(r.errors[0].message.find(phrase), std::string::npos) << "missing '" << phrase << "' in\n"
+                                                                 << job::format_errors(r.errors);
+}
+
+}  // namespace
+
+TEST(GmshJob, DataAndFileGiveTheSameBodies) {
+  const auto by_file = job::parse(flat_patch_gmsh(), in_examples());
+  ASSERT_TRUE(by_file.ok()) << job::format_errors(by_file.errors);
+  json inline_job = flat_patch_gmsh();
+  const std::string text = read_text(kExamples + "flat_patch_gmsh.msh");
+  for (auto& body : inline_job["bodies"]) body["mesh"]["gmsh"] = {{"data", text}, {"surface", body["name"]}};
+  const auto by_data = job::parse(inline_job);  // no directory: data needs none
+  ASSERT_TRUE(by_data.ok()) << job::format_errors(by_data.errors);
+  for (size_t b = 0; b < 2; ++b) {
+    const auto& x = by_file.problem->bodies[b].mesh;
+    const auto& y = by_data.problem->bodies[b].mesh;
+    EXPECT_EQ(x.nodes, y.nodes);
+    EXPECT_EQ(x.cells, y.cells);
+    EXPECT_EQ(x.edge_set_nodes("left"), y.edge_set_nodes("left"));
+  }
+}
+
+TEST(GmshJob, WithoutADirectoryAFileIsRefusedAndDataIsAskedFor) {
+  const auto r = job::parse(flat_patch_gmsh());  // the server's limits: no mesh directory
+  ASSERT_EQ(r.errors.size(), 2u) << job::format_errors(r.errors);
+  for (size_t b = 0; b < 2; ++b) {
+    EXPECT_EQ(r.errors[b].pointer, "/bodies/" + std::to_string(b) + "/mesh/gmsh/file");
+    EXPECT_NE(r.errors[b].message.find("the server reads no files for a job; send the .msh file's text as \"data\""),
+              std::string::npos)
+        << r.errors[b].message;
+  }
+}
+
+TEST(GmshJob, FieldAndFileErrorsAreReportedAtTheirPointers) {
+  json job = flat_patch_gmsh();
+  job["bodies"][0]["mesh"]["gmsh"]["file"] = "missing.msh";
+  expect_only_error(job::parse(job, in_examples()), "/bodies/0/mesh/gmsh/file",
+                    "the mesh file 'missing.msh' (" + (fs::path(kExamples) / "missing.msh").lexically_normal().string() +
+                        ") cannot be opened: No such file or directory");
+  job = flat_patch_gmsh();
+  job["bodies"][0]["mesh"]["gmsh"]["data"] = "x";
+  expect_only_error(job::parse(job, in_examples()), "/bodies/0/mesh/gmsh", "give exactly one of file");
+  job["bodies"][0]["mesh"]["gmsh"].erase("file");
+  job["bodies"][0]["mesh"]["gmsh"]["data"] = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n";
+  expect_only_error(job::parse(job, in_examples()), "/bodies/0/mesh/gmsh/data",
+                    "the mesh data (MSH text): line 2: MSH format version 2.2 is not supported");
+  job = flat_patch_gmsh();
+  job["bodies"][1]["mesh"]["gmsh"]["surface"] = "punch";
+  expect_only_error(job::parse(job, in_examples()), "/bodies/1/mesh/gmsh/surface",
+                    "the file has no physical surface 'punch'; its physical surfaces are 'lower' and 'upper'");
+  job = flat_patch_gmsh();
+  job["bodies"][1]["mesh"]["gmsh"]["surfce"] = "upper";
+  const auto r = job::parse(job, in_examples());
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.errors[0].pointer, "/bodies/1/mesh/gmsh/surfce") << job::format_errors(r.errors);
+  job = flat_patch_gmsh();
+  job["bodies"][1]["mesh"]["block"] = {{"corners", {{0, 0}, {1, 0}, {1, 1}, {0, 1}}}, {"nx", 1}, {"ny", 1}};
+  const auto both = job::parse(job, in_examples());
+  ASSERT_FALSE(both.ok());
+  EXPECT_NE(job::format_errors(both.errors).find("not several"), std::string::npos) << job::format_errors(both.errors);
+}
+
+TEST(GmshJob, ACurveOfAnotherSurfaceIsNamedAsSuch) {
+  json job = flat_patch_gmsh();
+  job["bodies"][0]["boundary"][1]["edge"] = "upper_top";
+  expect_only_error(job::parse(job, in_examples()), "/bodies/0/boundary/1/edge",
+                    "physical curve 'upper_top' is not on the boundary of surface 'lower'; the physical curves on its "
+                    "boundary are lower_bottom, lower_top and left");
+  job = flat_patch_gmsh();
+  job["contacts"][0]["master"] = "lower.upper_bottom";
+  expect_only_error(job::parse(job, in_examples()), "/contacts/0/master",
+                    "physical curve 'upper_bottom' is not on the boundary of surface 'lower'");
+  job = flat_patch_gmsh();
+  job["contacts"][0]["master"] = "lower.nothing";
+  expect_only_error(job::parse(job, in_examples()), "/contacts/0/master", "body 'lower' has no edge 'nothing'");
+}
+
+TEST(GmshJob, TheMeshCountsInTheLimitOnDegreesOfFreedom) {
+  job::Limits limits = in_examples();
+  limits.max_dofs = 100;  // the file has 115 nodes
+  const auto r = job::parse(flat_patch_gmsh(), limits);
+  ASSERT_EQ(r.errors.size(), 2u) << job::format_errors(r.errors);
+  EXPECT_NE(r.errors[0].message.find("nodes, more than the 50 that the limit on degrees of freedom allows"),
+            std::string::npos)
+      << r.errors[0].message;
+  // The file fits exactly (115 nodes, 230 dofs); two bodies of the larger surface together do not.
+  limits.max_dofs = 230;
+  json job = flat_patch_gmsh();
+  job["bodies"][0]["mesh"]["gmsh"]["surface"] = "upper";
+  job["bodies"][0]["boundary"] = job["bodies"][1]["boundary"];
+  job["contacts"] = json::array();
+  expect_only_error(job::parse(job, limits), "/bodies", "more than the limit of 230");
+}
+
+TEST(GmshJob, AnEdgeNameMustBeUsableInTheJob) {
+  Msh m = square();
+  std::get<2>(m.names[2]) = "top edge";
+  json job = flat_patch_gmsh();
+  job["bodies"].erase(1);
+  job["contacts"] = json::array();
+  job["bodies"][0]["mesh"]["gmsh"] = {{"data", m.text()}, {"surface", "sq"}};
+  job["bodies"][0]["boundary"] = {{{"edge", "bottom"}, {"displacement", {{"x", 0}, {"y", 0}}}}};
+  expect_only_error(job::parse(job), "/bodies/0/mesh/gmsh",
+                    "physical curve name 'top edge' must consist of letters, digits, '_' and '-' only");
+}
+
+TEST(GmshJob, ParseFileReadsMeshesRelativeToTheJobFile) {
+  const fs::path dir = fs::path(CONTACT_BINARY_DIR) / "test_gmsh_output" / "jobs";
+  fs::create_directories(dir / "meshes");
+  fs::copy_file(kExamples + "flat_patch_gmsh.msh", dir / "meshes" / "patch.msh", fs::copy_options::overwrite_existing);
+  json job = flat_patch_gmsh();
+  for (auto& body : job["bodies"]) body["mesh"]["gmsh"]["file"] = "meshes/patch.msh";
+  std::ofstream(dir / "job.json") << job.dump();
+  const auto r = job::parse_file((dir / "job.json").string());
+  ASSERT_TRUE(r.ok()) << job::format_errors(r.errors);
+  EXPECT_EQ(r.problem->bodies[0].mesh.num_nodes() + r.problem->bodies[1].mesh.num_nodes(), 115);
+  expect_only_error(job::parse_file((dir / "absent.json").string()), "", "cannot open the job file");
+}
