@@ -128,8 +128,27 @@ check("accepts the fast settings (gamma auto, Anderson, interface Newton, augmen
                                                           robin={"psi": 1e7}))))
 rejected_at("grading towards both bottom and top",
             lambda d: d["bodies"][0]["mesh"]["block"].update(grading={"bottom": 4, "top": 4}), ["bodies", 0, "mesh"])
-rejected_at("a condition with both displacement and traction",
-            lambda d: d["bodies"][0]["boundary"][0].update(traction=[0, 0]), ["bodies", 0, "boundary", 0], "oneOf")
+rejected_at("a condition with both a traction and a force",
+            lambda d: d["bodies"][0]["boundary"][2].update(force=[0, 1]), ["bodies", 0, "boundary", 2], "not")
+rejected_at("a condition on both an edge and a vertex",
+            lambda d: d["bodies"][0]["boundary"][2].update(vertex="top_right"), ["bodies", 0, "boundary", 2], "oneOf")
+rejected_at("a traction at a vertex",
+            lambda d: d["bodies"][0]["boundary"].__setitem__(2, {"vertex": "top_right", "traction": [0, 1]}),
+            ["bodies", 0, "boundary", 2], "not")
+rejected_at("free with a displacement",
+            lambda d: d["bodies"][0]["boundary"][0].update(free=True), ["bodies", 0, "boundary", 0], "not")
+rejected_at("a condition with no kind", lambda d: d["bodies"][0]["boundary"].__setitem__(2, {"edge": "right"}),
+            ["bodies", 0, "boundary", 2], "anyOf")
+check("accepts forces on an edge and at a vertex, and a displacement with a load on its free component",
+      not errors_of(mutated(lambda d: d["bodies"][0].update(boundary=[
+          {"edge": "left", "displacement": {"x": 0}, "traction": [0, -1]},
+          {"edge": "top", "force": [0, -100]},
+          {"vertex": "top_right", "displacement": {"y": 0}, "force": [5, 0]}]))))
+rejected_at("loading with both steps and factors", lambda d: d.update(loading={"steps": 2, "factors": [1]}),
+            ["loading"], "oneOf")
+rejected_at("loading with 0 steps", lambda d: d.update(loading={"steps": 0}), ["loading", "steps"], "minimum")
+rejected_at("a negative load factor", lambda d: d.update(loading={"factors": [0.5, -1]}),
+            ["loading", "factors", 1], "exclusiveMinimum")
 rejected_at("an empty displacement", lambda d: d["bodies"][0]["boundary"][0].update(displacement={}),
             ["bodies", 0, "boundary", 0, "displacement"], "minProperties")
 rejected_at("free = false", lambda d: d["bodies"][0]["boundary"].__setitem__(2, {"edge": "right", "free": False}),
