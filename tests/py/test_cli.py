@@ -52,10 +52,14 @@ with tempfile.TemporaryDirectory() as tmp:
     check("one summary line that counts the iterations once",
           len(stop) == 1 and stop[0].count(" after ") == 1 and stop[0].count("iterations") == 1, "\n".join(stop))
 
-    # --version
+    # --version, on both programs.
     r = run("--version")
     check("--version exits 0 and names the program", r.returncode == 0 and r.stdout.startswith("contact-solve "),
           r.stdout + r.stderr)
+    r = subprocess.run([os.path.join(BIN, "server", "contactd"), "--version"], capture_output=True, text=True,
+                       timeout=30)
+    check("contactd --version exits 0 and names the program", r.returncode == 0
+          and r.stdout.strip() == "contactd " + run("--version").stdout.split()[-1], r.stdout + r.stderr)
 
     # --validate only checks.
     r = run(EXAMPLE, "--validate")
