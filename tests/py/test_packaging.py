@@ -44,17 +44,22 @@ def needed_libraries(binary):
     return {name: resolved.get(name) for name in names}
 
 
-def owner(path):
-    """The Debian package that installed a file (with merged /usr, dpkg may know it under /lib or /usr/lib)."""
-    if not path:
-        return None
-    real = os.path.realpath(path)
-    for candidate in (path, real, "/usr" + path, "/usr" + real, path.replace("/usr/lib/", "/lib/", 1),
-                      real.replace("/usr/lib/", "/lib/", 1)):
-        r = subprocess.run(["dpkg", "-S", candidate], capture_output=True, text=True)
-        if r.returncode == 0:
-            return r.stdout.split(":")[0].strip()
-    return None
+def owners(paths):
+    """{path: the Debian package that installed it} in one dpkg call (with merged /usr, dpkg may know a file under
+    /lib or /usr/lib, by its name or by the name its symbolic link points to)."""
+    variants = {}
+    for path in filter(None, paths):
+        real = os.path.realpath(path)
+        for candidate in (path, real, "/usr" + path, "/usr" + real, path.replace("/usr/lib/", "/lib/", 1),
+                          real.replace("/usr/lib/", "/lib/", 1)):
+            variants.setdefault(candidate, path)
+    out = subprocess.run(["dpkg", "-S", *variants], capture_output=True, text=True).stdout
+    found = {}
+    for line in out.splitlines():
+        package, _, file = line.partition(": ")
+        if file in variants:
+            found.setdefault(variants[file], package.split(":")[0].strip())
+    return found
 
 
 def pattern_regex(pattern):
@@ -104,8 +109,8 @@ runtime = set(lists.get("RUNTIME_PACKAGES", [])) | BASE_IMAGE_PACKAGES
 for binary in (os.path.join(BIN, "contact-solve"), os.path.join(BIN, "server", "contactd")):
     libraries = needed_libraries(binary)
     check(f"{os.path.basename(binary)}: its libraries read", len(libraries) >= 4, libraries)
-    owners = {lib: owner(path) for lib, path in libraries.items()}
-    missing = {lib: pkg for lib, pkg in owners.items() if pkg not in runtime}
+    packages = owners(libraries.values())
+    missing = {lib: packages.get(path) for lib, path in libraries.items() if packages.get(path) not in runtime}
     check(f"{os.path.basename(binary)}: the runtime packages provide every library it loads", not missing, missing)
 
 patterns = [line.strip() for line in read(".dockerignore").splitlines() if line.strip() and not line.startswith("#")]
