@@ -143,6 +143,16 @@ def run_cli(job, tmp, *args):
     return subprocess.run([CLI, path, *args], capture_output=True, text=True, timeout=120)
 
 
+def solve_normalized(job, tmp, what):
+    """The job with every default filled in, as the solver stores it (/input/normalized of its result file)."""
+    out = os.path.join(tmp, "normalized.hdf")
+    r = run_cli(job, tmp, "-o", out, "-q")
+    if not check(f"{what} solves", r.returncode == 0, r.stdout[-400:] + r.stderr[-400:]):
+        sys.exit(checks.finish())
+    with h5py.File(out, "r") as f:
+        return json.loads(f["input/normalized"].asstr()[()])
+
+
 def parser_fields(job, pointers, tmp):
     """{pointer: the parser's allowed fields there}: an unknown field is put at every pointer (objects of `job`)
     and the parser's error for each names the fields allowed."""
@@ -257,19 +267,12 @@ def main():
         check("Contacts: the gap.* rows are the gap object's fields", sub.get("gap", set()) == gap,
               f"documented {sorted(sub.get('gap', set()))}, parser {sorted(gap)}")
 
-        # Defaults: solve the page's small example (with an empty adaptivity, which fills in its defaults) and
-        # compare every default the tables give as one JSON value with the normalised job.
-        small_adaptive = copy.deepcopy(small)
-        small_adaptive["adaptivity"] = {"max_steps": 1}
-        out = os.path.join(tmp, "small.hdf")
-        path = os.path.join(tmp, "small.json")
-        with open(path, "w") as f:
-            json.dump(small_adaptive, f)
-        r = subprocess.run([CLI, path, "-o", out, "-q"], capture_output=True, text=True, timeout=120)
-        check("the page's small example solves", r.returncode == 0, r.stdout[-400:] + r.stderr[-400:])
-        with h5py.File(out, "r") as f:
-            normalized = json.loads(f["input/normalized"].asstr()[()])
-        given = small_adaptive
+        # Defaults: solve the page's small example with an adaptivity section (one step, so that it is quick),
+        # which fills in its other defaults, and compare every default the tables give as one JSON value with the
+        # normalised job.
+        given = copy.deepcopy(small)
+        given["adaptivity"] = {"max_steps": 1}
+        normalized = solve_normalized(given, tmp, "the page's small example with adaptivity")
         places = [("Top level", normalized, given), ("`model`", normalized["model"], given.get("model", {})),
                   ("Bodies", normalized["bodies"][0], given["bodies"][0]),
                   ("Block mesh", normalized["bodies"][0]["mesh"]["block"], given["bodies"][0]["mesh"]["block"]),
@@ -300,13 +303,7 @@ def main():
         section = doc.get("A complete small example", "")
         m = re.search(r"solver section reads\s*`(\{.*?\})`", section, re.S)
         shown = json.loads(m.group(1)) if m else None
-        plain = os.path.join(tmp, "plain.json")
-        with open(plain, "w") as f:
-            json.dump(small, f)
-        r = subprocess.run([CLI, plain, "-o", out, "-q"], capture_output=True, text=True, timeout=120)
-        check("the page's small example solves without adaptivity", r.returncode == 0, r.stderr[-400:])
-        with h5py.File(out, "r") as f:
-            normalized = json.loads(f["input/normalized"].asstr()[()])
+        normalized = solve_normalized(small, tmp, "the page's small example")
         check("the page's filled-in solver section is the parser's", shown is not None
               and same(shown, normalized["solver"]), f"docs {shown}, parser {normalized['solver']}")
         m = re.search(r"the contact is named\s*`\"([^`]*)\"`\s*with gap\s*`(\{.*?\})`", section, re.S)
