@@ -20,7 +20,7 @@ TEST_PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   python3-jsonschema
   iproute2                                  # ss: tests/server/test_connections.py reads the listen backlog
-  chromium chromium-driver python3-selenium # tests/server/test_web_page.py drives the web page headless
+  chromium chromium-driver python3-selenium # tests/clients/test_web_page.py drives the web page
 )
 RUNTIME_PACKAGES=(
   libcholmod3 libopenblas0-pthread libhdf5-103-1 libcpp-httplib0.11 ca-certificates curl
