@@ -107,13 +107,6 @@ Figures solve_job(const json& job) {
   return f;
 }
 
-std::vector<int> parse_sizes(const std::string& list) {
-  std::vector<int> out;
-  std::stringstream in(list);
-  std::string item;
-  while (std::getline(in, item, ',')) out.push_back(std::stoi(item));
-  return out;
-}
 
 }  // namespace
 
@@ -122,7 +115,7 @@ int main(int argc, char** argv) {
   int monolithic_up_to = 512, exact_monolithic_up_to = 256;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string flag = argv[i];
-    if (flag == "--sizes") sizes = parse_sizes(argv[i + 1]);
+    if (flag == "--sizes") sizes = bench::parse_int_list(argv[i + 1]);
     else if (flag == "--monolithic-up-to") monolithic_up_to = std::stoi(argv[i + 1]);
     else if (flag == "--exact-monolithic-up-to") exact_monolithic_up_to = std::stoi(argv[i + 1]);
   }

@@ -7,6 +7,9 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <sstream>
+#include <string>
+#include <vector>
 
 namespace contact::bench {
 
@@ -23,6 +26,15 @@ inline Problem parse_or_exit(const nlohmann::json& job) {
     std::exit(2);
   }
   return std::move(*r.problem);
+}
+
+// "128,256,512" -> {128, 256, 512} (a command-line list).
+inline std::vector<int> parse_int_list(const std::string& list) {
+  std::vector<int> out;
+  std::stringstream in(list);
+  std::string item;
+  while (std::getline(in, item, ',')) out.push_back(std::stoi(item));
+  return out;
 }
 
 }  // namespace contact::bench

@@ -106,6 +106,7 @@ void HttpServer::register_routes() {
     core_.Get(pattern, [this, handler](const Request& req, Response& res) { (this->*handler)(req, res); });
   };
   get("/", &HttpServer::handle_root);
+  get(R"(/web/[A-Za-z0-9_./-]+)", &HttpServer::handle_web_file);
   get("/healthz", &HttpServer::handle_healthz);
   get("/readyz", &HttpServer::handle_readyz);
   get("/metrics", &HttpServer::handle_metrics);
@@ -113,6 +114,8 @@ void HttpServer::register_routes() {
   get("/v1/schema", &HttpServer::handle_schema);
   get(R"(/v1/job\.schema\.json)", &HttpServer::handle_schema);  // so that openapi.yaml's "./job.schema.json" resolves
   get(R"(/v1/openapi\.yaml)", &HttpServer::handle_openapi);
+  get("/v1/examples", &HttpServer::handle_examples);
+  get(R"(/v1/examples/([A-Za-z0-9_-]{1,64})(?:\.json)?)", &HttpServer::handle_example);
   get("/v1/jobs", &HttpServer::handle_list);
   get(job, &HttpServer::handle_get);
   get(job + "/events", &HttpServer::handle_events);

@@ -1,6 +1,7 @@
 // The HTTP face of contactd: one class owns the transport (connection gate, HTTP threads, httplib's request
 // processing: http_transport.hpp); the routes are registered in one place (register_routes) and each handler is
-// short: parse the request, call the JobQueue, map the outcome to a response (http_handlers.cpp).
+// short: parse the request, call the JobQueue, map the outcome to a response (http_jobs.cpp, http_streams.cpp;
+// the service endpoints in http_service.cpp; the web page and the examples in http_web.cpp).
 // Cross-cutting rules live in the pre-routing handler (framing, Host allow-list, cross-site rules, bearer token,
 // Content-Encoding and media type, body size, "not ready"), the error handler (JSON problem documents for every
 // 4xx/5xx, 405 with Allow) and the exception handler (500). The API is specified in api/openapi.yaml and explained
@@ -94,6 +95,9 @@ class HttpServer {
   void on_response(const Request& req, const Response& res);
 
   void handle_root(const Request& req, Response& res);
+  void handle_web_file(const Request& req, Response& res);
+  void handle_examples(const Request& req, Response& res);
+  void handle_example(const Request& req, Response& res);
   void handle_healthz(const Request& req, Response& res);
   void handle_readyz(const Request& req, Response& res);
   void handle_metrics(const Request& req, Response& res);

@@ -1,18 +1,13 @@
-// The service endpoints (/, /healthz, /readyz, /metrics, /problems/*, the schema and the API spec) and the job
+// The service endpoints (/healthz, /readyz, /metrics, /problems/*, the schema and the API spec) and the job
 // resource shared by the job handlers.
 #include "http_server.hpp"
+
+#include "assets.hpp"
 
 #include "problem.hpp"
 #include "util.hpp"
 
-#include "solve.hpp"
-
 namespace contactd {
-
-namespace assets {
-std::string_view job_schema();
-std::string_view openapi_yaml();
-}  // namespace assets
 
 nlohmann::json HttpServer::job_resource(const JobRecord& r, int queue_position) const {
   const std::int64_t now = now_unix_us();
@@ -55,20 +50,6 @@ nlohmann::json HttpServer::job_resource(const JobRecord& r, int queue_position) 
                                            : nlohmann::json(nullptr);
   j["idempotency_key"] = r.idempotency_key.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.idempotency_key);
   return j;
-}
-
-void HttpServer::handle_root(const Request&, Response& res) {
-  send_json(res, 200,
-            {{"service", "contactd"},
-             {"version", contact::solver_version()},
-             {"links",
-              {{"jobs", "/v1/jobs"},
-               {"validate", "/v1/validate"},
-               {"schema", "/v1/schema"},
-               {"openapi", "/v1/openapi.yaml"},
-               {"health", "/healthz"},
-               {"ready", "/readyz"},
-               {"metrics", "/metrics"}}}});
 }
 
 void HttpServer::handle_healthz(const Request&, Response& res) {

@@ -190,6 +190,7 @@ void capture_stdout() {
 
 int main(int argc, char** argv) {
   CLI::App app{"contactd: the contact solver as an HTTP service (docs/server.md)"};
+  app.set_version_flag("--version", std::string("contactd ") + contact::solver_version());
   Config config;
   add_flags(app, config);
   CLI11_PARSE(app, argc, argv);

@@ -28,18 +28,37 @@ struct Material {
   double nu = 0.0;  // Poisson's ratio, in (-1, 0.5)
 };
 
-// One boundary condition on a named edge of a body. Edges without a condition are traction-free.
+// One boundary condition on a named edge, or at a named vertex, of a body. Edges without a condition are
+// traction-free. Loads and prescribed displacements are scaled by the load factor of the step being solved.
+// `kind` is the load (traction, force) or its absence (displacement only, free); prescribed displacement components
+// (ux, uy) may come with a load on the other component (a sliding support that is pushed, a point held in x and
+// loaded in y).
 struct BoundaryCondition {
-  enum class Kind { displacement, traction, free };
+  enum class Kind { displacement, traction, force, free };
   std::string edge;
   Kind kind = Kind::free;
+  std::string vertex;  // instead of an edge: a named vertex (Mesh::vertices): a point support or a point load
   // displacement: only the given components are prescribed
   std::optional<double> ux, uy;
   // traction: either a vector (force per length) or a normal pressure (positive = pushing into the body)
   bool normal_pressure = false;
   Eigen::Vector2d traction = Eigen::Vector2d::Zero();
   double pressure = 0.0;
+  // force: the total force on the edge, spread as a uniform traction, or a point load at the vertex (per unit
+  // thickness in plane strain, the total in plane stress, like every force)
+  Eigen::Vector2d force = Eigen::Vector2d::Zero();
 };
+
+inline bool prescribes_displacement(const BoundaryCondition& bc) { return bc.ux.has_value() || bc.uy.has_value(); }
+
+// The nodes a condition acts on: the vertex's node, or the edge's nodes in order (empty if unknown).
+inline std::vector<int> condition_nodes(const mesh::Mesh& mesh, const BoundaryCondition& bc) {
+  if (!bc.vertex.empty()) {
+    auto it = mesh.vertices.find(bc.vertex);
+    return it == mesh.vertices.end() ? std::vector<int>{} : std::vector<int>{it->second};
+  }
+  return mesh.edge_set_nodes(bc.edge);
+}
 
 struct Body {
   std::string name;
@@ -147,6 +166,12 @@ struct AdaptivitySettings {
   int max_steps = 20;       // refinement steps (converge_then_refine)
 };
 
+// Load steps: every prescribed displacement, traction, force and body force is scaled by each factor in turn;
+// each step is solved starting from the previous one and stored as a result step. {1} = one step, the full load.
+struct LoadingSpec {
+  std::vector<double> factors = {1.0};
+};
+
 struct Problem {
   std::string name;
   Model model;
@@ -154,6 +179,7 @@ struct Problem {
   std::vector<ContactPair> contacts;
   SolverSettings solver;
   AdaptivitySettings adaptivity;
+  LoadingSpec loading;
   nlohmann::json submitted;   // the job JSON as submitted
   nlohmann::json normalized;  // the same with every default filled in
 };

@@ -99,10 +99,11 @@ struct PairField {
   double force = 0.0;            // sum of weight x pressure: the total normal force
 };
 
-// One mesh state: without adaptivity there is a single step.
+// One mesh state of the adaptive loop, or one load step; without either there is a single step.
 struct Step {
   int index = 0;
   int iteration = 0;  // the DDM iteration at which this step's mesh was final
+  double load_factor = 1.0;  // the load factor of this step (Problem::loading)
   std::vector<BodyField> bodies;
   std::vector<PairField> pairs;
 };

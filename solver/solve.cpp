@@ -2,6 +2,7 @@
 
 #include "adapt/adaptive.hpp"
 #include "ddm/driver.hpp"
+#include "ddm/load_steps.hpp"
 
 #include <chrono>
 #include <exception>
@@ -72,8 +73,13 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
     ddm::MethodRunner method(system, active.solver);
     int updates = 0;
     std::vector<Step> steps;
-    ddm::MethodOutcome outcome = adaptive ? adapt::run_adaptive(working, system, context, method, steps, updates)
-                                          : ddm::run_enforced(system, problem.solver, context, method, updates);
+    ddm::MethodOutcome outcome;
+    if (adaptive) {
+      system.set_load_factor(problem.loading.factors.back());
+      outcome = adapt::run_adaptive(working, system, context, method, steps, updates);
+    } else {
+      outcome = ddm::run_load_steps(system, problem.solver, problem.loading.factors, context, method, steps, updates);
+    }
     result.converged = outcome.converged;
     result.stop_reason = outcome.reason;
     result.message = outcome.message;
@@ -84,13 +90,7 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
     result.indicator_seconds = outcome.indicator_seconds;
     result.history = std::move(outcome.history);
     result.factorization_seconds = system.total_factorization_seconds();
-    if (adaptive) {
-      result.steps = std::move(steps);
-    } else if (!outcome.u.empty()) {
-      result.steps.push_back(outcome.z.empty() ? system.fields(outcome.u, outcome.iterations)
-                                               : system.fields(outcome.u, outcome.z, outcome.iterations,
-                                                               &outcome.rigid_amplitudes));
-    }
+    result.steps = std::move(steps);
     if (updates > 0 && !result.steps.empty()) {
       std::ostringstream os;
       os << "; remaining penetration " << max_penetration(result.steps.back());

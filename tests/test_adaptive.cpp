@@ -13,15 +13,10 @@
 using namespace contact;
 using nlohmann::json;
 using contact::testing::example;
+using contact::testing::body;
 using contact::testing::run;
 
 namespace {
-
-const BodyField& body(const Step& s, const std::string& name) {
-  for (const auto& b : s.bodies)
-    if (b.name == name) return b;
-  throw std::runtime_error("no body " + name);
-}
 
 // Number of cells whose centre lies in [x0, x1), and their largest level.
 std::pair<int, int> cells_in(const BodyField& b, double x0, double x1) {

@@ -1,5 +1,6 @@
 // Gmsh meshes: the MSH 4.1 reader, a physical surface as a body (edges, orientation, arcs), every kind of bad file
 // with its message, and the job's gmsh meshes (file, data, the server's refusal of files, references to curves).
+#include "fem/body_solver.hpp"
 #include "job/job.hpp"
 #include "mesh/gmsh.hpp"
 
@@ -189,6 +190,34 @@ TEST(GmshReader, QuadrangleAndMixedSurfaces) {
   EXPECT_TRUE(s.mesh.has_triangles());
   EXPECT_EQ(s.mesh.num_cells(), 4);
   EXPECT_NEAR(area(s.mesh), 2.0, 1e-15);
+}
+
+// square() with the physical point "corner" at (2, 1) (node 3) and "far" at a node of no surface (node 7).
+Msh square_with_points() {
+  Msh m = square();
+  m.nodes.push_back({5, 5, 0});
+  m.blocks.push_back({0, 1, 15, {{3}}});
+  m.blocks.push_back({0, 2, 15, {{7}}});
+  m.names.push_back({0, 20, "corner"});
+  m.names.push_back({0, 21, "far"});
+  m.groups[{0, 1}] = {20};
+  m.groups[{0, 2}] = {21};
+  return m;
+}
+
+TEST(GmshReader, PhysicalPointsOnTheSurfaceAreItsVertices) {
+  const auto s = surface_of(square_with_points(), "sq");
+  ASSERT_TRUE(s.errors.empty()) << s.errors[0];
+  EXPECT_EQ(s.vertices, std::vector<std::string>{"corner"});
+  EXPECT_EQ(s.points_elsewhere, std::vector<std::string>{"far"});
+  ASSERT_EQ(s.mesh.vertices.count("corner"), 1u);
+  EXPECT_EQ(s.mesh.nodes[static_cast<size_t>(s.mesh.vertices.at("corner"))], mesh::Point(2, 1));
+  EXPECT_EQ(s.mesh.num_nodes(), 6);  // the far point's node is not the body's
+  // One name on two points of the surface: not one vertex.
+  Msh m = square_with_points();
+  m.blocks.push_back({0, 3, 15, {{4}}});
+  m.groups[{0, 3}] = {20};
+  expect_error(surface_of(m, "sq"), "physical point 'corner' has 2 points on surface 'sq': a vertex is one point");
 }
 
 TEST(GmshErrors, FilesThatAreNotMsh41AsciiAreRefusedSayingWhat) {
@@ -431,4 +460,30 @@ TEST(GmshJob, ParseFileReadsMeshesRelativeToTheJobFile) {
   ASSERT_TRUE(r.ok()) << job::format_errors(r.errors);
   EXPECT_EQ(r.problem->bodies[0].mesh.num_nodes() + r.problem->bodies[1].mesh.num_nodes(), 115);
   expect_only_error(job::parse_file((dir / "absent.json").string()), "", "cannot open the job file");
+}
+
+TEST(GmshJob, APointLoadAtAPhysicalPointIsCarriedByTheSupports) {
+  // The square of triangles held along its bottom, a force at the physical point "corner": the supports' reactions
+  // balance it exactly, and a point of no surface is named as such.
+  json job = flat_patch_gmsh();
+  job["bodies"].erase(1);
+  job["contacts"] = json::array();
+  job["bodies"][0]["mesh"]["gmsh"] = {{"data", square_with_points().text()}, {"surface", "sq"}};
+  job["bodies"][0]["boundary"] = {{{"edge", "bottom"}, {"displacement", {{"x", 0}, {"y", 0}}}},
+                                  {{"vertex", "corner"}, {"force", {3.0, -7.0}}}};
+  const auto r = job::parse(job);
+  ASSERT_TRUE(r.ok()) << job::format_errors(r.errors);
+  const Body& body = r.problem->bodies[0];
+  EXPECT_EQ(body.mesh.nodes[static_cast<size_t>(body.mesh.vertices.at("corner"))], mesh::Point(2, 1));
+  fem::BodySolver solver(body, r.problem->model);
+  ASSERT_TRUE(solver.ok()) << solver.error();
+  const Eigen::VectorXd u = solver.solve(Eigen::VectorXd());
+  const Eigen::VectorXd R = solver.reactions(u, Eigen::VectorXd());
+  Eigen::Vector2d total = Eigen::Vector2d::Zero();
+  for (int n = 0; n < body.mesh.num_nodes(); ++n) total += R.segment<2>(2 * n);
+  EXPECT_LE((total + Eigen::Vector2d(3.0, -7.0)).norm(), 1e-9);
+  EXPECT_GT(u[2 * body.mesh.vertices.at("corner")], 0.0);  // pulled to the right
+  job["bodies"][0]["boundary"][1]["vertex"] = "far";
+  expect_only_error(job::parse(job), "/bodies/0/boundary/1/vertex",
+                    "physical point 'far' is not on surface 'sq'; the physical points on it are corner");
 }

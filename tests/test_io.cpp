@@ -704,3 +704,21 @@ TEST(ResultFile, TriangleAndMixedMeshesRoundTripAndTheViewsTypeEveryCell) {
     EXPECT_NE(text.find("/steps/1/bodies/" + last.bodies[b].name + "/stress_node_tensor</DataItem>"), std::string::npos);
   }
 }
+
+TEST(Xdmf, LoadStepsAreTimedByTheirLoadFactor) {
+  // ParaView's time axis of a load-stepped result is the load; adaptive steps (one load) keep their index.
+  Fixture f = make_fixture();
+  ASSERT_GE(f.result.steps.size(), 2u);
+  for (size_t k = 0; k < f.result.steps.size(); ++k)
+    f.result.steps[k].load_factor = static_cast<double>(k + 1) / static_cast<double>(f.result.steps.size() * 2);
+  const fs::path hdf = output_dir() / "load_steps.hdf";
+  const std::string xmf = io::xdmf_path_for(hdf.string());
+  io::write_xdmf(xmf, hdf.filename().string(), f.result);
+  const std::string text = read_text(xmf);
+  for (size_t k = 0; k < f.result.steps.size(); ++k) {
+    std::ostringstream value;
+    value.precision(17);
+    value << f.result.steps[k].load_factor;
+    EXPECT_NE(text.find("<Time Value=\"" + value.str() + "\"/>"), std::string::npos) << value.str();
+  }
+}

@@ -432,7 +432,22 @@ TEST(JobErrors, UnknownEdgeInBoundaryListsTheEdgesTheBodyHas) {
 TEST(JobErrors, ConditionWithTwoKindsIsRejected) {
   json job = small_job();
   job["bodies"][0]["boundary"][0]["traction"] = {0, 0};
-  expect_only_error(parse(job), "/bodies/0/boundary/0", "exactly one of displacement, traction or free");
+  job["bodies"][0]["boundary"][0]["force"] = {0, 1};
+  expect_only_error(parse(job), "/bodies/0/boundary/0", "give a displacement, a load (traction or force)");
+  job["bodies"][0]["boundary"][0].erase("traction");
+  job["bodies"][0]["boundary"][0]["free"] = true;
+  expect_only_error(parse(job), "/bodies/0/boundary/0", "give a displacement, a load (traction or force)");
+}
+
+TEST(JobErrors, LoadAlongAPrescribedDisplacementComponentIsRejected) {
+  // u_x = 0 on the left edge with a traction: its y component is a load, its x component would go into the support.
+  json job = small_job();
+  job["bodies"][0]["boundary"][0]["traction"] = {0, -1};
+  EXPECT_TRUE(parse(job).ok()) << listing(parse(job));
+  job["bodies"][0]["boundary"][0]["traction"] = {1, -1};
+  expect_only_error(parse(job), "/bodies/0/boundary/0", "the load's x component acts where the x displacement");
+  job["bodies"][0]["boundary"][0]["traction"] = {{"normal", 1.0}};
+  expect_only_error(parse(job), "/bodies/0/boundary/0", "a normal pressure cannot be combined with a displacement");
 }
 
 TEST(JobErrors, DisplacementWithoutComponentsIsRejected) {
@@ -480,17 +495,24 @@ TEST(JobErrors, SamePairTwiceIsRejectedEvenWithSlaveAndMasterSwapped) {
   expect_only_error(parse(swapped), "/contacts/1", "slave and master swapped");
 }
 
-TEST(JobErrors, BodyFreeToSlideInXIsNotRestrained) {
+TEST(JobErrors, FloatingBodyWithTheNeumannSchemeNamesTheBodyItsFreeMotionAndTheMethodsThatTakeIt) {
   json job = small_job();
   job["bodies"][1]["boundary"].erase(0);  // only {"y": 0} on the bottom remains
-  expect_only_error(parse(job), "/bodies/1/boundary",
-                    "body 'lower' is not restrained against rigid motion: translation in x is free");
+  job["solver"] = {{"method", "neumann"}};
+  expect_only_error(parse(job), "/solver/method", "body 'lower' floats (translation in x is free");
+  EXPECT_NE(listing(parse(job)).find("\"interface_newton\""), std::string::npos) << listing(parse(job));
+  // With the default method a floating body in contact is a valid job (whether its contacts hold it is decided by
+  // the solve).
+  job.erase("solver");
+  EXPECT_TRUE(parse(job).ok()) << listing(parse(job));
 }
 
-TEST(JobErrors, BodyWithoutDisplacementConditionsHasAllThreeRigidMotionsFree) {
+TEST(JobErrors, BodyWithoutDisplacementConditionsAndWithoutContactHasAllThreeRigidMotionsFree) {
   json job = small_job();
   job["bodies"][0]["boundary"] = {{{"edge", "top"}, {"traction", {{"normal", 1.0}}}}};
-  expect_only_error(parse(job), "/bodies/0/boundary", "translation in x, translation in y and rotation are free");
+  job.erase("contacts");
+  expect_only_error(parse(job), "/bodies/0/boundary",
+                    "translation in x, translation in y and rotation are free) and touches no other body");
 }
 
 TEST(JobErrors, BodyHeldOnlyAgainstTranslationsRotatesAboutTheCornerThatNamesIt) {
@@ -499,7 +521,80 @@ TEST(JobErrors, BodyHeldOnlyAgainstTranslationsRotatesAboutTheCornerThatNamesIt)
   json job = small_job();
   job["bodies"][1]["boundary"] =
       json::parse(R"([{"edge": "bottom", "displacement": {"x": 0}}, {"edge": "left", "displacement": {"y": 0}}])");
+  job.erase("contacts");
   expect_only_error(parse(job), "/bodies/1/boundary", "rotation about (0, -1) is free");
+}
+
+TEST(JobBoundary, VertexConditionsForcesAndLoadingAreReadAndBadOnesNamed) {
+  json job = small_job();
+  job["bodies"][0]["boundary"].push_back({{"vertex", "bottom_right"}, {"force", {0, -5}}});
+  job["bodies"][0]["boundary"].push_back({{"edge", "right"}, {"force", {1, 0}}});
+  job["loading"] = {{"steps", 4}};
+  ParseResult r = parse(job);
+  ASSERT_TRUE(r.ok()) << listing(r);
+  const auto& bc = r.problem->bodies[0].boundary;
+  ASSERT_EQ(bc.size(), 4u);
+  EXPECT_EQ(bc[2].vertex, "bottom_right");
+  EXPECT_EQ(bc[2].kind, contact::BoundaryCondition::Kind::force);
+  EXPECT_EQ(bc[2].force, Eigen::Vector2d(0, -5));
+  EXPECT_EQ(bc[3].edge, "right");
+  EXPECT_EQ(r.problem->loading.factors, (std::vector<double>{0.25, 0.5, 0.75, 1.0}));
+  // Unknown vertex, a traction at a vertex, both edge and vertex, two conditions at one vertex.
+  json bad = small_job();
+  bad["bodies"][0]["boundary"] = {{{"vertex", "middle"}, {"displacement", {{"x", 0}}}},
+                                  {{"vertex", "top_left"}, {"traction", {0, 1}}},
+                                  {{"vertex", "top_right"}, {"edge", "top"}, {"force", {0, 1}}},
+                                  {{"vertex", "bottom_left"}, {"force", {0, 1}}},
+                                  {{"vertex", "bottom_left"}, {"force", {0, 2}}}};
+  r = parse(bad);
+  const std::string text = listing(r);
+  EXPECT_NE(text.find("/bodies/0/boundary/0/vertex: the body has no vertex 'middle'; its vertices are"), std::string::npos) << text;
+  EXPECT_NE(text.find("/bodies/0/boundary/1: a vertex takes a displacement"), std::string::npos) << text;
+  EXPECT_NE(text.find("/bodies/0/boundary/2: give exactly one of edge"), std::string::npos) << text;
+  EXPECT_NE(text.find("/bodies/0/boundary/4/vertex: vertex 'bottom_left' already has a condition at /bodies/0/boundary/3"),
+            std::string::npos) << text;
+  // Loading: both forms, none, a non-positive factor, too many steps, and load steps with adaptivity.
+  for (const auto& [loading, words] : std::vector<std::pair<json, std::string>>{
+           {{{"steps", 2}, {"factors", {1}}}, "give either steps"},
+           {json::object(), "give either steps"},
+           {{{"factors", {0.5, -1}}}, "/loading/factors/1"},
+           {{{"steps", 5000}}, "steps = 5000 is too large"}}) {
+    json j = small_job();
+    j["loading"] = loading;
+    EXPECT_NE(listing(parse(j)).find(words), std::string::npos) << loading.dump() << ": " << listing(parse(j));
+  }
+  json adaptive = small_job();
+  adaptive["loading"] = {{"steps", 2}};
+  adaptive["adaptivity"] = json::object();
+  EXPECT_NE(listing(parse(adaptive)).find("load steps and adaptivity together"), std::string::npos);
+}
+
+TEST(JobBoundary, ExplicitMeshVerticesTakePointLoadsAndBadOnesAreNamed) {
+  json job = small_job();
+  json mesh = explicit_mesh();
+  for (auto& node : mesh["nodes"]) node[1] = node[1].get<double>() - 1.0;  // below the upper block
+  mesh["edges"] = {{"base", {{0, 1}, {1, 2}}}, {"cap", {{5, 4}, {4, 3}}}, {"wall", {{3, 0}}}};
+  mesh["vertices"] = {{"corner", 0}, {"tip", 5}};
+  job["bodies"][1]["mesh"] = mesh;
+  job["bodies"][1]["boundary"] = {{{"edge", "base"}, {"displacement", {{"y", 0}}}},
+                                  {{"vertex", "corner"}, {"displacement", {{"x", 0}}}},
+                                  {{"vertex", "tip"}, {"force", {3, 0}}}};
+  job["contacts"][0]["master"] = "lower.cap";
+  ParseResult r = parse(job);
+  ASSERT_TRUE(r.ok()) << listing(r);
+  EXPECT_EQ(r.problem->bodies[1].mesh.vertices.at("corner"), 0);
+  EXPECT_EQ(r.problem->bodies[1].mesh.vertices.at("tip"), 5);
+  EXPECT_EQ(r.problem->normalized["bodies"][1]["mesh"]["vertices"], mesh["vertices"]);
+  json bad = job;
+  bad["bodies"][1]["mesh"]["vertices"] = {{"corner", 9}, {"b.d", 1}};
+  bad["bodies"][1]["boundary"].erase(2);
+  const std::string text = listing(parse(bad));
+  EXPECT_NE(text.find("/bodies/1/mesh/vertices/corner: vertex 'corner' node index = 9 is out of range"), std::string::npos)
+      << text;
+  EXPECT_NE(text.find("/bodies/1/mesh/vertices/b.d"), std::string::npos) << text;
+  bad = job;
+  bad["bodies"][1]["boundary"][2]["vertex"] = "nose";
+  expect_only_error(parse(bad), "/bodies/1/boundary/2/vertex", "the body has no vertex 'nose'; its vertices are");
 }
 
 TEST(JobErrors, RigidMotionIsNotCheckedForABodyWithOtherErrors) {

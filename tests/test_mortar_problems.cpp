@@ -99,7 +99,7 @@ TEST(MortarHertz, CylinderArcOnGradedNonMatchingBlockMatchesTheFormulaWithDefaul
     const double P = 2.0 * pair.force, R = 10.0;
     const double inv_E_star = 2 * (1 - 0.3 * 0.3) / 2.1e5;
     const double a = std::sqrt(4 * P * R * inv_E_star / M_PI), p0 = 2 * P / (M_PI * a);
-    // The half-width from the profile (p^2 linear in x^2: support.hpp).
+    ASSERT_GT((pair.pressure.array() > 0).count(), 8);
     const double a_fit = contact::testing::hertz_half_width(pair);
     EXPECT_LE(a / 6.0, 0.05);  // small next to the bodies (the cylinder's half model is 6 wide)
     EXPECT_NEAR(a_fit, a, 0.01 * a) << (swapped ? "block slave" : "cylinder slave");

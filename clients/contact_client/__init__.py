@@ -6,7 +6,8 @@ python3-matplotlib (imported only by the commands and functions that need them).
 As a command (clients/contact_client.py, or python3 -m contact_client with clients/ on the path):
 
     contact_client.py submit api/examples/seed_layers.json --wait -o seed.hdf
-    contact_client.py watch ID                # live progress line; reconnects with Last-Event-ID
+    contact_client.py watch ID                # live progress (a tqdm counter on a terminal), resumed with
+                                              # Last-Event-ID after a drop; -q: errors only
     contact_client.py status ID | list | cancel ID | delete ID
     contact_client.py download ID -o seed.hdf [--xmf]
     contact_client.py validate my_job.json

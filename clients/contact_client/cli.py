@@ -24,7 +24,10 @@ def _cmd_submit(c, a):
 
 
 def _follow(c, job_id, a):
+    """Follows the job to its end with the progress display; with -o downloads the result. With -q nothing is
+    printed but errors: a job that does not end SUCCEEDED is one ("error: job ... ended FAILED ...")."""
     out = None
+    progress = None
     try:
         if a.events_out:
             try:
@@ -40,17 +43,23 @@ def _follow(c, job_id, a):
             if e.get("type") == "end":
                 end = e
     finally:
+        if progress:
+            progress.close()
         if out:
             out.close()
     state = word(end.get("state")) if end else None
     if getattr(a, "output", None):
         if end and end.get("result_available") is True:
             c.download(job_id, a.output, xmf=getattr(a, "xmf", False))
-            sys.stderr.write(f"wrote {a.output} ({os.path.getsize(a.output)} bytes)\n")
+            if not a.quiet:
+                sys.stderr.write(f"wrote {a.output} ({os.path.getsize(a.output)} bytes)\n")
         else:
-            sys.stderr.write(f"no result to download (job {state})\n")
+            sys.stderr.write(f"error: no result to download (job {state})\n")
     if state != "SUCCEEDED":
-        sys.stderr.write(f"job {job_id} ended {state}\n")
+        reason = word(end.get("stop_reason")) if end else ""
+        message = word(end.get("message"), 500) if end and end.get("message") else ""
+        sys.stderr.write(f"error: job {job_id} ended {state}" + (f" ({reason})" if reason else "")
+                         + (f": {message}" if message else "") + "\n")
         return EXIT_JOB
     return EXIT_OK
 
@@ -141,8 +150,8 @@ def _cmd_plot(c, a):
             events = read_events(a.events)
         except (OSError, ValueError) as exc:
             raise BadInput(f"cannot read events from {a.events}: {one_line(exc)}") from None
-    plot_result(result, a.output, events=events, warp=a.warp, title=a.title)
-    print(f"wrote {a.output} (1000 x 800 px)")
+    warp = plot_result(result, a.output, events=events, warp=a.warp, title=a.title)
+    print(f"wrote {a.output} (1000 x 800 px; " + (f"mesh displaced x {warp:g})" if warp else "undeformed mesh)"))
     return EXIT_OK
 
 
@@ -169,7 +178,7 @@ def build_parser():
 
     def follow_opts(sp):
         sp.add_argument("-q", "--quiet", action="store_true",
-                        help="no iteration lines when not on a terminal (state changes and the end only)")
+                        help="print nothing but errors (no progress, no state changes, no end line)")
         sp.add_argument("--events-out", metavar="FILE", help="also save every event as NDJSON (for plot --events)")
         sp.add_argument("--retries", type=int, default=5, help="reconnections in a row before giving up (5)")
 
@@ -219,12 +228,14 @@ def build_parser():
     s.set_defaults(func=_cmd_validate)
 
     s = sub.add_parser("plot", parents=[common],
-                       help="plot a result: pressure along each pair, final mesh by von Mises stress")
+                       help="plot a result: pressure along each pair, deformed mesh by von Mises stress")
     s.add_argument("file", metavar="FILE.hdf")
     s.add_argument("-o", "--output", required=True, metavar="PNG")
     s.add_argument("--events", metavar="FILE",
                    help="the job's saved events (--events-out, or NDJSON/SSE from curl): one curve per iteration")
-    s.add_argument("--warp", type=float, default=0.0, help="draw the mesh displaced by this factor")
+    s.add_argument("--warp", type=float, default=None,
+                   help="draw the mesh displaced by this factor times the displacement (default: the factor that "
+                        "makes the largest displacement 4%% of the mesh; 0: undeformed)")
     s.add_argument("--title")
     s.set_defaults(func=_cmd_plot)
     return p

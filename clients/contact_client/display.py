@@ -1,10 +1,9 @@
-"""What the commands print: the live progress of a job and a job's state. Every value comes from the server and
-is formatted through num() / word() / dicts(), which accept anything (a string where a number belongs, a list
-where an object belongs) and never raise."""
+"""What the commands print: the live progress of a job (a tqdm counter on a terminal) and a job's state. Every
+value comes from the server and is formatted through num() / word() / dicts(), which accept anything (a string
+where a number belongs, a list where an object belongs) and never raise."""
 import json
 import shutil
 import sys
-import time
 
 from .errors import one_line
 
@@ -36,76 +35,94 @@ def obj(value):
 
 
 class Progress:
-    """The live progress display of watch and submit --wait, on stderr: one line redrawn in place on a
-    terminal; one plain line per iteration otherwise."""
+    """The live progress display of watch and submit --wait, on stderr.
+
+    On a terminal, with Debian's python3-tqdm: a tqdm counter redrawn in place, with the iteration, what decides
+    convergence (the measure: residuals, or the complementarity and the active set), the force and maximum
+    pressure of each pair, the DOFs of each body and the solver's elapsed time; state changes and adaptive steps
+    are printed above it. Otherwise (a pipe, a log, or no tqdm): one plain line per iteration.
+    quiet: nothing at all (the commands print errors only); events_out still receives every event."""
 
     def __init__(self, stream=None, quiet=False, events_out=None):
         self.out = stream or sys.stderr
-        self.tty = hasattr(self.out, "isatty") and self.out.isatty()
         self.quiet = quiet
-        self.pending = ""        # the last line drawn in place (TTY)
-        self.last_draw = 0.0
-        self.pending_text = None  # a line not drawn yet (redraws are limited to 10 per second)
         self.events_out = events_out
+        self.bar = None
+        self.tqdm = None
+        if not quiet and hasattr(self.out, "isatty") and self.out.isatty():
+            try:
+                from tqdm import tqdm
+                self.tqdm = tqdm
+            except ImportError:  # python3-tqdm missing: plain lines
+                self.tqdm = None
 
     def _line(self, text):
-        if self.tty and self.pending:
-            self.out.write("\n")  # the live line stays, as the last iteration before this line
-            self.pending = ""
-        self.out.write(text + "\n")
-        self.out.flush()
-
-    def _live(self, text, force=False):
-        if not self.tty:
-            if not self.quiet:
-                self._line(text)
+        if self.quiet:
             return
-        now = time.monotonic()
-        if not force and now - self.last_draw < 0.1:
-            self.pending_text = text
+        if self.bar is not None:
+            self.bar.write(text, file=self.out)  # above the bar, which is redrawn below
+        else:
+            self.out.write(text + "\n")
+            self.out.flush()
+
+    def _iteration(self, e):
+        if self.tqdm is None:
+            self._line(format_iteration(e))
+            return
+        iteration = e.get("iteration")
+        if not isinstance(iteration, int) or isinstance(iteration, bool):
             return
         width = shutil.get_terminal_size((100, 20)).columns - 1
-        for candidate in text:
-            if len(candidate) <= width:
-                break
-        self.out.write("\r\x1b[K" + candidate[:max(10, width)])
-        self.out.flush()
-        self.pending = text
-        self.pending_text = None
-        self.last_draw = now
+        tail = len("  [00:00, 0000.00it/s]")
+        forms = compact_iterations(e, elapsed=False)
+        text = next((f for f in forms if len(f) + tail <= width), forms[-1][:max(10, width - tail)])
+        if self.bar is None or iteration < self.bar.n:  # a job run again from the start counts again
+            self._close_bar()
+            # "iter 84  paper 8.96e-05  res 1.34e-02  active 15  force 142.53  p_max 184.47  dofs 16640/16640
+            #  [00:03, 27.1it/s]": tqdm keeps the elapsed time and the rate.
+            self.bar = self.tqdm(desc=text, total=None, file=self.out, unit="it", dynamic_ncols=True,
+                                 mininterval=0.1, bar_format="{desc}  [{elapsed}, {rate_fmt}]")
+        else:
+            self.bar.set_description_str(text, refresh=False)
+        self.bar.update(iteration - self.bar.n)
+
+    def _close_bar(self):
+        if self.bar is not None:
+            self.bar.close()
+            self.bar = None
 
     def note(self, text):
         self._line(text)
+
+    def close(self):
+        self._close_bar()
 
     def __call__(self, e):
         if self.events_out:
             self.events_out.write(json.dumps(e) + "\n")
             self.events_out.flush()
         t = e.get("type")
+        if self.quiet:
+            return
         if t == "iteration":
-            self._live(compact_iterations(e) if self.tty else format_iteration(e))
+            self._iteration(e)
         elif t == "state":
             msg = f": {word(e['message'], 500)}" if e.get("message") else ""
             self._line(f"state {word(e.get('state'))}{msg}")
         elif t == "step":
             bodies = ", ".join(f"{word(b.get('name'))} {num(b.get('elements'), 'd')} cells"
                                for b in dicts(e.get("bodies")))
-            if self.pending_text:
-                self._live(self.pending_text, force=True)
             self._line(f"step {num(e.get('step'), 'd')} at iteration {num(e.get('iteration'), 'd')}: {bodies}")
         elif t == "end":
-            if self.pending_text:
-                self._live(self.pending_text, force=True)
-            if self.tty and self.pending:
-                self.out.write("\n")
-                self.pending = ""
+            if self.bar is not None:
+                self.bar.refresh()
+            self._close_bar()
             conv = word(e.get("stop_reason")) or "?"
             if conv != "converged" and e.get("state") == "SUCCEEDED":
                 conv += ", not converged"
             msg = f": {word(e['message'], 500)}" if e.get("message") else ""
-            self.out.write(f"end {word(e.get('state'))} ({conv}) after {num(e.get('iterations'), 'd')} "
-                           f"iterations, {num(e.get('solve_seconds', 0), '.3g')} s{msg}\n")
-            self.out.flush()
+            self._line(f"end {word(e.get('state'))} ({conv}) after {num(e.get('iterations'), 'd')} "
+                       f"iterations, {num(e.get('solve_seconds', 0), '.3g')} s{msg}")
 
 
 def _measure_parts(e, wide=True):
@@ -119,8 +136,9 @@ def _measure_parts(e, wide=True):
     if measure == "gradient":
         return [f"gradient {num(e.get('fixed_point_residual'), '.2e', 'nan')}", active]
     digits = ".3e" if wide else ".2e"
-    return [f"paper {num(e.get('paper_criterion'), digits, 'nan')}",
-            f"{'residual' if wide else 'res'} {num(e.get('fixed_point_residual'), digits, 'nan')}"]
+    parts = [f"paper {num(e.get('paper_criterion'), digits, 'nan')}",
+             f"{'residual' if wide else 'res'} {num(e.get('fixed_point_residual'), digits, 'nan')}"]
+    return parts if wide else parts + [f"active {num(e.get('active_nodes', 0), 'd')}"]
 
 
 def _label(e):
@@ -145,20 +163,23 @@ def format_iteration(e):
     return "  ".join(parts)
 
 
-def compact_iterations(e):
+def compact_iterations(e, elapsed=True):
     """The terminal's live line, in forms from the fullest to the shortest (the first that fits is drawn):
-    "iter 12  paper 1.23e-03  res 2.22e-02  force 140.9  p_max 166.4  dofs 528/528  0.05s", or for the
-    active-set methods "step 2  active 245 (3 changed)  compl 1.20e-03  force ..." (several pairs or bodies:
-    values joined by '/', in the order of the job)."""
+    "iter 12  paper 1.23e-03  res 2.22e-02  active 15  force 140.9  p_max 166.4  dofs 528/528  0.05s", or for
+    the active-set methods "step 2  active 245 (3 changed)  compl 1.20e-03  force ..." (several pairs or bodies:
+    values joined by '/', in the order of the job). elapsed=False leaves out the solver's elapsed time."""
     pairs, bodies = dicts(e.get("pairs")), dicts(e.get("bodies"))
-    parts = [f"{_label(e)} {num(e.get('iteration', 0), 'd')}"] + _measure_parts(e, wide=False)
+    head = [f"{_label(e)} {num(e.get('iteration', 0), 'd')}"] + _measure_parts(e, wide=False)
+    extra = []  # left out from the end first when the line is too long
     if pairs:
-        parts.append("force " + "/".join(num(p.get("force", 0), ".5g") for p in pairs))
-        parts.append("p_max " + "/".join(num(p.get("max_pressure", 0), ".5g") for p in pairs))
+        extra.append("force " + "/".join(num(p.get("force", 0), ".5g") for p in pairs))
+        extra.append("p_max " + "/".join(num(p.get("max_pressure", 0), ".5g") for p in pairs))
     if bodies:
-        parts.append("dofs " + "/".join(num(b.get("dofs"), "d") for b in bodies))
-    elapsed = [f"{num(e['elapsed_seconds'], '.1f')}s"] if e.get("elapsed_seconds") is not None else []
-    return ["  ".join(parts + elapsed), " ".join(parts + elapsed), " ".join(parts)]
+        extra.append("dofs " + "/".join(num(b.get("dofs"), "d") for b in bodies))
+    seconds = [f"{num(e['elapsed_seconds'], '.1f')}s"] if elapsed and e.get("elapsed_seconds") is not None else []
+    forms = ["  ".join(head + extra + seconds), " ".join(head + extra + seconds)]
+    forms += [" ".join(head + extra[:k]) for k in range(len(extra), -1, -1)]
+    return forms + [" ".join(head[:2])]
 
 
 def print_job(job, out):

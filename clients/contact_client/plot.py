@@ -12,17 +12,48 @@ def _spread(n, k):
     return sorted({round(i * (n - 1) / (k - 1)) for i in range(k)})
 
 
-def plot_result(result, png, events=None, warp=0.0, title=None, max_curves=12):
+def auto_warp(step, fraction=0.04):
+    """The displacement scale that makes the largest displacement of the step `fraction` of the meshes' extent,
+    rounded down to 1, 2 or 5 times a power of ten (0 when nothing moves)."""
+    import numpy as np
+    extent, largest = 0.0, 0.0
+    for b in step["bodies"].values():
+        xy, u = b.get("points"), b.get("displacement")
+        if xy is not None and len(xy):
+            extent = max(extent, float(np.max(xy.max(axis=0) - xy.min(axis=0))))
+        if u is not None and len(u):
+            largest = max(largest, float(np.max(np.hypot(u[:, 0], u[:, 1]))))
+    if largest <= 0 or extent <= 0 or not np.isfinite(largest):
+        return 0.0
+    raw = fraction * extent / largest
+    power = 10.0 ** np.floor(np.log10(raw))
+    return float(max(m for m in (1.0, 2.0, 5.0) if m * power <= raw * (1 + 1e-12)) * power)
+
+
+def contact_pressure(c):
+    """A pair's pressure per slave node, NaN where the node takes no part in the contact (status 1 to 3: not
+    opposite the master, a crosspoint, barely covered; docs/results-format.md), so curves break there."""
+    import numpy as np
+    p = np.asarray(c["pressure"], dtype=float).copy()
+    status = c.get("status")
+    if status is not None and len(status) == len(p):
+        p[np.isin(np.asarray(status), (1, 2, 3))] = np.nan
+    return p
+
+
+def plot_result(result, png, events=None, warp=None, title=None, max_curves=12):
     """Draws one figure of 1000 x 800 pixels (10 x 8 inches at 100 dpi) into png:
 
     top: the contact pressure against x along each pair (one panel per pair), one curve per adaptive step;
          with a single step, the pressure profile of each iteration when `events` (the job's events, a list of
          dicts or a path to saved events) are given (at most max_curves of them, spread over the run), and the
-         final profile from the file;
-    bottom: each body's final mesh, cells coloured by von Mises stress, edges drawn (refinement shows as
-         smaller cells), one colour bar. warp > 0 draws the mesh displaced by warp x displacement.
+         final profile from the file (slave nodes that take no part in the contact are left out);
+    bottom: each body's final mesh, deformed, cells coloured by von Mises stress, edges drawn (refinement shows
+         as smaller cells), the slave edge of each pair in red, one colour bar. The mesh is drawn displaced by
+         warp x displacement: warp=None picks the scale that makes the largest displacement 4 % of the mesh
+         (auto_warp), 0 draws the undeformed mesh.
 
-    result is a path or the dict of read_result(). Returns png."""
+    result is a path or the dict of read_result(). Returns the scale the mesh was drawn with."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.cm
@@ -41,6 +72,8 @@ def plot_result(result, png, events=None, warp=0.0, title=None, max_curves=12):
                        "first iteration)")
     final = steps[-1]
     pair_names = final["pair_names"]
+    if warp is None:
+        warp = auto_warp(final)
     attrs = result["attrs"]
 
     fig = plt.figure(figsize=(10, 8), dpi=100)
@@ -49,7 +82,8 @@ def plot_result(result, png, events=None, warp=0.0, title=None, max_curves=12):
                           hspace=0.32, wspace=0.4)
     name = attrs.get("name") or os.path.basename(result.get("path", ""))
     stop = attrs.get("stop_reason", "")
-    fig.suptitle(title or f"{name}: {attrs.get('iterations', '?')} iterations, {stop}, "
+    iterations = attrs.get("iterations", "?")
+    fig.suptitle(title or f"{name}: {iterations} iteration{'' if iterations == 1 else 's'}, {stop}, "
                  f"{len(steps)} step{'s' if len(steps) != 1 else ''}", fontsize=12)
 
     iteration_profiles = {}
@@ -74,7 +108,8 @@ def plot_result(result, png, events=None, warp=0.0, title=None, max_curves=12):
             for k in _spread(len(steps), max_curves):
                 c = steps[k]["contacts"].get(pair)
                 if c is not None and "x" in c:
-                    curves.append((k, c["x"], c["pressure"], f" (iter {steps[k]['iteration']}, {len(c['x'])} nodes)"))
+                    curves.append((k, c["x"], contact_pressure(c),
+                                   f" (iter {steps[k]['iteration']}, {len(c['x'])} nodes)"))
             span = (0, len(steps) - 1)
         else:
             profiles = iteration_profiles.get(pair, [])
@@ -95,7 +130,7 @@ def plot_result(result, png, events=None, warp=0.0, title=None, max_curves=12):
             sm = matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap)
             fig.colorbar(sm, ax=ax, fraction=0.05, pad=0.02).set_label(what, fontsize=8)
         if "x" in c_final:
-            ax.plot(c_final["x"], c_final["pressure"], color="black", lw=1.5, ls=(0, (5, 3)) if curves else "-",
+            ax.plot(c_final["x"], contact_pressure(c_final), color="black", lw=1.5, ls=(0, (5, 3)) if curves else "-",
                     label=f"final (iter {final['iteration']}, from the file)", zorder=5)
         ax.set_xlabel("x of the slave edge node")
         ax.set_ylabel("contact pressure")
@@ -125,6 +160,17 @@ def plot_result(result, png, events=None, warp=0.0, title=None, max_curves=12):
             centre = (flat.min(axis=0) + flat.max(axis=0)) / 2
             ax.text(centre[0], centre[1], body, ha="center", va="center", fontsize=9, zorder=5,
                     bbox=dict(boxstyle="round,pad=0.2", facecolor="white", alpha=0.75, edgecolor="none"))
+    # The slave edge of each pair, displaced like its body.
+    for pair in pair_names:
+        c = final["contacts"].get(pair, {})
+        body = final["bodies"].get(c.get("attrs", {}).get("slave_body"))
+        nodes = c.get("node")
+        if body is None or nodes is None or not len(nodes):
+            continue
+        xy = body["points"][nodes]
+        if warp and "displacement" in body and len(body["displacement"]) == len(body["points"]):
+            xy = xy + warp * body["displacement"][nodes]
+        ax.plot(xy[:, 0], xy[:, 1], color="red", lw=1.2, zorder=4)
     verts = np.concatenate(polys) if polys else np.zeros((0, 4, 2))
     vals = np.concatenate(values) if values else np.zeros(0)
     # Edges thin out on fine meshes so that the colours still show.
@@ -139,7 +185,7 @@ def plot_result(result, png, events=None, warp=0.0, title=None, max_curves=12):
     ax.set_aspect("equal", adjustable="datalim")  # the panel keeps its size; the shorter side's range grows
     ax.set_xlabel("x")
     ax.set_ylabel("y")
-    ax.set_title("final mesh" + (f" (displacement x {warp:g})" if warp else "") + ": "
+    ax.set_title("final mesh" + (f", deformed (displacement x {warp:g})" if warp else ", undeformed") + ": "
                  + ", ".join(f"{b} {m} cells" + (f", refinement level <= {lv}" if lv else "")
                              for b, m, lv in levels), fontsize=10)
     cb = fig.colorbar(pc, ax=ax, fraction=0.04, pad=0.02)
@@ -147,4 +193,4 @@ def plot_result(result, png, events=None, warp=0.0, title=None, max_curves=12):
     os.makedirs(os.path.dirname(os.path.abspath(png)), exist_ok=True)
     fig.savefig(png, dpi=100)
     plt.close(fig)
-    return png
+    return warp

@@ -38,6 +38,13 @@ struct RefineOutcome {
   bool any = false;
 };
 
+// Notes are joined by "; " (none before the first or after the last).
+void add_note(std::string& notes, const std::string& note) {
+  if (note.empty()) return;
+  if (!notes.empty()) notes += "; ";
+  notes += note;
+}
+
 RefineOutcome mark_and_refine(Problem& problem, const std::vector<IndicatorResult>& eta) {
   const auto& s = problem.adaptivity;
   RefineOutcome out;
@@ -49,9 +56,9 @@ RefineOutcome mark_and_refine(Problem& problem, const std::vector<IndicatorResul
     if (!adapts(s, a) || eta[a].eta.size() == 0) continue;
     auto& mesh = problem.bodies[a].mesh;
     const Marking m = mark(mesh, eta[a].eta, s.delta, s.max_level, s.max_dofs);
-    if (m.dof_limit_hit) out.note += "body '" + problem.bodies[a].name + "': max_dofs reached, refinement cut back; ";
-    if (m.level_limit_hit) out.note += "body '" + problem.bodies[a].name + "': cells at max_level not refined; ";
-    if (!eta[a].note.empty()) out.note += eta[a].note + "; ";
+    if (m.dof_limit_hit) add_note(out.note, "body '" + problem.bodies[a].name + "': max_dofs reached, refinement cut back");
+    if (m.level_limit_hit) add_note(out.note, "body '" + problem.bodies[a].name + "': cells at max_level not refined");
+    add_note(out.note, eta[a].note);
     if (m.cells.empty()) continue;
     out.refinements[a] = mesh::refine(mesh, m.cells, s.max_level);
     out.refined[a] = out.refinements[a].refined_cells;
@@ -121,7 +128,7 @@ ddm::MethodOutcome converge_then_refine(Problem& working, ddm::ContactSystem& sy
     RefineOutcome r = mark_and_refine(working, eta);
     if (!r.any) {
       std::ostringstream os;
-      os << "adaptive: no cell marked after " << step << " refinement steps (" << r.note << "last solve: " << o.message << ")";
+      os << "adaptive: no cell marked after " << step << " refinement steps (" << (r.note.empty() ? "" : r.note + "; ") << "last solve: " << o.message << ")";
       total.message = os.str();
       return total;
     }

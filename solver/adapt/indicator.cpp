@@ -131,18 +131,36 @@ IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fe
     r.note = "body '" + body.name + "': its boundary is not one closed polygon; zz indicator used instead of fem_bem";
     return r;
   }
-  // Boundary conditions per side, from the body's edge sets.
+  // Boundary conditions per side, from the body's edge sets (vertex conditions hold no side).
   std::map<std::pair<int, int>, const BoundaryCondition*> condition;
+  std::map<const BoundaryCondition*, double> edge_length;  // for a total force spread over its edge
+  bool any_support = false;
   for (const auto& bc : body.boundary) {
+    if (!bc.vertex.empty()) continue;
     auto it = m.edge_sets.find(bc.edge);
     if (it == m.edge_sets.end()) continue;
+    any_support = any_support || prescribes_displacement(bc);
     for (const auto& e : it->second) {
       const auto n = m.edge_nodes(e);
       condition[key(n[0], n[1])] = &bc;
+      edge_length[&bc] += (m.nodes[static_cast<size_t>(n[1])] - m.nodes[static_cast<size_t>(n[0])]).norm();
     }
   }
+  if (!any_support) {
+    // Tractions all round (a floating body, or one held at vertices only): the boundary-element problem is
+    // determined only up to a rigid motion, which this collocation does not remove.
+    IndicatorResult r = zz_indicator(body, solver, u, normalization);
+    r.note = "body '" + body.name + "': no edge with a prescribed displacement; zz indicator used instead of fem_bem";
+    return r;
+  }
+  const double factor = solver.load_factor();
+  // Point loads join the contact forces: both are nodal forces, lumped over the sides next to their node.
+  Eigen::VectorXd nodal_load = contact_load.size() ? contact_load : Eigen::VectorXd::Zero(2 * m.num_nodes());
+  for (const auto& bc : body.boundary)
+    if (!bc.vertex.empty() && bc.kind == BoundaryCondition::Kind::force)
+      for (int node : condition_nodes(m, bc)) nodal_load.segment<2>(2 * node) += factor * bc.force;
   const size_t nb = loop.size();
-  // Contact forces to tractions: lumped over the boundary sides that carry them.
+  // Nodal forces to tractions: lumped over the boundary sides that carry them.
   std::vector<double> half_length(nb, 0.0);
   for (size_t i = 0; i < nb; ++i) {
     const double L = (m.nodes[static_cast<size_t>(loop[(i + 1) % nb])] - m.nodes[static_cast<size_t>(loop[i])]).norm();
@@ -164,16 +182,18 @@ IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fe
     Eigen::Vector2d traction = Eigen::Vector2d::Zero();
     if (bc && bc->kind == BoundaryCondition::Kind::traction)
       traction = bc->normal_pressure ? Eigen::Vector2d(-bc->pressure * outward.normalized()) : bc->traction;
+    if (bc && bc->kind == BoundaryCondition::Kind::force) traction = bc->force / (edge_length[bc] * thickness);
+    traction *= factor;
     for (int comp = 0; comp < 2; ++comp) {
-      const bool prescribed = bc && bc->kind == BoundaryCondition::Kind::displacement && (comp == 0 ? bc->ux : bc->uy);
+      const bool prescribed = bc && (comp == 0 ? bc->ux : bc->uy);
       el.displacement_prescribed[static_cast<size_t>(comp)] = prescribed;
       if (prescribed) {
         el.value(comp, 0) = u[2 * a + comp];
         el.value(comp, 1) = u[2 * b + comp];
       } else {
         // Contact forces are per thickness-weighted length: divide the lumped force by length x thickness.
-        const double ta = contact_load.size() ? contact_load[2 * a + comp] / (half_length[i] * thickness) : 0.0;
-        const double tb = contact_load.size() ? contact_load[2 * b + comp] / (half_length[(i + 1) % nb] * thickness) : 0.0;
+        const double ta = nodal_load[2 * a + comp] / (half_length[i] * thickness);
+        const double tb = nodal_load[2 * b + comp] / (half_length[(i + 1) % nb] * thickness);
         el.value(comp, 0) = traction[comp] + ta;
         el.value(comp, 1) = traction[comp] + tb;
       }

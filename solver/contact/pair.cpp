@@ -31,8 +31,8 @@ double analytic_gap(const GapSpec& spec, const Eigen::Vector2d& x) {
 std::map<int, std::array<bool, 2>> prescribed_components(const Body& body) {
   std::map<int, std::array<bool, 2>> out;
   for (const auto& bc : body.boundary) {
-    if (bc.kind != BoundaryCondition::Kind::displacement) continue;
-    for (int node : body.mesh.edge_set_nodes(bc.edge)) {
+    if (!prescribes_displacement(bc)) continue;
+    for (int node : condition_nodes(body.mesh, bc)) {
       auto& p = out[node];
       p[0] = p[0] || bc.ux.has_value();
       p[1] = p[1] || bc.uy.has_value();

@@ -180,8 +180,14 @@ ActiveSetResult solve_active_set(const Eigen::MatrixXd& H, const Eigen::VectorXd
   Eigen::VectorXd z = z0 && z0->size() == n ? *z0 : Eigen::VectorXd::Zero(n);
   Eigen::VectorXd h = g + H * z;
   std::vector<char> active = predict(z, h);
-  // A floating body's position is part of the answer: without a guess, start from every node in contact.
-  if (!eq.empty() && !(z0 && z0->size() == n)) active.assign(static_cast<size_t>(n), 1);
+  // A floating body's position is part of the answer (alpha), so the gaps of a guess z0 alone predict nothing:
+  // start from the nodes the guess presses, or from every node in contact without a guess.
+  if (!eq.empty()) {
+    if (z0 && z0->size() == n)
+      for (Eigen::Index j = 0; j < n; ++j) active[static_cast<size_t>(j)] = (*z0)[j] > 0;
+    else
+      active.assign(static_cast<size_t>(n), 1);
+  }
   std::set<std::vector<char>> seen;
   out.z = z;
   out.h = h;

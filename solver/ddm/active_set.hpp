@@ -58,8 +58,8 @@ struct ActiveSetResult {
 using StepCallback = std::function<bool(const Eigen::VectorXd& z, const Eigen::VectorXd& h, const ActiveSetStep&)>;
 
 // on_step is called after every step with the current z and h; returning false cancels. `z0` (optional, same
-// size as g) gives the first active set {z0 - h(z0) / H_jj > 0}; without it, the nodes where g < 0, or every node
-// when there are equalities (a floating body's own position is not known before the solve).
+// size as g) gives the first active set {z0 - h(z0) / H_jj > 0} ({z0 > 0} with equalities: a floating body's
+// own position is not known before the solve); without it, the nodes where g < 0, or every node with equalities.
 ActiveSetResult solve_active_set(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int max_steps,
                                  const StepCallback& on_step, const Eigen::VectorXd* z0 = nullptr,
                                  const Equalities& equalities = {});

@@ -84,6 +84,7 @@ void ContactSystem::rebuild(const std::vector<char>& changed, TaskRunner& runner
     bodies_[a].reset();  // free the old factorisation first
     bodies_[a] = std::make_unique<fem::BodySolver>(problem_.bodies[a], problem_.model, factorization_ != Factorization::none,
                                                    interface_dofs(a), may_float(a));
+    bodies_[a]->set_load_factor(load_factor_);
   });
   for (size_t a : todo) {
     if (!bodies_[a]->ok()) append_error(error_, bodies_[a]->error());

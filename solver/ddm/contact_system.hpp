@@ -51,6 +51,13 @@ class ContactSystem {
   double setup_seconds() const { return setup_seconds_; }
   double factorization_seconds() const { return factorization_seconds_; }  // summed over bodies
 
+  // The load factor of every body (load steps): scales the bodies' loads and prescribed values.
+  void set_load_factor(double factor) {
+    load_factor_ = factor;
+    for (auto& b : bodies_) b->set_load_factor(factor);
+  }
+  double load_factor() const { return load_factor_; }
+
   // Augmented-Lagrangian multipliers of pair k per row (an empty vector: none).
   void set_multipliers(size_t k, Eigen::VectorXd rows) { pairs_[k].multiplier = std::move(rows); }
 
@@ -107,6 +114,7 @@ class ContactSystem {
   std::vector<mortar::PenaltyChoice> penalties_;
   std::string error_;
   double setup_seconds_ = 0.0, factorization_seconds_ = 0.0;
+  double load_factor_ = 1.0;
 };
 
 // Relative norm used by both stopping tests: ||a - b|| / max(||a||, ||b||), 0 when both vanish.

@@ -30,7 +30,7 @@ std::string InterfaceNewton::unheld_bodies(const std::vector<Eigen::Index>& rows
 
 std::vector<Eigen::VectorXd> InterfaceNewton::rigid_amplitudes(const Eigen::VectorXd& alpha) const {
   std::vector<Eigen::VectorXd> out(system_.n_bodies());
-  if (alpha.size() != problem_.equilibrium().G.rows()) return out;
+  if (alpha.size() != problem_.equilibrium().G.rows()) return out;  // (G does not depend on the load)
   for (const auto& f : problem_.floating()) out[f.body] = alpha.segment(f.offset, f.count);
   return out;
 }
@@ -55,6 +55,7 @@ MethodOutcome InterfaceNewton::solve(const SolverSettings& settings, RunContext&
     }
   }
 
+  const Equalities equilibrium = ip.equilibrium();
   // The first active set: from the previous solve (augmented-Lagrangian updates), else from the nested coarse
   // solves (active_set.hpp), which keeps the number of steps independent of the mesh.
   std::string first_note;
@@ -68,7 +69,7 @@ MethodOutcome InterfaceNewton::solve(const SolverSettings& settings, RunContext&
         position[ip.offset(k) + r] = pairs[k].node_arc[pairs[k].node_of_row[static_cast<size_t>(r)]];
       }
     std::vector<std::pair<Eigen::Index, int>> levels;
-    z0 = nested_initial_guess(H, g, line, position, ip.equilibrium(), &levels);
+    z0 = nested_initial_guess(H, g, line, position, equilibrium, &levels);
     if (!levels.empty()) {
       std::ostringstream os;
       os << "first active set from coarse solves:";
@@ -79,7 +80,8 @@ MethodOutcome InterfaceNewton::solve(const SolverSettings& settings, RunContext&
 
   std::vector<std::vector<char>> previous_active;
   const Eigen::VectorXd penalty_diagonal = H.diagonal() - ip.compliance().diagonal();  // theta area (0: exact)
-  const Eigen::VectorXd shift = g - ip.free_gap();                                      // -theta area lambda
+  const Eigen::VectorXd free_gap = ip.free_gap();
+  const Eigen::VectorXd shift = g - free_gap;                                           // -theta area lambda
   auto on_step = [&](const Eigen::VectorXd& z, const Eigen::VectorXd& h, const ActiveSetStep& step) {
     // The reported gaps are the physical ones: h without the penalty's theta area z and the multipliers' shift.
     const Eigen::VectorXd gap = h - penalty_diagonal.cwiseProduct(z) - shift;
@@ -96,7 +98,7 @@ MethodOutcome InterfaceNewton::solve(const SolverSettings& settings, RunContext&
   const int max_steps = std::max(1, settings.max_iterations);
   const ActiveSetResult result = solve_active_set(H, g, max_steps, on_step,
                                                   z0.size() == m && z0.cwiseAbs().maxCoeff() > 0 ? &z0 : nullptr,
-                                                  ip.equilibrium());
+                                                  equilibrium);
   last_z_ = result.z;
   out.iterations = result.steps;
   if (result.cancelled) {

@@ -39,10 +39,12 @@ InterfaceProblem::InterfaceProblem(const ContactSystem& system, TaskRunner& runn
   for (size_t k = 0; k < pairs.size(); ++k) offset_[k + 1] = offset_[k] + pairs[k].n_rows();
   const Eigen::Index m = offset_.back();
   D_.resize(m);
-  g_free_.resize(m);
+  gap0_.resize(m);
+  g_loads_ = Eigen::VectorXd::Zero(m);
+  factor_ = system.load_factor();
   for (size_t k = 0; k < pairs.size(); ++k) {
     D_.segment(offset_[k], pairs[k].n_rows()) = pairs[k].area;
-    g_free_.segment(offset_[k], pairs[k].n_rows()) = pairs[k].gap0;
+    gap0_.segment(offset_[k], pairs[k].n_rows()) = pairs[k].gap0;
   }
   const size_t n_bodies = system.n_bodies();
   std::vector<BodyRows> rows(n_bodies);
@@ -92,7 +94,7 @@ InterfaceProblem::InterfaceProblem(const ContactSystem& system, TaskRunner& runn
   for (size_t a = 0; a < n_bodies; ++a) {
     const BodyRows& R = rows[a];
     for (size_t i = 0; i < R.rows.size(); ++i) {
-      g_free_[R.rows[i]] += g_body[a][static_cast<Eigen::Index>(i)];
+      g_loads_[R.rows[i]] += g_body[a][static_cast<Eigen::Index>(i)];
       for (size_t j = 0; j < R.rows.size(); ++j)
         F_(R.rows[i], R.rows[j]) += F_body[a](static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j));
     }
@@ -108,6 +110,14 @@ InterfaceProblem::InterfaceProblem(const ContactSystem& system, TaskRunner& runn
     for (size_t i = 0; i < R.rows.size(); ++i) equilibrium_.G.block(f.offset, R.rows[i], f.count, 1) = G_body[f.body].col(static_cast<Eigen::Index>(i));
     equilibrium_.e.segment(f.offset, f.count) = e_body[f.body];
   }
+}
+
+Eigen::VectorXd InterfaceProblem::free_gap() const {
+  return gap0_ + (system_.load_factor() / factor_) * g_loads_;
+}
+
+Equalities InterfaceProblem::equilibrium() const {
+  return Equalities{equilibrium_.G, (system_.load_factor() / factor_) * equilibrium_.e};
 }
 
 Pressures InterfaceProblem::split(const Eigen::VectorXd& stacked) const {

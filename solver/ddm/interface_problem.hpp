@@ -30,7 +30,8 @@ class InterfaceProblem {
 
   Eigen::Index size() const { return F_.rows(); }
   const Eigen::MatrixXd& compliance() const { return F_; }    // F (weighted gap per unit nodal pressure)
-  const Eigen::VectorXd& free_gap() const { return g_free_; }  // weighted gaps with no contact force
+  // Weighted gaps with no contact force, at the system's current load factor (the bodies' part scales with it).
+  Eigen::VectorXd free_gap() const;
   const Eigen::VectorXd& weights() const { return D_; }       // area of every row, stacked
   Eigen::Index offset(size_t pair) const { return offset_[pair]; }
 
@@ -44,8 +45,8 @@ class InterfaceProblem {
     Eigen::Index offset = 0, count = 0;
   };
   const std::vector<Floating>& floating() const { return floating_; }
-  // The equilibrium of the floating bodies, G z = e (empty without floating bodies).
-  const Equalities& equilibrium() const { return equilibrium_; }
+  // The equilibrium of the floating bodies, G z = e, at the current load factor (empty without floating bodies).
+  Equalities equilibrium() const;
 
   // The bodies' displacements for pressures z and rigid-mode amplitudes alpha (empty without floating bodies):
   // one solve per body, in parallel.
@@ -55,7 +56,8 @@ class InterfaceProblem {
   const ContactSystem& system_;
   std::vector<Eigen::Index> offset_;
   Eigen::MatrixXd F_;
-  Eigen::VectorXd g_free_, D_;
+  Eigen::VectorXd gap0_, g_loads_, D_;  // g_loads_: the bodies' free responses' gaps at load factor factor_
+  double factor_ = 1.0;
   std::vector<Floating> floating_;
   Equalities equilibrium_;
 };

@@ -72,7 +72,7 @@ Stacked stack(const ContactSystem& system, bool shift_by_multipliers) {
       for (SpMat::InnerIterator it(Bs, col); it; ++it) tb.emplace_back(s.row_offset[k] + it.row(), s.offset[sb] + it.col(), -it.value());
     for (int col = 0; col < Bm.outerSize(); ++col)
       for (SpMat::InnerIterator it(Bm, col); it; ++it) tb.emplace_back(s.row_offset[k] + it.row(), s.offset[mb] + it.col(), it.value());
-    Eigen::VectorXd g0 = pair.gap0 + pair.Gm * cm.g() - pair.Gs * cs.g();
+    Eigen::VectorXd g0 = pair.gap0 + pair.Gm * system.body(mb).prescribed() - pair.Gs * system.body(sb).prescribed();
     if (shift_by_multipliers && pair.multiplier.size() == pair.n_rows())
       g0 -= pair.theta * pair.area.cwiseProduct(pair.multiplier);  // the augmented Lagrangian's shifted gap
     s.g0.segment(s.row_offset[k], pair.n_rows()) = g0;
@@ -93,7 +93,7 @@ Stacked stack(const ContactSystem& system, bool shift_by_multipliers) {
 Displacements to_bodies(const ContactSystem& system, const Stacked& s, const Eigen::VectorXd& x) {
   Displacements u(system.n_bodies());
   for (size_t a = 0; a < u.size(); ++a)
-    u[a] = system.body(a).constraints().expand(x.segment(s.offset[a], system.body(a).n_free()));
+    u[a] = system.body(a).expand(x.segment(s.offset[a], system.body(a).n_free()));
   return u;
 }
 
@@ -109,7 +109,11 @@ MethodOutcome run_exact(const ContactSystem& system, const SolverSettings& setti
   const Eigen::Index n = s.b.size(), m = s.g0.size();
   const Eigen::SparseMatrix<double, Eigen::RowMajor> Brows = s.B;
   Eigen::VectorXd x = Eigen::VectorXd::Zero(n), z = Eigen::VectorXd::Zero(m);
-  std::vector<char> active(static_cast<size_t>(m), 0);
+  // A floating body is held only by its contacts: start with every contact node active (the saddle-point system
+  // of an empty active set would be singular), and let the active set shrink to the nodes that press.
+  bool floating = false;
+  for (size_t a = 0; a < system.n_bodies(); ++a) floating = floating || system.body(a).floating();
+  std::vector<char> active(static_cast<size_t>(m), floating ? 1 : 0);
   bool first = true;
   std::vector<std::vector<char>> report_active;
   std::vector<Eigen::VectorXd> zone(system.n_bodies());
@@ -145,10 +149,15 @@ MethodOutcome run_exact(const ContactSystem& system, const SolverSettings& setti
     lu.compute(kkt);
     if (lu.info() != Eigen::Success) {
       out.reason = StopReason::error;
-      out.message = "monolithic: the saddle-point system of the active set could not be factorised (" + lu.lastErrorMessage() + ")";
+      out.message = std::string("monolithic: the saddle-point system of the active set is singular (") +
+                    (floating ? "a floating body is not held by the contact nodes in contact: " : "") +
+                    lu.lastErrorMessage() + ")";
       return out;
     }
-    const Eigen::VectorXd solution = lu.solve(rhs);
+    // Two steps of iterative refinement: the saddle-point matrix mixes stiffnesses and lengths, and the unsymmetric
+    // LU loses a few digits on it.
+    Eigen::VectorXd solution = lu.solve(rhs);
+    for (int refine = 0; refine < 2; ++refine) solution += lu.solve(Eigen::VectorXd(rhs - kkt * solution));
     x = solution.head(n);
     z.setZero();
     for (Eigen::Index i = 0; i < na; ++i) z[A[i]] = solution[n + i];
@@ -221,6 +230,8 @@ MethodOutcome run_penalty(const ContactSystem& system, const SolverSettings& set
   };
 
   Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
+  bool floating = false;
+  for (size_t a = 0; a < system.n_bodies(); ++a) floating = floating || system.body(a).floating();
   std::vector<std::vector<char>> active_report;
   std::vector<Eigen::VectorXd> zone(system.n_bodies());
   {
@@ -236,17 +247,19 @@ MethodOutcome run_penalty(const ContactSystem& system, const SolverSettings& set
       out.message = "cancelled";
       break;
     }
-    // Newton matrix on the current active set: K + B^T W_A B.
+    // Newton matrix on the current active set: K + B^T W_A B. With a floating body the first step also counts
+    // the touching nodes (g = 0) as active, or the matrix would be singular.
     const Eigen::VectorXd g = s.g0 + s.B * x;
     Eigen::VectorXd wa = Eigen::VectorXd::Zero(g.size());
     for (Eigen::Index r = 0; r < g.size(); ++r)
-      if (g[r] < 0) wa[r] = w_over_theta[r];
+      if (g[r] < 0 || (k == 1 && floating && g[r] <= 0)) wa[r] = w_over_theta[r];
     const SpMat H = s.K + SpMat(s.B.transpose() * wa.asDiagonal() * s.B);
     const Eigen::VectorXd grad = gradient(x);
     factor.compute(H);
     if (factor.info() != Eigen::Success) {
       out.reason = StopReason::error;
-      out.message = "monolithic: the Newton matrix could not be factorised";
+      out.message = std::string("monolithic: the Newton matrix could not be factorised") +
+                    (floating ? " (a floating body is not held by the contact nodes in contact)" : "");
       break;
     }
     const Eigen::VectorXd step = factor.solve(-grad);

@@ -33,8 +33,8 @@ class RobinMap final : public BodyMap {
     runner_.run(u.size(), [&](size_t a) {
       const auto& body = system_.body(a);
       const auto& c = body.constraints();
-      const Eigen::VectorXd load = psi_[a] * (u[a] - c.g()) + contact[a];
-      out[a] = c.expand(solve(a, body.reduced_rhs() + c.T().transpose() * load));
+      const Eigen::VectorXd load = psi_[a] * (u[a] - body.prescribed()) + contact[a];
+      out[a] = body.expand(solve(a, body.reduced_rhs() + c.T().transpose() * load));
     });
     return out;
   }

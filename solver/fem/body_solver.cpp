@@ -42,8 +42,8 @@ void BodySolver::setup_constraints() {
       constraints_.add_line(2 * node + c, {{2 * ends.first + c, 0.5}, {2 * ends.second + c, 0.5}});
   std::vector<PrescribedDof> prescribed;
   for (const auto& bc : body_.boundary) {
-    if (bc.kind != BoundaryCondition::Kind::displacement) continue;
-    for (int node : body_.mesh.edge_set_nodes(bc.edge)) {
+    if (!prescribes_displacement(bc)) continue;
+    for (int node : condition_nodes(body_.mesh, bc)) {
       if (bc.ux) {
         constraints_.add_dirichlet(2 * node, *bc.ux);
         prescribed.push_back({node, 0});
@@ -108,17 +108,29 @@ void BodySolver::assemble_system() {
   const bool has_body_force = body_.body_force.squaredNorm() > 0;
 
   // Edge tractions: constant over each straight side, so the consistent load is half the side's force at
-  // each end node (exact). A normal pressure p acts as t = -p n with n the outward normal.
+  // each end node (exact). A normal pressure p acts as t = -p n with n the outward normal. A total force on an
+  // edge is the uniform traction force / (length x thickness); at a vertex it is a point load.
   for (const auto& bc : body_.boundary) {
-    if (bc.kind != BoundaryCondition::Kind::traction) continue;
+    if (bc.kind == BoundaryCondition::Kind::force && !bc.vertex.empty()) {
+      for (int node : condition_nodes(m, bc)) f_ext_.segment<2>(2 * node) += bc.force;
+      continue;
+    }
+    if (bc.kind != BoundaryCondition::Kind::traction && bc.kind != BoundaryCondition::Kind::force) continue;
     auto it = m.edge_sets.find(bc.edge);
     if (it == m.edge_sets.end()) continue;
+    double edge_length = 0;
+    for (const auto& e : it->second) {
+      const auto nn = m.edge_nodes(e);
+      edge_length += (m.nodes[static_cast<size_t>(nn[1])] - m.nodes[static_cast<size_t>(nn[0])]).norm();
+    }
     for (const auto& e : it->second) {
       const auto nn = m.edge_nodes(e);
       const Eigen::Vector2d a = m.nodes[static_cast<size_t>(nn[0])], b = m.nodes[static_cast<size_t>(nn[1])];
       const double length = (b - a).norm();
       Eigen::Vector2d t = bc.traction;
-      if (bc.normal_pressure) {
+      if (bc.kind == BoundaryCondition::Kind::force) {
+        t = bc.force / (edge_length * elasticity_.thickness);
+      } else if (bc.normal_pressure) {
         const Eigen::Vector2d outward((b - a).y() / length, -(b - a).x() / length);
         t = -bc.pressure * outward;
       }
@@ -241,6 +253,16 @@ Eigen::MatrixXd BodySolver::solve_reduced(const Eigen::MatrixXd& reduced_rhs) co
   return factor_->solve(reduced_rhs);
 }
 
+Eigen::VectorXd BodySolver::reduced_rhs() const { return load_factor_ * rhs_base_; }
+
+Eigen::VectorXd BodySolver::external_load() const { return load_factor_ * f_ext_; }
+
+Eigen::VectorXd BodySolver::prescribed() const { return load_factor_ * constraints_.g(); }
+
+Eigen::VectorXd BodySolver::expand(const Eigen::VectorXd& x) const {
+  return constraints_.T() * x + load_factor_ * constraints_.g();
+}
+
 Eigen::VectorXd BodySolver::solve_homogeneous(const Eigen::VectorXd& load) const {
   if (n_free() == 0) return Eigen::VectorXd::Zero(n_dofs());
   const Eigen::VectorXd rhs = constraints_.T().transpose() * load;
@@ -248,11 +270,11 @@ Eigen::VectorXd BodySolver::solve_homogeneous(const Eigen::VectorXd& load) const
 }
 
 Eigen::VectorXd BodySolver::solve(const Eigen::VectorXd& extra_load) const {
-  if (n_free() == 0) return constraints_.g();
+  if (n_free() == 0) return prescribed();
   if (!factor_) throw std::logic_error("BodySolver::solve called on a solver built without factorisation");
-  Eigen::VectorXd rhs = rhs_base_;
+  Eigen::VectorXd rhs = load_factor_ * rhs_base_;
   if (extra_load.size() > 0) rhs.noalias() += constraints_.T().transpose() * extra_load;
-  return constraints_.expand(factor_->solve(rhs));
+  return expand(factor_->solve(rhs));
 }
 
 Eigen::VectorXd BodySolver::reactions(const Eigen::VectorXd& u, const Eigen::VectorXd& extra_load) const {
@@ -267,7 +289,7 @@ Eigen::VectorXd BodySolver::reactions(const Eigen::VectorXd& u, const Eigen::Vec
     const CellVector fe = cell_stiffness(m, c, elasticity_) * cell_values(m, c, u);
     for (Eigen::Index i = 0; i < dofs.size(); ++i) r[dofs[i]] += fe[i];
   }
-  r -= f_ext_;
+  r -= load_factor_ * f_ext_;
   if (extra_load.size() > 0) r -= extra_load;
   for (int d = 0; d < r.size(); ++d)
     if (!constraints_.is_dirichlet(d)) r[d] = 0.0;

@@ -64,8 +64,14 @@ class BodySolver {
   // The stiffness of all dofs, assembled on demand (not kept: the solver needs only the reduced one).
   Eigen::SparseMatrix<double> stiffness() const;
   const Eigen::SparseMatrix<double>& reduced_stiffness() const { return K_red_; }
-  const Eigen::VectorXd& external_load() const { return f_ext_; }               // all dofs
-  const Eigen::VectorXd& reduced_rhs() const { return rhs_base_; }              // T^T (f_ext - K g)
+  // The body's own loads and prescribed values are scaled by the load factor (load steps; 1 by default): the
+  // factorisation does not change, only these.
+  void set_load_factor(double factor) { load_factor_ = factor; }
+  double load_factor() const { return load_factor_; }
+  Eigen::VectorXd external_load() const;   // all dofs: tractions, forces, body force
+  Eigen::VectorXd reduced_rhs() const;     // T^T (f_ext - K g)
+  Eigen::VectorXd prescribed() const;      // g: the prescribed values (and 0 elsewhere), all dofs
+  Eigen::VectorXd expand(const Eigen::VectorXd& x) const;  // T x + g
   const Elasticity& elasticity() const { return elasticity_; }
   // The free unknowns behind the interface dofs, in the order of the rows of interface_factor(), and the
   // lower-triangular L_ZZ with L_ZZ L_ZZ^T = the Schur complement of the reduced stiffness on them (both empty
@@ -99,6 +105,7 @@ class BodySolver {
   Eigen::VectorXd f_ext_, rhs_base_;
   std::vector<int> interface_dofs_;
   bool allow_floating_ = false, factorize_ = true;
+  double load_factor_ = 1.0;
   Eigen::MatrixXd rigid_modes_;
   std::vector<std::string> rigid_mode_names_;
   std::vector<int> fixing_dofs_;

@@ -119,11 +119,17 @@ void read_history(hid_t file, ResultFile& r) {
     Handle g = h5::open_group(history, "steps");
     StepHistory& s = r.step_history;
     s.body_names = h5::read_strings_attribute(g, "body_names");
+    s.pair_names = h5::read_strings_attribute(g, "pair_names");
     const auto nb = static_cast<Eigen::Index>(s.body_names.size());
+    const auto np = static_cast<Eigen::Index>(s.pair_names.size());
     s.step = h5::read_vector<int>(g, "step");
     s.iteration = h5::read_vector<int>(g, "iteration");
+    s.load_factor = h5::read_vector<double>(g, "load_factor");
     s.elements = read_matrix<int>(g, "elements", nb);
     s.dofs = read_matrix<int>(g, "dofs", nb);
+    s.force = read_matrix<double>(g, "force", np);
+    s.contact_begin = read_matrix<double>(g, "contact_begin", np);
+    s.contact_end = read_matrix<double>(g, "contact_end", np);
   }
 }
 
@@ -148,6 +154,13 @@ BodyField read_body(hid_t bodies, const std::string& name) {
   b.von_mises_cell = read_column<double>(g, "von_mises");
   if (h5::has_link(g, "indicator")) b.indicator_cell = read_column<double>(g, "indicator");
   b.reaction = read_matrix<double>(g, "reaction", 2);
+  if (h5::has_attribute(g, "free_motions")) {
+    b.free_motions = h5::read_strings_attribute(g, "free_motions");
+    const auto c = h5::read_attribute_array<double>(g, "rigid_center");
+    const auto m = h5::read_attribute_array<double>(g, "rigid_motion");
+    if (c.size() == 2) b.rigid_center = Eigen::Vector2d(c[0], c[1]);
+    if (m.size() == 3) b.rigid_motion = Eigen::Vector3d(m[0], m[1], m[2]);
+  }
   return b;
 }
 
@@ -184,6 +197,7 @@ void read_steps(hid_t file, ResultFile& r) {
     Step s;
     s.index = k;
     s.iteration = h5::read_attribute<std::int32_t>(g, "iteration");
+    s.load_factor = h5::read_attribute<double>(g, "load_factor");
     Handle bodies = h5::open_group(g, "bodies");
     for (const auto& name : h5::read_strings_attribute(g, "body_names")) s.bodies.push_back(read_body(bodies, name));
     Handle contacts = h5::open_group(g, "contacts");

@@ -70,9 +70,11 @@ struct IterationHistory {
 
 // /history/steps: one row per adaptive step. dofs = 2 x nodes (see the format document).
 struct StepHistory {
-  std::vector<std::string> body_names;
+  std::vector<std::string> body_names, pair_names;
   std::vector<int> step, iteration;
+  std::vector<double> load_factor;
   Eigen::MatrixXi elements, dofs;
+  Eigen::MatrixXd force, contact_begin, contact_end;  // S x P
 };
 
 // How a string attribute is stored (VTKHDF's Type must be fixed-length with size == its text length).

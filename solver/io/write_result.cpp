@@ -206,26 +206,52 @@ void write_step_history(hid_t history, const Result& result) {
   const auto n = static_cast<Eigen::Index>(result.steps.size());
   const std::vector<std::string> names =
       result.steps.empty() ? std::vector<std::string>{} : body_names_of(result.steps.front());
+  const std::vector<std::string> pairs =
+      result.steps.empty() ? std::vector<std::string>{} : pair_names_of(result.steps.front());
   const auto nb = static_cast<Eigen::Index>(names.size());
+  const auto np = static_cast<Eigen::Index>(pairs.size());
   std::vector<std::int32_t> step, iteration;
+  std::vector<double> load_factor;
   Eigen::MatrixXi elements(n, nb), dofs(n, nb);
+  Eigen::MatrixXd force(n, np), contact_begin(n, np), contact_end(n, np);
   for (Eigen::Index k = 0; k < n; ++k) {
     const Step& s = result.steps[static_cast<size_t>(k)];
     if (body_names_of(s) != names)
       throw std::runtime_error("step " + rows_text(k) + " does not have the bodies of step 0 in the same order");
+    if (pair_names_of(s) != pairs)
+      throw std::runtime_error("step " + rows_text(k) + " does not have the pairs of step 0 in the same order");
     step.push_back(static_cast<std::int32_t>(k));
     iteration.push_back(s.iteration);
+    load_factor.push_back(s.load_factor);
     for (Eigen::Index b = 0; b < nb; ++b) {
       const mesh::Mesh& m = s.bodies[static_cast<size_t>(b)].mesh;
       elements(k, b) = m.num_cells();
       dofs(k, b) = 2 * m.num_nodes();
     }
+    for (Eigen::Index p = 0; p < np; ++p) {
+      const PairField& pair = s.pairs[static_cast<size_t>(p)];
+      force(k, p) = pair.force;
+      // The contact zone along the slave edge: arc length of the first and last node in contact (0, 0 if none).
+      contact_begin(k, p) = contact_end(k, p) = 0.0;
+      bool first = true;
+      for (Eigen::Index j = 0; j < pair.active.size(); ++j) {
+        if (!pair.active[j]) continue;
+        if (first) contact_begin(k, p) = pair.arc_length[j];
+        contact_end(k, p) = pair.arc_length[j];
+        first = false;
+      }
+    }
   }
   h5::write_attribute(g, "body_names", names);
+  h5::write_attribute(g, "pair_names", pairs);
   h5::write_vector(g, "step", step);
   h5::write_vector(g, "iteration", iteration);
+  h5::write_vector(g, "load_factor", load_factor);
   write_matrix(g, "elements", elements);
   write_matrix(g, "dofs", dofs);
+  write_matrix(g, "force", force);
+  write_matrix(g, "contact_begin", contact_begin);
+  write_matrix(g, "contact_end", contact_end);
 }
 
 // ---- steps --------------------------------------------------------------------------------------------
@@ -278,6 +304,11 @@ void write_body(hid_t bodies, const BodyField& b, const std::string& where) {
   write_column(g, "von_mises", b.von_mises_cell);
   if (b.indicator_cell.size() > 0) write_column(g, "indicator", b.indicator_cell);
   write_matrix(g, "reaction", b.reaction);
+  if (!b.free_motions.empty()) {
+    h5::write_attribute(g, "free_motions", b.free_motions);
+    h5::write_attribute_array<double>(g, "rigid_center", {b.rigid_center.x(), b.rigid_center.y()});
+    h5::write_attribute_array<double>(g, "rigid_motion", {b.rigid_motion.x(), b.rigid_motion.y(), b.rigid_motion.z()});
+  }
 }
 
 void write_pair(hid_t contacts, const PairField& p, const std::string& where) {
@@ -332,6 +363,7 @@ void write_steps(hid_t file, const Result& result) {
     const std::string where = "step " + std::to_string(k);
     Handle g = h5::create_group(steps, std::to_string(k));
     h5::write_attribute<std::int32_t>(g, "iteration", s.iteration);
+    h5::write_attribute<double>(g, "load_factor", s.load_factor);
     h5::write_attribute(g, "body_names", body_names_of(s));
     h5::write_attribute(g, "pair_names", pair_names_of(s));
     Handle bodies = h5::create_group(g, "bodies");

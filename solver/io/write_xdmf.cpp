@@ -126,10 +126,19 @@ void write_xdmf(const std::string& xmf_path, const std::string& hdf_file_name, c
       << "<Xdmf Version=\"3.0\">\n"
       << "  <Domain>\n"
       << "    <Grid Name=\"steps\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  // Load steps are timed by their load factor (ParaView's time axis is then the load), when the factors
+  // increase; adaptive steps (all at one load) by their index.
+  bool by_load = result.steps.size() > 1;
+  for (size_t k = 1; k < result.steps.size(); ++k)
+    by_load = by_load && result.steps[k].load_factor > result.steps[k - 1].load_factor;
   for (size_t k = 0; k < result.steps.size(); ++k) {
     const Step& s = result.steps[k];
+    std::ostringstream time;
+    time.precision(17);
+    if (by_load) time << s.load_factor;
+    else time << k;
     out << "    <Grid Name=\"step " << k << "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n"
-        << "      <Time Value=\"" << k << "\"/>\n";
+        << "      <Time Value=\"" << time.str() << "\"/>\n";
     for (const auto& b : s.bodies) w.body("/steps/" + std::to_string(k), b);
     for (const auto& p : s.pairs) w.pair("/steps/" + std::to_string(k), p);
     out << "    </Grid>\n";

@@ -141,6 +141,8 @@ std::optional<GmshBody> GmshMeshes::read(const json& value, const std::string& p
   out.mesh = std::move(s.mesh);
   out.edges = std::move(s.edges);
   out.elsewhere = std::move(s.elsewhere);
+  out.vertices = std::move(s.vertices);
+  out.points_elsewhere = std::move(s.points_elsewhere);
   out.surface = *surface;
   return out;
 }

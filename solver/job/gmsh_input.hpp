@@ -18,6 +18,8 @@ struct GmshBody {
   mesh::Mesh mesh;
   std::vector<std::string> edges;      // physical curves on the surface's boundary (the body's edge names)
   std::vector<std::string> elsewhere;  // the file's other physical curves (for "not on this surface" messages)
+  std::vector<std::string> vertices;   // physical points on the surface (the body's vertex names)
+  std::vector<std::string> points_elsewhere;  // the file's other physical points
   std::string surface;
 };
 

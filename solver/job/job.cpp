@@ -143,6 +143,7 @@ struct MeshInput {
   double dofs = -1.0;        // 2 * nodes, known from the sizes alone; < 0 if unknown
   bool edges_known = false;  // the edge names are known (even if other fields are bad)
   std::vector<std::string> edge_names;
+  std::vector<std::string> vertex_names;  // named vertices (a block's corners, an explicit mesh's "vertices")
   // block
   mesh::BlockSpec block;
   std::map<std::string, std::string> curve_pointers;  // edge name -> pointer of its curve object
@@ -150,6 +151,7 @@ struct MeshInput {
   std::vector<Point> nodes;
   std::vector<mesh::Cell> quads;
   std::vector<std::pair<std::string, std::vector<std::array<int, 2>>>> edge_pairs;
+  std::map<std::string, int> vertices;  // named vertices of an explicit mesh: name -> node
   // gmsh: the surface's mesh, built while reading (gmsh_input.hpp)
   std::optional<GmshBody> gmsh;
 };
@@ -159,17 +161,24 @@ struct BodyInput {
   bool has_name = false;
   Body body;
   MeshInput mesh;
+  std::vector<std::string> free_motions;  // rigid motions its displacement conditions leave free (a floating body)
 };
 
 bool has_edge(const MeshInput& m, const std::string& name) {
   return std::find(m.edge_names.begin(), m.edge_names.end(), name) != m.edge_names.end();
 }
 
-// For a Gmsh body: why `edge`, a physical curve of the file, is not one of its edges; nullopt otherwise.
-std::optional<std::string> curve_elsewhere(const MeshInput& m, const std::string& edge) {
-  if (!m.gmsh || std::find(m.gmsh->elsewhere.begin(), m.gmsh->elsewhere.end(), edge) == m.gmsh->elsewhere.end())
-    return std::nullopt;
-  return "physical curve '" + edge + "' is not on the boundary of surface '" + m.gmsh->surface +
+// For a Gmsh body: why `name`, a physical curve (or, for a vertex, a physical point) of the file, is not one of
+// its edges (vertices); nullopt otherwise.
+std::optional<std::string> gmsh_elsewhere(const MeshInput& m, const std::string& name, bool vertex = false) {
+  if (!m.gmsh) return std::nullopt;
+  const auto& other = vertex ? m.gmsh->points_elsewhere : m.gmsh->elsewhere;
+  if (std::find(other.begin(), other.end(), name) == other.end()) return std::nullopt;
+  if (vertex)
+    return "physical point '" + name + "' is not on surface '" + m.gmsh->surface + "'; " +
+           (m.vertex_names.empty() ? std::string("it has no physical points")
+                                   : "the physical points on it are " + join_names(m.vertex_names));
+  return "physical curve '" + name + "' is not on the boundary of surface '" + m.gmsh->surface +
          "'; the physical curves on its boundary are " + join_names(m.edge_names);
 }
 
@@ -178,8 +187,8 @@ class JobReader {
   JobReader(const json& job, const Limits& limits) : job_(job), limits_(limits), normalized_(job), gmsh_(limits) {}
 
   ParseResult run() {
-    Fields top(job_, "", "the job", {"name", "version", "model", "bodies", "contacts", "solver", "adaptivity"},
-               errors_);
+    Fields top(job_, "", "the job",
+               {"name", "version", "model", "bodies", "contacts", "solver", "adaptivity", "loading"}, errors_);
     if (!top.ok()) return finish();
     read_header(top);
     read_model(top);
@@ -187,7 +196,9 @@ class JobReader {
     read_contacts(top);
     read_solver(top);
     if (const json* a = top.find("adaptivity")) read_adaptivity(*a, top.at("adaptivity"));
+    read_loading(top);
     resolve_method_defaults();
+    check_floating_bodies();
     check_work_limits();
     return finish();
   }
@@ -557,7 +568,10 @@ class JobReader {
     for (auto& in : inputs_) {
       if (!in.mesh.valid) continue;
       build_mesh(in);
-      if (errors_.count_under(in.pointer) == 0) check_restrained(in);
+      if (errors_.count_under(in.pointer) == 0) {
+        check_restrained(in);
+        check_loads_reach_the_body(in);
+      }
     }
   }
 
@@ -617,9 +631,10 @@ class JobReader {
       return;
     }
     const bool block = value.contains("block");
-    const bool arrays = value.contains("nodes") || value.contains("quads") || value.contains("edges");
+    const bool arrays =
+        value.contains("nodes") || value.contains("quads") || value.contains("edges") || value.contains("vertices");
     if (block == arrays) {
-      Fields f(value, pointer, "mesh", {"block", "nodes", "quads", "edges"}, errors_);
+      Fields f(value, pointer, "mesh", {"block", "nodes", "quads", "edges", "vertices"}, errors_);
       errors_.add(pointer, block ? "give either a block or explicit nodes and quads, not both"
                                  : "give either {\"block\": {...}} or explicit \"nodes\" and \"quads\"");
       return;
@@ -638,6 +653,7 @@ class JobReader {
     m.kind = MeshInput::Kind::block;
     m.edges_known = true;
     m.edge_names = {"bottom", "right", "top", "left"};
+    m.vertex_names = {"bottom_left", "bottom_right", "top_right", "top_left"};
     const size_t before = errors_.size();
     Fields f(value, pointer, "block", {"corners", "nx", "ny", "edges", "grading"}, errors_);
     if (!f.ok()) return;
@@ -739,8 +755,12 @@ class JobReader {
     for (const auto& name : m.gmsh->edges)
       if (auto problem = name_problem(name, "physical curve name", limits_.max_name_length, false))
         errors_.add(pointer, "surface '" + m.gmsh->surface + "': " + *problem + " to be used as an edge name");
+    for (const auto& name : m.gmsh->vertices)
+      if (auto problem = name_problem(name, "physical point name", limits_.max_name_length, false))
+        errors_.add(pointer, "surface '" + m.gmsh->surface + "': " + *problem + " to be used as a vertex name");
     m.edges_known = true;
     m.edge_names = m.gmsh->edges;
+    m.vertex_names = m.gmsh->vertices;
     m.dofs = 2.0 * m.gmsh->mesh.num_nodes();
     m.valid = errors_.size() == before;
   }
@@ -791,7 +811,7 @@ class JobReader {
   void read_arrays(const json& value, const std::string& pointer, MeshInput& m, json& out) {
     m.kind = MeshInput::Kind::arrays;
     const size_t before = errors_.size();
-    Fields f(value, pointer, "mesh", {"nodes", "quads", "edges"}, errors_);
+    Fields f(value, pointer, "mesh", {"nodes", "quads", "edges", "vertices"}, errors_);
     const json* nodes = f.require("nodes", "an array of points [[x, y], ...], or use {\"block\": {...}}");
     const json* quads = f.require("quads", "an array of quads [[i, j, k, l], ...] (node indices, counter-clockwise)");
     size_t node_count = 0;
@@ -870,6 +890,26 @@ class JobReader {
       m.edges_known = true;
       set_default(out, "edges", json::object());
     }
+    // Named vertices {"name": node index}: where point loads and point supports go.
+    if (const json* v = f.find("vertices")) {
+      if (!v->is_object()) {
+        errors_.add(f.at("vertices"),
+                    "vertices must be an object {\"name\": node index, ...}, got " + read::type_name(*v));
+      } else {
+        for (const auto& item : v->items()) {
+          const std::string vp = child(f.at("vertices"), item.key());
+          if (auto problem = name_problem(item.key(), "vertex name", limits_.max_name_length, false)) {
+            errors_.add(vp, *problem);
+            continue;
+          }
+          m.vertex_names.push_back(item.key());
+          if (!nodes_ok) continue;
+          if (auto n = index(item.value(), vp, "vertex '" + item.key() + "' node index")) m.vertices[item.key()] = *n;
+        }
+      }
+    } else {
+      set_default(out, "vertices", json::object());
+    }
     m.valid = errors_.size() == before && nodes_ok && !m.quads.empty();
   }
 
@@ -930,31 +970,50 @@ class JobReader {
       errors_.add(pointer, "boundary must be an array of conditions, got " + read::type_name(value));
       return;
     }
-    std::map<std::string, std::string> first_pointer_of_edge;
+    std::map<std::string, std::string> first_pointer_of_place;
     for (size_t j = 0; j < value.size(); ++j) {
       const std::string bp = child(pointer, j);
-      Fields f(value[j], bp, "a boundary condition", {"edge", "displacement", "traction", "free"}, errors_);
+      Fields f(value[j], bp, "a boundary condition", {"edge", "vertex", "displacement", "traction", "force", "free"},
+               errors_);
       if (!f.ok()) continue;
       const size_t before = errors_.size();
       BoundaryCondition bc;
-      if (const json* e = f.require("edge", "the name of one of the body's edges"))
-        if (auto s = read::string(*e, f.at("edge"), "edge", errors_)) {
-          bc.edge = *s;
-          if (in.mesh.edges_known && !has_edge(in.mesh, *s)) {
-            errors_.add(f.at("edge"), curve_elsewhere(in.mesh, *s).value_or(
-                                          "the body has no edge '" + read::shown(*s) + "'; its edges are " +
-                                          join_names(in.mesh.edge_names)));
+      if (f.has("edge") == f.has("vertex")) {
+        errors_.add(bp, "give exactly one of edge (a named edge of the body) and vertex (a named vertex)");
+        continue;
+      }
+      const bool at_vertex = f.has("vertex");
+      const std::string place_key = at_vertex ? "vertex" : "edge";
+      const std::vector<std::string>& names = at_vertex ? in.mesh.vertex_names : in.mesh.edge_names;
+      if (const json* e = f.find(place_key))
+        if (auto s = read::string(*e, f.at(place_key), place_key, errors_)) {
+          (at_vertex ? bc.vertex : bc.edge) = *s;
+          const bool known = std::find(names.begin(), names.end(), *s) != names.end();
+          if (in.mesh.edges_known && !known) {
+            const auto elsewhere = gmsh_elsewhere(in.mesh, *s, at_vertex);
+            errors_.add(f.at(place_key),
+                        elsewhere.value_or("the body has no " + place_key + " '" + read::shown(*s) + "'; " +
+                                           (names.empty() ? std::string("it has no named ") + place_key + "s"
+                                                          : "its " + std::string(at_vertex ? "vertices" : "edges") +
+                                                                " are " + join_names(names))));
           } else {
-            auto [it, inserted] = first_pointer_of_edge.emplace(*s, bp);
+            auto [it, inserted] = first_pointer_of_place.emplace(place_key + ":" + *s, bp);
             if (!inserted)
-              errors_.add(f.at("edge"),
-                          "edge '" + *s + "' already has a condition at " + it->second +
-                              "; give each edge one condition (displacement fixes only its given components)");
+              errors_.add(f.at(place_key), place_key + " '" + *s + "' already has a condition at " + it->second +
+                                               "; give each " + place_key +
+                                               " one condition (displacement fixes only its given components)");
           }
         }
-      const int kinds = int(f.has("displacement")) + int(f.has("traction")) + int(f.has("free"));
-      if (kinds != 1) {
-        errors_.add(bp, "give exactly one of displacement, traction or free");
+      const int loads = int(f.has("traction")) + int(f.has("force"));
+      const int kinds = int(f.has("displacement")) + loads + int(f.has("free"));
+      if (kinds == 0 || loads > 1 || (f.has("free") && kinds > 1)) {
+        errors_.add(bp, "give a displacement, a load (traction or force), a displacement with a load on the other "
+                        "component, or free");
+        continue;
+      }
+      if (at_vertex && (f.has("traction") || f.has("free"))) {
+        errors_.add(bp, "a vertex takes a displacement (a point support) or a force (a point load), not " +
+                            std::string(f.has("traction") ? "a traction (a force per length)" : "free"));
         continue;
       }
       if (const json* d = f.find("displacement")) {
@@ -964,7 +1023,10 @@ class JobReader {
           errors_.add(f.at("displacement"), "give at least one of the components x and y");
         if (const json* x = df.find("x")) bc.ux = read::number(*x, df.at("x"), "displacement x", errors_);
         if (const json* y = df.find("y")) bc.uy = read::number(*y, df.at("y"), "displacement y", errors_);
-      } else if (const json* t = f.find("traction")) {
+        if (loads && bc.ux && bc.uy)
+          errors_.add(bp, "both displacement components are prescribed: a load here would go straight into the support");
+      }
+      if (const json* t = f.find("traction")) {
         bc.kind = BoundaryCondition::Kind::traction;
         if (t->is_object()) {
           Fields tf(*t, f.at("traction"), "traction", {"normal"}, errors_);
@@ -978,11 +1040,25 @@ class JobReader {
           errors_.add(f.at("traction"),
                       "traction must be a vector [tx, ty] or {\"normal\": p}, got " + read::type_name(*t));
         }
-      } else {
+      } else if (const json* fo = f.find("force")) {
+        bc.kind = BoundaryCondition::Kind::force;
+        if (auto v = read::pair(*fo, f.at("force"), "force", errors_)) bc.force = *v;
+      } else if (f.has("free")) {
         bc.kind = BoundaryCondition::Kind::free;
         auto b = read::boolean(*f.find("free"), f.at("free"), "free", errors_);
         if (b && !*b) errors_.add(f.at("free"), "free must be true (an edge without a condition is free anyway)");
       }
+      if (f.has("displacement") && bc.normal_pressure)
+        errors_.add(bp, "a normal pressure cannot be combined with a displacement (part of it would go into the "
+                        "support); give the traction as a vector [tx, ty] along the free component");
+      // A load component along a prescribed displacement component would go straight into the support.
+      const Eigen::Vector2d load = bc.kind == BoundaryCondition::Kind::force ? bc.force
+                                   : bc.kind == BoundaryCondition::Kind::traction && !bc.normal_pressure ? bc.traction
+                                                                                                         : Eigen::Vector2d::Zero();
+      for (int c = 0; c < 2; ++c)
+        if ((c == 0 ? bc.ux : bc.uy) && load[c] != 0.0)
+          errors_.add(bp, std::string("the load's ") + (c == 0 ? "x" : "y") + " component acts where the " +
+                              (c == 0 ? "x" : "y") + " displacement is prescribed: it would go straight into the support");
       if (errors_.size() == before) in.body.boundary.push_back(bc);
     }
   }
@@ -1004,6 +1080,7 @@ class JobReader {
         for (const auto& [name, pairs] : m.edge_pairs)
           if (auto message = mesh::add_edge_set(mesh, name, pairs))
             errors_.add(child(child(mp, "edges"), name), "edge '" + name + "': " + *message);
+      mesh.vertices = std::move(m.vertices);
       check_arrays(mesh, mp);
     }
     // A bad curve can invert every cell of a block: report a few, then how many more, not thousands of lines.
@@ -1038,26 +1115,120 @@ class JobReader {
       }
   }
 
-  void check_restrained(const BodyInput& in) {
+  // Phase 4: the rigid motions a body's displacement conditions leave free. A body that some are free for may
+  // still be held by its contacts (check_floating_bodies decides, once the contacts and the method are known).
+  void check_restrained(BodyInput& in) {
     const mesh::Mesh& mesh = in.body.mesh;
     std::set<fem::PrescribedDof> dofs;
     for (const auto& bc : in.body.boundary) {
-      if (bc.kind != BoundaryCondition::Kind::displacement) continue;
-      auto it = mesh.edge_sets.find(bc.edge);
-      if (it == mesh.edge_sets.end()) continue;
-      for (const auto& side : it->second)
-        for (int node : mesh.edge_nodes(side)) {
-          if (bc.ux) dofs.insert({node, 0});
-          if (bc.uy) dofs.insert({node, 1});
-        }
+      if (!prescribes_displacement(bc)) continue;
+      for (int node : condition_nodes(mesh, bc)) {
+        if (bc.ux) dofs.insert({node, 0});
+        if (bc.uy) dofs.insert({node, 1});
+      }
     }
-    const auto free = fem::free_rigid_motions(mesh, std::vector<fem::PrescribedDof>(dofs.begin(), dofs.end()));
-    if (free.empty()) return;
-    errors_.add(child(in.pointer, "boundary"),
-                "body '" + in.body.name + "' is not restrained against rigid motion: " + join_names(free) +
-                    (free.size() == 1 ? " is" : " are") +
-                    " free; prescribe a displacement component on one of its edges (contact does not hold a body: "
-                    "each body is solved on its own)");
+    in.free_motions = fem::free_rigid_motions(mesh, std::vector<fem::PrescribedDof>(dofs.begin(), dofs.end()));
+  }
+
+  // A traction or force whose every node is held in both directions by displacement conditions would go straight
+  // into the supports and move nothing: almost certainly a mistake in the job, so an error at that condition.
+  void check_loads_reach_the_body(const BodyInput& in) {
+    const mesh::Mesh& mesh = in.body.mesh;
+    std::map<int, std::array<bool, 2>> held;
+    for (const auto& bc : in.body.boundary) {
+      if (!prescribes_displacement(bc)) continue;
+      for (int node : condition_nodes(mesh, bc)) {
+        held[node][0] = held[node][0] || bc.ux.has_value();
+        held[node][1] = held[node][1] || bc.uy.has_value();
+      }
+    }
+    for (size_t j = 0; j < in.body.boundary.size(); ++j) {
+      const auto& bc = in.body.boundary[j];
+      if (bc.kind != BoundaryCondition::Kind::force && bc.kind != BoundaryCondition::Kind::traction) continue;
+      const auto nodes = condition_nodes(mesh, bc);
+      const bool all_held = !nodes.empty() && std::all_of(nodes.begin(), nodes.end(), [&](int node) {
+        auto it = held.find(node);
+        return it != held.end() && it->second[0] && it->second[1];
+      });
+      if (all_held)
+        errors_.add(child(child(in.pointer, "boundary"), j),
+                    std::string("the ") + (bc.kind == BoundaryCondition::Kind::force ? "force" : "traction") + " on " +
+                        (bc.vertex.empty() ? "edge '" + bc.edge + "'" : "vertex '" + bc.vertex + "'") +
+                        " acts only on nodes whose displacement is prescribed in both directions: it would go "
+                        "straight into the supports and load nothing");
+    }
+  }
+
+  // A floating body (free rigid motions) is accepted when it touches another body and the method solves the
+  // interface problem with its equilibrium (interface_newton, monolithic); the fixed-point schemes solve every
+  // body alone with Neumann data on its contact zone, which a floating body cannot take.
+  void check_floating_bodies() {
+    const Method method = problem_.solver.method;
+    for (size_t i = 0; i < inputs_.size(); ++i) {
+      const BodyInput& in = inputs_[i];
+      if (in.free_motions.empty()) continue;
+      const std::string free = join_names(in.free_motions) + (in.free_motions.size() == 1 ? " is" : " are") + " free";
+      bool in_contact = false;
+      for (const auto& c : problem_.contacts)
+        in_contact = in_contact || c.slave_body == static_cast<int>(i) || c.master_body == static_cast<int>(i);
+      if (!in_contact) {
+        errors_.add(child(in.pointer, "boundary"),
+                    "body '" + in.body.name + "' is not restrained against rigid motion (" + free +
+                        ") and touches no other body: prescribe a displacement component on one of its edges or "
+                        "vertices, or give it a contact that can hold it");
+      } else if (method == Method::neumann || method == Method::robin) {
+        errors_.add(method_pointer_.empty() ? child(in.pointer, "boundary") : method_pointer_,
+                    "body '" + in.body.name + "' floats (" + free + ": only its contacts hold it), and method \"" +
+                        (method == Method::neumann ? "neumann" : "robin") +
+                        "\" solves every body on its own with contact tractions as loads, which a floating body "
+                        "cannot take; use method \"interface_newton\" (the default) or \"monolithic\", or restrain "
+                        "the body");
+      }
+    }
+  }
+
+  // "loading": {"steps": N} (factors 1/N, 2/N, ..., 1) or {"factors": [f1, f2, ...]}.
+  void read_loading(const Fields& top) {
+    const json* v = top.find("loading");
+    if (!v) {
+      set_default(normalized_, "loading", json{{"steps", 1}});
+      return;
+    }
+    const std::string pointer = top.at("loading");
+    Fields f(*v, pointer, "loading", {"steps", "factors"}, errors_);
+    if (!f.ok()) return;
+    if (f.has("steps") == f.has("factors")) {
+      errors_.add(pointer, "give either steps (a number of equal load steps) or factors (the load factor of each step)");
+      return;
+    }
+    std::vector<double> factors;
+    if (const json* n = f.find("steps")) {
+      if (auto x = bounded_int(*n, f.at("steps"), "steps", 1, errors_)) {
+        if (*x > limits_.max_load_steps) {
+          errors_.add(f.at("steps"), "steps = " + std::to_string(*x) + " is too large (at most " +
+                                         std::to_string(limits_.max_load_steps) + "): each step is a whole solve");
+          return;
+        }
+        for (int k = 1; k <= *x; ++k) factors.push_back(static_cast<double>(k) / *x);
+      }
+    } else if (const json* list = f.find("factors")) {
+      if (!list->is_array() || list->empty()) {
+        errors_.add(f.at("factors"), "factors must be a non-empty array of positive numbers, got " + read::type_name(*list));
+        return;
+      }
+      if (static_cast<long>(list->size()) > limits_.max_load_steps) {
+        errors_.add(f.at("factors"), "factors has " + std::to_string(list->size()) + " entries: at most " +
+                                         std::to_string(limits_.max_load_steps) + " load steps");
+        return;
+      }
+      for (size_t k = 0; k < list->size(); ++k)
+        if (auto x = positive((*list)[k], child(f.at("factors"), k), "load factor", errors_)) factors.push_back(*x);
+    }
+    if (factors.empty()) return;
+    if (problem_.adaptivity.enabled && factors.size() > 1)
+      errors_.add(pointer, "load steps and adaptivity together are not supported: refine for one load, or step a "
+                           "fixed mesh");
+    problem_.loading.factors = std::move(factors);
   }
 
   // ---- contacts ------------------------------------------------------------------------------------------
@@ -1083,7 +1254,7 @@ class JobReader {
       if (inputs_[b].has_name && inputs_[b].body.name == body) {
         const MeshInput& m = inputs_[b].mesh;
         if (m.edges_known && !has_edge(m, edge)) {
-          errors_.add(pointer, curve_elsewhere(m, edge).value_or("body '" + body + "' has no edge '" + read::shown(edge) +
+          errors_.add(pointer, gmsh_elsewhere(m, edge).value_or("body '" + body + "' has no edge '" + read::shown(edge) +
                                                                  "'; its edges are " + join_names(m.edge_names)));
           return std::nullopt;
         }

@@ -28,6 +28,7 @@ struct Limits {
   int max_iterations = 100'000;        // solver.max_iterations
   int max_updates = 1'000;             // solver.augmented_lagrangian.max_updates
   int max_adaptive_steps = 100;        // adaptivity.max_steps
+  int max_load_steps = 1000;           // loading.steps, or the number of loading.factors
   std::size_t max_name_length = 64;    // body, edge and contact names (identifiers)
   std::size_t max_job_name_length = 256;
   // Gmsh meshes given as {"file": ...} are read relative to this directory (the job file's: parse_file sets it).

@@ -207,6 +207,38 @@ void add_curves(const File& f, const std::unordered_map<std::size_t, int>& local
   }
 }
 
+// Physical points: one whose point lies on this surface (a node of its mesh) becomes a named vertex.
+void add_points(const File& f, const std::unordered_map<std::size_t, int>& local, const std::string& name,
+                Surface& out) {
+  std::map<std::string, std::set<int>> points;  // name -> physical tags (of dimension 0)
+  std::vector<std::string> order;
+  for (const auto& [group, n] : f.physical_names)
+    if (group.first == 0) {
+      if (!points.count(n)) order.push_back(n);
+      points[n].insert(group.second);
+    }
+  for (const auto& point : order) {
+    std::set<int> nodes;  // this surface's nodes among the point's
+    for (const auto& b : f.blocks) {
+      if (b.dim != 0 || !in_groups(f, 0, b.entity, points[point])) continue;
+      for (const auto& element : b.nodes)
+        for (std::size_t tag : element) {
+          auto it = local.find(tag);
+          if (it != local.end()) nodes.insert(it->second);
+        }
+    }
+    if (nodes.empty()) {
+      out.points_elsewhere.push_back(point);
+    } else if (nodes.size() > 1) {
+      out.errors.push_back("physical point '" + point + "' has " + std::to_string(nodes.size()) +
+                           " points on surface '" + name + "': a vertex is one point (give each its own name)");
+    } else {
+      out.mesh.vertices[point] = *nodes.begin();
+      out.vertices.push_back(point);
+    }
+  }
+}
+
 // The circle through all the nodes of each curve entity's lines, where there is one (Gmsh's Circle and
 // Ellipse arcs with equal axes): the boundary sides on it get it as their true geometry, so that refinement puts
 // new nodes on the arc rather than on the chord. Straight and other curves are left to their chords.
@@ -318,6 +350,7 @@ Surface surface(const File& f, const std::string& name) {
   const auto side_count = check_topology(m, raw.tags, name, out.errors);
   if (!out.errors.empty()) return out;
   add_curves(f, local, side_count, name, out);
+  add_points(f, local, name, out);
   add_arcs(f, local, side_count, out.mesh);
   return out;
 }

@@ -164,6 +164,7 @@ Mesh make_block(const BlockSpec& spec) {
   for (int j = ny - 1; j >= 0; --j) l.push_back({cell(0, j), 3});
   for (const auto& [name, c] : spec.curves)
     if (c.kind != Curve::Kind::line) m.edge_curves[name] = c;
+  m.vertices = {{"bottom_left", node(0, 0)}, {"bottom_right", node(nx, 0)}, {"top_right", node(nx, ny)}, {"top_left", node(0, ny)}};
   return m;
 }
 

@@ -84,6 +84,9 @@ struct Mesh {
   // True geometry of single boundary sides, by (smaller node, larger node): the arcs of a Gmsh mesh's curves.
   // Refinement puts a split side's midpoint on its curve and passes the curve on to the two halves.
   std::map<std::pair<int, int>, Curve> side_curves;
+  // Named vertices (point loads and point supports): a block's corners are "bottom_left" (corner 0),
+  // "bottom_right" (1), "top_right" (2) and "top_left" (3). Refinement keeps node indices, so these stay valid.
+  std::map<std::string, int> vertices;
   // Edges split by refinement: (smaller node, larger node) -> midpoint node. A cell side (a, b) whose edge is
   // split carries a hanging node (the neighbour across it is refined); see hanging_nodes().
   std::map<std::pair<int, int>, int> edge_midpoint;
@@ -120,7 +123,8 @@ struct BlockSpec {
 };
 
 // Builds the block mesh with edge sets "bottom", "right", "top", "left" (each ordered counter-clockwise along
-// the boundary). Assumes the spec was validated (nx, ny >= 1, ratios > 0, corners on their curves).
+// the boundary) and the four corners as named vertices. Assumes the spec was validated (nx, ny >= 1, ratios > 0,
+// corners on their curves).
 Mesh make_block(const BlockSpec& spec);
 
 // Completes a parabola or arc Curve for the edge from p to q: for a parabola, fills b and c from a; returns

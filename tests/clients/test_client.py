@@ -52,6 +52,38 @@ def run(*args, url=None, token=None, stdin=None, timeout=60):
                           env=env, timeout=timeout)
 
 
+def run_tty(*args, url=None, columns=120, timeout=60):
+    """The client with its stderr on a terminal (a pseudo-terminal of `columns` columns), as a user sees it:
+    (exit code, stdout, what the terminal received)."""
+    import fcntl
+    import pty
+    import select
+    import termios
+    master, slave = pty.openpty()
+    fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 40, columns, 0, 0))
+    env = {k: v for k, v in os.environ.items() if k not in ("CONTACT_URL", "CONTACT_TOKEN")}
+    env.update(CONTACT_URL=url, COLUMNS=str(columns))
+    proc = subprocess.Popen([sys.executable, CLIENT, *args], stdout=subprocess.PIPE, stderr=slave, env=env)
+    os.close(slave)
+    received, deadline = b"", time.time() + timeout
+    while time.time() < deadline:
+        ready, _, _ = select.select([master], [], [], 0.2)
+        if ready:
+            try:
+                chunk = os.read(master, 65536)
+            except OSError:  # the child closed its end
+                break
+            if not chunk:
+                break
+            received += chunk
+        elif proc.poll() is not None:
+            break
+    os.close(master)
+    out = proc.stdout.read().decode()
+    proc.wait(timeout=10)
+    return proc.returncode, out, received.decode("utf-8", "replace")
+
+
 def png_size(path):
     """(width, height) from the PNG header."""
     with open(path, "rb") as f:
@@ -217,8 +249,15 @@ def test_module(server, tmp):
           and hist.get("pair_names") == [pair], hist.get("pair_names"))
 
     png = os.path.join(tmp, "module_seed.png")
-    cc.plot_result(r, png, events=events)
+    warp = cc.plot_result(r, png, events=events)
     check_png("module plot", png)
+    u = np.concatenate([b["displacement"] for b in r["steps"][-1]["bodies"].values()])
+    check("module plot: the mesh drawn deformed, the largest displacement 2 to 4 % of the mesh's 4 cm",
+          warp > 0 and 0.02 * 4 <= warp * np.abs(np.hypot(u[:, 0], u[:, 1])).max() <= 0.04 * 4 + 1e-12, warp)
+    nodes = {"pressure": np.array([1.0, 2.0, 3.0, 4.0, 5.0]), "status": np.array([0, 1, 2, 3, 4], dtype=np.int8)}
+    p = cc.plot.contact_pressure(nodes)
+    check("module plot: nodes outside the contact (status 1 to 3) break the pressure curve",
+          np.isnan(p[1:4]).all() and p[0] == 1.0 and p[4] == 5.0, p)
 
     check("module: status", c.status(jid).get("state") == "SUCCEEDED")
     listed = c.list()
@@ -324,6 +363,30 @@ def test_cli(server, tmp):
               all(w in lines[-1] for w in ("paper ", "residual ", "dofs upper ", " lower ", "force ", "p_max ")),
               lines[-1])
     check("cli progress ends with the state", "end SUCCEEDED (converged)" in r.stderr, r.stderr[-400:])
+
+    # On a terminal: a tqdm counter redrawn in place with the iteration, the measure, the active set and the
+    # elapsed time; the state changes above it; the end line after it.
+    code, out, screen = run_tty("submit", SEED, "--wait", url=url)
+    check("cli on a terminal: exit 0, the id on stdout", code == 0 and UUID_RE.match(out.strip()), (code, out))
+    redraws = [part.split("\n")[0].rstrip() for part in screen.split("\r") if part.startswith("iter ")]
+    counter = r"^iter \d+ .*  \[\d\d:\d\d, [0-9.?]+ ?it/s\]$"
+    check("cli on a terminal: a tqdm counter redrawn in place",
+          len(redraws) >= 2 and all(re.match(counter, part) for part in redraws), screen[:600])
+    last = redraws[-1] if redraws else ""
+    check("cli on a terminal: iteration, residuals, active set, force, elapsed in the counter",
+          all(w in last for w in ("paper ", "res ", "active ", "force ", "p_max ")), last)
+    check("cli on a terminal: lines fit the terminal", all(len(line) <= 120 for part in screen.split("\r")
+                                                           for line in part.split("\n")), screen[:300])
+    check("cli on a terminal: states above, the end after",
+          "state RUNNING" in screen and re.search(r"end SUCCEEDED \(converged\) after \d+ iterations", screen)
+          and screen.index("state RUNNING") < screen.index("end SUCCEEDED"), screen[-400:])
+
+    # -q: nothing but errors.
+    r = run("submit", SEED, "--wait", "-q", "-o", os.path.join(tmp, "quiet.hdf"), url=url)
+    check("cli -q: silent on success (only the id on stdout)", r.returncode == 0 and r.stderr == ""
+          and UUID_RE.match(r.stdout.strip()) and os.path.exists(os.path.join(tmp, "quiet.hdf")), r)
+    code, out, screen = run_tty("watch", out.strip() or jid, "-q", url=url)
+    check("cli -q on a terminal: silent", code == 0 and screen.strip() == "", repr(screen[:300]))
     check("cli submit -o downloads", os.path.exists(hdf) and os.path.getsize(hdf) > 1000)
     saved = cc.read_events(ev) if os.path.exists(ev) else []
     check("cli --events-out saves every event", [e["seq"] for e in saved] == list(range(1, len(saved) + 1))
@@ -357,6 +420,13 @@ def test_cli(server, tmp):
     r = run("plot", dl, "-o", png, "--events", ev)
     check("cli plot exits 0", r.returncode == 0, r.stdout + r.stderr)
     check_png("cli plot", png)
+    m = re.search(r"mesh displaced x ([0-9.e+-]+)\)", r.stdout)
+    check("cli plot draws the deformed mesh by default (a scale that shows the displacement)",
+          m is not None and float(m.group(1)) >= 10, r.stdout)
+    r = run("plot", dl, "-o", os.path.join(tmp, "flat.png"), "--warp", "0")
+    check("cli plot --warp 0: undeformed", r.returncode == 0 and "undeformed mesh" in r.stdout, r.stdout + r.stderr)
+    check("the deformed and undeformed plots differ",
+          open(png, "rb").read() != open(os.path.join(tmp, "flat.png"), "rb").read())
     r = run("plot", os.path.join(tmp, "missing.hdf"), "-o", os.path.join(tmp, "x.png"))
     check("cli plot of a missing file: exit 2", r.returncode == 2 and r.stderr.startswith("error: "), r.stderr)
 
@@ -399,7 +469,11 @@ def test_cli(server, tmp):
         watcher.kill()
         wout, werr = watcher.communicate()
     check("cli watch of a cancelled job: exit 3, state printed", watcher.returncode == 3
-          and "end CANCELLED" in werr and "ended CANCELLED" in werr, (watcher.returncode, werr[-300:]))
+          and "end CANCELLED" in werr and "error: job " + long_id + " ended CANCELLED (cancelled)" in werr,
+          (watcher.returncode, werr[-300:]))
+    r = run("watch", long_id, "-q", url=url)
+    check("cli watch -q of a cancelled job: exit 3, one error line",
+          r.returncode == 3 and r.stderr.startswith("error: job ") and len(r.stderr.splitlines()) == 1, r.stderr)
     r = run("delete", long_id, url=url)
     check("cli delete", r.returncode == 0, r.stderr)
 

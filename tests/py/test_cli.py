@@ -52,10 +52,29 @@ with tempfile.TemporaryDirectory() as tmp:
     check("one summary line that counts the iterations once",
           len(stop) == 1 and stop[0].count(" after ") == 1 and stop[0].count("iterations") == 1, "\n".join(stop))
 
-    # --version
+    # Notes (here: the adaptive loop's "cells at max_level not refined") are whole sentences joined by "; ",
+    # without a stray separator at either end.
+    with open(os.path.join(SRC, "api", "examples", "seed_layers_adaptive.json")) as f:
+        adaptive = json.load(f)
+    adaptive["adaptivity"]["max_level"] = 1
+    capped = os.path.join(tmp, "capped.json")
+    with open(capped, "w") as f:
+        json.dump(adaptive, f)
+    r = run(capped, "-o", os.path.join(tmp, "capped.hdf"))
+    notes = [line[line.rindex("  [") + 3:-1] for line in r.stdout.splitlines()
+             if line.startswith("iter ") and line.endswith("]")]
+    check("adaptive notes are shown", r.returncode == 0 and any("max_level" in n for n in notes), r.stdout[-600:])
+    check("no note starts or ends with a separator", all(n.strip() == n and not n.endswith(";")
+                                                        and not n.startswith(";") for n in notes), notes[:5])
+
+    # --version, on both programs.
     r = run("--version")
     check("--version exits 0 and names the program", r.returncode == 0 and r.stdout.startswith("contact-solve "),
           r.stdout + r.stderr)
+    r = subprocess.run([os.path.join(BIN, "server", "contactd"), "--version"], capture_output=True, text=True,
+                       timeout=30)
+    check("contactd --version exits 0 and names the program", r.returncode == 0
+          and r.stdout.strip() == "contactd " + run("--version").stdout.split()[-1], r.stdout + r.stderr)
 
     # --validate only checks.
     r = run(EXAMPLE, "--validate")

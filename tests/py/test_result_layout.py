@@ -50,8 +50,9 @@ def expect(condition, message):
 
 
 class Context:
-    def __init__(self, path, job_path=None, bodies=()):
+    def __init__(self, path, job_path=None, bodies=(), floating=()):
         self.path = path
+        self.floating = floating
         self.job_path = job_path
         self.bodies = bodies
         self.f = h5py.File(path, "r")
@@ -143,6 +144,40 @@ def step_history(c):
     expect(g["iteration"].shape == (n,), "history/steps/iteration length")
     expect(g["elements"].shape == (n, nb) and g["dofs"].shape == (n, nb), "history/steps matrix shapes")
     expect(list(g["step"][()]) == list(range(n)), "step column is not 0..n-1")
+    pairs = names(g.attrs["pair_names"])
+    np_ = len(pairs)
+    for name in ("force", "contact_begin", "contact_end"):
+        expect(g[name].shape == (n, np_), f"history/steps/{name} has shape {g[name].shape}, expected {(n, np_)}")
+    expect(g["load_factor"].shape == (n,) and np.all(g["load_factor"][()] > 0), "history/steps/load_factor")
+    expect(np.all(g["contact_begin"][()] <= g["contact_end"][()]), "contact_begin > contact_end")
+    for k in range(n):
+        st = c.f["steps"][str(k)]
+        expect(float(st.attrs["load_factor"]) == float(g["load_factor"][k]), f"step {k} load_factor attribute")
+        for p, pair in enumerate(pairs):
+            group = st["contacts"][pair]
+            expect(float(g["force"][k, p]) == float(group.attrs["force"]), f"step {k} pair {pair} force vs attribute")
+            arc, active = group["arc_length"][()], group["active"][()]
+            if active.any():
+                expect(g["contact_begin"][k, p] == arc[active == 1].min() and g["contact_end"][k, p] == arc[active == 1].max(),
+                       f"step {k} pair {pair} contact zone is not the span of the active nodes")
+
+
+@check
+def floating_bodies(c):
+    """A floating body's group names its free motions and its rigid motion; other bodies have none of them."""
+    steps = c.f["steps"]
+    for k in range(int(steps.attrs["count"])):
+        for body, b in steps[str(k)]["bodies"].items():
+            keys = {"free_motions", "rigid_center", "rigid_motion"} & set(b.attrs.keys())
+            expect(keys in (set(), {"free_motions", "rigid_center", "rigid_motion"}),
+                   f"step {k} body {body} has only {keys} of the floating-body attributes")
+            if keys:
+                expect(len(names(b.attrs["free_motions"])) >= 1, f"step {k} body {body} free_motions empty")
+                expect(b.attrs["rigid_center"].shape == (2,) and b.attrs["rigid_motion"].shape == (3,),
+                       f"step {k} body {body} rigid_center/rigid_motion shapes")
+    for body in c.floating:
+        last = steps[str(int(steps.attrs["count"]) - 1)]["bodies"][body]
+        expect("free_motions" in last.attrs, f"floating body {body} has no free_motions")
 
 
 @check
@@ -309,8 +344,12 @@ def xdmf_sidecar(c):
     children = temporal.findall("Grid")
     expect(len(children) == count, f"{len(children)} step grids for {count} steps")
     hdf_name = os.path.basename(c.path)
+    # Load steps are timed by their (increasing) load factors, adaptive steps by their index.
+    factors = [float(f) for f in c.f["history/steps/load_factor"][()]]
+    by_load = len(factors) > 1 and all(b > a for a, b in zip(factors, factors[1:]))
     for k, step in enumerate(children):
-        expect(step.find("Time").get("Value") == str(k), f"step {k} has Time {step.find('Time').get('Value')}")
+        time = float(step.find("Time").get("Value"))
+        expect(time == (factors[k] if by_load else k), f"step {k} has Time {time}")
         grids = {g.get("Name"): g for g in step.findall("Grid")}
         st = c.f["steps"][str(k)]
         expect(sorted(grids) == sorted(names(st.attrs["body_names"]) + names(st.attrs["pair_names"])),
@@ -330,16 +369,19 @@ def xdmf_sidecar(c):
 
 
 def run_cli(tmp, name, solver="own"):
-    """contact-solve on api/examples/<name> with its own solver settings, or with the defaults (solver="default")."""
+    """contact-solve on api/examples/<name> with its own solver settings, or with the defaults (solver="default"),
+    or with the defaults in 3 load steps (solver="steps")."""
     binary = os.path.join(os.environ.get("CONTACT_BINARY_DIR", "build"), "contact-solve")
     job = os.path.join(os.environ.get("CONTACT_SOURCE_DIR", "."), "api", "examples", name)
     for needed in (binary, job):
         if not os.path.exists(needed):
             raise RuntimeError(f"{needed} does not exist")
-    if solver == "default":
+    if solver in ("default", "steps"):
         with open(job, encoding="utf-8") as fh:
             document = json.load(fh)
         document.pop("solver", None)
+        if solver == "steps":
+            document["loading"] = {"steps": 3}
         job = os.path.join(tmp, "default_" + name)
         with open(job, "w", encoding="utf-8") as fh:
             json.dump(document, fh)
@@ -375,9 +417,11 @@ def main():
             if len(sys.argv) > 1:
                 contexts.append(("", Context(sys.argv[1])))
             else:
-                for name, solver in (("seed_layers.json", "own"), ("seed_layers.json", "default"), ("stack3.json", "default")):
+                for name, solver in (("seed_layers.json", "own"), ("seed_layers.json", "default"), ("stack3.json", "default"),
+                                     ("stack3_floating.json", "steps")):
                     path, job = run_cli(tmp, name, solver)
-                    contexts.append((f"[{solver} {name}] ", Context(path, job_path=job)))
+                    floating = ("middle",) if name == "stack3_floating.json" else ()
+                    contexts.append((f"[{solver} {name}] ", Context(path, job_path=job, floating=floating)))
         except Exception as e:  # a file is unavailable: one failure, nothing else to check
             print(f"FAIL produce a result file: {e}")
             print("0 passed, 1 failed")

@@ -1,17 +1,23 @@
 #!/usr/bin/env python3
-"""api/job.schema.json: it is a valid draft 2020-12 schema, every example job validates against it, it is
-closed (additionalProperties false on every fixed-key object), and bad jobs are rejected for the reason
-expected. Standard library plus Debian's python3-jsonschema; exits non-zero on any failure."""
+"""api/job.schema.json: it is a valid draft 2020-12 schema, every example job validates against it and is
+accepted by the job parser (contact-solve --validate), it is closed (additionalProperties false on every
+fixed-key object), and bad jobs are rejected for the reason expected, by the schema and by the parser at the same
+place. Standard library plus Debian's python3-jsonschema; exits non-zero on any failure.
+(docs/job-format.md against the parser and the schema: test_job_format_doc.py.)"""
 
 import copy
 import glob
 import json
 import os
+import subprocess
 import sys
+import tempfile
 
 from jsonschema import Draft202012Validator
 
 SOURCE = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
+BINARY = os.environ.get("CONTACT_BINARY_DIR", os.path.join(SOURCE, "build"))
+CLI = os.path.join(BINARY, "contact-solve")
 SCHEMA_PATH = os.path.join(SOURCE, "api", "job.schema.json")
 EXAMPLES = sorted(glob.glob(os.path.join(SOURCE, "api", "examples", "*.json")))
 EXPECTED_EXAMPLES = {"seed_layers", "seed_layers_curved", "flat_patch", "flat_patch_nonmatching", "hertz", "stack3"}
@@ -72,6 +78,8 @@ for path in EXAMPLES:
     errs = errors_of(load(path))
     check(f"example {os.path.basename(path)} validates", not errs,
           "; ".join(f"{'/'.join(map(str, e.absolute_path))}: {e.message}" for e in errs))
+    r = subprocess.run([CLI, path, "--validate"], capture_output=True, text=True, timeout=60)
+    check(f"example {os.path.basename(path)} is accepted by the parser", r.returncode == 0, r.stderr[-600:])
 
 # --- bad documents --------------------------------------------------------------------------------------------
 base = load(os.path.join(SOURCE, "api", "examples", "seed_layers.json"))
@@ -83,12 +91,30 @@ def mutated(change):
     return doc
 
 
+def parser_errors(document):
+    """The JSON pointers of the parser's errors for the document (contact-solve --validate, exit code 2)."""
+    with tempfile.NamedTemporaryFile("w", suffix=".json") as f:
+        # Python writes an infinite float as Infinity, which is not JSON: the text a user would write is 1e400.
+        f.write(json.dumps(document).replace("Infinity", "1e400"))
+        f.flush()
+        r = subprocess.run([CLI, f.name, "--validate"], capture_output=True, text=True, timeout=60)
+    if r.returncode != 2:
+        return None
+    return [line.split(": ", 1)[0] for line in r.stderr.splitlines()[1:] if line.startswith("/")]
+
+
 def rejected_at(name, change, path, keyword=None):
-    """The mutated example is invalid, with an error at `path` (a list of keys and indices)."""
-    errs = errors_of(mutated(change))
+    """The mutated example is invalid, with an error at `path` (a list of keys and indices), for the schema and
+    for the parser (whose error is at that place or inside it)."""
+    doc = mutated(change)
+    errs = errors_of(doc)
     at = [e for e in errs if list(e.absolute_path) == path and (keyword is None or e.validator == keyword)]
     check(f"rejects {name}", bool(at),
           "errors were: " + ("; ".join(f"{list(e.absolute_path)} {e.validator}: {e.message}" for e in errs) or "none"))
+    pointer = "".join(f"/{p}" for p in path)
+    found = parser_errors(doc)
+    check(f"the parser rejects {name} too, at {pointer or 'the top'}",
+          found is not None and any(p == pointer or p.startswith(pointer + "/") for p in found), found)
 
 
 rejected_at("an unknown top-level field", lambda d: d.update(solvr={}), [], "additionalProperties")
@@ -128,8 +154,27 @@ check("accepts the fast settings (gamma auto, Anderson, interface Newton, augmen
                                                           robin={"psi": 1e7}))))
 rejected_at("grading towards both bottom and top",
             lambda d: d["bodies"][0]["mesh"]["block"].update(grading={"bottom": 4, "top": 4}), ["bodies", 0, "mesh"])
-rejected_at("a condition with both displacement and traction",
-            lambda d: d["bodies"][0]["boundary"][0].update(traction=[0, 0]), ["bodies", 0, "boundary", 0], "oneOf")
+rejected_at("a condition with both a traction and a force",
+            lambda d: d["bodies"][0]["boundary"][2].update(force=[0, 1]), ["bodies", 0, "boundary", 2], "not")
+rejected_at("a condition on both an edge and a vertex",
+            lambda d: d["bodies"][0]["boundary"][2].update(vertex="top_right"), ["bodies", 0, "boundary", 2], "oneOf")
+rejected_at("a traction at a vertex",
+            lambda d: d["bodies"][0]["boundary"].__setitem__(2, {"vertex": "top_right", "traction": [0, 1]}),
+            ["bodies", 0, "boundary", 2], "not")
+rejected_at("free with a displacement",
+            lambda d: d["bodies"][0]["boundary"][0].update(free=True), ["bodies", 0, "boundary", 0], "not")
+rejected_at("a condition with no kind", lambda d: d["bodies"][0]["boundary"].__setitem__(2, {"edge": "right"}),
+            ["bodies", 0, "boundary", 2], "anyOf")
+check("accepts forces on an edge and at a vertex, and a displacement with a load on its free component",
+      not errors_of(mutated(lambda d: d["bodies"][0].update(boundary=[
+          {"edge": "left", "displacement": {"x": 0}, "traction": [0, -1]},
+          {"edge": "top", "force": [0, -100]},
+          {"vertex": "top_right", "displacement": {"y": 0}, "force": [5, 0]}]))))
+rejected_at("loading with both steps and factors", lambda d: d.update(loading={"steps": 2, "factors": [1]}),
+            ["loading"], "oneOf")
+rejected_at("loading with 0 steps", lambda d: d.update(loading={"steps": 0}), ["loading", "steps"], "minimum")
+rejected_at("a negative load factor", lambda d: d.update(loading={"factors": [0.5, -1]}),
+            ["loading", "factors", 1], "exclusiveMinimum")
 rejected_at("an empty displacement", lambda d: d["bodies"][0]["boundary"][0].update(displacement={}),
             ["bodies", 0, "boundary", 0, "displacement"], "minProperties")
 rejected_at("free = false", lambda d: d["bodies"][0]["boundary"].__setitem__(2, {"edge": "right", "free": False}),
@@ -139,6 +184,13 @@ rejected_at("no bodies", lambda d: d.update(bodies=[]), ["bodies"], "minItems")
 rejected_at("a quad repeating a node",
             lambda d: d["bodies"][0].update(mesh={"nodes": [[0, 0], [1, 0], [1, 1], [0, 1]], "quads": [[0, 1, 1, 3]]}),
             ["bodies", 0, "mesh"])
+gmsh = {"file": "flat_patch_gmsh.msh", "surface": "lower"}
+rejected_at("a gmsh mesh with both file and data",
+            lambda d: d["bodies"][0].update(mesh={"gmsh": {**gmsh, "data": "$MeshFormat"}}), ["bodies", 0, "mesh"])
+rejected_at("a gmsh mesh without its surface",
+            lambda d: d["bodies"][0].update(mesh={"gmsh": {"data": "$MeshFormat"}}), ["bodies", 0, "mesh"])
+rejected_at("a gmsh mesh with a block beside it",
+            lambda d: d["bodies"][0]["mesh"].update(gmsh=gmsh), ["bodies", 0, "mesh"])
 
 # The defaults the schema documents are the solver's (solver/problem.hpp): a spot check of the important ones.
 solver_props = schema["$defs"]["solver"]["properties"]

@@ -75,6 +75,50 @@ with Server() as server, tempfile.TemporaryDirectory() as tmp:
     r = server.get("/readyz")
     check("readyz 200 ready", r.status == 200 and r.json()["status"] == "ready", r)
     check("index links", server.get("/").json()["links"]["jobs"] == "/v1/jobs")
+
+    # --- the web page and the examples, compiled into the binary --------------------------------------------
+    r = server.get("/", headers={"Accept": "text/html,application/xhtml+xml,*/*;q=0.8"})
+    with open(os.path.join(SRC, "server", "web", "index.html"), "rb") as f:
+        check("a browser gets the page at /", r.status == 200 and r.content_type.startswith("text/html")
+              and r.body == f.read(), r)
+    csp = r.headers.get("content-security-policy", "")
+    check("the page has a CSP: scripts from the server only, no inline code",
+          "script-src 'self'" in csp and "unsafe-inline" not in csp and "frame-ancestors 'none'" in csp, csp)
+    check("/ says it varies by Accept", "accept" in r.headers.get("vary", "").lower(), r.headers)
+    web_dir = os.path.join(SRC, "server", "web")
+    web_files = sorted(os.path.relpath(os.path.join(d, n), web_dir) for d, _, names in os.walk(web_dir) for n in names)
+    wrong = []
+    for rel in web_files:
+        if rel == "index.html":
+            continue
+        r = server.get("/web/" + rel)
+        with open(os.path.join(web_dir, rel), "rb") as f:
+            if r.status != 200 or r.body != f.read():
+                wrong.append((rel, r.status))
+    check("every file of server/web is served byte for byte under /web/", len(web_files) >= 8 and not wrong, wrong)
+    r = server.get("/web/app.js")
+    check("scripts as text/javascript, nosniff", r.content_type.startswith("text/javascript")
+          and r.headers.get("x-content-type-options") == "nosniff", r.headers)
+    check("an unchanged file is 304", server.get("/web/app.js", headers={"If-None-Match": r.headers.get("etag", "")})
+          .status == 304)
+    check("the vendored plotting library's licence is served",
+          b"MIT License" in server.get("/web/vendor/uPlot.LICENSE").body)
+    r = server.get("/web/index.html")
+    check("/web/index.html redirects to the page", r.status == 302 and r.headers.get("location") == "../", r)
+    r = server.get("/web/nope.js")
+    check("an unknown web file is a 404 problem", r.status == 404 and r.is_problem(), r)
+    r = server.get("/v1/examples")
+    names = sorted(os.path.splitext(n)[0] for n in os.listdir(os.path.join(SRC, "api", "examples"))
+                   if n.endswith(".json"))
+    check("/v1/examples lists api/examples", r.status == 200 and [e["name"] for e in r.json()["examples"]] == names,
+          r)
+    with open(os.path.join(SRC, "api", "examples", "seed_layers.json"), "rb") as f:
+        seed_bytes = f.read()
+    check("an example is served as its file", server.get("/v1/examples/seed_layers").body == seed_bytes
+          and server.get("/v1/examples/seed_layers.json").body == seed_bytes)
+    r = server.get("/v1/examples/nope")
+    check("an unknown example is a 404 problem naming the list", r.status == 404 and r.is_problem()
+          and "/v1/examples" in r.json()["detail"], r)
     r = server.get("/v1/schema")
     with open(os.path.join(SRC, "api", "job.schema.json"), "rb") as f:
         check("schema is api/job.schema.json", r.status == 200 and r.body == f.read(), r)
@@ -247,7 +291,8 @@ with Server() as server, tempfile.TemporaryDirectory() as tmp:
         paths = re.findall(r"^  (/[^:\s]+):\s*$", f.read(), re.M)
     missing = []
     for path in paths:
-        concrete = path.replace("{id}", job_id).replace("{type}", "invalid-job")
+        concrete = path.replace("{id}", job_id).replace("{type}", "invalid-job").replace("{name}", "flat_patch")
+        concrete = concrete.replace("{path}", "app.js")
         r = server.get(concrete)
         if r.status == 404:
             missing.append(path)

@@ -1,0 +1,225 @@
+// The selected job: its state and outcome, the live plots fed by its event stream, the mesh sizes per body, the
+// event log, the download links and the cancel / delete buttons.
+
+import {ApiError, api, download, getToken} from "./api.js";
+import {ConvergencePlot, PressurePlot} from "./plots.js";
+import {followEvents} from "./stream.js";
+
+const $ = (id) => document.getElementById(id);
+const TERMINAL = new Set(["SUCCEEDED", "FAILED", "CANCELLED"]);
+const MAX_LOG = 300;
+
+export class JobView {
+  // onChange(): the job list should be refreshed (a state changed, the job was deleted).
+  constructor({onChange}) {
+    this.onChange = onChange;
+    this.id = null;
+    this.controller = null;
+    this.convergence = new ConvergencePlot($("convergence"), $("convergence-title"));
+    this.pairs = new Map();
+    $("cancel").addEventListener("click", () => this.cancel());
+    $("delete").addEventListener("click", () => this.remove());
+    for (const [id, file] of [["result-link", "result"], ["xmf-link", "result.xmf"]]) {
+      $(id).addEventListener("click", (ev) => {
+        // A link cannot send the token: with one, fetch the file and save it.
+        if (!getToken()) return;
+        ev.preventDefault();
+        const name = `${this.name || "result"}.${file === "result" ? "hdf" : "xmf"}`;
+        download(`v1/jobs/${this.id}/${file}`, name).catch((e) => this.message(e.message, true));
+      });
+    }
+    window.addEventListener("resize", () => {
+      this.convergence.resize();
+      for (const p of this.pairs.values()) p.resize();
+    });
+  }
+
+  show(id) {
+    if (id === this.id) return;
+    this.close();
+    this.id = id;
+    this.name = "";
+    this.state = "";
+    $("no-job").hidden = true;
+    $("job").hidden = false;
+    $("job-name").textContent = "";
+    $("job-id").textContent = id;
+    $("job-outcome").textContent = "";
+    $("job-iteration").textContent = "";
+    $("mesh").replaceChildren();
+    $("log").replaceChildren();
+    this.message("");
+    this.setState("");
+    this.links(false);
+    this.refresh();
+    this.follow();
+  }
+
+  close() {
+    if (this.controller) this.controller.abort();
+    this.controller = null;
+    this.convergence.reset();
+    for (const p of this.pairs.values()) p.destroy();
+    this.pairs.clear();
+    $("pressure").replaceChildren();
+    $("pressure").dataset.iteration = "0";
+    this.id = null;
+  }
+
+  hide() {
+    this.close();
+    $("job").hidden = true;
+    $("no-job").hidden = false;
+  }
+
+  message(text, error = false) {
+    const el = $("job-message");
+    el.textContent = text;
+    el.className = "message" + (text ? (error ? " error" : " ok") : "");
+  }
+
+  setState(state) {
+    this.state = state;
+    const el = $("job-state");
+    el.textContent = state;
+    el.className = "state state-" + state;
+    $("cancel").hidden = !state || TERMINAL.has(state);
+    $("delete").hidden = !TERMINAL.has(state);
+  }
+
+  links(available) {
+    for (const [id, file] of [["result-link", "result"], ["xmf-link", "result.xmf"]]) {
+      const a = $(id);
+      a.hidden = !available;
+      if (available) {
+        a.href = `v1/jobs/${this.id}/${file}`;
+        a.download = `${this.name || "result"}.${file === "result" ? "hdf" : "xmf"}`;
+      } else {
+        a.removeAttribute("href");
+      }
+    }
+  }
+
+  // The job resource: name, state, outcome, links.
+  async refresh() {
+    const id = this.id;
+    try {
+      const job = await api(`v1/jobs/${id}`);
+      if (id !== this.id) return;
+      this.name = job.name || "";
+      $("job-name").textContent = this.name;
+      this.setState(job.state || "");
+      const outcome = [];
+      if (job.stop_reason) outcome.push(`stop: ${job.stop_reason}${job.converged === false ? " (not converged)" : ""}`);
+      if (job.queue_position) outcome.push(`queue position ${job.queue_position}`);
+      $("job-outcome").textContent = outcome.join(", ");
+      if (job.message) this.message(job.message, job.state === "FAILED");
+      this.links(job.result_available === true);
+    } catch (e) {
+      if (id === this.id) this.message(e.message, true);
+    }
+  }
+
+  log(text) {
+    const list = $("log");
+    const li = document.createElement("li");
+    li.textContent = text;
+    list.append(li);
+    while (list.childElementCount > MAX_LOG) list.firstElementChild.remove();
+    list.scrollTop = list.scrollHeight;
+  }
+
+  async follow() {
+    const id = this.id;
+    const controller = new AbortController();
+    this.controller = controller;
+    try {
+      const end = await followEvents(id, (e) => this.onEvent(e),
+                                     {signal: controller.signal, onNote: (t) => this.log(t)});
+      if (id === this.id && !end && !controller.signal.aborted) this.log("the stream ended without an end event");
+    } catch (e) {
+      if (id === this.id) this.message(e instanceof ApiError ? e.message : String(e), true);
+    }
+  }
+
+  onEvent(e) {
+    switch (e.type) {
+      case "iteration":
+        this.onIteration(e);
+        break;
+      case "state":
+        if (e.state === "QUEUED" && this.convergence.x.length) this.convergence.reset();
+        this.setState(e.state);
+        this.log(`state ${e.state}${e.message ? ": " + e.message : ""}`);
+        this.onChange();
+        break;
+      case "step": {
+        const bodies = (e.bodies || []).map((b) => `${b.name} ${b.elements} cells`).join(", ");
+        this.log(`step ${e.step} at iteration ${e.iteration}: ${bodies}`);
+        break;
+      }
+      case "end":
+        this.setState(e.state);
+        this.log(`end ${e.state} (${e.stop_reason}) after ${e.iterations} iterations` +
+                 `${e.message ? ": " + e.message : ""}`);
+        this.refresh();
+        this.onChange();
+        break;
+      default:
+        break;
+    }
+  }
+
+  onIteration(e) {
+    if (this.state !== "RUNNING") this.setState("RUNNING");
+    this.convergence.add(e);
+    $("job-iteration").textContent = `iteration ${e.iteration}`;
+    for (const pair of Array.isArray(e.pairs) ? e.pairs : []) {
+      let plot = this.pairs.get(pair.name);
+      if (!plot) {
+        const el = document.createElement("div");
+        el.className = "pair";
+        $("pressure").append(el);
+        plot = new PressurePlot(el, String(pair.name));
+        this.pairs.set(pair.name, plot);
+      }
+      plot.add(e.iteration, pair);
+    }
+    $("pressure").dataset.iteration = String(e.iteration);
+    this.meshTable(Array.isArray(e.bodies) ? e.bodies : []);
+  }
+
+  meshTable(bodies) {
+    const rows = bodies.map((b) => {
+      const tr = document.createElement("tr");
+      for (const v of [b.name, b.elements, b.dofs, b.elements_refined]) {
+        const td = document.createElement("td");
+        td.textContent = v === undefined || v === null ? "" : String(v);
+        tr.append(td);
+      }
+      return tr;
+    });
+    $("mesh").replaceChildren(...rows);
+  }
+
+  async cancel() {
+    try {
+      await api(`v1/jobs/${this.id}/cancel`, {method: "POST"});
+      this.message("cancellation requested: the job stops within one iteration");
+    } catch (e) {
+      this.message(e.message, true);
+    }
+  }
+
+  async remove() {
+    const id = this.id;
+    try {
+      await api(`v1/jobs/${id}`, {method: "DELETE"});
+      this.hide();
+      if (window.location.hash === `#job=${id}`) history.replaceState(null, "", window.location.pathname);
+      this.onChange();
+    } catch (e) {
+      this.message(e.message, true);
+    }
+  }
+}

@@ -1,0 +1,15 @@
+// Load steps (Problem::loading): the same contact problem under growing (or any) load factors. Every prescribed
+// displacement, traction, force and body force is scaled by the step's factor (BodySolver::set_load_factor: the
+// factorisations stay), each step is solved with the chosen method starting from the previous step's answer
+// (interface Newton: its active set; the fixed-point schemes: its displacements), and each step's fields become
+// one result Step with its factor. The iteration reports run on across the steps.
+#pragma once
+
+#include "driver.hpp"
+
+namespace contact::ddm {
+
+MethodOutcome run_load_steps(ContactSystem& system, const SolverSettings& settings, const std::vector<double>& factors,
+                             RunContext& context, MethodRunner& runner, std::vector<Step>& steps, int& updates);
+
+}  // namespace contact::ddm

@@ -1,0 +1,315 @@
+#!/usr/bin/env python3
+"""contactd's web page in a real browser: Debian's chromium, headless, driven by python3-selenium through
+chromium-driver, against the real contactd.
+
+Without a token: the page lists jobs; a job pasted into the form and submitted through the page runs, and while
+it runs (the API still says RUNNING) the convergence plot gains points, the pressure plot and the mesh table
+follow the iterations; the page's Cancel stops it; an example picked from the list fills the form with the
+file's text and solves, and the page's download link serves the HDF5 result; an invalid job shows every error
+with its pointer; the page's Delete removes a job. With a token: the page says it needs one, works once it is
+entered (the list, submit, the live plot through the stream read with the Authorization header, the download
+saved by the browser), and keeps it across a reload. Throughout: no script error and no Content-Security-Policy
+violation in the browser's console.
+
+Exits 77 (CTest: skipped) with a message saying why only when chromium cannot be started here."""
+import json
+import os
+import shutil
+import sys
+import tempfile
+import time
+import urllib.request
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(HERE, "..", ".."))
+sys.path.insert(0, os.path.join(SRC, "tests", "server"))
+from harness import EXAMPLES, Checks, Server, example, long_job  # noqa: E402
+
+checks = Checks()
+check = checks.check
+SKIP = 77
+CHROMIUM_FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+                  "--disable-background-networking", "--disable-component-update", "--disable-sync",
+                  "--no-first-run", "--window-size=1400,1000"]
+
+
+def skip(reason):
+    print(f"SKIP: {reason}", flush=True)
+    sys.exit(SKIP)
+
+
+try:
+    from selenium import webdriver
+    from selenium.common.exceptions import WebDriverException
+    from selenium.webdriver.chrome.service import Service
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.support.ui import Select
+except ImportError as exc:
+    skip(f"python3-selenium is not installed ({exc}); bash scripts/setup.sh installs it")
+
+
+class Browser:
+    """A headless chromium with a fresh profile, and the waits the checks need."""
+
+    def __init__(self, downloads):
+        self.profile = tempfile.mkdtemp(prefix="contactd-chromium-")
+        chromium = shutil.which("chromium") or "/usr/bin/chromium"
+        driver = shutil.which("chromedriver") or "/usr/bin/chromedriver"
+        options = webdriver.ChromeOptions()
+        options.binary_location = chromium
+        for flag in CHROMIUM_FLAGS + [f"--user-data-dir={self.profile}"]:
+            options.add_argument(flag)
+        options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+        try:
+            self.driver = webdriver.Chrome(service=Service(driver), options=options)
+        except (WebDriverException, OSError) as exc:
+            shutil.rmtree(self.profile, ignore_errors=True)
+            skip(f"chromium cannot start here ({str(exc).strip().splitlines()[0][:300]}); "
+                 "it needs Debian's chromium and chromium-driver (bash scripts/setup.sh)")
+        self.driver.set_script_timeout(30)
+        self.driver.execute_cdp_cmd("Page.setDownloadBehavior", {"behavior": "allow", "downloadPath": downloads})
+        self.console = []
+
+    def quit(self):
+        try:
+            self.driver.quit()
+        finally:
+            shutil.rmtree(self.profile, ignore_errors=True)
+
+    def el(self, element_id):
+        return self.driver.find_element(By.ID, element_id)
+
+    def text(self, element_id):
+        return self.el(element_id).text
+
+    def attr(self, element_id, name):
+        return self.el(element_id).get_attribute(name)
+
+    def wait(self, predicate, timeout=30, interval=0.1):
+        """predicate() until true (exceptions count as false); returns its last value."""
+        deadline = time.time() + timeout
+        value = None
+        while time.time() < deadline:
+            try:
+                value = predicate()
+            except WebDriverException:
+                value = None
+            if value:
+                return value
+            time.sleep(interval)
+        return value
+
+    def rows(self, element_id):
+        """The cells' text of a table body, read at one instant (the page rebuilds some tables as events come)."""
+        return self.driver.execute_script(
+            "return Array.from(document.getElementById(arguments[0]).rows)"
+            "  .map(r => Array.from(r.cells).map(c => c.textContent));", element_id)
+
+    def set_job_text(self, text):
+        box = self.el("job-text")
+        box.clear()
+        box.send_keys(text)
+
+    def logs(self):
+        """New console entries since the last call."""
+        entries = self.driver.get_log("browser")
+        self.console += entries
+        return entries
+
+
+def errors_in(entries):
+    """Console entries that are script errors or policy violations. The browser also logs every failed request
+    ("Failed to load resource: ... 400"), which the tests cause on purpose."""
+    return [e["message"] for e in entries if e.get("level") == "SEVERE"
+            and "Failed to load resource" not in e.get("message", "")]
+
+
+def points(b):
+    return int(b.attr("convergence", "data-points") or 0)
+
+
+def test_without_token(server, b, downloads):
+    base = f"http://127.0.0.1:{server.port}/"
+    b.driver.get(base)
+    check("page: title", b.driver.title == "contactd", b.driver.title)
+    check("page: the empty job list says so", b.wait(lambda: b.text("jobs-status") == "no jobs yet"),
+          b.text("jobs-status"))
+    check("page: the version from the server", b.wait(lambda: b.text("version").startswith("version ")),
+          b.text("version"))
+    check("page: the plotting library loaded", b.driver.execute_script("return typeof uPlot") == "function")
+
+    # 1. A long job pasted into the form and submitted through the page; its plot grows while it runs.
+    b.set_job_text(json.dumps(long_job(name="web-long")))
+    b.el("submit").click()
+    job_id = b.wait(lambda: b.text("job-id"), 10)
+    if not check("submit: the page selects the new job",
+                 bool(job_id) and server.get(f"/v1/jobs/{job_id}").status == 200, (job_id, b.text("submit-message"))):
+        return
+    check("submit: the address names the job", b.driver.current_url.endswith(f"#job={job_id}"), b.driver.current_url)
+    check("running: the page shows RUNNING", b.wait(lambda: b.text("job-state") == "RUNNING", 20), b.text("job-state"))
+    first = b.wait(lambda: points(b) > 0, 20) and points(b)
+    time.sleep(1.0)
+    second = points(b)
+    running = server.job(job_id)["state"]
+    check("running: the convergence plot receives points", bool(first) and first > 0, first)
+    check("running: more points a second later, while the job still runs",
+          second > first and running == "RUNNING", (first, second, running))
+    check("running: the plot is drawn (a canvas)",
+          len(b.driver.find_elements(By.CSS_SELECTOR, "#convergence canvas")) >= 1)
+    check("running: the convergence title names the measure",
+          "fixed-point" in b.text("convergence-title"), b.text("convergence-title"))
+    check("running: one pressure plot for the pair, at a recent iteration",
+          len(b.driver.find_elements(By.CSS_SELECTOR, "#pressure .pair canvas")) == 1
+          and int(b.attr("pressure", "data-iteration")) > 0
+          and "upper.bottom-lower.top" in b.text("pressure"), b.text("pressure"))
+    rows = b.rows("mesh")
+    progress = server.job(job_id)["progress"]
+    expected = [[x["name"], str(x["elements"]), str(x["dofs"])] for x in progress["bodies"]]
+    check("running: the mesh table has each body's elements and unknowns",
+          [r[:3] for r in rows] == expected, (rows, expected))
+    check("running: the job list shows it RUNNING",
+          b.wait(lambda: b.driver.find_element(By.CSS_SELECTOR, f'#jobs tr[data-id="{job_id}"]')
+                 .get_attribute("data-state") == "RUNNING", 10))
+
+    # 2. Cancel through the page.
+    b.el("cancel").click()
+    check("cancel: the page shows CANCELLED", b.wait(lambda: b.text("job-state") == "CANCELLED", 30),
+          b.text("job-state"))
+    check("cancel: the server says CANCELLED", server.wait_done(job_id, 30)["state"] == "CANCELLED")
+    check("cancel: the event log ends with the end event", "end CANCELLED" in b.text("log"), b.text("log")[-300:])
+    long_points = points(b)
+
+    # 3. An example picked from the list, submitted, solved; its result downloadable from the page.
+    Select(b.el("example")).select_by_value("flat_patch")
+    with open(os.path.join(EXAMPLES, "flat_patch.json")) as f:
+        patch_text = f.read()
+    check("example: the form holds the file's text",
+          b.wait(lambda: b.el("job-text").get_attribute("value") == patch_text, 10))
+    b.el("submit").click()
+    patch_id = b.wait(lambda: b.text("job-id") if b.text("job-id") != job_id else None, 10)
+    check("example: solved", b.wait(lambda: b.text("job-state") == "SUCCEEDED", 30), b.text("job-state"))
+    end = server.wait_done(patch_id, 30) if patch_id else {}
+    check("example: every iteration plotted",
+          b.wait(lambda: points(b) == end.get("iterations"), 5), (points(b), end.get("iterations")))
+    check("example: the plot of the new job starts afresh", points(b) < long_points, (points(b), long_points))
+    check("example: the active-set method's measure",
+          "complementarity" in b.text("convergence-title"), b.text("convergence-title"))
+    link = b.wait(lambda: b.el("result-link").is_displayed() and b.attr("result-link", "href"), 10)
+    check("example: a download link to the result", bool(link) and link.endswith(f"/v1/jobs/{patch_id}/result"),
+          link)
+    check("example: and to the XDMF sidecar", (b.attr("xmf-link", "href") or "").endswith("/result.xmf"))
+    if link:
+        with urllib.request.urlopen(link, timeout=10) as r:
+            check("example: the link serves the HDF5 file", r.read(8) == b"\x89HDF\r\n\x1a\n")
+
+    # 4. An invalid job: every error with its pointer, no job created.
+    bad = example("flat_patch.json")
+    bad["bodies"][1]["material"]["nu"] = 0.5
+    bad["solver"] = {"gama": 0.1}
+    jobs_before = len(server.get("/v1/jobs").json()["jobs"])
+    b.set_job_text(json.dumps(bad))
+    b.el("submit").click()
+    message = b.wait(lambda: "/solver/gama" in b.text("submit-message") and b.text("submit-message"), 10)
+    check("invalid job: every error with its pointer", bool(message) and "/bodies/1/material/nu" in message
+          and "error" in b.attr("submit-message", "class"), b.text("submit-message"))
+    check("invalid job: no job created", len(server.get("/v1/jobs").json()["jobs"]) == jobs_before)
+    b.el("validate").click()
+    check("validate: the same errors", b.wait(lambda: "/bodies/1/material/nu" in b.text("submit-message"), 10))
+
+    # 5. Select the cancelled job in the list and delete it through the page.
+    b.driver.find_element(By.CSS_SELECTOR, f'#jobs tr[data-id="{job_id}"]').click()
+    check("select: the list selects the job", b.wait(lambda: b.text("job-id") == job_id, 10), b.text("job-id"))
+    check("select: its stream is replayed into the plot", b.wait(lambda: points(b) == long_points, 20),
+          (points(b), long_points))
+    b.wait(lambda: b.el("delete").is_displayed(), 10)
+    b.el("delete").click()
+    check("delete: gone from the server", b.wait(lambda: server.get(f"/v1/jobs/{job_id}").status == 404, 10))
+    check("delete: gone from the list",
+          b.wait(lambda: not b.driver.find_elements(By.CSS_SELECTOR, f'#jobs tr[data-id="{job_id}"]'), 10))
+    errors = errors_in(b.logs())
+    check("no script error or CSP violation in the console", not errors, errors)
+
+
+def test_with_token(b, downloads):
+    token = "web-page-test-token"
+    ITERATIONS = 600  # about 1 s on an idle machine: long enough to see points arrive while it runs
+    with Server(token=token) as server:
+        base = f"http://127.0.0.1:{server.port}/"
+        b.driver.get(base)
+        check("token: the page says one is needed",
+              b.wait(lambda: b.el("banner").is_displayed() and "requires a bearer token" in b.text("banner"), 10),
+              b.text("banner"))
+        b.el("token").send_keys("wrong-token")
+        b.el("token-save").click()
+        check("token: a wrong one is refused", b.wait(lambda: "refused the token" in b.text("banner"), 10),
+              b.text("banner"))
+        b.el("token").clear()
+        b.el("token").send_keys(token)
+        b.el("token-save").click()
+        if not check("token: with it the list loads", b.wait(lambda: not b.el("banner").is_displayed()
+                                                              and b.text("jobs-status") == "no jobs yet", 10),
+                     (b.text("banner"), b.text("jobs-status"))):
+            return
+        check("token: the examples load", b.wait(lambda: len(Select(b.el("example")).options) > 5, 10))
+
+        # A job that runs a few seconds, followed live through the stream read with the token.
+        b.set_job_text(json.dumps(long_job(max_iterations=ITERATIONS, name="web-token")))
+        b.el("submit").click()
+        job_id = b.wait(lambda: b.text("job-id"), 10)
+        if not check("token: submitted through the page", bool(job_id), b.text("submit-message")):
+            return
+        live = b.wait(lambda: points(b) > 0 and server.job(job_id)["state"] == "RUNNING" and points(b), 20)
+        check("token: points arrive while the job runs", bool(live), points(b))
+        end = server.wait_done(job_id, 60)
+        check("token: the job ends SUCCEEDED", end.get("state") == "SUCCEEDED", end.get("state"))
+        check("token: every iteration reached the plot", b.wait(lambda: points(b) == ITERATIONS, 20), points(b))
+
+        # The download link cannot carry the header: the page fetches the file with it and saves it.
+        link = b.wait(lambda: b.el("result-link").is_displayed(), 10)
+        check("token: download link shown", bool(link))
+        if link:
+            b.el("result-link").click()
+            saved = os.path.join(downloads, "web-token.hdf")
+            got = b.wait(lambda: os.path.exists(saved) and os.path.getsize(saved) > 0
+                         and not os.path.exists(saved + ".crdownload"), 20)
+            body = open(saved, "rb").read() if got else b""
+            check("token: the browser saved the result", body[:8] == b"\x89HDF\r\n\x1a\n", len(body))
+            check("token: the saved file is the job's result", body == server.get(f"/v1/jobs/{job_id}/result").body)
+
+        b.driver.refresh()
+        check("token: kept across a reload", b.wait(lambda: b.el("token").get_attribute("value") == token
+                                                    and f'data-id="{job_id}"' in b.el("jobs").get_attribute("innerHTML"),
+                                                    10))
+        check("token: the reloaded page follows the job in the address",
+              b.wait(lambda: b.text("job-id") == job_id and points(b) == ITERATIONS, 20), (b.text("job-id"), points(b)))
+        errors = errors_in(b.logs())
+        check("token: no script error or CSP violation in the console", not errors, errors)
+
+
+def run_with_server(browser, downloads):
+    with Server() as server:
+        test_without_token(server, browser, downloads)
+
+
+def main():
+    downloads = tempfile.mkdtemp(prefix="contactd-downloads-")
+    browser = Browser(downloads)
+    try:
+        for name, run in (("without a token", lambda: run_with_server(browser, downloads)),
+                          ("with a token", lambda: test_with_token(browser, downloads))):
+            t0 = time.time()
+            try:
+                run()
+            except Exception as exc:  # a crash of one part is a failure; the other part still runs
+                import traceback
+                traceback.print_exc()
+                check(f"{name}: the checks ran to the end", False, repr(exc)[:300])
+            print(f"{name}: {time.time() - t0:.1f} s", flush=True)
+    finally:
+        browser.quit()
+        shutil.rmtree(downloads, ignore_errors=True)
+    checks.finish()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,213 @@
+// Bodies held by their contacts alone (floating bodies), force control, body forces and load steps. Every expected
+// number comes from mechanics: equilibrium of a free body, Hertz's formula, the linearity of the problem.
+#include "job/job.hpp"
+#include "solve.hpp"
+#include "support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace contact;
+using nlohmann::json;
+using contact::testing::example;
+using contact::testing::body;
+using contact::testing::hertz_half_width;
+using contact::testing::run;
+
+namespace {
+
+// The sum of the contact forces a pair exerts on its slave body, from the equilibrium of the supports: the
+// y-components of the reactions of a body.
+double vertical_reaction(const BodyField& b) { return b.reaction.col(1).sum(); }
+
+}  // namespace
+
+TEST(Floating, FreeCylinderPressedByAForceMatchesHertzForThatForce) {
+  // api/examples/hertz_force.json: the half model of a cylinder (R = 10) held only by the symmetry line and its
+  // contact (translation in y free), a force P/2 on its top.
+  const json job = example("hertz_force.json");
+  const Result r = run(job);
+  ASSERT_TRUE(r.converged) << r.message;
+  const Step& s = r.steps.back();
+  const BodyField& cylinder = body(s, "cylinder");
+  ASSERT_EQ(cylinder.free_motions, std::vector<std::string>{"translation in y"});
+  const double P = -2.0 * job["bodies"][1]["boundary"][1]["force"][1].get<double>(), R = 10.0;
+  // Equilibrium of the free body: its supports carry nothing vertically, the lower block's carry P/2.
+  EXPECT_NEAR(vertical_reaction(cylinder), 0.0, 1e-9 * P);
+  EXPECT_NEAR(vertical_reaction(body(s, "lower")), P / 2, 1e-9 * P);
+  const double inv_E_star = 2 * (1 - 0.3 * 0.3) / 2.1e5;
+  const double a = std::sqrt(4 * P * R * inv_E_star / M_PI), p0 = 2 * P / (M_PI * a);
+  EXPECT_NEAR(hertz_half_width(s.pairs[0]), a, 0.01 * a);
+  EXPECT_NEAR(s.pairs[0].pressure.maxCoeff(), p0, 0.01 * p0);
+  // The cylinder sank (its rigid motion is a downward translation, no rotation).
+  EXPECT_LT(cylinder.rigid_motion.y(), 0.0);
+  EXPECT_NEAR(cylinder.rigid_motion.z(), 0.0, 1e-12);
+}
+
+TEST(Floating, MiddleBlockHeldOnlyByItsContactsIsInEquilibrium) {
+  // api/examples/stack3_floating.json: the middle block has only the symmetry condition u_x = 0.
+  const Result r = run(example("stack3_floating.json"));
+  ASSERT_TRUE(r.converged) << r.message;
+  const Step& s = r.steps.back();
+  ASSERT_EQ(s.pairs.size(), 2u);
+  const double above = s.pairs[0].force, below = s.pairs[1].force;
+  ASSERT_GT(above, 0.0);
+  EXPECT_NEAR(above, below, 1e-10 * above);  // the block's equilibrium (flat interfaces: normal = vertical)
+  EXPECT_NEAR(vertical_reaction(body(s, "bottom")), below, 1e-10 * below);
+  EXPECT_NEAR(-vertical_reaction(body(s, "top")), above, 1e-10 * above);
+  EXPECT_NEAR(vertical_reaction(body(s, "middle")), 0.0, 1e-10 * above);
+  // The same problem with the middle block clamped at its far end (api/examples/stack3.json) carries less
+  // through the lower interface: the clamp takes part of the load.
+  const Result clamped = run([] {
+    json j = example("stack3.json");
+    j.erase("solver");
+    return j;
+  }());
+  ASSERT_TRUE(clamped.converged);
+  EXPECT_LT(clamped.steps.back().pairs[1].force, below);
+}
+
+TEST(Floating, BlockUnderItsOwnWeightPressesWithItsWeight) {
+  // A block 2 x 1 of weight density w resting on a clamped block: held by the symmetry line and the contact.
+  json job = example("flat_patch.json");
+  job.erase("solver");
+  const double w = 0.078;
+  job["bodies"][1]["boundary"] = {{{"edge", "left"}, {"displacement", {{"x", 0}}}}};
+  job["bodies"][1]["body_force"] = {0.0, -w};
+  const Result r = run(job);
+  ASSERT_TRUE(r.converged) << r.message;
+  const double weight = w * 2.0 * 1.0;
+  EXPECT_NEAR(r.steps.back().pairs[0].force, weight, 1e-10 * weight);
+  EXPECT_NEAR(vertical_reaction(body(r.steps.back(), "lower")), weight, 1e-10 * weight);
+}
+
+TEST(Floating, ForceControlWithTheReactionOfADisplacementControlledRunGivesTheSameField) {
+  // The punch held at one vertex: first both displacement components are prescribed there (the rotation about it
+  // is free, held by the contact), then only u_x, with the reaction that run found as a point load in y
+  // (translation in y free as well). The linear problem has the same solution.
+  json job = example("punch_force.json");
+  json& punch = job["bodies"][1];
+  punch["boundary"] = {{{"vertex", "top_left"}, {"displacement", {{"x", 0}, {"y", -0.002}}}}};
+  const Result displaced = run(job);
+  ASSERT_TRUE(displaced.converged) << displaced.message;
+  const BodyField& p1 = body(displaced.steps.back(), "punch");
+  EXPECT_EQ(p1.free_motions.size(), 1u);  // the rotation about the vertex
+  Eigen::Index node = -1;
+  for (Eigen::Index k = 0; k < p1.reaction.rows(); ++k)
+    if (p1.reaction.row(k).norm() > 0) node = k;
+  ASSERT_GE(node, 0);
+  const double force_y = p1.reaction(node, 1);  // the support's force on the punch becomes a load
+  ASSERT_LT(force_y, 0.0);
+  punch["boundary"] = {{{"vertex", "top_left"}, {"displacement", {{"x", 0}}}, {"force", {0.0, force_y}}}};
+  const Result forced = run(job);
+  ASSERT_TRUE(forced.converged) << forced.message;
+  const BodyField& p2 = body(forced.steps.back(), "punch");
+  EXPECT_EQ(p2.free_motions.size(), 2u);  // translation in y and rotation
+  for (size_t b = 0; b < 2; ++b) {
+    const auto& u1 = displaced.steps.back().bodies[b].displacement;
+    const auto& u2 = forced.steps.back().bodies[b].displacement;
+    EXPECT_LE((u1 - u2).cwiseAbs().maxCoeff(), 1e-8 * u1.cwiseAbs().maxCoeff()) << displaced.steps.back().bodies[b].name;
+  }
+  EXPECT_NEAR(p2.displacement(node, 1), -0.002, 1e-8 * 0.002);
+}
+
+TEST(LoadSteps, TheLastStepEqualsTheSingleStepSolveAndTheForceGrows) {
+  // api/examples/seed_layers_steps.json: the paper's problem in 10 load steps.
+  const json job = example("seed_layers_steps.json");
+  const Result steps = run(job);
+  ASSERT_TRUE(steps.converged) << steps.message;
+  ASSERT_EQ(steps.steps.size(), 10u);
+  json single = job;
+  single.erase("loading");
+  const Result one = run(single);
+  ASSERT_TRUE(one.converged);
+  const Step& last = steps.steps.back();
+  EXPECT_EQ(last.load_factor, 1.0);
+  for (size_t b = 0; b < last.bodies.size(); ++b) {
+    const auto& u1 = last.bodies[b].displacement;
+    const auto& u2 = one.steps.back().bodies[b].displacement;
+    EXPECT_LE((u1 - u2).cwiseAbs().maxCoeff(), 1e-10 * u2.cwiseAbs().maxCoeff());
+  }
+  EXPECT_NEAR(last.pairs[0].force, one.steps.back().pairs[0].force, 1e-10 * last.pairs[0].force);
+  for (size_t k = 0; k < steps.steps.size(); ++k) {
+    EXPECT_NEAR(steps.steps[k].load_factor, 0.1 * static_cast<double>(k + 1), 1e-15);
+    if (k > 0) EXPECT_GT(steps.steps[k].pairs[0].force, steps.steps[k - 1].pairs[0].force);
+  }
+}
+
+TEST(LoadSteps, HertzHalfWidthGrowsLikeTheSquareRootOfTheForce) {
+  // The free cylinder under 4 load steps of its force: a^2 = 4 P R / (pi E*), so a / sqrt(P) is the same at
+  // every step (within the profile fit's accuracy), and each step agrees with the formula.
+  json job = example("hertz_force.json");
+  job["loading"] = {{"factors", {0.25, 0.5, 0.75, 1.0}}};
+  const Result r = run(job);
+  ASSERT_TRUE(r.converged) << r.message;
+  ASSERT_EQ(r.steps.size(), 4u);
+  const double P_full = -2.0 * job["bodies"][1]["boundary"][1]["force"][1].get<double>(), R = 10.0;
+  const double inv_E_star = 2 * (1 - 0.3 * 0.3) / 2.1e5;
+  for (const Step& s : r.steps) {
+    const double P = s.load_factor * P_full;
+    const double a = std::sqrt(4 * P * R * inv_E_star / M_PI);
+    EXPECT_NEAR(hertz_half_width(s.pairs[0]), a, 0.02 * a) << "load factor " << s.load_factor;
+  }
+}
+
+TEST(FloatingErrors, AFloatingBodyPulledAwayFromItsContactIsNamedWithItsFreeMotion) {
+  json job = example("punch_force.json");
+  job["bodies"][1]["boundary"][1]["force"] = {0, 200};  // upwards: nothing holds the punch
+  const Result r = run(job);
+  EXPECT_EQ(r.stop_reason, StopReason::error);
+  EXPECT_NE(r.message.find("body 'punch' floats (translation in y"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("'punch.bottom-block.top'"), std::string::npos) << r.message;
+}
+
+TEST(FloatingErrors, ABodyThatSlidesFreelyOnAFlatContactIsNamed) {
+  // Frictionless flat contact cannot hold a horizontal translation.
+  json job = example("punch_force.json");
+  job["bodies"][1]["boundary"] = {{{"edge", "top"}, {"force", {0, -200}}}};
+  const Result r = run(job);
+  EXPECT_EQ(r.stop_reason, StopReason::error);
+  EXPECT_NE(r.message.find("body 'punch' floats (translation in x"), std::string::npos) << r.message;
+}
+
+TEST(FloatingErrors, AForceOnAFullyHeldEdgeAndAFloatingBodyWithTheNeumannSchemeAreValidationErrors) {
+  json job = example("punch_force.json");
+  job["bodies"][0]["boundary"].push_back({{"vertex", "bottom_left"}, {"force", {1, 0}}});
+  auto parsed = job::parse(job);
+  ASSERT_FALSE(parsed.ok());
+  EXPECT_NE(job::format_errors(parsed.errors).find("/bodies/0/boundary/1: the force on vertex 'bottom_left' acts only on "
+                                                   "nodes whose displacement is prescribed"),
+            std::string::npos)
+      << job::format_errors(parsed.errors);
+  json neumann = example("stack3_floating.json");
+  neumann["solver"] = {{"method", "neumann"}};
+  parsed = job::parse(neumann);
+  ASSERT_FALSE(parsed.ok());
+  EXPECT_NE(job::format_errors(parsed.errors).find("body 'middle' floats"), std::string::npos)
+      << job::format_errors(parsed.errors);
+}
+
+TEST(Floating, InterfaceNewtonWithTheCoarseProblemEqualsTheMonolithicSaddlePointSolution) {
+  // The FETI-style interface problem (generalised inverses, rigid modes, equilibrium constraints) against the
+  // whole saddle-point system factorised at once: independent algebra for the same discrete problem.
+  for (const char* name : {"stack3_floating.json", "punch_force.json"}) {
+    json job = example(name);
+    job.erase("solver");
+    const Result r = run(job);
+    ASSERT_TRUE(r.converged) << name << ": " << r.message;
+    job["solver"] = {{"method", "monolithic"}};
+    const Result reference = run(job);
+    ASSERT_TRUE(reference.converged) << name << ": " << reference.message;
+    for (size_t b = 0; b < r.steps.back().bodies.size(); ++b) {
+      const auto& u = r.steps.back().bodies[b].displacement;
+      const auto& v = reference.steps.back().bodies[b].displacement;
+      EXPECT_LE((u - v).cwiseAbs().maxCoeff(), 1e-8 * v.cwiseAbs().maxCoeff()) << name << " body " << b;
+    }
+    for (size_t k = 0; k < r.steps.back().pairs.size(); ++k) {
+      const auto& p = r.steps.back().pairs[k].pressure;
+      const auto& q = reference.steps.back().pairs[k].pressure;
+      EXPECT_LE((p - q).cwiseAbs().maxCoeff(), 1e-8 * q.cwiseAbs().maxCoeff()) << name << " pair " << k;
+    }
+  }
+}
