@@ -166,7 +166,7 @@ class JobReader {
 
   ParseResult run() {
     Fields top(job_, "", "the job",
-               {"name", "version", "model", "bodies", "contacts", "solver", "adaptivity", "loading"}, errors_);
+               {"name", "version", "model", "bodies", "contacts", "solver", "adaptivity", "loading", "parallel"}, errors_);
     if (!top.ok()) return finish();
     read_header(top);
     read_model(top);
@@ -175,6 +175,7 @@ class JobReader {
     read_solver(top);
     if (const json* a = top.find("adaptivity")) read_adaptivity(*a, top.at("adaptivity"));
     read_loading(top);
+    read_parallel(top);
     resolve_method_defaults();
     check_floating_bodies();
     check_work_limits();
@@ -1146,6 +1147,32 @@ class JobReader {
                         "cannot take; use method \"interface_newton\" (the default) or \"monolithic\", or restrain "
                         "the body");
       }
+    }
+  }
+
+  // "parallel": {"ranks": N}: the MPI ranks a server runs the job on (docs/parallel.md); contact-solve takes
+  // mpirun's number instead.
+  void read_parallel(const Fields& top) {
+    const json* v = top.find("parallel");
+    if (!v) {
+      set_default(normalized_, "parallel", json{{"ranks", 1}});
+      return;
+    }
+    Fields f(*v, top.at("parallel"), "parallel", {"ranks"}, errors_);
+    if (!f.ok()) return;
+    const json* n = f.find("ranks");
+    if (!n) {
+      if (normalized_.is_object() && normalized_["parallel"].is_object()) normalized_["parallel"]["ranks"] = 1;
+      return;
+    }
+    if (auto x = bounded_int(*n, f.at("ranks"), "ranks", 1, errors_)) {
+      if (*x > limits_.max_ranks) {
+        errors_.add(f.at("ranks"), "ranks = " + std::to_string(*x) + " is more than the " +
+                                       std::to_string(limits_.max_ranks) + " MPI ranks accepted here" +
+                                       (limits_.ranks_hint.empty() ? "" : " (" + limits_.ranks_hint + ")"));
+        return;
+      }
+      problem_.ranks = *x;
     }
   }
 
