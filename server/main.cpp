@@ -213,9 +213,17 @@ int main(int argc, char** argv) {
   config.http.allowed_hosts = contactd::parse_host_list(config.allowed_hosts);
   config.queue.mpi.launcher = contactd::split_launcher(config.mpi_launcher);
   if (config.queue.mpi.solver.empty()) {
+    // Next to contactd (an installation, the Docker image), or one level up (the build tree: build/server/);
+    // else the one on the PATH.
     std::error_code ec;
     const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
-    config.queue.mpi.solver = (ec ? std::filesystem::path(argv[0]) : self).parent_path() / "contact-solve";
+    const auto dir = (ec ? std::filesystem::path(argv[0]) : self).parent_path();
+    config.queue.mpi.solver = "contact-solve";
+    for (const auto& candidate : {dir / "contact-solve", dir.parent_path() / "contact-solve"})
+      if (std::filesystem::is_regular_file(candidate, ec)) {
+        config.queue.mpi.solver = candidate.string();
+        break;
+      }
   }
   // Retention is checked a few times per retention period (at most every 10 s).
   config.queue.janitor_interval_seconds =
