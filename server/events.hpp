@@ -18,9 +18,6 @@ nlohmann::json state_event(JobState state, const std::string& message, int attem
 // "iteration": every field of the IterationReport, the pressure profile of every pair included.
 nlohmann::json iteration_event(const contact::IterationReport& report);
 
-// The short progress summary kept in the job resource: the iteration event without the pressure profiles.
-nlohmann::json progress_summary(const contact::IterationReport& report);
-
 // "step": one mesh state of the result: {"step", "iteration", "bodies": [{"name", "elements", "nodes"}]}.
 nlohmann::json step_event(const contact::Step& step);
 

@@ -42,6 +42,8 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include "mpi_job.hpp"
+
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -59,6 +61,7 @@ struct QueueSettings {
   double retention_seconds = 7 * 86400.0;          // finished jobs older than this are deleted; 0 = kept
   std::uint64_t retention_bytes = 10ull << 30;     // finished jobs beyond this total are deleted, oldest first
   double janitor_interval_seconds = 10.0;          // how often retention runs
+  MpiSettings mpi;                                 // jobs with parallel.ranks > 1 (mpi_job.hpp)
 };
 
 // What /readyz and /metrics report about the jobs.

@@ -44,12 +44,21 @@ class EventObserver final : public contact::Observer {
   EventObserver(Job& job, std::mutex& records_mutex, Metrics& metrics)
       : job_(job), records_mutex_(records_mutex), metrics_(metrics) {}
 
-  void on_iteration(const contact::IterationReport& report) override {
-    job_.events.append("iteration", iteration_event(report));
-    nlohmann::json summary = progress_summary(report);
+  void on_iteration(const contact::IterationReport& report) override { on_iteration_json(iteration_event(report)); }
+
+  // The same for an iteration as JSON (from an MPI run's progress lines).
+  void on_iteration_json(const nlohmann::json& event) {
+    job_.events.append("iteration", event);
+    nlohmann::json summary = event;  // the summary is the event without the pressure profiles
+    if (summary.contains("pairs") && summary["pairs"].is_array())
+      for (auto& pair : summary["pairs"])
+        if (pair.is_object()) {
+          pair.erase("positions");
+          pair.erase("pressures");
+        }
     {
       std::lock_guard<std::mutex> lock(records_mutex_);
-      job_.record.iterations = report.iteration;
+      job_.record.iterations = event.value("iteration", 0);
       job_.record.progress = std::move(summary);
     }
     metrics_.iteration_done();
@@ -136,6 +145,7 @@ void JobQueue::run(const std::shared_ptr<Job>& job) {
   outcome.converged = false;
   contact::Result result;
   std::optional<contact::Problem> problem;
+  std::optional<MpiOutcome> mpi;  // a job run on MPI ranks: the child wrote the result file
   try {
     auto parsed = validate(store_.read_job(id));
     if (!parsed.ok()) {
@@ -145,7 +155,18 @@ void JobQueue::run(const std::shared_ptr<Job>& job) {
     } else {
       problem = std::move(parsed.problem);
       EventObserver observer(*job, mutex_, metrics_);
-      result = contact::solve(*problem, observer, job->cancel);
+      if (problem->ranks > 1) {
+        mpi = run_mpi_job(settings_.mpi, problem->ranks, store_.job_path(id), store_.result_path(id), id,
+                          settings_.max_dofs, [&](const nlohmann::json& j) { observer.on_iteration_json(j); },
+                          job->cancel);
+        result.stop_reason = mpi->stop_reason;
+        result.message = public_message(mpi->message, store_.data_dir());
+        result.iterations = mpi->iterations;
+        result.converged = mpi->converged;
+        result.wall_seconds = mpi->wall_seconds;
+      } else {
+        result = contact::solve(*problem, observer, job->cancel);
+      }
     }
   } catch (const std::bad_alloc&) {
     result = contact::Result{};
@@ -194,7 +215,11 @@ void JobQueue::run(const std::shared_ptr<Job>& job) {
   }
 
   // The result file: written before the job is marked done, so that `end` means "downloadable now".
-  if (problem && !result.steps.empty() && result.stop_reason != contact::StopReason::error) {
+  if (mpi) {
+    outcome.result_available = mpi->result_written && result.stop_reason != contact::StopReason::error;
+    if (!outcome.result_available) store_.remove_result(id);
+    for (const auto& step : mpi->steps) job->events.append("step", step);
+  } else if (problem && !result.steps.empty() && result.stop_reason != contact::StopReason::error) {
     try {
       contact::io::WriteInfo info;
       info.job_id = id;

@@ -22,6 +22,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <thread>
 
 namespace {
@@ -30,9 +31,11 @@ namespace {
 struct Config {
   std::string data_dir = "./contactd-data";
   std::string allowed_hosts;  // parsed into http.allowed_hosts
+  std::string mpi_launcher;   // split into queue.mpi.launcher
   contactd::QueueSettings queue = [] {
     contactd::QueueSettings q;
     q.workers = 0;  // the number of cores
+    q.mpi.max_ranks = 4;
     return q;
   }();
   contactd::HttpSettings http;
@@ -64,6 +67,17 @@ void add_flags(CLI::App& app, Config& c) {
       ->envname("CONTACTD_MAX_DOFS")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  app.add_option("--mpi-launcher", c.mpi_launcher,
+                 "run jobs with parallel.ranks > 1 through this launcher, {ranks} replaced, e.g. 'mpirun -n {ranks}' "
+                 "(docs/parallel.md; empty: every job runs in this process)")
+      ->envname("CONTACTD_MPI_LAUNCHER");
+  app.add_option("--max-ranks", c.queue.mpi.max_ranks, "largest parallel.ranks accepted (with --mpi-launcher)")
+      ->envname("CONTACTD_MAX_RANKS")
+      ->check(CLI::Range(1, 4096))
+      ->capture_default_str();
+  app.add_option("--solver-binary", c.queue.mpi.solver,
+                 "the contact-solve that MPI jobs run (default: the one next to contactd)")
+      ->envname("CONTACTD_SOLVER_BINARY");
   app.add_option("--time-limit-seconds", c.queue.time_limit_seconds, "wall-time limit per run (0: none)")
       ->envname("CONTACTD_TIME_LIMIT_SECONDS")
       ->check(CLI::Range(0.0, 1e9))
@@ -197,6 +211,20 @@ int main(int argc, char** argv) {
   if (config.queue.workers == 0)
     config.queue.workers = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   config.http.allowed_hosts = contactd::parse_host_list(config.allowed_hosts);
+  config.queue.mpi.launcher = contactd::split_launcher(config.mpi_launcher);
+  if (config.queue.mpi.solver.empty()) {
+    // Next to contactd (an installation, the Docker image), or one level up (the build tree: build/server/);
+    // else the one on the PATH.
+    std::error_code ec;
+    const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
+    const auto dir = (ec ? std::filesystem::path(argv[0]) : self).parent_path();
+    config.queue.mpi.solver = "contact-solve";
+    for (const auto& candidate : {dir / "contact-solve", dir.parent_path() / "contact-solve"})
+      if (std::filesystem::is_regular_file(candidate, ec)) {
+        config.queue.mpi.solver = candidate.string();
+        break;
+      }
+  }
   // Retention is checked a few times per retention period (at most every 10 s).
   config.queue.janitor_interval_seconds =
       config.queue.retention_seconds > 0 ? std::min(10.0, std::max(0.2, config.queue.retention_seconds / 4)) : 10.0;

@@ -180,6 +180,7 @@ struct Problem {
   SolverSettings solver;
   AdaptivitySettings adaptivity;
   LoadingSpec loading;
+  int ranks = 1;              // parallel.ranks: MPI ranks a server launches (contact-solve takes mpirun's)
   nlohmann::json submitted;   // the job JSON as submitted
   nlohmann::json normalized;  // the same with every default filled in
 };

@@ -44,12 +44,29 @@ double max_penetration(const Step& step) {
 }  // namespace
 
 Result solve(const Problem& problem, Observer& observer, const CancelToken& cancel) {
+  try {
+    ddm::ThreadTaskRunner runner(ddm::choose_threads(problem.solver.threads, problem.bodies.size()));
+    return solve(problem, observer, cancel, runner);
+  } catch (const std::exception& e) {  // no thread for the pool
+    Result result;
+    result.stop_reason = StopReason::error;
+    result.message = std::string("internal error: ") + e.what();
+    return result;
+  }
+}
+
+Result solve(const Problem& problem, Observer& observer, const CancelToken& cancel, ddm::TaskRunner& runner) {
   const auto start = std::chrono::steady_clock::now();
   Result result;
   result.method = method_name(problem.solver.method);
   result.enforcement = enforcement_name(problem.solver.enforcement);
   try {
-    ddm::ThreadTaskRunner runner(ddm::choose_threads(problem.solver.threads, problem.bodies.size()));
+    if (runner.distributed() && problem.solver.method == Method::monolithic) {
+      result.stop_reason = StopReason::error;
+      result.message = "method 'monolithic' factorises all bodies as one system in one process: run it on one rank "
+                       "(without mpirun), or choose interface_newton, neumann or robin";
+      return result;
+    }
     // Adaptivity refines the meshes: it works on its own copy of the problem.
     Problem working;
     const bool adaptive = problem.adaptivity.enabled;

@@ -6,10 +6,19 @@
 
 namespace contact {
 
+namespace ddm {
+class TaskRunner;
+}
+
 // Solves the contact problem with the method of problem.solver. Reports every iteration to `observer` and
 // stops with StopReason::cancelled within one iteration of `cancel` being set. Never throws for a numerical
 // failure (singular body, factorisation failure): it returns a Result with stop_reason == error and a message.
 Result solve(const Problem& problem, Observer& observer, const CancelToken& cancel);
+
+// The same on the caller's executor of the per-body work: MPI ranks (solver/mpi/mpi_runner.hpp), where every
+// rank calls solve() with the same problem and a `cancel` that the runner keeps equal on all ranks; each rank
+// returns the same Result (the root reports progress and writes the file).
+Result solve(const Problem& problem, Observer& observer, const CancelToken& cancel, ddm::TaskRunner& runner);
 
 // The version string recorded in result files.
 const char* solver_version();

@@ -19,14 +19,24 @@ std::vector<IndicatorResult> estimate(const Problem& problem, const ddm::Contact
                                       const ddm::Displacements& u, const ddm::Displacements& contact_loads,
                                       ddm::TaskRunner& runner) {
   std::vector<IndicatorResult> out(problem.bodies.size());
-  runner.run(problem.bodies.size(), [&](size_t a) {
+  const ddm::BodyShare share{[&](size_t a, ddm::Packer& p) {
+                               p.put(out[a].eta);
+                               p.put(out[a].note);
+                               p.put(out[a].seconds);
+                             },
+                             [&](size_t a, ddm::Unpacker& in) {
+                               out[a].eta = in.get_vector();
+                               out[a].note = in.get_string();
+                               out[a].seconds = in.get_double();
+                             }};
+  runner.run_bodies(problem.bodies.size(), [&](size_t a) {
     if (!adapts(problem.adaptivity, a)) return;
     const Body& body = problem.bodies[a];
     const Normalization norm = problem.adaptivity.normalization;
     out[a] = problem.adaptivity.indicator == Indicator::fem_bem
                  ? fem_bem_indicator(body, problem.model, system.body(a), u[a], contact_loads[a], norm)
                  : zz_indicator(body, system.body(a), u[a], norm);
-  });
+  }, share);
   return out;
 }
 

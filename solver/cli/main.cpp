@@ -1,24 +1,35 @@
 // contact-solve: the solver without the server.
 //   contact-solve JOB.json [-o RESULT.hdf]     solve, print one progress line per iteration, write the result
 //   contact-solve JOB.json --validate          only check the job
+//   mpirun -n N contact-solve JOB.json ...     the bodies spread over N MPI ranks (docs/parallel.md)
 // Exit codes: 0 converged; 1 solver or I/O error; 2 invalid job (errors printed with their JSON pointers);
 // 3 stopped without converging (max_iterations or cancelled; the result file is still written).
+#include "io/progress_json.hpp"
 #include "io/result_file.hpp"
 #include "job/job.hpp"
+#include "session.hpp"
 #include "solve.hpp"
 
 #include <CLI/CLI.hpp>
 
+#include <atomic>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <sstream>
 
 namespace {
 
-contact::CancelToken* g_cancel = nullptr;
-extern "C" void on_interrupt(int) {
-  if (g_cancel) g_cancel->cancel();  // an atomic store: async-signal-safe
+// A stop request (SIGINT, SIGTERM, or SIGUSR1 which mpirun forwards to every rank): the solver sees it at its
+// next iteration, on every rank at the same point (cli/session.hpp).
+// One process: the request is the cancel token itself.
+std::atomic<bool> g_stop_request{false};
+contact::CancelToken* g_direct_cancel = nullptr;
+extern "C" void on_interrupt(int) {  // atomic stores only: async-signal-safe
+  g_stop_request.store(true);
+  if (g_direct_cancel) g_direct_cancel->cancel();
 }
 
 const char* method_name(contact::Method m) {
@@ -45,8 +56,15 @@ const char* enforcement_name(contact::Enforcement e) {
 // fixed-point schemes both stopping measures; then per pair force, max pressure and active nodes.
 class ProgressPrinter final : public contact::Observer {
  public:
-  explicit ProgressPrinter(bool quiet) : quiet_(quiet) {}
+  ProgressPrinter(bool quiet, bool ndjson) : quiet_(quiet), ndjson_(ndjson) {}
   void on_iteration(const contact::IterationReport& r) override {
+    if (ndjson_) {
+      nlohmann::json line = contact::io::iteration_json(r);
+      line["type"] = "iteration";
+      std::printf("%s\n", line.dump().c_str());
+      std::fflush(stdout);
+      return;
+    }
     if (quiet_) return;
     const bool active_set = r.measure == contact::Measure::complementarity;
     std::printf("%s %4d", active_set ? "step" : "iter", r.iteration);
@@ -69,77 +87,83 @@ class ProgressPrinter final : public contact::Observer {
   }
 
  private:
-  bool quiet_;
+  bool quiet_, ndjson_;
 };
 
-}  // namespace
+// Ranks other than 0 report nothing.
+class Silent final : public contact::Observer {
+ public:
+  void on_iteration(const contact::IterationReport&) override {}
+};
 
-int main(int argc, char** argv) {
-  CLI::App app{
-      "contact-solve: frictionless contact of elastic bodies by domain decomposition (each body solved on its own).\n"
-      "Methods (job field solver.method): interface_newton (default: exact dual-mortar contact, primal-dual active\n"
-      "set on the bodies' interface Schur complements), neumann (the paper's penalty Neumann DDM (16)-(17)), robin,\n"
-      "monolithic (reference). See docs/job-format.md."};
-  app.set_version_flag("--version", std::string("contact-solve ") + contact::solver_version());
-  std::string job_path, output;
-  bool validate_only = false, quiet = false;
-  long max_dofs = contact::job::Limits{}.max_dofs;
-  int threads = -1;
-  app.add_option("job", job_path, "contact job (JSON, see docs/job-format.md)")->required();
-  app.add_option("-o,--output", output, "result file (HDF5; default: the job file's name with .hdf)");
-  app.add_flag("--validate", validate_only, "only validate the job and exit");
-  app.add_flag("-q,--quiet", quiet, "no per-iteration lines");
-  app.add_option("--max-dofs", max_dofs, "reject jobs with more unknowns than this")->check(CLI::PositiveNumber);
-  app.add_option("--threads", threads, "threads for the per-body solves (overrides the job; 0 = automatic)")
-      ->check(CLI::NonNegativeNumber);
-  CLI11_PARSE(app, argc, argv);
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot open job file '" + path + "'");
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
+}
 
-  contact::job::Limits limits;
-  limits.max_dofs = max_dofs;
-  // Gmsh mesh files are read relative to the job file's directory.
-  auto parsed = contact::job::parse_file(job_path, limits);
-  if (!parsed.ok()) {
-    std::cerr << job_path << ": the job is invalid (" << parsed.errors.size() << " error"
-              << (parsed.errors.size() == 1 ? "" : "s") << "):\n"
-              << contact::job::format_errors(parsed.errors);
-    return 2;
-  }
-  contact::Problem& problem = *parsed.problem;
-  if (threads >= 0) problem.solver.threads = threads;
-  if (validate_only) {
-    long dofs = 0;
-    for (const auto& b : problem.bodies) dofs += 2L * b.mesh.num_nodes();
-    std::cout << job_path << ": valid (" << problem.bodies.size() << " bodies, " << problem.contacts.size()
-              << " contact pairs, " << dofs << " dofs before constraints)\n";
-    return 0;
-  }
-  if (output.empty()) output = std::filesystem::path(job_path).stem().string() + ".hdf";
 
+// Everything after the job is parsed: solve on this process's share, report and write on rank 0. Returns the
+// exit code (rank 0's decides for all).
+int solve_and_write(contact::cli::Session& session, contact::Problem& problem, const std::string& output,
+                    const std::string& job_id, bool quiet, bool ndjson) {
+  const bool root = session.root();
   contact::CancelToken cancel;
-  g_cancel = &cancel;
+  if (session.size() == 1) g_direct_cancel = &cancel;
   std::signal(SIGINT, on_interrupt);
   std::signal(SIGTERM, on_interrupt);
+  std::signal(SIGUSR1, on_interrupt);
 
   const bool fixed_point = problem.solver.method == contact::Method::neumann || problem.solver.method == contact::Method::robin;
   const bool adaptive_paper = problem.adaptivity.enabled && problem.adaptivity.strategy == contact::AdaptStrategy::paper;
   const bool active_set = !fixed_point && !adaptive_paper &&
                           (problem.solver.method == contact::Method::interface_newton ||
                            problem.solver.enforcement == contact::Enforcement::exact);
-  std::printf("%s: %zu bodies, %zu contact pairs, method %s, enforcement %s\n", problem.name.c_str(),
-              problem.bodies.size(), problem.contacts.size(), method_name(problem.solver.method),
-              enforcement_name(problem.solver.enforcement));
-  ProgressPrinter printer(quiet);
-  const contact::Result result = contact::solve(problem, printer, cancel);
-  g_cancel = nullptr;
+  if (root && !ndjson) {
+    std::printf("%s: %zu bodies, %zu contact pairs, method %s, enforcement %s\n", problem.name.c_str(),
+                problem.bodies.size(), problem.contacts.size(), method_name(problem.solver.method),
+                enforcement_name(problem.solver.enforcement));
+    if (session.size() > 1) std::printf("%d MPI ranks (%s)\n", session.size(), session.placement(problem).c_str());
+    std::fflush(stdout);
+  }
+  ProgressPrinter printer(quiet, ndjson);
+  Silent silent;
+  std::unique_ptr<contact::ddm::TaskRunner> runner = session.runner(problem, &g_stop_request, &cancel);
+  const contact::Result result =
+      contact::solve(problem, root ? static_cast<contact::Observer&>(printer) : silent, cancel, *runner);
+  g_direct_cancel = nullptr;
+  const std::string traffic = session.traffic(*runner);
+  if (!root) return 0;
 
-  std::printf("stop: %s after %d %s, %.3f s (setup %.3f s): %s\n", contact::to_string(result.stop_reason),
-              result.iterations, active_set ? "steps" : "iterations", result.wall_seconds, result.setup_seconds,
-              result.message.c_str());
+  if (!ndjson) {
+    std::printf("stop: %s after %d %s, %.3f s (setup %.3f s): %s\n", contact::to_string(result.stop_reason),
+                result.iterations, active_set ? "steps" : "iterations", result.wall_seconds, result.setup_seconds,
+                result.message.c_str());
+    if (!traffic.empty()) std::printf("mpi: %s\n", traffic.c_str());
+  }
+  nlohmann::json summary = {{"type", "result"},
+                            {"stop_reason", contact::to_string(result.stop_reason)},
+                            {"message", result.message},
+                            {"converged", result.converged},
+                            {"iterations", result.iterations},
+                            {"wall_seconds", result.wall_seconds},
+                            {"ranks", session.size()},
+                            {"traffic", traffic},
+                            {"result_written", false},
+                            {"steps", nlohmann::json::array()}};
+  auto finish = [&](int code) {
+    if (ndjson) std::printf("%s\n", summary.dump().c_str());
+    std::fflush(stdout);
+    return code;
+  };
   if (result.steps.empty()) {
     std::cerr << "error: " << result.message << "\n";
-    return 1;
+    return finish(1);
   }
   for (const auto& p : result.steps.back().pairs) {
+    if (ndjson) break;
     double p_max = 0, penetration = 0;
     for (Eigen::Index j = 0; j < p.pressure.size(); ++j) {
       p_max = std::max(p_max, p.pressure[j]);
@@ -153,17 +177,106 @@ int main(int argc, char** argv) {
                   p.enforcement.c_str(), p.theta, p.force, p_max, penetration);
   }
   try {
-    contact::io::write_result(output, problem, result);
+    contact::io::WriteInfo info;
+    info.job_id = job_id;
+    contact::io::write_result(output, problem, result, info);
     std::filesystem::path xmf = std::filesystem::path(output).replace_extension(".xmf");
     contact::io::write_xdmf(xmf.string(), std::filesystem::path(output).filename().string(), result);
     // ParaView's Xdmf3 readers abort on a bare file name (they join it with the data file's name): "./x.xmf".
     if (!xmf.has_parent_path()) xmf = std::filesystem::path(".") / xmf;
-    std::printf("wrote %s and %s (in ParaView, open %s with the Xdmf3 Reader)\n", output.c_str(), xmf.string().c_str(),
-                xmf.string().c_str());
+    if (!ndjson)
+      std::printf("wrote %s and %s (in ParaView, open %s with the Xdmf3 Reader)\n", output.c_str(),
+                  xmf.string().c_str(), xmf.string().c_str());
+    summary["result_written"] = true;
+    for (const auto& step : result.steps) summary["steps"].push_back(contact::io::step_json(step));
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
-    return 1;
+    summary["message"] = std::string("cannot write the result file: ") + e.what();
+    return finish(1);
   }
-  if (result.stop_reason == contact::StopReason::error) return 1;
-  return result.converged ? 0 : 3;
+  if (result.stop_reason == contact::StopReason::error) return finish(1);
+  return finish(result.converged ? 0 : 3);
+}
+
+// Rank 0 reads the job file; every rank gets its text ("" and false when it cannot be read: the error is printed).
+bool read_job(const contact::cli::Session& session, const std::string& path, std::string& text) {
+  int ok = 1;
+  if (session.root()) {
+    try {
+      text = read_file(path);
+    } catch (const std::exception& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      ok = 0;
+    }
+  }
+  if (!session.broadcast(ok)) return false;
+  text = session.broadcast(text);
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  contact::cli::Session session(&argc, &argv);
+  CLI::App app{
+      "contact-solve: frictionless contact of elastic bodies by domain decomposition (each body solved on its own).\n"
+      "Methods (job field solver.method): interface_newton (default: exact dual-mortar contact, primal-dual active\n"
+      "set on the bodies' interface Schur complements), neumann (the paper's penalty Neumann DDM (16)-(17)), robin,\n"
+      "monolithic (reference). See docs/job-format.md. Under `mpirun -n N` the bodies are spread over N ranks\n"
+      "(docs/parallel.md)."};
+  app.set_version_flag("--version", std::string("contact-solve ") + contact::solver_version());
+  std::string job_path, output, job_id, progress = "text";
+  bool validate_only = false, quiet = false;
+  long max_dofs = contact::job::Limits{}.max_dofs;
+  int threads = -1;
+  app.add_option("job", job_path, "contact job (JSON, see docs/job-format.md)")->required();
+  app.add_option("-o,--output", output, "result file (HDF5; default: the job file's name with .hdf)");
+  app.add_flag("--validate", validate_only, "only validate the job and exit");
+  app.add_flag("-q,--quiet", quiet, "no per-iteration lines");
+  app.add_option("--max-dofs", max_dofs, "reject jobs with more unknowns than this")->check(CLI::PositiveNumber);
+  app.add_option("--threads", threads, "threads for the per-body solves (per rank under mpirun; overrides the job; "
+                                       "0 = automatic)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--progress", progress,
+                 "text (default): one line per iteration; ndjson: one JSON object per iteration and a final "
+                 "\"result\" object, as contactd reads them (docs/parallel.md)")
+      ->check(CLI::IsMember({"text", "ndjson"}));
+  app.add_option("--job-id", job_id, "job id recorded in the result file (contactd sets it)");
+  bool no_mesh_files = false;
+  app.add_flag("--no-mesh-files", no_mesh_files,
+               "refuse Gmsh meshes given by file, as contactd does (it passes this flag): only \"data\"");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return session.root() ? app.exit(e) : (e.get_exit_code() == 0 ? 0 : 2);
+  }
+  const bool ndjson = progress == "ndjson";
+
+  std::string text;
+  if (!read_job(session, job_path, text)) return 2;
+  contact::job::Limits limits;
+  limits.max_dofs = max_dofs;
+  // Gmsh mesh files are read relative to the job file's directory (by every rank).
+  if (!no_mesh_files) limits.mesh_directory = contact::job::job_directory(job_path);
+  auto parsed = contact::job::parse_text(text, limits);
+  if (!parsed.ok()) {
+    if (session.root())
+      std::cerr << job_path << ": the job is invalid (" << parsed.errors.size() << " error"
+                << (parsed.errors.size() == 1 ? "" : "s") << "):\n"
+                << contact::job::format_errors(parsed.errors);
+    return 2;
+  }
+  contact::Problem& problem = *parsed.problem;
+  if (threads >= 0) problem.solver.threads = threads;
+  if (validate_only) {
+    long dofs = 0;
+    for (const auto& b : problem.bodies) dofs += 2L * b.mesh.num_nodes();
+    if (session.root())
+      std::cout << job_path << ": valid (" << problem.bodies.size() << " bodies, " << problem.contacts.size()
+                << " contact pairs, " << dofs << " dofs before constraints)\n";
+    return 0;
+  }
+  if (output.empty()) output = std::filesystem::path(job_path).stem().string() + ".hdf";
+  const int code = solve_and_write(session, problem, output, job_id, quiet, ndjson);
+  return session.broadcast(code);
 }

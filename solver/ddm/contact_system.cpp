@@ -23,20 +23,38 @@ void append_error(std::string& errors, const std::string& e) { errors += (errors
 }  // namespace
 
 ContactSystem::ContactSystem(const Problem& problem, TaskRunner& runner, Factorization factorization)
-    : problem_(problem), factorization_(factorization) {
+    : problem_(problem), factorization_(factorization), runner_(runner) {
   const auto t0 = std::chrono::steady_clock::now();
   fem::limit_blas_threads();
   discretize_pairs();
   bodies_.resize(problem.bodies.size());
-  runner.run(bodies_.size(), [&](size_t a) {
-    bodies_[a] = std::make_unique<fem::BodySolver>(problem.bodies[a], problem.model, factorization != Factorization::none,
-                                                   interface_dofs(a), may_float(a));
-  });
+  runner.run_bodies(bodies_.size(), [&](size_t a) { bodies_[a] = make_body(a, true); }, body_outcome_share());
   for (const auto& b : bodies_) {
     if (!b->ok()) append_error(error_, b->error());
     factorization_seconds_ += b->factorization_seconds();
   }
   setup_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::unique_ptr<fem::BodySolver> ContactSystem::make_body(size_t a, bool local) const {
+  auto b = std::make_unique<fem::BodySolver>(problem_.bodies[a], problem_.model, factorization_ != Factorization::none,
+                                             interface_dofs(a), may_float(a), local);
+  b->set_load_factor(load_factor_);
+  return b;
+}
+
+BodyShare ContactSystem::body_outcome_share() {
+  // The owner's outcome (an error such as a singular stiffness, the factorisation time); the other processes set
+  // up the body's constraints and rigid modes themselves (the same on every process).
+  return {[this](size_t a, Packer& out) {
+            out.put(bodies_[a]->error());
+            out.put(bodies_[a]->factorization_seconds());
+          },
+          [this](size_t a, Unpacker& in) {
+            bodies_[a] = make_body(a, false);
+            const std::string error = in.get_string();
+            bodies_[a]->adopt_outcome(error, in.get_double());
+          }};
 }
 
 void ContactSystem::discretize_pairs() {
@@ -79,13 +97,10 @@ void ContactSystem::rebuild(const std::vector<char>& changed, TaskRunner& runner
   for (size_t a = 0; a < bodies_.size(); ++a)
     if (changed[a] || (factorization_ == Factorization::interface && interface_dofs(a) != bodies_[a]->interface_dofs()))
       todo.push_back(a);
-  runner.run(todo.size(), [&](size_t i) {
-    const size_t a = todo[i];
+  runner.run_bodies(todo, [&](size_t a) {
     bodies_[a].reset();  // free the old factorisation first
-    bodies_[a] = std::make_unique<fem::BodySolver>(problem_.bodies[a], problem_.model, factorization_ != Factorization::none,
-                                                   interface_dofs(a), may_float(a));
-    bodies_[a]->set_load_factor(load_factor_);
-  });
+    bodies_[a] = make_body(a, true);
+  }, body_outcome_share());
   for (size_t a : todo) {
     if (!bodies_[a]->ok()) append_error(error_, bodies_[a]->error());
     factorization_seconds_ += bodies_[a]->factorization_seconds();
@@ -138,8 +153,12 @@ Eigen::VectorXd ContactSystem::zone_normals(size_t a, const Eigen::VectorXd& u_a
 
 Displacements ContactSystem::solve_bodies(const Displacements& loads, TaskRunner& runner) const {
   Displacements u(bodies_.size());
-  runner.run(bodies_.size(), [&](size_t a) { u[a] = bodies_[a]->solve(loads[a]); });
+  runner.run_bodies(bodies_.size(), [&](size_t a) { u[a] = bodies_[a]->solve(loads[a]); }, share_vectors(u));
   return u;
+}
+
+BodyShare share_vectors(std::vector<Eigen::VectorXd>& v) {
+  return {[&v](size_t a, Packer& out) { out.put(v[a]); }, [&v](size_t a, Unpacker& in) { v[a] = in.get_vector(); }};
 }
 
 Displacements ContactSystem::elastic_layer_guess(TaskRunner& runner) const {
@@ -217,6 +236,25 @@ Step ContactSystem::fields(const Displacements& u, const Pressures& z, int itera
   Step step;
   step.iteration = iteration;
   const Displacements loads = loads_from_pressures(z);
+  // Stresses and support reactions on each body's owner (the reactions need its assembled loads).
+  std::vector<fem::StressFields> stress(bodies_.size());
+  std::vector<Eigen::VectorXd> reaction(bodies_.size());
+  const BodyShare share{[&](size_t a, Packer& out) {
+                          out.put(stress[a].cell);
+                          out.put(stress[a].node);
+                          out.put(stress[a].von_mises_cell);
+                          out.put(reaction[a]);
+                        },
+                        [&](size_t a, Unpacker& in) {
+                          stress[a].cell = in.get_matrix();
+                          stress[a].node = in.get_matrix();
+                          stress[a].von_mises_cell = in.get_vector();
+                          reaction[a] = in.get_vector();
+                        }};
+  runner_.run_bodies(bodies_.size(), [&](size_t a) {
+    stress[a] = bodies_[a]->stresses(u[a]);
+    reaction[a] = bodies_[a]->reactions(u[a], loads[a]);
+  }, share);
   for (size_t a = 0; a < bodies_.size(); ++a) {
     const Body& body = problem_.bodies[a];
     BodyField f;
@@ -224,11 +262,10 @@ Step ContactSystem::fields(const Displacements& u, const Pressures& z, int itera
     f.mesh = body.mesh;
     const int n = body.mesh.num_nodes();
     f.displacement = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>(u[a].data(), n, 2);
-    const auto s = bodies_[a]->stresses(u[a]);
-    f.stress_cell = s.cell;
-    f.stress_node = s.node;
-    f.von_mises_cell = s.von_mises_cell;
-    const Eigen::VectorXd R = bodies_[a]->reactions(u[a], loads[a]);
+    f.stress_cell = stress[a].cell;
+    f.stress_node = stress[a].node;
+    f.von_mises_cell = stress[a].von_mises_cell;
+    const Eigen::VectorXd& R = reaction[a];
     f.reaction = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>(R.data(), n, 2);
     if (bodies_[a]->floating()) {
       f.free_motions = bodies_[a]->rigid_mode_names();

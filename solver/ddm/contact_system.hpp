@@ -94,7 +94,8 @@ class ContactSystem {
   // The nodal gaps (weighted gap / D) of displacements u.
   Pressures nodal_gaps(const Displacements& u) const;
 
-  // Final fields (one Step) for displacements u with pressures z (the penalty form computes z from u), and the
+  // Final fields (one Step), the bodies' stresses and reactions computed on the runner the system was built with,
+  // for displacements u with pressures z (the penalty form computes z from u), and the
   // floating bodies' rigid-mode amplitudes if known.
   Step fields(const Displacements& u, const Pressures& z, int iteration,
               const std::vector<Eigen::VectorXd>* rigid_amplitudes = nullptr) const;
@@ -106,9 +107,13 @@ class ContactSystem {
   std::vector<int> interface_dofs(size_t a) const;
   // Whether body a may float (held by its contacts): in a pair, and a method that handles it.
   bool may_float(size_t a) const;
+  // Body a's solver: assembled and factorised (local), or only its constraints (owned by another process).
+  std::unique_ptr<fem::BodySolver> make_body(size_t a, bool local) const;
+  BodyShare body_outcome_share();
 
   const Problem& problem_;
   Factorization factorization_ = Factorization::plain;
+  TaskRunner& runner_;  // the one it was built with (fields() runs per-body work on it)
   std::vector<std::unique_ptr<fem::BodySolver>> bodies_;
   std::vector<mortar::PairDiscretization> pairs_;
   std::vector<mortar::PenaltyChoice> penalties_;
@@ -116,6 +121,9 @@ class ContactSystem {
   double setup_seconds_ = 0.0, factorization_seconds_ = 0.0;
   double load_factor_ = 1.0;
 };
+
+// How one full vector per body (displacements, loads) moves from its owner to the other processes.
+BodyShare share_vectors(std::vector<Eigen::VectorXd>& per_body);
 
 // Relative norm used by both stopping tests: ||a - b|| / max(||a||, ||b||), 0 when both vanish.
 double relative_change(const Eigen::VectorXd& now, const Eigen::VectorXd& before);

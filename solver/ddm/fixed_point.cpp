@@ -59,7 +59,7 @@ Displacements NeumannMap::apply(const Displacements& u) { return system_.solve_b
 Displacements NeumannMap::linear_response(const Displacements& du) {
   const Displacements loads = system_.loads_from_pressures(linear_pressures(system_, du));
   Displacements out(loads.size());
-  runner_.run(loads.size(), [&](size_t a) { out[a] = system_.body(a).solve_homogeneous(loads[a]); });
+  runner_.run_bodies(loads.size(), [&](size_t a) { out[a] = system_.body(a).solve_homogeneous(loads[a]); }, share_vectors(out));
   return out;
 }
 

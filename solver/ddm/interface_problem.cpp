@@ -50,8 +50,21 @@ InterfaceProblem::InterfaceProblem(const ContactSystem& system, TaskRunner& runn
   std::vector<BodyRows> rows(n_bodies);
   std::vector<Eigen::MatrixXd> F_body(n_bodies), G_body(n_bodies);
   std::vector<Eigen::VectorXd> g_body(n_bodies), e_body(n_bodies);
-  runner.run(n_bodies, [&](size_t a) {
-    rows[a] = body_rows(system, a, offset_);
+  for (size_t a = 0; a < n_bodies; ++a) rows[a] = body_rows(system, a, offset_);
+  // Each body's part on its owner; F_a (|rows| squared numbers) is what moves between processes.
+  const BodyShare share{[&](size_t a, Packer& out) {
+                          out.put(F_body[a]);
+                          out.put(G_body[a]);
+                          out.put(g_body[a]);
+                          out.put(e_body[a]);
+                        },
+                        [&](size_t a, Unpacker& in) {
+                          F_body[a] = in.get_matrix();
+                          G_body[a] = in.get_matrix();
+                          g_body[a] = in.get_vector();
+                          e_body[a] = in.get_vector();
+                        }};
+  runner.run_bodies(n_bodies, [&](size_t a) {
     const BodyRows& R = rows[a];
     const auto& body = system.body(a);
     if (body.floating()) {
@@ -88,7 +101,7 @@ InterfaceProblem::InterfaceProblem(const ContactSystem& system, TaskRunner& runn
     }
     const Eigen::MatrixXd W = L.triangularView<Eigen::Lower>().solve(BzT);
     F_body[a] = W.transpose() * W;
-  });
+  }, share);
   F_ = Eigen::MatrixXd::Zero(m, m);
   Eigen::Index r = 0;
   for (size_t a = 0; a < n_bodies; ++a) {

@@ -22,7 +22,7 @@ class RobinMap final : public BodyMap {
  public:
   RobinMap(const ContactSystem& system, const SolverSettings& settings, TaskRunner& runner)
       : system_(system), settings_(settings), runner_(runner), psi_(system.n_bodies()), factor_(system.n_bodies()),
-        active_(system.pairs().size()) {}
+        remote_(system.n_bodies(), 0), active_(system.pairs().size()) {}
 
   std::string error;
 
@@ -30,12 +30,12 @@ class RobinMap final : public BodyMap {
     update_weights(u);
     const Displacements contact = system_.contact_loads(u);
     Displacements out(u.size());
-    runner_.run(u.size(), [&](size_t a) {
+    runner_.run_bodies(u.size(), [&](size_t a) {
       const auto& body = system_.body(a);
       const auto& c = body.constraints();
       const Eigen::VectorXd load = psi_[a] * (u[a] - body.prescribed()) + contact[a];
       out[a] = body.expand(solve(a, body.reduced_rhs() + c.T().transpose() * load));
-    });
+    }, share_vectors(out));
     return out;
   }
 
@@ -43,10 +43,10 @@ class RobinMap final : public BodyMap {
     update_weights(du, /*all_active=*/true);
     const Displacements loads = system_.loads_from_pressures(linear_pressures(system_, du));
     Displacements out(du.size());
-    runner_.run(du.size(), [&](size_t a) {
+    runner_.run_bodies(du.size(), [&](size_t a) {
       const auto& c = system_.body(a).constraints();
       out[a] = c.T() * solve(a, c.T().transpose() * (psi_[a] * du[a] + loads[a]));
-    });
+    }, share_vectors(out));
     return out;
   }
 
@@ -71,22 +71,27 @@ class RobinMap final : public BodyMap {
                                                                        u[static_cast<size_t>(pair.master_body)]));
         for (Eigen::Index q = 0; q < p.size(); ++q) now[static_cast<size_t>(q)] = p[q] > 0 ? 1 : 0;
       }
-      if (now != active_[k] || !factor_[static_cast<size_t>(pair.slave_body)]) {
+      const size_t sb = static_cast<size_t>(pair.slave_body);
+      if (now != active_[k] || (!factor_[sb] && !remote_[sb])) {
         active_[k] = std::move(now);
         changed[static_cast<size_t>(pair.slave_body)] = changed[static_cast<size_t>(pair.master_body)] = 1;
       }
     }
     for (size_t a = 0; a < system_.n_bodies(); ++a)
-      if (!factor_[a]) changed[a] = 1;
+      if (!factor_[a] && !remote_[a]) changed[a] = 1;
     std::vector<size_t> todo;
     for (size_t a = 0; a < changed.size(); ++a)
       if (changed[a]) todo.push_back(a);
     if (todo.empty()) return;
-    runner_.run(todo.size(), [&](size_t i) { refactorize(todo[i]); });
-    factorizations_ += static_cast<int>(todo.size());
-    for (size_t a : todo)
+    // Each owner refactorises its bodies; the others only note that the weights changed (a failure throws on the
+    // owner, and run_bodies throws it everywhere).
+    runner_.run_bodies(todo, [&](size_t a) {
+      refactorize(a);
       if (factor_[a]->info() != Eigen::Success)
-        throw std::runtime_error("robin: the stiffness of body " + std::to_string(a) + " plus the Robin term could not be factorised");
+        throw std::runtime_error("robin: the stiffness of body '" + system_.problem().bodies[a].name +
+                                 "' plus the Robin term could not be factorised");
+    }, BodyShare{[](size_t, Packer&) {}, [this](size_t a, Unpacker&) { psi_[a].resize(0, 0); remote_[a] = 1; }});
+    factorizations_ += static_cast<int>(todo.size());
   }
 
   void refactorize(size_t a) {
@@ -117,6 +122,7 @@ class RobinMap final : public BodyMap {
   TaskRunner& runner_;
   std::vector<Eigen::SparseMatrix<double>> psi_;
   std::vector<std::unique_ptr<Factor>> factor_;
+  std::vector<char> remote_;  // set up by another process (its factor_ stays empty here)
   std::vector<std::vector<char>> active_;
   int factorizations_ = 0;
 };

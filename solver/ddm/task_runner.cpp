@@ -47,6 +47,17 @@ void ThreadTaskRunner::work_loop() {
   }
 }
 
+void TaskRunner::run_bodies(const std::vector<size_t>& bodies, const std::function<void(size_t)>& task,
+                            const BodyShare& /*share*/) {
+  run(bodies.size(), [&](size_t i) { task(bodies[i]); });
+}
+
+void TaskRunner::run_bodies(size_t n_bodies, const std::function<void(size_t)>& task, const BodyShare& share) {
+  std::vector<size_t> all(n_bodies);
+  for (size_t a = 0; a < n_bodies; ++a) all[a] = a;
+  run_bodies(all, task, share);
+}
+
 void ThreadTaskRunner::run(size_t n, const std::function<void(size_t)>& task) {
   if (n == 0) return;
   if (workers_.empty() || n == 1) {

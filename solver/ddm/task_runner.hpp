@@ -1,6 +1,8 @@
-// "Run these N independent tasks": the one interface through which the DDM runs its per-body work, so that
-// threads serve today and other executors (MPI ranks) can serve later without touching the DDM code.
+// "Run these N independent tasks": the one interface through which the DDM runs its per-body work, threads of
+// one process (ThreadTaskRunner, here) or MPI ranks that each own some bodies (solver/mpi/mpi_runner.hpp).
 #pragma once
+
+#include "body_share.hpp"
 
 #include <condition_variable>
 #include <cstddef>
@@ -17,6 +19,20 @@ class TaskRunner {
   // Calls task(i) for i = 0..n-1, possibly concurrently, and returns when all have finished. The first
   // exception thrown by a task is rethrown here after every task has finished.
   virtual void run(size_t n, const std::function<void(size_t)>& task) = 0;
+
+  // Per-body work: task(a) for every body a in `bodies`, on the process that owns a. On return every process
+  // holds every task's outputs: a distributed runner moves them with `share` (one process: nothing moves). A
+  // task that throws on any process makes run_bodies throw the same message on every process.
+  virtual void run_bodies(const std::vector<size_t>& bodies, const std::function<void(size_t)>& task,
+                          const BodyShare& share);
+  void run_bodies(size_t n_bodies, const std::function<void(size_t)>& task, const BodyShare& share);
+
+  // Whether this process owns body a (holds its matrices, runs its tasks).
+  virtual bool owns(size_t /*body*/) const { return true; }
+  // Whether other processes take part (bodies they own have no matrices here).
+  virtual bool distributed() const { return false; }
+  // The process that reports progress and writes results.
+  virtual bool is_root() const { return true; }
 };
 
 // A fixed pool of worker threads (the calling thread works too). threads <= 1 runs everything inline.

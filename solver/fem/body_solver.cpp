@@ -20,16 +20,17 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }  // namespace
 
 BodySolver::BodySolver(const Body& body, const Model& model, bool factorize_now, const std::vector<int>& interface_dofs,
-                       bool allow_floating)
+                       bool allow_floating, bool local)
     : body_(body),
       elasticity_(make_elasticity(body.material, model)),
       constraints_(2 * body.mesh.num_nodes()),
       interface_dofs_(interface_dofs),
       allow_floating_(allow_floating),
-      factorize_(factorize_now) {
+      factorize_(factorize_now),
+      local_(local) {
   const auto t0 = std::chrono::steady_clock::now();
   setup_constraints();
-  if (!ok()) return;
+  if (!ok() || !local) return;
   assemble_system();
   assembly_seconds_ = seconds_since(t0);
   if (factorize_now) factorize();
@@ -271,7 +272,9 @@ Eigen::VectorXd BodySolver::solve_homogeneous(const Eigen::VectorXd& load) const
 
 Eigen::VectorXd BodySolver::solve(const Eigen::VectorXd& extra_load) const {
   if (n_free() == 0) return prescribed();
-  if (!factor_) throw std::logic_error("BodySolver::solve called on a solver built without factorisation");
+  if (!factor_)
+    throw std::logic_error(local_ ? "BodySolver::solve called on a solver built without factorisation"
+                                  : "body '" + body_.name + "' is solved by another process");
   Eigen::VectorXd rhs = load_factor_ * rhs_base_;
   if (extra_load.size() > 0) rhs.noalias() += constraints_.T().transpose() * extra_load;
   return expand(factor_->solve(rhs));

@@ -34,8 +34,18 @@ class BodySolver {
   // allow_floating: a body that its own displacement conditions do not restrain is accepted (it is held by its
   // contacts): its rigid modes R are fixed at a few well-chosen dofs for the factorisation, so every solve gives
   // a particular solution K^+ f (zero at those dofs; meaningful when R^T f = 0), and the caller adds R alpha.
+  // local = false: the body belongs to another process (MPI ranks, ddm/task_runner.hpp): only its constraints and
+  // rigid modes are set up (the same as on its owner), nothing is assembled or factorised, and the owner's outcome
+  // arrives through adopt_outcome(). Its solves throw; its stresses and reactions need no factorisation and work.
   BodySolver(const Body& body, const Model& model, bool factorize = true, const std::vector<int>& interface_dofs = {},
-             bool allow_floating = false);
+             bool allow_floating = false, bool local = true);
+
+  bool local() const { return local_; }
+  // A body of another process: its owner's error (if any) and factorisation seconds.
+  void adopt_outcome(const std::string& error, double factorization_seconds) {
+    error_ = error;
+    factorization_seconds_ = factorization_seconds;
+  }
 
   bool ok() const { return error_.empty(); }
   const std::string& error() const { return error_; }
@@ -104,7 +114,7 @@ class BodySolver {
   Eigen::SparseMatrix<double> K_red_;
   Eigen::VectorXd f_ext_, rhs_base_;
   std::vector<int> interface_dofs_;
-  bool allow_floating_ = false, factorize_ = true;
+  bool allow_floating_ = false, factorize_ = true, local_ = true;
   double load_factor_ = 1.0;
   Eigen::MatrixXd rigid_modes_;
   std::vector<std::string> rigid_mode_names_;

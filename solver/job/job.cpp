@@ -188,7 +188,7 @@ class JobReader {
 
   ParseResult run() {
     Fields top(job_, "", "the job",
-               {"name", "version", "model", "bodies", "contacts", "solver", "adaptivity", "loading"}, errors_);
+               {"name", "version", "model", "bodies", "contacts", "solver", "adaptivity", "loading", "parallel"}, errors_);
     if (!top.ok()) return finish();
     read_header(top);
     read_model(top);
@@ -197,6 +197,7 @@ class JobReader {
     read_solver(top);
     if (const json* a = top.find("adaptivity")) read_adaptivity(*a, top.at("adaptivity"));
     read_loading(top);
+    read_parallel(top);
     resolve_method_defaults();
     check_floating_bodies();
     check_work_limits();
@@ -1187,6 +1188,32 @@ class JobReader {
     }
   }
 
+  // "parallel": {"ranks": N}: the MPI ranks a server runs the job on (docs/parallel.md); contact-solve takes
+  // mpirun's number instead.
+  void read_parallel(const Fields& top) {
+    const json* v = top.find("parallel");
+    if (!v) {
+      set_default(normalized_, "parallel", json{{"ranks", 1}});
+      return;
+    }
+    Fields f(*v, top.at("parallel"), "parallel", {"ranks"}, errors_);
+    if (!f.ok()) return;
+    const json* n = f.find("ranks");
+    if (!n) {
+      if (normalized_.is_object() && normalized_["parallel"].is_object()) normalized_["parallel"]["ranks"] = 1;
+      return;
+    }
+    if (auto x = bounded_int(*n, f.at("ranks"), "ranks", 1, errors_)) {
+      if (*x > limits_.max_ranks) {
+        errors_.add(f.at("ranks"), "ranks = " + std::to_string(*x) + " is more than the " +
+                                       std::to_string(limits_.max_ranks) + " MPI ranks accepted here" +
+                                       (limits_.ranks_hint.empty() ? "" : " (" + limits_.ranks_hint + ")"));
+        return;
+      }
+      problem_.ranks = *x;
+    }
+  }
+
   // "loading": {"steps": N} (factors 1/N, 2/N, ..., 1) or {"factors": [f1, f2, ...]}.
   void read_loading(const Fields& top) {
     const json* v = top.find("loading");
@@ -1539,9 +1566,13 @@ ParseResult parse_file(const std::string& path, Limits limits) {
   std::ostringstream text;
   if (!in) return failure("", "cannot open the job file '" + path + "': " + std::strerror(errno));
   text << in.rdbuf();  // an empty file leaves the text empty: malformed JSON, said by parse_text
-  const std::filesystem::path directory = std::filesystem::path(path).parent_path();
-  limits.mesh_directory = directory.empty() ? std::string(".") : directory.string();
+  limits.mesh_directory = job_directory(path);
   return parse_text(text.str(), limits);
+}
+
+std::string job_directory(const std::string& path) {
+  const std::filesystem::path directory = std::filesystem::path(path).parent_path();
+  return directory.empty() ? std::string(".") : directory.string();
 }
 
 std::string format_errors(const std::vector<ValidationError>& errors) {

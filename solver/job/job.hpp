@@ -22,13 +22,15 @@ struct ValidationError {
 // A job over any of them is rejected with an error at the field's pointer, before anything is built.
 struct Limits {
   long max_dofs = 2'000'000;  // total over all bodies; larger jobs are rejected, not attempted
-  int max_bodies = 64;
-  int max_contacts = 256;
+  int max_bodies = 512;
+  int max_contacts = 2048;
   int max_threads = 64;                // solver.threads
   int max_iterations = 100'000;        // solver.max_iterations
   int max_updates = 1'000;             // solver.augmented_lagrangian.max_updates
   int max_adaptive_steps = 100;        // adaptivity.max_steps
   int max_load_steps = 1000;           // loading.steps, or the number of loading.factors
+  int max_ranks = 4096;                // parallel.ranks (contactd: its --max-ranks, 1 without an MPI launcher)
+  std::string ranks_hint;              // appended to the message when parallel.ranks is over max_ranks
   std::size_t max_name_length = 64;    // body, edge and contact names (identifiers)
   std::size_t max_job_name_length = 256;
   // Gmsh meshes given as {"file": ...} are read relative to this directory (the job file's: parse_file sets it).
@@ -51,8 +53,11 @@ ParseResult parse(const nlohmann::json& job, const Limits& limits = {});
 ParseResult parse_text(const std::string& text, const Limits& limits = {});
 
 // Same from a job file: its Gmsh mesh files are read relative to its directory (limits.mesh_directory is set to
-// it). A job file that cannot be read gives one error with pointer "".
+// job_directory(path)). A job file that cannot be read gives one error with pointer "".
 ParseResult parse_file(const std::string& path, Limits limits = {});
+
+// The directory of the job file at `path` ("." for a bare file name): where its Gmsh mesh files are read from.
+std::string job_directory(const std::string& path);
 
 // One line per error: "<pointer>: <message>".
 std::string format_errors(const std::vector<ValidationError>& errors);

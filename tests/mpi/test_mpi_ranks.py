@@ -1,0 +1,117 @@
+#!/usr/bin/env python3
+"""contact-solve under mpirun: the same job on 1, 2 and 3 ranks gives the same displacements and pressures
+(to 1e-12 relative) after the same number of iterations; the brick wall carries its load through every course;
+a failure on one rank ends every rank with its message and exit code 1.
+
+Exits 77 (skipped) when mpirun is missing or contact-solve was built without MPI."""
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(HERE, "..", ".."))
+BIN = os.environ.get("CONTACT_BINARY_DIR", os.path.join(SRC, "build"))
+CLI = os.path.join(BIN, "contact-solve")
+EXAMPLES = os.path.join(SRC, "api", "examples")
+sys.path.insert(0, HERE)
+from compare_results import max_relative_difference  # noqa: E402
+
+import h5py  # noqa: E402
+
+passed, failed = 0, 0
+
+
+def check(name, condition, detail=""):
+    global passed, failed
+    if condition:
+        passed += 1
+    else:
+        failed += 1
+        print(f"FAIL {name}: {detail}")
+
+
+# mpirun refuses root unless told; more ranks than cores need --oversubscribe.
+ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_rmaps_base_oversubscribe="1")
+
+
+def mpirun(ranks, *args, env=None, timeout=300):
+    return subprocess.run(["mpirun", "-n", str(ranks), CLI, *args], capture_output=True, text=True, timeout=timeout,
+                          env=env or ENV)
+
+
+if not shutil.which("mpirun"):
+    print("SKIP: mpirun not found (Debian's openmpi-bin; scripts/setup.sh installs it)")
+    sys.exit(77)
+
+with tempfile.TemporaryDirectory() as tmp:
+    probe = mpirun(2, os.path.join(EXAMPLES, "flat_patch.json"), "-o", os.path.join(tmp, "probe.hdf"), "-q")
+    if "MPI ranks" not in probe.stdout:
+        print("SKIP: contact-solve was built without MPI (CONTACT_WITH_MPI off or MPI not found)\n" + probe.stdout[-300:])
+        sys.exit(77)
+
+    # An adaptive job, smaller than the example so that three runs stay short.
+    with open(os.path.join(EXAMPLES, "seed_layers_adaptive.json")) as f:
+        adaptive = json.load(f)
+    adaptive["adaptivity"]["max_steps"] = 3
+    adaptive_path = os.path.join(tmp, "adaptive.json")
+    with open(adaptive_path, "w") as f:
+        json.dump(adaptive, f)
+
+    jobs = {
+        "stack3": os.path.join(EXAMPLES, "stack3.json"),               # the paper's Neumann DDM, 1477 iterations
+        "stack3_floating": os.path.join(EXAMPLES, "stack3_floating.json"),  # interface Newton, a floating body
+        "brick_wall": os.path.join(EXAMPLES, "brick_wall.json"),       # 69 bodies, 120 pairs, 68 floating
+        "adaptive": adaptive_path,                                      # meshes refined between solves
+    }
+    for name, job in jobs.items():
+        files = {}
+        for ranks in (1, 2, 3):
+            out = os.path.join(tmp, f"{name}.{ranks}.hdf")
+            r = mpirun(ranks, job, "-o", out, "-q")
+            check(f"{name} on {ranks} ranks exits 0", r.returncode == 0, r.stdout[-500:] + r.stderr[-500:])
+            if ranks > 1:
+                check(f"{name} on {ranks} ranks says so", f"{ranks} MPI ranks" in r.stdout and "mpi:" in r.stdout,
+                      r.stdout[:300])
+            files[ranks] = out
+        for ranks in (2, 3):
+            try:
+                worst, where, it1, itn = max_relative_difference(files[1], files[ranks])
+            except Exception as e:  # noqa: BLE001 - a missing file is a failure, reported
+                check(f"{name}: {ranks} ranks readable", False, str(e))
+                continue
+            check(f"{name}: {ranks} ranks = 1 rank to 1e-12", worst <= 1e-12, f"{worst:.3e} at {where}")
+            check(f"{name}: {ranks} ranks, same iterations", it1 == itn, f"{it1} vs {itn}")
+
+    # The wall: every course carries the whole load, pressure x width (vertical equilibrium of the bricks above).
+    with open(jobs["brick_wall"]) as f:
+        wall = json.load(f)
+    top_bricks = [b for b in wall["bodies"] if any("traction" in c for c in b["boundary"])]
+    width = sum(b["mesh"]["block"]["corners"][1][0] - b["mesh"]["block"]["corners"][0][0] for b in top_bricks)
+    pressure = top_bricks[0]["boundary"][-1]["traction"]["normal"]
+    with h5py.File(os.path.join(tmp, "brick_wall.3.hdf"), "r") as f:
+        last = f["steps"][str(len(f["steps"]) - 1)]["contacts"]
+        per_course = {}
+        for name, pair in last.items():
+            course = name.split("_")[0]  # "b3" from "b3_1.bottom-b2_0.top"
+            per_course[course] = per_course.get(course, 0.0) + float(pair.attrs["force"])
+    expected = pressure * width
+    worst = max(abs(v - expected) / expected for v in per_course.values())
+    check("every course of the wall carries pressure x width (1e-10)", len(per_course) == 8 and worst < 1e-10,
+          f"{per_course} vs {expected}")
+
+    # A failure on rank 1 (injected into the task of body 2, which rank 1 owns): every rank stops with the
+    # message, exit code 1, and no result file.
+    out = os.path.join(tmp, "failed.hdf")
+    env = dict(ENV, CONTACT_MPI_FAIL_BODY="2")
+    r = subprocess.run(["mpirun", "-x", "CONTACT_MPI_FAIL_BODY", "-n", "2", CLI, jobs["stack3"], "-o", out, "-q"],
+                       capture_output=True, text=True, timeout=120, env=env)
+    check("a failing rank: exit code 1", r.returncode == 1, f"{r.returncode} {r.stderr[-400:]}")
+    check("a failing rank: the message names the rank and the body",
+          "rank 1: body 2" in r.stdout + r.stderr, r.stdout[-400:] + r.stderr[-400:])
+    check("a failing rank: no result file", not os.path.exists(out))
+
+print(f"{passed} passed, {failed} failed")
+sys.exit(1 if failed else 0)
