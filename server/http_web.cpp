@@ -35,6 +35,41 @@ const assets::File* find(const std::vector<assets::File>& files, std::string_vie
   return nullptr;
 }
 
+// The examples as served: a Gmsh mesh that an example names by "file" is put in as "data", the file's text (a job
+// sent to the server carries its meshes: the server reads no files for a job). Built once; owns the texts.
+const std::vector<assets::File>& served_examples() {
+  static const std::vector<std::string> texts = [] {
+    std::vector<std::string> out;
+    for (const auto& e : assets::examples()) {
+      std::string text(e.data);
+      if (text.find("\"gmsh\"") != std::string::npos) {
+        auto job = nlohmann::ordered_json::parse(text);  // keeps the fields in the file's order
+        for (auto& body : job.at("bodies")) {
+          if (!body.contains("mesh") || !body["mesh"].contains("gmsh")) continue;
+          auto& gmsh = body["mesh"]["gmsh"];
+          if (!gmsh.is_object() || !gmsh.contains("file")) continue;
+          const auto* mesh = find(assets::example_meshes(), gmsh["file"].get<std::string>());
+          if (!mesh) continue;  // left as it is: the server's validation names the file
+          nlohmann::ordered_json inlined;
+          for (auto& [key, value] : gmsh.items()) inlined[key == "file" ? "data" : key] = value;
+          inlined["data"] = std::string(mesh->data);
+          gmsh = std::move(inlined);
+        }
+        text = job.dump(2) + "\n";
+      }
+      out.push_back(std::move(text));
+    }
+    return out;
+  }();
+  static const std::vector<assets::File> files = [] {
+    std::vector<assets::File> out;
+    for (size_t k = 0; k < assets::examples().size(); ++k)
+      out.push_back({assets::examples()[k].name, assets::examples()[k].content_type, texts[k]});
+    return out;
+  }();
+  return files;
+}
+
 // Sends an embedded file with its validator; 304 when the client has it already.
 void send_file(const httplib::Request& req, httplib::Response& res, const assets::File& file) {
   const std::string etag = etag_of(file.data);
@@ -94,7 +129,7 @@ void HttpServer::handle_web_file(const Request& req, Response& res) {
 
 void HttpServer::handle_examples(const Request&, Response& res) {
   nlohmann::json list = nlohmann::json::array();
-  for (const auto& e : assets::examples()) {
+  for (const auto& e : served_examples()) {
     const std::string name(e.name);
     list.push_back({{"name", name}, {"bytes", e.data.size()}, {"href", "/v1/examples/" + name}});
   }
@@ -103,7 +138,7 @@ void HttpServer::handle_examples(const Request&, Response& res) {
 
 void HttpServer::handle_example(const Request& req, Response& res) {
   std::string name = req.matches[1];
-  const auto* file = find(assets::examples(), name);
+  const auto* file = find(served_examples(), name);
   if (!file) {
     send_problem(res, 404, "", "no example '" + clip(name, 64) + "'; GET /v1/examples lists them", req.path);
     return;

@@ -160,7 +160,9 @@ class Client:
     @staticmethod
     def _job_body(job):
         """The bytes to send for a job: a dict is serialised; a path (str or os.PathLike) is read and sent
-        unchanged (after checking that it is JSON); bytes are sent as they are; '-' reads standard input."""
+        unchanged (after checking that it is JSON), except that the Gmsh meshes it names by "file" are put in as
+        "data" (read relative to the job file, as contact-solve does: the server reads no files); bytes are sent
+        as they are; '-' reads standard input."""
         if isinstance(job, dict):
             return json.dumps(job).encode()
         if isinstance(job, (bytes, bytearray)):
@@ -176,12 +178,34 @@ class Client:
             except OSError as exc:
                 raise BadInput(f"cannot read {where}: {exc.strerror or exc}") from None
         try:
-            json.loads(data.decode("utf-8"))
+            doc = json.loads(data.decode("utf-8"))
         except UnicodeDecodeError as exc:
             raise BadInput(f"{where}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
         except ValueError as exc:
             raise BadInput(f"{where}: not JSON: {exc}") from None
+        if isinstance(job, (str, os.PathLike)) and where != "standard input":
+            return Client._with_meshes(doc, os.path.dirname(where)) or data
         return data
+
+    @staticmethod
+    def _with_meshes(doc, directory):
+        """The job serialised with every {"gmsh": {"file": f}} of its bodies as {"gmsh": {"data": <f's text>}}
+        (f relative to `directory`); None when it names no mesh file."""
+        bodies = doc.get("bodies") if isinstance(doc, dict) else None
+        meshes = [b["mesh"]["gmsh"] for b in bodies or [] if isinstance(b, dict) and isinstance(b.get("mesh"), dict)
+                  and isinstance(b["mesh"].get("gmsh"), dict) and isinstance(b["mesh"]["gmsh"].get("file"), str)
+                  and "data" not in b["mesh"]["gmsh"]]  # both: left for the server to refuse
+        for gmsh in meshes:
+            path = os.path.join(directory, gmsh["file"])
+            try:
+                with open(path, encoding="utf-8") as f:
+                    text = f.read()
+            except (OSError, UnicodeDecodeError) as exc:
+                raise BadInput(f"cannot read the Gmsh mesh {path}: {getattr(exc, 'strerror', None) or exc}") from None
+            rest = {k: v for k, v in gmsh.items() if k != "file"}
+            gmsh.clear()
+            gmsh.update({"data": text, **rest})
+        return json.dumps(doc).encode() if meshes else None
 
     @staticmethod
     def _check_id(job_id):

@@ -148,12 +148,14 @@ def plot_result(result, png, events=None, warp=None, title=None, max_curves=12):
         xy = b["points"]
         if warp and "displacement" in b and len(b["displacement"]) == len(xy):
             xy = xy + warp * b["displacement"]
-        quads = b["quads"]
-        polys.append(xy[quads])
+        cells = b["cells"] if "cells" in b else b["quads"]  # files before triangles have quads only
+        # A triangle's fourth entry is -1: drawn as its first node again, so that every cell has four corners.
+        cells = np.where(cells >= 0, cells, cells[:, :1])
+        polys.append(xy[cells])
         vm = b.get("von_mises")
-        values.append(vm if vm is not None and len(vm) == len(quads) else np.full(len(quads), np.nan))
+        values.append(vm if vm is not None and len(vm) == len(cells) else np.full(len(cells), np.nan))
         lv = b.get("level")
-        levels.append((body, len(quads), int(lv.max()) if lv is not None and len(lv) else 0))
+        levels.append((body, len(cells), int(lv.max()) if lv is not None and len(lv) else 0))
     for body, xy in zip(final["body_names"], polys):
         if len(xy):
             flat = xy.reshape(-1, 2)

@@ -14,7 +14,8 @@ def read_result(path):
     {"attrs": {...root attributes...},
      "body_names": [...], "pair_names": [...],                        # of the final step
      "steps": [{"step": k, "iteration": i,
-                "bodies": {name: {"points", "quads", "level", "von_mises", "displacement", "stress_cell", ...}},
+                "bodies": {name: {"points", "cells" (-1 ends a triangle), "cell_types", "quads" (all-quadrilateral
+                                  meshes only), "level", "von_mises", "displacement", "stress_cell", ...}},
                 "contacts": {pair: {"position", "x", "arc_length", "pressure", "gap", "normal_gap", "active",
                                     "attrs": {...}}}}, ...],                   # in step order; the last is final
      "history": {"iterations": {"iteration", "fixed_point_residual", "max_pressure" (I, P), ...,

@@ -202,6 +202,8 @@ def test_module(server, tmp):
     check("module: health", c.health().get("status") == "ok")
     v = c.validate(SEED)
     check("module: validate", v.get("valid") is True and v.get("dofs", 0) > 0 and len(v.get("bodies", [])) == 2, v)
+    v = c.validate(os.path.join(EXAMPLES, "flat_patch_gmsh.json"))  # its meshes read and sent as "data"
+    check("module: validate a job file with Gmsh meshes", v.get("valid") is True and v.get("dofs", 0) == 230, v)
 
     job = c.submit(SEED)
     jid = job.get("id", "")
@@ -346,6 +348,20 @@ def test_module(server, tmp):
     apng = os.path.join(tmp, "adaptive.png")
     cc.plot_result(ahdf, apng)
     check_png("adaptive plot", apng)
+
+    # A Gmsh job file: its meshes go in as "data"; triangles are read and drawn.
+    gid = c.submit(os.path.join(EXAMPLES, "flat_patch_gmsh.json"))["id"]
+    fin = c.wait(gid)
+    check("gmsh: SUCCEEDED", fin.get("state") == "SUCCEEDED", fin)
+    ghdf = os.path.join(tmp, "gmsh.hdf")
+    c.download(gid, ghdf)
+    gr = cc.read_result(ghdf)
+    types = {name: set(b["cell_types"].tolist()) for name, b in gr["steps"][-1]["bodies"].items()}
+    check("gmsh: triangles read", types == {"upper": {5}, "lower": {5}}
+          and "quads" not in gr["steps"][-1]["bodies"]["upper"], types)
+    gpng = os.path.join(tmp, "gmsh.png")
+    cc.plot_result(ghdf, gpng)
+    check_png("gmsh plot", gpng)
 
 
 def test_cli(server, tmp):

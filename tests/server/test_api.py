@@ -116,6 +116,21 @@ with Server() as server, tempfile.TemporaryDirectory() as tmp:
         seed_bytes = f.read()
     check("an example is served as its file", server.get("/v1/examples/seed_layers").body == seed_bytes
           and server.get("/v1/examples/seed_layers.json").body == seed_bytes)
+    # A Gmsh example is served with its meshes in it ("data"): the server reads no files for a job.
+    with open(os.path.join(SRC, "api", "examples", "flat_patch_gmsh.msh")) as f:
+        msh = f.read()
+    served = server.get("/v1/examples/flat_patch_gmsh").json()
+    check("a Gmsh example is served with its .msh text as data, not a file name",
+          served is not None and all(b["mesh"]["gmsh"] == {"data": msh, "surface": b["name"]}
+                                     for b in served["bodies"])
+          and list(served) == list(example("flat_patch_gmsh.json")), served and served["bodies"][0]["mesh"])
+    r = server.request("POST", "/v1/validate", json_body=served)
+    check("the served Gmsh example is valid on the server", r.status == 200 and r.json()["valid"] is True, r)
+    r = server.request("POST", "/v1/validate", json_body=example("flat_patch_gmsh.json"))
+    check("a Gmsh mesh by file name is refused at its pointer, asking for data",
+          r.status == 400 and {e["pointer"] for e in r.json()["errors"]}
+          == {"/bodies/0/mesh/gmsh/file", "/bodies/1/mesh/gmsh/file"}
+          and "\"data\"" in r.json()["errors"][0]["message"], r)
     r = server.get("/v1/examples/nope")
     check("an unknown example is a 404 problem naming the list", r.status == 404 and r.is_problem()
           and "/v1/examples" in r.json()["detail"], r)
@@ -299,6 +314,11 @@ with Server() as server, tempfile.TemporaryDirectory() as tmp:
     check("every documented path is served", len(paths) >= 13 and not missing, (paths, missing))
     check("./job.schema.json resolves next to /v1/openapi.yaml", server.get("/v1/job.schema.json").body ==
           server.get("/v1/schema").body)
+
+    # The Gmsh example as served solves on the server (last: the checks above count the jobs).
+    gmsh_id = server.submit_id(server.get("/v1/examples/flat_patch_gmsh").json())
+    done = server.wait_done(gmsh_id)
+    check("the served Gmsh example solves on the server", done and done["state"] == "SUCCEEDED", done)
 
     check("server still alive", server.proc.poll() is None)
 
