@@ -23,17 +23,27 @@ inline nlohmann::json example(const std::string& name) {
   return nlohmann::json::parse(in);
 }
 
-// Parses (the test fails on validation errors) and solves without observer or cancellation. Gmsh mesh files are
-// read from api/examples/, where the examples' are.
-inline Result run(const nlohmann::json& job) {
+// Parses a job (the test fails on validation errors; an empty Problem then). Gmsh mesh files are read from
+// api/examples/, where the examples' are.
+inline Problem parse_or_fail(const nlohmann::json& job) {
   job::Limits limits;
   limits.mesh_directory = std::string(CONTACT_SOURCE_DIR) + "/api/examples";
   auto parsed = job::parse(job, limits);
   EXPECT_TRUE(parsed.ok()) << job::format_errors(parsed.errors);
-  if (!parsed.ok()) return {};
+  return parsed.ok() ? std::move(*parsed.problem) : Problem{};
+}
+
+// Solves without observer or cancellation.
+inline Result solve_quietly(const Problem& problem) {
   Observer quiet;
   CancelToken cancel;
-  return solve(*parsed.problem, quiet, cancel);
+  return solve(problem, quiet, cancel);
+}
+
+// Parses (the test fails on validation errors) and solves quietly.
+inline Result run(const nlohmann::json& job) {
+  const Problem problem = parse_or_fail(job);
+  return problem.bodies.empty() ? Result{} : solve_quietly(problem);
 }
 
 // The body of a step by name (throws if it has none).

@@ -13,23 +13,11 @@
 using namespace contact;
 using nlohmann::json;
 using contact::testing::example;
+using contact::testing::parse_or_fail;
 using contact::testing::run;
+using contact::testing::solve_quietly;
 
 namespace {
-
-Problem parsed(const json& job) {
-  job::Limits limits;
-  limits.mesh_directory = std::string(CONTACT_SOURCE_DIR) + "/api/examples";
-  auto r = job::parse(job, limits);
-  EXPECT_TRUE(r.ok()) << job::format_errors(r.errors);
-  return r.ok() ? std::move(*r.problem) : Problem{};
-}
-
-Result solve_quietly(const Problem& problem) {
-  Observer quiet;
-  CancelToken cancel;
-  return solve(problem, quiet, cancel);
-}
 
 // flat_patch_gmsh: E = 2.1e5, nu = 0.3, plane strain, both blocks 1 high, the top pressed down by 0.001, the
 // bottom held in y and the left in x. Exact: eps_yy = -0.0005 everywhere (s_xx = 0, eps_zz = 0), so
@@ -78,7 +66,7 @@ TEST(GmshProblems, FlatPatchOnNonMatchingTrianglesIsExactAlsoWithHangingNodes) {
   swapped["contacts"][0] = {{"slave", "lower.lower_top"}, {"master", "upper.upper_bottom"}};
   expect_exact_flat_patch(run(swapped), "lower as slave");
   // Local refinement at the interface and inside both bodies: hanging nodes on the contact edges too.
-  Problem problem = parsed(job);
+  Problem problem = parse_or_fail(job);
   refine_near(problem, Eigen::Vector2d(0.7, 0.0), 0.4);
   refine_near(problem, Eigen::Vector2d(0.6, 0.05), 0.15);
   size_t hanging = 0;

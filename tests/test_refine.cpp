@@ -2,6 +2,7 @@
 #include "fem/body_solver.hpp"
 #include "lame_ring.hpp"
 #include "mesh/mesh.hpp"
+#include "refine_checks.hpp"
 
 #include <gtest/gtest.h>
 
@@ -9,6 +10,8 @@
 #include <random>
 
 using namespace contact;
+using contact::testing::max_nodes_inside_a_side;
+using contact::testing::refine_towards;
 
 namespace {
 
@@ -17,44 +20,6 @@ mesh::Mesh square(int n) {
   s.corners = {mesh::Point(0, 0), mesh::Point(2, 0), mesh::Point(2, 2), mesh::Point(0, 2)};
   s.nx = s.ny = n;
   return mesh::make_block(s);
-}
-
-// Refines cells containing the point p, `times` times (a local refinement towards p). Returns the number of
-// cells the 1-irregularity closure added.
-int refine_towards(mesh::Mesh& m, const mesh::Point& p, int times) {
-  int closure = 0;
-  for (int t = 0; t < times; ++t) {
-    std::vector<int> marked;
-    for (int c = 0; c < m.num_cells(); ++c) {
-      Eigen::Vector2d lo = m.nodes[static_cast<size_t>(m.cells[static_cast<size_t>(c)][0])], hi = lo;
-      for (int k : m.cells[static_cast<size_t>(c)]) {
-        lo = lo.cwiseMin(m.nodes[static_cast<size_t>(k)]);
-        hi = hi.cwiseMax(m.nodes[static_cast<size_t>(k)]);
-      }
-      if ((p.array() >= lo.array() - 1e-12).all() && (p.array() <= hi.array() + 1e-12).all()) marked.push_back(c);
-    }
-    closure += mesh::refine(m, marked).closure_cells;
-  }
-  return closure;
-}
-
-// At most one hanging node per side: no side of an active cell contains two nodes strictly inside it.
-int max_nodes_inside_a_side(const mesh::Mesh& m) {
-  int worst = 0;
-  for (int c = 0; c < m.num_cells(); ++c)
-    for (int s = 0; s < 4; ++s) {
-      const auto e = m.edge_nodes({c, s});
-      const Eigen::Vector2d a = m.nodes[static_cast<size_t>(e[0])], b = m.nodes[static_cast<size_t>(e[1])];
-      int inside = 0;
-      for (int n = 0; n < m.num_nodes(); ++n) {
-        const Eigen::Vector2d x = m.nodes[static_cast<size_t>(n)];
-        const double t = (x - a).dot(b - a) / (b - a).squaredNorm();
-        const double off = std::abs((x - a).x() * (b - a).y() - (x - a).y() * (b - a).x()) / (b - a).norm();
-        if (t > 1e-9 && t < 1 - 1e-9 && off < 1e-9) ++inside;
-      }
-      worst = std::max(worst, inside);
-    }
-  return worst;
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include "mesh/mesh.hpp"
 #include "element_checks.hpp"
 #include "lame_ring.hpp"
+#include "refine_checks.hpp"
 #include "triangle_meshes.hpp"
 
 #include <gtest/gtest.h>
@@ -16,6 +17,8 @@
 #include <random>
 
 using namespace contact;
+using contact::testing::max_nodes_inside_a_side;
+using contact::testing::refine_towards;
 using contact::testing::split_into_triangles;
 
 namespace {
@@ -37,40 +40,6 @@ void distort(mesh::Mesh& m, double amount, unsigned seed = 7) {
     const bool boundary = p.x() <= lo.x() || p.x() >= hi.x() || p.y() <= lo.y() || p.y() >= hi.y();
     if (!boundary) p += Eigen::Vector2d(shift(rng), shift(rng));
   }
-}
-
-// Refines the cells whose bounding box holds p, `times` times.
-void refine_towards(mesh::Mesh& m, const mesh::Point& p, int times) {
-  for (int t = 0; t < times; ++t) {
-    std::vector<int> marked;
-    for (int c = 0; c < m.num_cells(); ++c) {
-      Eigen::Vector2d lo = m.nodes[static_cast<size_t>(m.cells[static_cast<size_t>(c)][0])], hi = lo;
-      for (int k : m.cells[static_cast<size_t>(c)]) {
-        lo = lo.cwiseMin(m.nodes[static_cast<size_t>(k)]);
-        hi = hi.cwiseMax(m.nodes[static_cast<size_t>(k)]);
-      }
-      if ((p.array() >= lo.array() - 1e-12).all() && (p.array() <= hi.array() + 1e-12).all()) marked.push_back(c);
-    }
-    mesh::refine(m, marked);
-  }
-}
-
-// The most nodes strictly inside one side of an active cell (1 = at most one hanging node per side).
-int max_nodes_inside_a_side(const mesh::Mesh& m) {
-  int worst = 0;
-  for (int c = 0; c < m.num_cells(); ++c)
-    for (int s = 0; s < m.cells[static_cast<size_t>(c)].size(); ++s) {
-      const auto e = m.edge_nodes({c, s});
-      const Eigen::Vector2d a = m.nodes[static_cast<size_t>(e[0])], b = m.nodes[static_cast<size_t>(e[1])];
-      int inside = 0;
-      for (const auto& x : m.nodes) {
-        const double t = (x - a).dot(b - a) / (b - a).squaredNorm();
-        const double off = std::abs((x - a).x() * (b - a).y() - (x - a).y() * (b - a).x()) / (b - a).norm();
-        if (t > 1e-9 && t < 1 - 1e-9 && off < 1e-9) ++inside;
-      }
-      worst = std::max(worst, inside);
-    }
-  return worst;
 }
 
 double total_area(const mesh::Mesh& m) {
@@ -158,41 +127,11 @@ TEST(P1PatchTest, LinearFieldIsExactOnDistortedTriangleAndMixedMeshes) {
 }
 
 TEST(P1PatchTest, TractionsGiveUniformStressAndBalancedReactionsOnAMixedMesh) {
-  const double sxx = 30, syy = -50;
+  // The traction patch test of the Q1 element (element_checks.hpp), the top loaded as a normal pressure.
   mesh::Mesh quads = block(6, 5);
   distort(quads, 0.15, 11);
-  Body body;
-  body.name = "patch";
-  body.material = {2.1e5, 0.3};
-  body.mesh = split_into_triangles(quads, [](int c) { return c % 2 == 1; });
-  BoundaryCondition left{"left", BoundaryCondition::Kind::displacement};
-  left.ux = 0.0;
-  BoundaryCondition bottom{"bottom", BoundaryCondition::Kind::displacement};
-  bottom.uy = 0.0;
-  BoundaryCondition right{"right", BoundaryCondition::Kind::traction};
-  right.traction = Eigen::Vector2d(sxx, 0);
-  BoundaryCondition top{"top", BoundaryCondition::Kind::traction};
-  top.normal_pressure = true;
-  top.pressure = -syy;
-  body.boundary = {left, bottom, right, top};
-  fem::BodySolver solver(body, Model{});
-  ASSERT_TRUE(solver.ok()) << solver.error();
-  const Eigen::VectorXd u = solver.solve(Eigen::VectorXd());
-  const auto s = solver.stresses(u);
-  for (int c = 0; c < body.mesh.num_cells(); ++c) {
-    EXPECT_NEAR(s.cell(c, 0), sxx, 1e-8 * 50) << c;
-    EXPECT_NEAR(s.cell(c, 1), syy, 1e-8 * 50) << c;
-    EXPECT_NEAR(s.cell(c, 2), 0.0, 1e-8 * 50) << c;
-    EXPECT_NEAR(s.cell(c, 3), 0.3 * (sxx + syy), 1e-8 * 50) << c;
-  }
-  const Eigen::VectorXd R = solver.reactions(u, Eigen::VectorXd());
-  double rx = 0, ry = 0;
-  for (int n = 0; n < body.mesh.num_nodes(); ++n) {
-    rx += R[2 * n];
-    ry += R[2 * n + 1];
-  }
-  EXPECT_NEAR(rx, -sxx * 2.0, 1e-9 * 100);
-  EXPECT_NEAR(ry, -syy * 3.0, 1e-9 * 150);
+  contact::testing::expect_uniform_traction_state(
+      contact::testing::uniform_traction_body(split_into_triangles(quads, [](int c) { return c % 2 == 1; }), true));
 }
 
 TEST(P1PatchTest, BodyForceIsBalancedByTheReactions) {
@@ -295,19 +234,10 @@ TEST(TriangleRefinement, LameRingConvergesAtSecondOrderInTheNodalDisplacements) 
 TEST(TriangleIndicators, BothIndicatorsVanishForTheExactUniformStateAndFindALocalError) {
   // The uniform state of the traction patch test is exact for P1: its FE stresses equal the recovered ones (zz)
   // and the boundary-element ones (fem_bem) up to the BEM's own error.
-  Body body;
-  body.name = "patch";
-  body.material = {2.1e5, 0.3};
   mesh::Mesh quads = block(6, 4);
   distort(quads, 0.12, 3);
-  body.mesh = split_into_triangles(quads, [](int c) { return c % 2 == 0; });
-  BoundaryCondition left{"left", BoundaryCondition::Kind::displacement};
-  left.ux = 0.0;
-  BoundaryCondition bottom{"bottom", BoundaryCondition::Kind::displacement};
-  bottom.uy = 0.0;
-  BoundaryCondition right{"right", BoundaryCondition::Kind::traction};
-  right.traction = Eigen::Vector2d(30, 0);
-  body.boundary = {left, bottom, right};
+  Body body = contact::testing::uniform_traction_body(split_into_triangles(quads, [](int c) { return c % 2 == 0; }),
+                                                      false);
   fem::BodySolver solver(body, Model{});
   ASSERT_TRUE(solver.ok()) << solver.error();
   const Eigen::VectorXd u = solver.solve(Eigen::VectorXd());
@@ -328,7 +258,8 @@ TEST(TriangleIndicators, BothIndicatorsVanishForTheExactUniformStateAndFindALoca
   ASSERT_FALSE(mesh::add_edge_set(body.mesh, "corner", corner).has_value());
   BoundaryCondition load{"corner", BoundaryCondition::Kind::traction};
   load.traction = Eigen::Vector2d(0, -100);
-  body.boundary = {left, bottom, load};
+  body.boundary.resize(2);  // the supports on the left and the bottom
+  body.boundary.push_back(load);
   fem::BodySolver loaded(body, Model{});
   ASSERT_TRUE(loaded.ok()) << loaded.error();
   const Eigen::VectorXd v = loaded.solve(Eigen::VectorXd());

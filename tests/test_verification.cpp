@@ -2,6 +2,7 @@
 // Hertz, symmetry, and the paper's run. Every expected number comes from mathematics, not from a past run.
 #include "job/job.hpp"
 #include "solve.hpp"
+#include "support.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,26 +12,13 @@
 
 using namespace contact;
 using nlohmann::json;
+using contact::testing::parse_or_fail;
 
 namespace {
 
-json load_example(const std::string& name) {
-  std::ifstream in(std::string(CONTACT_SOURCE_DIR) + "/api/examples/" + name);
-  EXPECT_TRUE(in.good()) << name;
-  return json::parse(in);
-}
+json load_example(const std::string& name) { return contact::testing::example(name); }
 
-Problem parse_or_fail(const json& job) {
-  auto r = job::parse(job);
-  EXPECT_TRUE(r.ok()) << job::format_errors(r.errors);
-  return r.ok() ? std::move(*r.problem) : Problem{};
-}
-
-Result run(const Problem& p) {
-  Observer quiet;
-  CancelToken cancel;
-  return solve(p, quiet, cancel);
-}
+Result run(const Problem& p) { return contact::testing::solve_quietly(p); }
 
 // The same job solved to a tight fixed-point residual by the Neumann DDM and by the monolithic solver.
 std::pair<Result, Result> ddm_and_monolithic(json job, double gamma) {

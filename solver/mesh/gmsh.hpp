@@ -62,9 +62,9 @@ std::string element_type_name(int type);
 struct Surface {
   bool found = false;                 // the file has a physical surface of that name
   Mesh mesh;                          // nodes, cells and an edge set per physical curve on its boundary
-  std::vector<std::string> edges;     // the names of those edge sets, in the file's order
+  std::vector<std::string> edges;     // the names of those edge sets, in the order of their physical tags
   std::vector<std::string> elsewhere; // physical curves of the file that are not on this surface's boundary
-  std::vector<std::string> vertices;  // physical points on this surface (mesh.vertices), in the file's order
+  std::vector<std::string> vertices;  // physical points on this surface (mesh.vertices), by physical tag
   std::vector<std::string> points_elsewhere;  // physical points of the file that are not on this surface
   std::vector<std::string> errors;    // empty if and only if the mesh is usable
 };

@@ -45,6 +45,19 @@ std::set<int> groups_named(const File& f, int dim, const std::string& name) {
   return out;
 }
 
+// Every name of the physical groups of dimension `dim`, in the order of their (first) physical tags, with its
+// physical tags.
+std::vector<std::pair<std::string, std::set<int>>> named_groups(const File& f, int dim) {
+  std::vector<std::pair<std::string, std::set<int>>> out;
+  for (const auto& [group, n] : f.physical_names) {
+    if (group.first != dim) continue;
+    auto it = std::find_if(out.begin(), out.end(), [&, name = n](const auto& g) { return g.first == name; });
+    if (it == out.end()) it = out.insert(out.end(), {n, {}});
+    it->second.insert(group.second);
+  }
+  return out;
+}
+
 bool in_groups(const File& f, int dim, int entity, const std::set<int>& groups) {
   auto it = f.entity_groups.find({dim, entity});
   if (it == f.entity_groups.end()) return false;
@@ -160,18 +173,11 @@ std::map<std::pair<int, int>, int> check_topology(const Mesh& m, const std::vect
 // Physical curves: their 2-node lines on this surface's boundary become edge sets.
 void add_curves(const File& f, const std::unordered_map<std::size_t, int>& local,
                 const std::map<std::pair<int, int>, int>& side_count, const std::string& name, Surface& out) {
-  std::map<std::string, std::set<int>> curves;  // name -> physical tags (of dimension 1)
-  std::vector<std::string> order;
-  for (const auto& [group, n] : f.physical_names)
-    if (group.first == 1) {
-      if (!curves.count(n)) order.push_back(n);
-      curves[n].insert(group.second);
-    }
-  for (const auto& curve : order) {
+  for (const auto& [curve, tags] : named_groups(f, 1)) {
     std::vector<std::array<int, 2>> pairs;
     std::vector<std::size_t> interior, second_order;
     for (const auto& b : f.blocks) {
-      if (b.dim != 1 || !in_groups(f, 1, b.entity, curves[curve])) continue;
+      if (b.dim != 1 || !in_groups(f, 1, b.entity, tags)) continue;
       for (size_t k = 0; k < b.tags.size(); ++k) {
         const auto& nodes = b.nodes[k];  // a line's two end nodes come first, whatever its order
         if (nodes.size() < 2) continue;
@@ -210,17 +216,10 @@ void add_curves(const File& f, const std::unordered_map<std::size_t, int>& local
 // Physical points: one whose point lies on this surface (a node of its mesh) becomes a named vertex.
 void add_points(const File& f, const std::unordered_map<std::size_t, int>& local, const std::string& name,
                 Surface& out) {
-  std::map<std::string, std::set<int>> points;  // name -> physical tags (of dimension 0)
-  std::vector<std::string> order;
-  for (const auto& [group, n] : f.physical_names)
-    if (group.first == 0) {
-      if (!points.count(n)) order.push_back(n);
-      points[n].insert(group.second);
-    }
-  for (const auto& point : order) {
+  for (const auto& [point, tags] : named_groups(f, 0)) {
     std::set<int> nodes;  // this surface's nodes among the point's
     for (const auto& b : f.blocks) {
-      if (b.dim != 0 || !in_groups(f, 0, b.entity, points[point])) continue;
+      if (b.dim != 0 || !in_groups(f, 0, b.entity, tags)) continue;
       for (const auto& element : b.nodes)
         for (std::size_t tag : element) {
           auto it = local.find(tag);
