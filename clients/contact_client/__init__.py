@@ -35,8 +35,8 @@ from .client import DEFAULT_TIMEOUT, DEFAULT_URL, STREAM_READ_TIMEOUT, Client
 from .display import Progress, compact_iterations, format_iteration
 from .errors import (EXIT_ERROR, EXIT_JOB, EXIT_OK, EXIT_USAGE, ApiError, BadAnswer, BadInput, ClientError,
                      ConnectionFailed, RequestTimeout)
-from .plot import plot_result
+from .plot import load_curve, plot_result
 from .results import read_events, read_result
 
 __all__ = ["Client", "ClientError", "ConnectionFailed", "RequestTimeout", "ApiError", "BadInput", "BadAnswer",
-           "read_result", "read_events", "plot_result", "DEFAULT_URL", "DEFAULT_TIMEOUT", "main"]
+           "read_result", "read_events", "plot_result", "load_curve", "DEFAULT_URL", "DEFAULT_TIMEOUT", "main"]

@@ -41,10 +41,51 @@ def contact_pressure(c):
     return p
 
 
+def load_curve(result):
+    """The force-load curve of a load-stepped result (Fig. 4 of the paper as a curve), from /history/steps:
+    {"load_factor": (S,), "pairs": {pair: {"force": (S,), "width": (S,)}}}, the width being contact_end -
+    contact_begin (the half-width of a symmetric half model). None unless the file holds more than one step at
+    increasing load factors (an adaptive run's steps all share load factor 1)."""
+    import numpy as np
+    h = result.get("history", {}).get("steps", {})
+    lf = np.asarray(h.get("load_factor", []), dtype=float)
+    if lf.ndim != 1 or len(lf) < 2 or not np.all(np.diff(lf) > 0):
+        return None
+    names = list(h.get("pair_names", []))
+    force = np.asarray(h.get("force", np.zeros((len(lf), 0))), dtype=float).reshape(len(lf), -1)
+    begin = np.asarray(h.get("contact_begin", np.zeros_like(force)), dtype=float).reshape(len(lf), -1)
+    end = np.asarray(h.get("contact_end", np.zeros_like(force)), dtype=float).reshape(len(lf), -1)
+    pairs = {name: {"force": force[:, j], "width": end[:, j] - begin[:, j]}
+             for j, name in enumerate(names) if j < force.shape[1]}
+    return {"load_factor": lf, "pairs": pairs}
+
+
+def _draw_load_curve(ax, curve):
+    """Force (left axis, solid) and contact width (right axis, dashed) of each pair against the load factor."""
+    import matplotlib.pyplot as plt
+    colors = plt.get_cmap("tab10")
+    lf = curve["load_factor"]
+    right = ax.twinx()
+    for j, (name, c) in enumerate(curve["pairs"].items()):
+        ax.plot(lf, c["force"], color=colors(j % 10), marker="o", ms=3, lw=1.2, label=f"{name}: force")
+        right.plot(lf, c["width"], color=colors(j % 10), marker="s", ms=3, lw=1.0, ls="--",
+                   label=f"{name}: contact width")
+    ax.set_xlabel("load factor")
+    ax.set_ylabel("contact force (solid)")
+    right.set_ylabel("contact width (dashed)")
+    ax.set_title(f"load curve ({len(lf)} load steps)", fontsize=10)
+    ax.grid(True, alpha=0.3)
+    if len(curve["pairs"]) <= 3:
+        handles = ax.get_legend_handles_labels()[0] + right.get_legend_handles_labels()[0]
+        ax.legend(handles, [h.get_label() for h in handles], fontsize=7, loc="upper left", framealpha=0.8)
+
+
 def plot_result(result, png, events=None, warp=None, title=None, max_curves=12):
     """Draws one figure of 1000 x 800 pixels (10 x 8 inches at 100 dpi) into png:
 
-    top: the contact pressure against x along each pair (one panel per pair), one curve per adaptive step;
+    top: the contact pressure against x along each pair (one panel per pair), one curve per adaptive or load
+         step; for a load-stepped result one more panel, the load curve (load_curve(): force and contact width
+         of each pair against the load factor);
          with a single step, the pressure profile of each iteration when `events` (the job's events, a list of
          dicts or a path to saved events) are given (at most max_curves of them, spread over the run), and the
          final profile from the file (slave nodes that take no part in the contact are left out);
@@ -77,8 +118,9 @@ def plot_result(result, png, events=None, warp=None, title=None, max_curves=12):
     attrs = result["attrs"]
 
     fig = plt.figure(figsize=(10, 8), dpi=100)
+    curve = load_curve(result)
     npairs = max(1, len(pair_names))
-    gs = fig.add_gridspec(2, npairs, height_ratios=[1.0, 1.25], left=0.08, right=0.92, top=0.92, bottom=0.07,
+    gs = fig.add_gridspec(2, npairs + (curve is not None), height_ratios=[1.0, 1.25], left=0.08, right=0.92, top=0.92, bottom=0.07,
                           hspace=0.32, wspace=0.4)
     name = attrs.get("name") or os.path.basename(result.get("path", ""))
     stop = attrs.get("stop_reason", "")
@@ -108,8 +150,9 @@ def plot_result(result, png, events=None, warp=None, title=None, max_curves=12):
             for k in _spread(len(steps), max_curves):
                 c = steps[k]["contacts"].get(pair)
                 if c is not None and "x" in c:
+                    load = f"load {steps[k]['load_factor']:g}, " if curve is not None else ""
                     curves.append((k, c["x"], contact_pressure(c),
-                                   f" (iter {steps[k]['iteration']}, {len(c['x'])} nodes)"))
+                                   f" ({load}iter {steps[k]['iteration']}, {len(c['x'])} nodes)"))
             span = (0, len(steps) - 1)
         else:
             profiles = iteration_profiles.get(pair, [])
@@ -140,6 +183,9 @@ def plot_result(result, png, events=None, warp=None, title=None, max_curves=12):
         ax.grid(True, alpha=0.3)
         if ax.get_legend_handles_labels()[0]:
             ax.legend(fontsize=7, loc="best", framealpha=0.8)
+
+    if curve is not None:
+        _draw_load_curve(fig.add_subplot(gs[0, npairs]), curve)
 
     ax = fig.add_subplot(gs[1, :])
     polys, values, levels = [], [], []

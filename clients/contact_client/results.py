@@ -13,7 +13,7 @@ def read_result(path):
 
     {"attrs": {...root attributes...},
      "body_names": [...], "pair_names": [...],                        # of the final step
-     "steps": [{"step": k, "iteration": i,
+     "steps": [{"step": k, "iteration": i, "load_factor": f,
                 "bodies": {name: {"points", "cells" (-1 ends a triangle), "cell_types", "quads" (all-quadrilateral
                                   meshes only), "level", "von_mises", "displacement", "stress_cell", ...}},
                 "contacts": {pair: {"position", "x", "arc_length", "pressure", "gap", "normal_gap", "active",
@@ -62,7 +62,8 @@ def read_result(path):
                 g = f["steps"][str(k)]
                 body_names = attr(g.attrs.get("body_names", np.array(list(g["bodies"].keys()), dtype=object)))
                 pair_names = attr(g.attrs.get("pair_names", np.array(list(g["contacts"].keys()), dtype=object)))
-                step = {"step": k, "iteration": int(g.attrs.get("iteration", 0)), "bodies": {}, "contacts": {},
+                step = {"step": k, "iteration": int(g.attrs.get("iteration", 0)),
+                        "load_factor": float(g.attrs.get("load_factor", 1.0)), "bodies": {}, "contacts": {},
                         "body_names": list(body_names), "pair_names": list(pair_names)}
                 for name in body_names:
                     step["bodies"][name] = group(g["bodies"][name])

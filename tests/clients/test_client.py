@@ -363,6 +363,35 @@ def test_module(server, tmp):
     cc.plot_result(ghdf, gpng)
     check_png("gmsh plot", gpng)
 
+    # Load steps: the force-load curve (Fig. 4 as a curve) from /history/steps, drawn as its own panel.
+    lid = c.submit(os.path.join(EXAMPLES, "seed_layers_steps.json"))["id"]
+    fin = c.wait(lid)
+    check("load steps: SUCCEEDED", fin.get("state") == "SUCCEEDED", fin)
+    lhdf = os.path.join(tmp, "steps.hdf")
+    c.download(lid, lhdf)
+    lr = cc.read_result(lhdf)
+    curve = cc.load_curve(lr)
+    check("load steps: a load curve of 10 steps at load factors 0.1 ... 1",
+          curve is not None and np.allclose(curve["load_factor"], np.arange(1, 11) / 10, rtol=0, atol=1e-12)
+          and [s["load_factor"] for s in lr["steps"]] == list(curve["load_factor"]),
+          curve and curve["load_factor"])
+    if curve is not None:
+        lp = curve["pairs"].get(pair, {})
+        force, width = lp.get("force", np.zeros(0)), lp.get("width", np.zeros(0))
+        check("load steps: force strictly and contact width weakly increasing with the load",
+              len(force) == 10 and np.all(np.diff(force) > 0) and np.all(np.diff(width) >= 0) and width[0] > 0,
+              (force, width))
+        # With the dual mortar basis the pair's force is the trapezoidal integral of its nodal pressures
+        # (D holds the lumped weights), so each step's curve point must equal the integral of that step's profile.
+        trapezoid = getattr(np, "trapezoid", None) or np.trapz  # numpy 2 renamed trapz
+        integrals = [trapezoid(s["contacts"][pair]["pressure"], s["contacts"][pair]["x"]) for s in lr["steps"]]
+        check("load steps: each step's force = the integral of its pressure profile",
+              len(force) == len(integrals) and np.allclose(force, integrals, rtol=1e-9, atol=0), (force, integrals))
+    check("no load curve for an adaptive run (its steps share load factor 1)", cc.load_curve(ar) is None)
+    lpng = os.path.join(tmp, "steps.png")
+    cc.plot_result(lr, lpng)
+    check_png("load steps plot", lpng)
+
 
 def test_cli(server, tmp):
     url = f"http://{HOST}:{server.port}"
