@@ -1,5 +1,5 @@
 // A body's Gmsh mesh in a job: {"gmsh": {"file": "model.msh" | "data": "<the file's text>", "surface": "name"}}.
-// Private to the job module (job.cpp reads the rest of the body).
+// Private to the job module (read_meshes.cpp calls it; the rest of the body is read by read_bodies.cpp).
 #pragma once
 
 #include "../mesh/gmsh.hpp"

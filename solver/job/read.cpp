@@ -221,4 +221,72 @@ const json* Fields::require(const std::string& key, const std::string& hint) con
   return value;
 }
 
+namespace {
+// Letters, digits, '_' and '-' (and '.' when `dot`), at least one. A plain loop: std::regex_match recurses once
+// per character and overflows the stack on a long name.
+bool is_identifier(const std::string& s, bool dot = false) {
+  return !s.empty() && std::all_of(s.begin(), s.end(), [dot](char c) {
+    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-' ||
+           (dot && c == '.');
+  });
+}
+}  // namespace
+
+std::optional<std::string> name_problem(const std::string& s, const std::string& what, size_t max_length, bool dot) {
+  const char* allowed = dot ? "letters, digits, '_', '-' and '.' only (pattern ^[A-Za-z0-9_.-]+$)"
+                            : "letters, digits, '_' and '-' only (pattern ^[A-Za-z0-9_-]+$)";
+  if (s.size() > max_length)
+    return what + " '" + read::shown(s) + "' is too long: at most " + std::to_string(max_length) + " characters";
+  if (!is_identifier(s, dot)) return what + " '" + read::shown(s) + "' must consist of " + allowed;
+  return std::nullopt;
+}
+
+std::optional<std::string> identifier(const json& value, const std::string& pointer, const std::string& what,
+                                      size_t max_length, Errors& errors) {
+  auto s = read::string(value, pointer, what, errors);
+  if (!s) return std::nullopt;
+  if (auto problem = name_problem(*s, what, max_length, false)) {
+    errors.add(pointer, *problem);
+    return std::nullopt;
+  }
+  return s;
+}
+
+std::optional<double> positive(const json& value, const std::string& pointer, const std::string& what, Errors& errors) {
+  auto x = read::number(value, pointer, what, errors);
+  if (x && !(*x > 0)) {
+    errors.add(pointer, what + " = " + format_number(*x) + " must be positive");
+    return std::nullopt;
+  }
+  return x;
+}
+
+std::optional<std::string> choice(const json& value, const std::string& pointer, const std::string& what,
+                                  const std::vector<std::string>& options, Errors& errors) {
+  auto s = read::string(value, pointer, what, errors);
+  if (!s) return std::nullopt;
+  if (std::find(options.begin(), options.end(), *s) == options.end()) {
+    std::vector<std::string> quoted;
+    for (const auto& o : options) quoted.push_back("\"" + o + "\"");
+    errors.add(pointer, what + " \"" + read::shown(*s) + "\" is not one of " + join_names(quoted));
+    return std::nullopt;
+  }
+  return s;
+}
+
+std::optional<int> bounded_int(const json& value, const std::string& pointer, const std::string& what, long long min,
+                               Errors& errors, long long max) {
+  auto n = read::integer(value, pointer, what, errors);
+  if (!n) return std::nullopt;
+  if (*n < min) {
+    errors.add(pointer, what + " = " + std::to_string(*n) + " must be at least " + std::to_string(min));
+    return std::nullopt;
+  }
+  if (*n > max) {
+    errors.add(pointer, what + " = " + std::to_string(*n) + " is too large (at most " + std::to_string(max) + ")");
+    return std::nullopt;
+  }
+  return static_cast<int>(*n);
+}
+
 }  // namespace contact::job::read

@@ -1,8 +1,9 @@
 // Reading JSON values with validation: typed views of a value that report what is wrong with it at its
-// RFC 6901 pointer instead of throwing. Private to the job module; job.cpp holds the format itself.
+// RFC 6901 pointer instead of throwing. Private to the job module; the job reader (job_reader.hpp) holds the format.
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -71,6 +72,22 @@ std::optional<bool> boolean(const json& value, const std::string& pointer, const
 // A point or vector written [x, y].
 std::optional<Eigen::Vector2d> pair(const json& value, const std::string& pointer, const std::string& what,
                                     Errors& errors);
+
+// Values of the job's own kinds, read and reported the same way. Names that other parts of the job refer to
+// (bodies, edges, vertices, contacts) consist of letters, digits, '_' and '-' (and '.' when `dot`), at least one.
+// Why `s` is not a name of at most `max_length` characters of the allowed set (the pattern quoted), or nullopt.
+std::optional<std::string> name_problem(const std::string& s, const std::string& what, size_t max_length, bool dot);
+// Reads a name that other parts of the job refer to ("body.edge"), so it must be an identifier.
+std::optional<std::string> identifier(const json& value, const std::string& pointer, const std::string& what,
+                                      size_t max_length, Errors& errors);
+// A number that must be > 0.
+std::optional<double> positive(const json& value, const std::string& pointer, const std::string& what, Errors& errors);
+// One of a fixed set of strings.
+std::optional<std::string> choice(const json& value, const std::string& pointer, const std::string& what,
+                                  const std::vector<std::string>& options, Errors& errors);
+// An integer in [min, max]; `max` defaults to what an int holds.
+std::optional<int> bounded_int(const json& value, const std::string& pointer, const std::string& what, long long min,
+                               Errors& errors, long long max = std::numeric_limits<int>::max());
 
 // The fields of one JSON object. Construction reports a value that is not an object and every field not in
 // `allowed` (unknown fields are errors: a misspelt optional field must not be silently ignored).

@@ -1,0 +1,155 @@
+// The reader of the job format v1 (docs/job-format.md, api/job.schema.json): JSON -> Problem. Private to the job
+// module. job.cpp holds the entry points of job.hpp and the reader's frame (run, the header, the model, the limits
+// on work); read_options.cpp, read_bodies.cpp, read_meshes.cpp and read_contacts.cpp read the parts of a job.
+//
+// Validation runs in phases so that every problem is reported at once and nothing expensive happens for a job
+// that is already known to be bad:
+//   1. read every field (types, ranges, unknown fields) without generating any mesh (a Gmsh mesh is read here,
+//      its size bounded by the limit on degrees of freedom, since its edge names come from the file);
+//   2. count the degrees of freedom from the mesh sizes alone and refuse the job if over the limit;
+//   3. generate the meshes and check their cells;
+//   4. check that each body is restrained against rigid motion (needs the mesh; only for bodies with no
+//      other error, since a broken body would give a misleading answer);
+//   5. resolve the contact pairs' references to bodies and edges.
+// Problem::normalized is the submitted document with every default written in.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "gmsh_input.hpp"
+#include "job.hpp"
+#include "read.hpp"
+
+namespace contact::job::detail {
+
+using nlohmann::json;
+using read::bounded_int;
+using read::child;
+using read::choice;
+using read::Errors;
+using read::Fields;
+using read::format_number;
+using read::identifier;
+using read::join_names;
+using read::name_problem;
+using read::positive;
+using Point = mesh::Point;
+
+// Writes a default into the normalized copy; a no-op where the copy is not an object (the job is bad then and
+// the copy is never used).
+void set_default(json& object, const std::string& key, json value);
+
+// ---------------------------------------------------------------------------------------------------------
+// Phase 1 records: what was read of a body before any mesh exists.
+
+struct MeshInput {
+  enum class Kind { unknown, block, arrays, gmsh };
+  Kind kind = Kind::unknown;
+  bool valid = false;        // every field read without error: the mesh can be built
+  double dofs = -1.0;        // 2 * nodes, known from the sizes alone; < 0 if unknown
+  bool edges_known = false;  // the edge names are known (even if other fields are bad)
+  std::vector<std::string> edge_names;
+  std::vector<std::string> vertex_names;  // named vertices (a block's corners, an explicit mesh's "vertices")
+  // block
+  mesh::BlockSpec block;
+  std::map<std::string, std::string> curve_pointers;  // edge name -> pointer of its curve object
+  // explicit arrays
+  std::vector<Point> nodes;
+  std::vector<mesh::Cell> quads;
+  std::vector<std::pair<std::string, std::vector<std::array<int, 2>>>> edge_pairs;
+  std::map<std::string, int> vertices;  // named vertices of an explicit mesh: name -> node
+  // gmsh: the surface's mesh, built while reading (gmsh_input.hpp)
+  std::optional<GmshBody> gmsh;
+};
+
+struct BodyInput {
+  std::string pointer;
+  bool has_name = false;
+  Body body;
+  MeshInput mesh;
+  std::vector<std::string> free_motions;  // rigid motions its displacement conditions leave free (a floating body)
+};
+
+// Questions on what was read of a mesh (read_meshes.cpp).
+bool has_edge(const MeshInput& m, const std::string& name);
+// For a Gmsh body: why `name`, a physical curve (or, for a vertex, a physical point) of the file, is not one of
+// its edges (vertices); nullopt otherwise.
+std::optional<std::string> gmsh_elsewhere(const MeshInput& m, const std::string& name, bool vertex = false);
+
+class JobReader {
+ public:
+  JobReader(const json& job, const Limits& limits) : job_(job), limits_(limits), normalized_(job), gmsh_(limits) {}
+  ParseResult run();
+
+ private:
+  // job.cpp: the frame, the header and the model, the normalized copy's parts
+  void check_work_limits();
+  ParseResult finish();
+  void read_header(const Fields& top);
+  void read_model(const Fields& top);
+  json& sub_object(json& parent, const std::string& key);
+  json& element(json& array, size_t index);
+  json& discard();
+
+  // read_options.cpp: solver, adaptivity, loading, parallel
+  void read_solver(const Fields& top);
+  void resolve_method_defaults();
+  void read_adaptivity(const json& value, const std::string& pointer);
+  void read_robin(const json& value, const std::string& pointer);
+  void read_augmented_lagrangian(const json& value, const std::string& pointer);
+  void read_penalty(const json& value, const std::string& pointer, json& out);
+  void read_parallel(const Fields& top);
+  void read_loading(const Fields& top);
+
+  // read_bodies.cpp: bodies, materials, boundary conditions; the checks on the built bodies
+  void read_bodies(const Fields& top);
+  void read_body(const json& value, BodyInput& in, json& out);
+  void read_material(const json& value, const std::string& pointer, Material& material);
+  void read_boundary(const json& value, const std::string& pointer, BodyInput& in);
+  void check_restrained(BodyInput& in);
+  void check_loads_reach_the_body(const BodyInput& in);
+  void check_floating_bodies();
+
+  // read_meshes.cpp: blocks and their curves, explicit arrays, Gmsh surfaces; building and checking the meshes
+  void read_mesh(const json& value, const std::string& pointer, MeshInput& m, json& out);
+  void read_block(const json& value, const std::string& pointer, MeshInput& m);
+  void read_gmsh(const json& value, const std::string& pointer, MeshInput& m);
+  std::optional<long long> read_count(const json& value, const std::string& pointer, const std::string& what);
+  void read_curve(const json& value, const std::string& pointer, const std::string& edge, MeshInput& m);
+  void read_arrays(const json& value, const std::string& pointer, MeshInput& m, json& out);
+  bool no_side_twice(const std::string& name, const std::vector<std::array<int, 2>>& pairs,
+                     const std::string& pointer);
+  template <typename Index>
+  void read_edge_set(const std::string& name, const json& value, const std::string& pointer, bool nodes_ok,
+                     const Index& index, MeshInput& m);
+  void build_mesh(BodyInput& in);
+  void check_arrays(const mesh::Mesh& mesh, const std::string& pointer);
+
+  // read_contacts.cpp: contact pairs and their gaps
+  struct EdgeRef {
+    int body = -1;
+    std::string edge;
+  };
+  std::optional<EdgeRef> resolve(const json& value, const std::string& pointer, const std::string& what);
+  void read_contacts(const Fields& top);
+  void read_gap(const Fields& contact, GapSpec& gap, json& out);
+
+  const json& job_;
+  const Limits& limits_;
+  json normalized_;
+  json discarded_;
+  Errors errors_;
+  Problem problem_;
+  bool method_given_ = false, enforcement_given_ = false;
+  std::string method_pointer_, enforcement_pointer_ = "/solver";
+  std::vector<BodyInput> inputs_;
+  GmshMeshes gmsh_;
+};
+
+}  // namespace contact::job::detail

@@ -1,0 +1,284 @@
+// The job's bodies: names, materials and boundary conditions (phase 1), then the limit on degrees of freedom
+// (phase 2), the meshes (phase 3, read_meshes.cpp) and the checks that need them (phase 4): restraint against
+// rigid motion, loads that reach the body, floating bodies held by their contacts.
+#include "job_reader.hpp"
+
+#include <algorithm>
+#include <array>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "../fem/rigid_modes.hpp"
+
+namespace contact::job::detail {
+
+void JobReader::read_bodies(const Fields& top) {
+  const json* list = top.require("bodies", "an array of at least one body");
+  if (!list) return;
+  if (!list->is_array()) {
+    errors_.add("/bodies", "bodies must be an array, got " + read::type_name(*list));
+    return;
+  }
+  if (list->empty()) {
+    errors_.add("/bodies", "at least one body is required");
+    return;
+  }
+  if (list->size() > static_cast<size_t>(limits_.max_bodies)) {  // refused before any body is read
+    errors_.add("/bodies", "the job has " + std::to_string(list->size()) + " bodies; at most " +
+                               std::to_string(limits_.max_bodies) + " are accepted");
+    return;
+  }
+  json& out_list = normalized_["bodies"];
+  std::map<std::string, std::string> first_pointer_of_name;
+  for (size_t i = 0; i < list->size(); ++i) {
+    BodyInput in;
+    in.pointer = child("/bodies", i);
+    read_body((*list)[i], in, element(out_list, i));
+    if (in.has_name) {
+      auto [it, inserted] = first_pointer_of_name.emplace(in.body.name, in.pointer);
+      if (!inserted)
+        errors_.add(child(in.pointer, "name"),
+                    "body name '" + in.body.name + "' is already used by " + it->second + "; names must be unique");
+    }
+    inputs_.push_back(std::move(in));
+  }
+
+  // Phase 2: the size limit, from the declared sizes alone, before anything is allocated.
+  double total = 0.0;
+  std::vector<std::string> parts;
+  for (const auto& in : inputs_) {
+    if (in.mesh.dofs < 0) continue;
+    total += in.mesh.dofs;
+    parts.push_back((in.has_name ? "'" + in.body.name + "'" : in.pointer) + " " + format_number(in.mesh.dofs));
+  }
+  if (total > static_cast<double>(limits_.max_dofs)) {
+    errors_.add("/bodies", "the meshes would have " + format_number(total) + " degrees of freedom (" +
+                               join_names(parts) + "), more than the limit of " +
+                               format_number(static_cast<double>(limits_.max_dofs)));
+    return;
+  }
+
+  // Phase 3: meshes; phase 4: rigid motion.
+  for (auto& in : inputs_) {
+    if (!in.mesh.valid) continue;
+    build_mesh(in);
+    if (errors_.count_under(in.pointer) == 0) {
+      check_restrained(in);
+      check_loads_reach_the_body(in);
+    }
+  }
+}
+
+void JobReader::read_body(const json& value, BodyInput& in, json& out) {
+  Fields f(value, in.pointer, "a body", {"name", "material", "mesh", "boundary", "body_force"}, errors_);
+  if (!f.ok()) return;
+  if (const json* n = f.require("name", "a name of letters, digits, '_' and '-', unique among the bodies"))
+    if (auto s = identifier(*n, f.at("name"), "body name", limits_.max_name_length, errors_)) {
+      in.body.name = *s;
+      in.has_name = true;
+    }
+  if (const json* m = f.require("material", "an object {\"E\": Young's modulus, \"nu\": Poisson's ratio}"))
+    read_material(*m, f.at("material"), in.body.material);
+  if (const json* m = f.require("mesh", "one of {\"block\": {...}}, {\"nodes\": ..., \"quads\": ..., \"edges\": ...} "
+                                        "or {\"gmsh\": {...}}"))
+    read_mesh(*m, f.at("mesh"), in.mesh, sub_object(out, "mesh"));
+  if (const json* b = f.find("boundary")) read_boundary(*b, f.at("boundary"), in);
+  set_default(out, "boundary", json::array());
+  if (const json* b = f.find("body_force"))
+    if (auto v = read::pair(*b, f.at("body_force"), "body_force", errors_)) in.body.body_force = *v;
+  set_default(out, "body_force", json::array({0.0, 0.0}));
+}
+
+void JobReader::read_material(const json& value, const std::string& pointer, Material& material) {
+  Fields f(value, pointer, "material", {"E", "nu"}, errors_);
+  if (const json* e = f.require("E", "Young's modulus, a positive number"))
+    if (auto x = read::number(*e, f.at("E"), "E", errors_)) {
+      if (*x > 0)
+        material.E = *x;
+      else
+        errors_.add(f.at("E"), "E = " + format_number(*x) + " must be positive (Young's modulus)");
+    }
+  if (const json* n = f.require("nu", "Poisson's ratio, a number in (-1, 0.5)"))
+    if (auto x = read::number(*n, f.at("nu"), "nu", errors_)) {
+      if (*x > -1 && *x < 0.5)
+        material.nu = *x;
+      else
+        errors_.add(f.at("nu"),
+                    "nu = " + format_number(*x) +
+                        " is outside (-1, 0.5): Poisson's ratio must be greater than -1 and less than 0.5");
+    }
+}
+
+void JobReader::read_boundary(const json& value, const std::string& pointer, BodyInput& in) {
+  if (!value.is_array()) {
+    errors_.add(pointer, "boundary must be an array of conditions, got " + read::type_name(value));
+    return;
+  }
+  std::map<std::string, std::string> first_pointer_of_place;
+  for (size_t j = 0; j < value.size(); ++j) {
+    const std::string bp = child(pointer, j);
+    Fields f(value[j], bp, "a boundary condition", {"edge", "vertex", "displacement", "traction", "force", "free"},
+             errors_);
+    if (!f.ok()) continue;
+    const size_t before = errors_.size();
+    BoundaryCondition bc;
+    if (f.has("edge") == f.has("vertex")) {
+      errors_.add(bp, "give exactly one of edge (a named edge of the body) and vertex (a named vertex)");
+      continue;
+    }
+    const bool at_vertex = f.has("vertex");
+    const std::string place_key = at_vertex ? "vertex" : "edge";
+    const std::vector<std::string>& names = at_vertex ? in.mesh.vertex_names : in.mesh.edge_names;
+    if (const json* e = f.find(place_key))
+      if (auto s = read::string(*e, f.at(place_key), place_key, errors_)) {
+        (at_vertex ? bc.vertex : bc.edge) = *s;
+        const bool known = std::find(names.begin(), names.end(), *s) != names.end();
+        if (in.mesh.edges_known && !known) {
+          const auto elsewhere = gmsh_elsewhere(in.mesh, *s, at_vertex);
+          errors_.add(f.at(place_key),
+                      elsewhere.value_or("the body has no " + place_key + " '" + read::shown(*s) + "'; " +
+                                         (names.empty() ? std::string("it has no named ") + place_key + "s"
+                                                        : "its " + std::string(at_vertex ? "vertices" : "edges") +
+                                                              " are " + join_names(names))));
+        } else {
+          auto [it, inserted] = first_pointer_of_place.emplace(place_key + ":" + *s, bp);
+          if (!inserted)
+            errors_.add(f.at(place_key), place_key + " '" + *s + "' already has a condition at " + it->second +
+                                             "; give each " + place_key +
+                                             " one condition (displacement fixes only its given components)");
+        }
+      }
+    const int loads = int(f.has("traction")) + int(f.has("force"));
+    const int kinds = int(f.has("displacement")) + loads + int(f.has("free"));
+    if (kinds == 0 || loads > 1 || (f.has("free") && kinds > 1)) {
+      errors_.add(bp, "give a displacement, a load (traction or force), a displacement with a load on the other "
+                      "component, or free");
+      continue;
+    }
+    if (at_vertex && (f.has("traction") || f.has("free"))) {
+      errors_.add(bp, "a vertex takes a displacement (a point support) or a force (a point load), not " +
+                          std::string(f.has("traction") ? "a traction (a force per length)" : "free"));
+      continue;
+    }
+    if (const json* d = f.find("displacement")) {
+      bc.kind = BoundaryCondition::Kind::displacement;
+      Fields df(*d, f.at("displacement"), "displacement", {"x", "y"}, errors_);
+      if (df.ok() && !df.has("x") && !df.has("y"))
+        errors_.add(f.at("displacement"), "give at least one of the components x and y");
+      if (const json* x = df.find("x")) bc.ux = read::number(*x, df.at("x"), "displacement x", errors_);
+      if (const json* y = df.find("y")) bc.uy = read::number(*y, df.at("y"), "displacement y", errors_);
+      if (loads && bc.ux && bc.uy)
+        errors_.add(bp, "both displacement components are prescribed: a load here would go straight into the support");
+    }
+    if (const json* t = f.find("traction")) {
+      bc.kind = BoundaryCondition::Kind::traction;
+      if (t->is_object()) {
+        Fields tf(*t, f.at("traction"), "traction", {"normal"}, errors_);
+        if (const json* p = tf.require("normal", "the normal pressure, positive pushing into the body")) {
+          bc.normal_pressure = true;
+          bc.pressure = read::number(*p, tf.at("normal"), "normal pressure", errors_).value_or(0.0);
+        }
+      } else if (t->is_array()) {
+        if (auto v = read::pair(*t, f.at("traction"), "traction", errors_)) bc.traction = *v;
+      } else {
+        errors_.add(f.at("traction"),
+                    "traction must be a vector [tx, ty] or {\"normal\": p}, got " + read::type_name(*t));
+      }
+    } else if (const json* fo = f.find("force")) {
+      bc.kind = BoundaryCondition::Kind::force;
+      if (auto v = read::pair(*fo, f.at("force"), "force", errors_)) bc.force = *v;
+    } else if (f.has("free")) {
+      bc.kind = BoundaryCondition::Kind::free;
+      auto b = read::boolean(*f.find("free"), f.at("free"), "free", errors_);
+      if (b && !*b) errors_.add(f.at("free"), "free must be true (an edge without a condition is free anyway)");
+    }
+    if (f.has("displacement") && bc.normal_pressure)
+      errors_.add(bp, "a normal pressure cannot be combined with a displacement (part of it would go into the "
+                      "support); give the traction as a vector [tx, ty] along the free component");
+    // A load component along a prescribed displacement component would go straight into the support.
+    const Eigen::Vector2d load = bc.kind == BoundaryCondition::Kind::force ? bc.force
+                                 : bc.kind == BoundaryCondition::Kind::traction && !bc.normal_pressure ? bc.traction
+                                                                                                       : Eigen::Vector2d::Zero();
+    for (int c = 0; c < 2; ++c)
+      if ((c == 0 ? bc.ux : bc.uy) && load[c] != 0.0)
+        errors_.add(bp, std::string("the load's ") + (c == 0 ? "x" : "y") + " component acts where the " +
+                            (c == 0 ? "x" : "y") + " displacement is prescribed: it would go straight into the support");
+    if (errors_.size() == before) in.body.boundary.push_back(bc);
+  }
+}
+
+// Phase 4: the rigid motions a body's displacement conditions leave free. A body that some are free for may
+// still be held by its contacts (check_floating_bodies decides, once the contacts and the method are known).
+void JobReader::check_restrained(BodyInput& in) {
+  const mesh::Mesh& mesh = in.body.mesh;
+  std::set<fem::PrescribedDof> dofs;
+  for (const auto& bc : in.body.boundary) {
+    if (!prescribes_displacement(bc)) continue;
+    for (int node : condition_nodes(mesh, bc)) {
+      if (bc.ux) dofs.insert({node, 0});
+      if (bc.uy) dofs.insert({node, 1});
+    }
+  }
+  in.free_motions = fem::free_rigid_motions(mesh, std::vector<fem::PrescribedDof>(dofs.begin(), dofs.end()));
+}
+
+// A traction or force whose every node is held in both directions by displacement conditions would go straight
+// into the supports and move nothing: almost certainly a mistake in the job, so an error at that condition.
+void JobReader::check_loads_reach_the_body(const BodyInput& in) {
+  const mesh::Mesh& mesh = in.body.mesh;
+  std::map<int, std::array<bool, 2>> held;
+  for (const auto& bc : in.body.boundary) {
+    if (!prescribes_displacement(bc)) continue;
+    for (int node : condition_nodes(mesh, bc)) {
+      held[node][0] = held[node][0] || bc.ux.has_value();
+      held[node][1] = held[node][1] || bc.uy.has_value();
+    }
+  }
+  for (size_t j = 0; j < in.body.boundary.size(); ++j) {
+    const auto& bc = in.body.boundary[j];
+    if (bc.kind != BoundaryCondition::Kind::force && bc.kind != BoundaryCondition::Kind::traction) continue;
+    const auto nodes = condition_nodes(mesh, bc);
+    const bool all_held = !nodes.empty() && std::all_of(nodes.begin(), nodes.end(), [&](int node) {
+      auto it = held.find(node);
+      return it != held.end() && it->second[0] && it->second[1];
+    });
+    if (all_held)
+      errors_.add(child(child(in.pointer, "boundary"), j),
+                  std::string("the ") + (bc.kind == BoundaryCondition::Kind::force ? "force" : "traction") + " on " +
+                      (bc.vertex.empty() ? "edge '" + bc.edge + "'" : "vertex '" + bc.vertex + "'") +
+                      " acts only on nodes whose displacement is prescribed in both directions: it would go "
+                      "straight into the supports and load nothing");
+  }
+}
+
+// A floating body (free rigid motions) is accepted when it touches another body and the method solves the
+// interface problem with its equilibrium (interface_newton, monolithic); the fixed-point schemes solve every
+// body alone with Neumann data on its contact zone, which a floating body cannot take.
+void JobReader::check_floating_bodies() {
+  const Method method = problem_.solver.method;
+  for (size_t i = 0; i < inputs_.size(); ++i) {
+    const BodyInput& in = inputs_[i];
+    if (in.free_motions.empty()) continue;
+    const std::string free = join_names(in.free_motions) + (in.free_motions.size() == 1 ? " is" : " are") + " free";
+    bool in_contact = false;
+    for (const auto& c : problem_.contacts)
+      in_contact = in_contact || c.slave_body == static_cast<int>(i) || c.master_body == static_cast<int>(i);
+    if (!in_contact) {
+      errors_.add(child(in.pointer, "boundary"),
+                  "body '" + in.body.name + "' is not restrained against rigid motion (" + free +
+                      ") and touches no other body: prescribe a displacement component on one of its edges or "
+                      "vertices, or give it a contact that can hold it");
+    } else if (method == Method::neumann || method == Method::robin) {
+      errors_.add(method_pointer_.empty() ? child(in.pointer, "boundary") : method_pointer_,
+                  "body '" + in.body.name + "' floats (" + free + ": only its contacts hold it), and method \"" +
+                      (method == Method::neumann ? "neumann" : "robin") +
+                      "\" solves every body on its own with contact tractions as loads, which a floating body "
+                      "cannot take; use method \"interface_newton\" (the default) or \"monolithic\", or restrain "
+                      "the body");
+    }
+  }
+}
+
+}  // namespace contact::job::detail

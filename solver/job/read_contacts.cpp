@@ -1,0 +1,128 @@
+// The job's contact pairs: their "body.edge" references resolved to the bodies read (phase 5), and their gaps.
+#include "job_reader.hpp"
+
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+
+namespace contact::job::detail {
+
+// "body.edge" -> indices; reports what is wrong at `pointer`.
+std::optional<JobReader::EdgeRef> JobReader::resolve(const json& value, const std::string& pointer,
+                                                    const std::string& what) {
+  auto s = read::string(value, pointer, what, errors_);
+  if (!s) return std::nullopt;
+  const size_t dot = s->find('.');
+  if (dot == std::string::npos || dot == 0 || dot + 1 == s->size() || s->find('.', dot + 1) != std::string::npos) {
+    errors_.add(pointer, what + " must be \"body.edge\" (e.g. \"upper.bottom\"), got \"" + read::shown(*s) + "\"");
+    return std::nullopt;
+  }
+  const std::string body = s->substr(0, dot), edge = s->substr(dot + 1);
+  std::vector<std::string> names;
+  for (size_t b = 0; b < inputs_.size(); ++b) {
+    if (inputs_[b].has_name) names.push_back(inputs_[b].body.name);
+    if (inputs_[b].has_name && inputs_[b].body.name == body) {
+      const MeshInput& m = inputs_[b].mesh;
+      if (m.edges_known && !has_edge(m, edge)) {
+        errors_.add(pointer, gmsh_elsewhere(m, edge).value_or("body '" + body + "' has no edge '" + read::shown(edge) +
+                                                               "'; its edges are " + join_names(m.edge_names)));
+        return std::nullopt;
+      }
+      return EdgeRef{static_cast<int>(b), edge};
+    }
+  }
+  errors_.add(pointer, "there is no body named '" + read::shown(body) + "'; the bodies are " + join_names(names));
+  return std::nullopt;
+}
+
+void JobReader::read_contacts(const Fields& top) {
+  json& out_list = sub_object(normalized_, "contacts");
+  const json* list = top.find("contacts");
+  if (!list) {
+    out_list = json::array();
+    return;
+  }
+  if (!list->is_array()) {
+    errors_.add("/contacts", "contacts must be an array, got " + read::type_name(*list));
+    return;
+  }
+  if (list->size() > static_cast<size_t>(limits_.max_contacts)) {  // refused before any pair is read
+    errors_.add("/contacts", "the job has " + std::to_string(list->size()) + " contact pairs; at most " +
+                                 std::to_string(limits_.max_contacts) + " are accepted");
+    return;
+  }
+  std::map<std::string, std::string> pointer_of_name;
+  std::map<std::pair<std::string, std::string>, std::string> pointer_of_pair;
+  for (size_t k = 0; k < list->size(); ++k) {
+    const std::string cp = child("/contacts", k);
+    json& out = element(out_list, k);
+    Fields f((*list)[k], cp, "a contact", {"name", "slave", "master", "gap"}, errors_);
+    if (!f.ok()) continue;
+    const size_t before = errors_.size();
+    ContactPair pair;
+    std::optional<EdgeRef> slave, master;
+    if (const json* s = f.require("slave", "the edge integrated over, \"body.edge\""))
+      slave = resolve(*s, f.at("slave"), "slave");
+    if (const json* m = f.require("master", "the edge projected on, \"body.edge\""))
+      master = resolve(*m, f.at("master"), "master");
+    if (slave && master) {
+      const std::string s = f.find("slave")->get<std::string>(), m = f.find("master")->get<std::string>();
+      pair.slave_body = slave->body;
+      pair.slave_edge = slave->edge;
+      pair.master_body = master->body;
+      pair.master_edge = master->edge;
+      pair.name = s + "-" + m;
+      if (slave->body == master->body) {
+        errors_.add(cp, "a body cannot be in contact with itself (slave " + s + ", master " + m + ")");
+      } else if (auto it = pointer_of_pair.find({s, m}); it != pointer_of_pair.end()) {
+        errors_.add(cp, "the pair " + s + " -> " + m + " is already given at " + it->second);
+      } else if (auto swapped = pointer_of_pair.find({m, s}); swapped != pointer_of_pair.end()) {
+        errors_.add(
+            cp, "the pair " + s + " -> " + m + " is already given, slave and master swapped, at " + swapped->second);
+      } else {
+        pointer_of_pair.emplace(std::make_pair(s, m), cp);
+      }
+    }
+    if (const json* n = f.find("name")) {
+      auto s = read::string(*n, f.at("name"), "contact name", errors_);
+      // Room for the default name, "body.edge-body.edge" (four identifiers).
+      auto problem = s ? name_problem(*s, "contact name", 4 * limits_.max_name_length + 3, true) : std::nullopt;
+      if (problem)
+        errors_.add(f.at("name"), *problem);
+      else if (s)
+        pair.name = *s;
+    }
+    if (!pair.name.empty()) {
+      auto [it, inserted] = pointer_of_name.emplace(pair.name, cp);
+      if (!inserted)
+        errors_.add(f.has("name") ? f.at("name") : cp,
+                    "contact name '" + pair.name + "' is already used by " + it->second + "; names must be unique");
+      set_default(out, "name", pair.name);
+    }
+    read_gap(f, pair.gap, sub_object(out, "gap"));
+    if (errors_.size() == before) problem_.contacts.push_back(pair);
+  }
+}
+
+void JobReader::read_gap(const Fields& contact, GapSpec& gap, json& out) {
+  if (const json* g = contact.find("gap")) {
+    Fields f(*g, contact.at("gap"), "gap", {"geometric", "constant", "parabola"}, errors_);
+    if (const json* v = f.find("geometric"))
+      if (auto b = read::boolean(*v, f.at("geometric"), "geometric", errors_)) gap.geometric = *b;
+    if (const json* v = f.find("constant"))
+      if (auto x = read::number(*v, f.at("constant"), "constant", errors_)) gap.constant = *x;
+    if (const json* p = f.find("parabola")) {
+      Fields pf(*p, f.at("parabola"), "parabola", {"r0", "x0"}, errors_);
+      if (const json* r = pf.require("r0", "the coefficient r0 of the added gap r0 (x - x0)^2"))
+        gap.parabola_r0 = read::number(*r, pf.at("r0"), "r0", errors_);
+      if (const json* x0 = pf.find("x0"))
+        if (auto x = read::number(*x0, pf.at("x0"), "x0", errors_)) gap.parabola_x0 = *x;
+      set_default(sub_object(out, "parabola"), "x0", 0.0);
+    }
+  }
+  set_default(out, "geometric", true);
+  set_default(out, "constant", 0.0);
+}
+
+}  // namespace contact::job::detail

@@ -1,0 +1,319 @@
+// The job's settings: "solver" (with the method and enforcement defaults, which depend on the adaptive strategy),
+// "adaptivity", "loading" and "parallel".
+#include "job_reader.hpp"
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+namespace contact::job::detail {
+
+void JobReader::read_solver(const Fields& top) {
+  json& out = sub_object(normalized_, "solver");
+  SolverSettings& s = problem_.solver;
+  if (const json* v = top.find("solver")) {
+    Fields f(*v, top.at("solver"), "solver",
+             {"method", "penalty", "gamma", "tolerance", "criterion", "max_iterations", "initial_guess", "threads",
+              "acceleration", "anderson_depth", "robin", "enforcement", "augmented_lagrangian"},
+             errors_);
+    if (const json* m = f.find("method")) {
+      method_pointer_ = f.at("method");
+      if (auto x = choice(*m, f.at("method"), "method", {"neumann", "monolithic", "interface_newton", "robin"}, errors_)) {
+        s.method = *x == "monolithic"         ? Method::monolithic
+                   : *x == "interface_newton" ? Method::interface_newton
+                   : *x == "robin"            ? Method::robin
+                                              : Method::neumann;
+        method_given_ = true;
+      }
+    }
+    if (const json* p = f.find("penalty")) read_penalty(*p, f.at("penalty"), sub_object(out, "penalty"));
+    if (const json* g = f.find("gamma")) {
+      if (g->is_string()) {
+        if (g->get<std::string>() == "auto")
+          s.gamma_auto = true;
+        else
+          errors_.add(f.at("gamma"), "gamma must be a number in (0, 2) or \"auto\", got \"" + g->get<std::string>() + "\"");
+      } else {
+        auto x = read::number(*g, f.at("gamma"), "gamma", errors_);
+        if (x && !(*x > 0 && *x < 2))
+          errors_.add(f.at("gamma"),
+                      "gamma = " + format_number(*x) +
+                          " is outside (0, 2): the relaxation weight must be greater than 0 and less than 2");
+        else if (x) {
+          s.gamma = *x;
+          s.gamma_auto = false;
+        }
+      }
+    }
+    if (const json* t = f.find("tolerance"))
+      if (auto x = positive(*t, f.at("tolerance"), "tolerance", errors_)) s.tolerance = *x;
+    if (const json* c = f.find("criterion"))
+      if (auto x = choice(*c, f.at("criterion"), "criterion", {"paper", "residual"}, errors_))
+        s.criterion = *x == "residual" ? Criterion::residual : Criterion::paper;
+    if (const json* n = f.find("max_iterations"))
+      if (auto x = bounded_int(*n, f.at("max_iterations"), "max_iterations", 1, errors_)) s.max_iterations = *x;
+    if (const json* g = f.find("initial_guess"))
+      if (auto x = choice(*g, f.at("initial_guess"), "initial_guess", {"zero", "elastic_layer"}, errors_))
+        s.initial_guess = *x == "zero" ? InitialGuess::zero : InitialGuess::elastic_layer;
+    if (const json* t = f.find("threads"))
+      if (auto x = bounded_int(*t, f.at("threads"), "threads", 0, errors_)) s.threads = *x;
+    if (const json* a = f.find("acceleration"))
+      if (auto x = choice(*a, f.at("acceleration"), "acceleration", {"none", "anderson"}, errors_))
+        s.acceleration = *x == "anderson" ? Acceleration::anderson : Acceleration::none;
+    if (const json* d = f.find("anderson_depth")) {
+      if (auto x = bounded_int(*d, f.at("anderson_depth"), "anderson_depth", 1, errors_)) {
+        if (*x > 50)
+          errors_.add(f.at("anderson_depth"), "anderson_depth = " + std::to_string(*x) + " is above 50");
+        else
+          s.anderson_depth = *x;
+      }
+    }
+    if (const json* r = f.find("robin")) read_robin(*r, f.at("robin"));
+    if (const json* e = f.find("enforcement")) {
+      enforcement_pointer_ = f.at("enforcement");
+      if (auto x = choice(*e, f.at("enforcement"), "enforcement", {"exact", "penalty", "augmented_lagrangian"}, errors_)) {
+        s.enforcement = *x == "augmented_lagrangian" ? Enforcement::augmented_lagrangian
+                        : *x == "penalty"            ? Enforcement::penalty
+                                                     : Enforcement::exact;
+        enforcement_given_ = true;
+      }
+    }
+    if (const json* a = f.find("augmented_lagrangian")) read_augmented_lagrangian(*a, f.at("augmented_lagrangian"));
+  }
+  set_default(out, "penalty", json{{"c", 0.05}});
+  set_default(out, "gamma", "auto");
+  set_default(out, "tolerance", 1e-8);
+  set_default(out, "criterion", "residual");
+  set_default(out, "max_iterations", 2000);
+  set_default(out, "initial_guess", "elastic_layer");
+  set_default(out, "threads", 0);
+  set_default(out, "acceleration", "anderson");
+  set_default(out, "anderson_depth", 10);
+  set_default(out, "robin", json{{"psi", "active_set"}});
+  set_default(out, "augmented_lagrangian", json{{"tolerance", 1e-6}, {"max_updates", 100}});
+  json& al = out["augmented_lagrangian"];
+  set_default(al, "tolerance", 1e-6);
+  set_default(al, "max_updates", 100);
+}
+
+// The method and enforcement defaults depend on each other and on the adaptive strategy, so they are filled
+// in after both sections are read; combinations that cannot run are errors here, never silent substitutes.
+//  * method: interface_newton, except neumann under the paper's adaptive strategy (which is a Neumann
+//    iteration interleaved with refinement);
+//  * enforcement: exact for interface_newton and monolithic; penalty for neumann and robin (they iterate on the
+//    penalty problem: exact is available to them only through augmented_lagrangian).
+void JobReader::resolve_method_defaults() {
+  SolverSettings& s = problem_.solver;
+  json& out = sub_object(normalized_, "solver");
+  const bool paper_strategy = problem_.adaptivity.enabled && problem_.adaptivity.strategy == AdaptStrategy::paper;
+  auto name = [](Method m) {
+    return m == Method::neumann ? "neumann" : m == Method::robin ? "robin" : m == Method::monolithic ? "monolithic" : "interface_newton";
+  };
+  if (!method_given_) s.method = paper_strategy ? Method::neumann : Method::interface_newton;
+  const bool fixed_point = s.method == Method::neumann || s.method == Method::robin;
+  if (!enforcement_given_) s.enforcement = fixed_point || paper_strategy ? Enforcement::penalty : Enforcement::exact;
+  if (paper_strategy && s.method != Method::neumann)
+    errors_.add(method_pointer_.empty() ? "/adaptivity/strategy" : method_pointer_,
+                std::string("the adaptive strategy \"paper\" interleaves single Neumann iterations (paper (16)-(17)) "
+                            "with refinement: it needs method \"neumann\", not \"") +
+                    name(s.method) + "\" (or use strategy \"converge_then_refine\", which works with every method)");
+  else if (paper_strategy && s.enforcement != Enforcement::penalty)
+    errors_.add(enforcement_pointer_,
+                "the adaptive strategy \"paper\" runs the paper's penalty iteration: enforcement must be \"penalty\" "
+                "(use strategy \"converge_then_refine\" for exact or augmented-Lagrangian contact)");
+  else if (fixed_point && s.enforcement == Enforcement::exact)
+    errors_.add(enforcement_pointer_,
+                std::string("method \"") + name(s.method) +
+                    "\" iterates on the penalty problem: enforcement \"exact\" is not available with it (use "
+                    "\"penalty\", or \"augmented_lagrangian\" for exact contact in the limit, or method "
+                    "\"interface_newton\")");
+  set_default(out, "method", name(s.method));
+  set_default(out, "enforcement", s.enforcement == Enforcement::exact     ? "exact"
+                                  : s.enforcement == Enforcement::penalty ? "penalty"
+                                                                          : "augmented_lagrangian");
+}
+
+void JobReader::read_adaptivity(const json& value, const std::string& pointer) {
+  Fields f(value, pointer, "adaptivity",
+           {"indicator", "normalization", "delta", "bodies", "max_level", "max_dofs", "strategy", "max_steps"},
+           errors_);
+  if (!f.ok()) return;
+  AdaptivitySettings& a = problem_.adaptivity;
+  a.enabled = true;
+  json& out = normalized_["adaptivity"];
+  if (const json* i = f.find("indicator"))
+    if (auto x = choice(*i, f.at("indicator"), "indicator", {"fem_bem", "zz"}, errors_))
+      a.indicator = *x == "zz" ? Indicator::zz : Indicator::fem_bem;
+  if (const json* nz = f.find("normalization"))
+    if (auto x = choice(*nz, f.at("normalization"), "normalization", {"rms", "area"}, errors_))
+      a.normalization = *x == "area" ? Normalization::area : Normalization::rms;
+  if (const json* d = f.find("delta"))
+    if (auto x = positive(*d, f.at("delta"), "delta", errors_)) a.delta = *x;
+  if (const json* l = f.find("max_level"))
+    if (auto x = bounded_int(*l, f.at("max_level"), "max_level", 0, errors_)) {
+      if (*x > 30)
+        errors_.add(f.at("max_level"), "max_level = " + std::to_string(*x) + " is above 30");
+      else
+        a.max_level = *x;
+    }
+  if (const json* d = f.find("max_dofs"))
+    if (auto x = bounded_int(*d, f.at("max_dofs"), "max_dofs", 1, errors_)) a.max_dofs = *x;
+  if (const json* st = f.find("strategy"))
+    if (auto x = choice(*st, f.at("strategy"), "strategy", {"paper", "converge_then_refine"}, errors_))
+      a.strategy = *x == "paper" ? AdaptStrategy::paper : AdaptStrategy::converge_then_refine;
+  if (const json* n = f.find("max_steps"))
+    if (auto x = bounded_int(*n, f.at("max_steps"), "max_steps", 1, errors_)) a.max_steps = *x;
+  if (const json* b = f.find("bodies")) {
+    const std::string bp = f.at("bodies");
+    if (!b->is_array()) {
+      errors_.add(bp, "bodies must be an array of body names, got " + read::type_name(*b));
+    } else {
+      for (size_t i = 0; i < b->size(); ++i) {
+        const std::string ip = child(bp, i);
+        if (!(*b)[i].is_string()) {
+          errors_.add(ip, "a body name must be a string, got " + read::type_name((*b)[i]));
+          continue;
+        }
+        const std::string name = (*b)[i].get<std::string>();
+        int found = -1;
+        std::string known;
+        for (size_t k = 0; k < inputs_.size(); ++k) {
+          if (inputs_[k].has_name && inputs_[k].body.name == name) found = static_cast<int>(k);
+          if (inputs_[k].has_name) known += (known.empty() ? "" : ", ") + inputs_[k].body.name;
+        }
+        if (found < 0)
+          errors_.add(ip, "unknown body '" + read::shown(name) + "'; the bodies are " + known);
+        else if (std::find(a.bodies.begin(), a.bodies.end(), found) == a.bodies.end())
+          a.bodies.push_back(found);
+      }
+    }
+  }
+  set_default(out, "indicator", "fem_bem");
+  set_default(out, "normalization", "rms");
+  set_default(out, "delta", 0.1);
+  if (!out.contains("bodies")) {
+    json all = json::array();
+    for (const auto& in : inputs_)
+      if (in.has_name) all.push_back(in.body.name);
+    out["bodies"] = all;
+  }
+  set_default(out, "max_level", 8);
+  set_default(out, "max_dofs", 400000);
+  set_default(out, "strategy", "converge_then_refine");
+  set_default(out, "max_steps", 20);
+}
+
+void JobReader::read_robin(const json& value, const std::string& pointer) {
+  Fields f(value, pointer, "robin", {"psi"}, errors_);
+  if (!f.ok()) return;
+  if (const json* p = f.find("psi")) {
+    if (p->is_string()) {
+      if (p->get<std::string>() != "active_set")
+        errors_.add(f.at("psi"), "psi must be a positive number or \"active_set\", got \"" + p->get<std::string>() + "\"");
+    } else if (auto x = positive(*p, f.at("psi"), "psi", errors_)) {
+      problem_.solver.robin.active_set = false;
+      problem_.solver.robin.psi = *x;
+    }
+  }
+}
+
+void JobReader::read_augmented_lagrangian(const json& value, const std::string& pointer) {
+  Fields f(value, pointer, "augmented_lagrangian", {"tolerance", "max_updates"}, errors_);
+  if (!f.ok()) return;
+  auto& al = problem_.solver.augmented_lagrangian;
+  if (const json* t = f.find("tolerance"))
+    if (auto x = positive(*t, f.at("tolerance"), "tolerance", errors_)) al.tolerance = *x;
+  if (const json* n = f.find("max_updates"))
+    if (auto x = bounded_int(*n, f.at("max_updates"), "max_updates", 1, errors_)) al.max_updates = *x;
+}
+
+void JobReader::read_penalty(const json& value, const std::string& pointer, json& out) {
+  PenaltySpec& p = problem_.solver.penalty;
+  Fields f(value, pointer, "penalty", {"theta", "c", "length"}, errors_);
+  if (!f.ok()) return;
+  if (f.has("theta") && (f.has("c") || f.has("length"))) {
+    errors_.add(pointer, "give either theta, or c (with an optional length), not both: theta = c * length / E");
+    return;
+  }
+  if (const json* t = f.find("theta")) {
+    if (auto x = positive(*t, f.at("theta"), "theta", errors_)) p.theta = *x;
+    return;
+  }
+  if (const json* c = f.find("c"))
+    if (auto x = positive(*c, f.at("c"), "c", errors_)) p.c = *x;
+  if (const json* l = f.find("length"))
+    if (auto x = positive(*l, f.at("length"), "length", errors_)) p.length = *x;
+  set_default(out, "c", 0.05);
+}
+
+// "parallel": {"ranks": N}: the MPI ranks a server runs the job on (docs/parallel.md); contact-solve takes
+// mpirun's number instead.
+void JobReader::read_parallel(const Fields& top) {
+  const json* v = top.find("parallel");
+  if (!v) {
+    set_default(normalized_, "parallel", json{{"ranks", 1}});
+    return;
+  }
+  Fields f(*v, top.at("parallel"), "parallel", {"ranks"}, errors_);
+  if (!f.ok()) return;
+  const json* n = f.find("ranks");
+  if (!n) {
+    if (normalized_.is_object() && normalized_["parallel"].is_object()) normalized_["parallel"]["ranks"] = 1;
+    return;
+  }
+  if (auto x = bounded_int(*n, f.at("ranks"), "ranks", 1, errors_)) {
+    if (*x > limits_.max_ranks) {
+      errors_.add(f.at("ranks"), "ranks = " + std::to_string(*x) + " is more than the " +
+                                     std::to_string(limits_.max_ranks) + " MPI ranks accepted here" +
+                                     (limits_.ranks_hint.empty() ? "" : " (" + limits_.ranks_hint + ")"));
+      return;
+    }
+    problem_.ranks = *x;
+  }
+}
+
+// "loading": {"steps": N} (factors 1/N, 2/N, ..., 1) or {"factors": [f1, f2, ...]}.
+void JobReader::read_loading(const Fields& top) {
+  const json* v = top.find("loading");
+  if (!v) {
+    set_default(normalized_, "loading", json{{"steps", 1}});
+    return;
+  }
+  const std::string pointer = top.at("loading");
+  Fields f(*v, pointer, "loading", {"steps", "factors"}, errors_);
+  if (!f.ok()) return;
+  if (f.has("steps") == f.has("factors")) {
+    errors_.add(pointer, "give either steps (a number of equal load steps) or factors (the load factor of each step)");
+    return;
+  }
+  std::vector<double> factors;
+  if (const json* n = f.find("steps")) {
+    if (auto x = bounded_int(*n, f.at("steps"), "steps", 1, errors_)) {
+      if (*x > limits_.max_load_steps) {
+        errors_.add(f.at("steps"), "steps = " + std::to_string(*x) + " is too large (at most " +
+                                       std::to_string(limits_.max_load_steps) + "): each step is a whole solve");
+        return;
+      }
+      for (int k = 1; k <= *x; ++k) factors.push_back(static_cast<double>(k) / *x);
+    }
+  } else if (const json* list = f.find("factors")) {
+    if (!list->is_array() || list->empty()) {
+      errors_.add(f.at("factors"), "factors must be a non-empty array of positive numbers, got " + read::type_name(*list));
+      return;
+    }
+    if (static_cast<long>(list->size()) > limits_.max_load_steps) {
+      errors_.add(f.at("factors"), "factors has " + std::to_string(list->size()) + " entries: at most " +
+                                       std::to_string(limits_.max_load_steps) + " load steps");
+      return;
+    }
+    for (size_t k = 0; k < list->size(); ++k)
+      if (auto x = positive((*list)[k], child(f.at("factors"), k), "load factor", errors_)) factors.push_back(*x);
+  }
+  if (factors.empty()) return;
+  if (problem_.adaptivity.enabled && factors.size() > 1)
+    errors_.add(pointer, "load steps and adaptivity together are not supported: refine for one load, or step a "
+                         "fixed mesh");
+  problem_.loading.factors = std::move(factors);
+}
+
+}  // namespace contact::job::detail
