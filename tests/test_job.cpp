@@ -392,7 +392,21 @@ TEST(JobErrors, UnknownFieldNamesAreEscapedInThePointer) {
 TEST(JobErrors, AdaptivityWithAnUnknownBodyNamesTheBodies) {
   json job = small_job();
   job["adaptivity"] = {{"indicator", "fem_bem"}, {"bodies", {"lower", "middle"}}};
-  expect_only_error(parse(job), "/adaptivity/bodies/1", "unknown body 'middle'");
+  expect_only_error(parse(job), "/adaptivity/bodies/1", "unknown body 'middle'; the bodies are upper and lower");
+}
+
+TEST(JobErrors, AWrongChoiceStringIsShownShortened) {
+  // A hostile string in a field that takes a number or a word: the message quotes it, cut short.
+  for (const char* field : {"gamma", "robin"}) {
+    json job = small_job();
+    const std::string huge(100000, 'x');
+    if (std::string(field) == "gamma") job["solver"]["gamma"] = huge;
+    else job["solver"] = {{"method", "robin"}, {"robin", {{"psi", huge}}}};
+    const ParseResult r = parse(job);
+    ASSERT_EQ(r.errors.size(), 1u) << listing(r);
+    EXPECT_LT(r.errors[0].message.size(), 300u) << field;
+    EXPECT_NE(r.errors[0].message.find("xxxx"), std::string::npos) << field;
+  }
 }
 
 TEST(JobErrors, AdaptivityWithAnUnknownIndicatorListsTheChoices) {

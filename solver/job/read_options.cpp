@@ -32,7 +32,7 @@ void JobReader::read_solver(const Fields& top) {
         if (g->get<std::string>() == "auto")
           s.gamma_auto = true;
         else
-          errors_.add(f.at("gamma"), "gamma must be a number in (0, 2) or \"auto\", got \"" + g->get<std::string>() + "\"");
+          errors_.add(f.at("gamma"), "gamma must be a number in (0, 2) or \"auto\", got \"" + read::shown(g->get<std::string>()) + "\"");
       } else {
         auto x = read::number(*g, f.at("gamma"), "gamma", errors_);
         if (x && !(*x > 0 && *x < 2))
@@ -176,13 +176,13 @@ void JobReader::read_adaptivity(const json& value, const std::string& pointer) {
         }
         const std::string name = (*b)[i].get<std::string>();
         int found = -1;
-        std::string known;
+        std::vector<std::string> known;
         for (size_t k = 0; k < inputs_.size(); ++k) {
           if (inputs_[k].has_name && inputs_[k].body.name == name) found = static_cast<int>(k);
-          if (inputs_[k].has_name) known += (known.empty() ? "" : ", ") + inputs_[k].body.name;
+          if (inputs_[k].has_name) known.push_back(inputs_[k].body.name);
         }
         if (found < 0)
-          errors_.add(ip, "unknown body '" + read::shown(name) + "'; the bodies are " + known);
+          errors_.add(ip, "unknown body '" + read::shown(name) + "'; the bodies are " + join_names(known));
         else if (std::find(a.bodies.begin(), a.bodies.end(), found) == a.bodies.end())
           a.bodies.push_back(found);
       }
@@ -209,7 +209,7 @@ void JobReader::read_robin(const json& value, const std::string& pointer) {
   if (const json* p = f.find("psi")) {
     if (p->is_string()) {
       if (p->get<std::string>() != "active_set")
-        errors_.add(f.at("psi"), "psi must be a positive number or \"active_set\", got \"" + p->get<std::string>() + "\"");
+        errors_.add(f.at("psi"), "psi must be a positive number or \"active_set\", got \"" + read::shown(p->get<std::string>()) + "\"");
     } else if (auto x = positive(*p, f.at("psi"), "psi", errors_)) {
       problem_.solver.robin.active_set = false;
       problem_.solver.robin.psi = *x;
