@@ -6,19 +6,20 @@ listed explicitly as pairs. Each brick is held sideways at one corner (a dowel: 
 vertex) and otherwise floats - its vertical position and its rotation are held by its contacts alone - so the
 job exercises many-body contact and the floating-body equilibrium far past three bodies.
 
-    scripts/make_brick_wall.py [--rows 8] [--bricks 8] [--cells 4] [-o api/examples/brick_wall.json]
+    scripts/make_brick_wall.py [--rows 8] [--bricks 8] [--cells 4] [--abutments] [-o api/examples/brick_wall.json]
 
 The default, 8 rows of 8 bricks, has 68 bricks, 69 bodies and 120 contact pairs (docs/parallel.md).
 
-Without the dowels the bricks would also float sideways, held only by head joints against abutments; that
-frictionless arrangement (every head joint a zero-gap contact closed by the Poisson expansion alone) makes the
-primal-dual active set cycle, so it is not offered."""
+With --abutments the bricks have no dowels: two clamped side walls (abutments) and frictionless head joints
+(each brick's right edge against the next one's left edge, the end bricks against the abutments) hold them
+sideways, so every brick floats in all three rigid motions and every head joint is a zero-gap contact closed by
+the Poisson expansion under the load alone (8 x 8: 71 bodies, 196 pairs)."""
 import argparse
 import json
 import sys
 
 
-def wall(rows, bricks, cells, length=0.24, height=0.07, pressure=2.0):
+def wall(rows, bricks, cells, length=0.24, height=0.07, pressure=2.0, abutments=False):
     E, nu = 1.0e4, 0.2            # MPa: brick
     E_base, nu_base = 3.0e4, 0.2  # concrete base
     width = bricks * length
@@ -28,7 +29,7 @@ def wall(rows, bricks, cells, length=0.24, height=0.07, pressure=2.0):
         bodies.append({"name": name, "material": {"E": E, "nu": nu},
                        "mesh": {"block": {"corners": [[x0, y0], [x1, y0], [x1, y1], [x0, y1]], "nx": nx,
                                           "ny": max(1, cells // 2)}},
-                       "boundary": [{"vertex": "bottom_left", "displacement": {"x": 0}}]})
+                       "boundary": [] if abutments else [{"vertex": "bottom_left", "displacement": {"x": 0}}]})
 
     base_t = 0.1
     bodies.append({"name": "base", "material": {"E": E_base, "nu": nu_base},
@@ -61,10 +62,23 @@ def wall(rows, bricks, cells, length=0.24, height=0.07, pressure=2.0):
                 for below, b0, b1 in layout[r - 1]:
                     if min(x1, b1) - max(x0, b0) > 1e-9:
                         pair(f"{name}.bottom", f"{below}.top")
+    if abutments:
+        top = rows * height
+        for side, x0, x1 in (("left", -0.1, 0.0), ("right", width, width + 0.1)):
+            bodies.append({"name": f"abutment_{side}", "material": {"E": E_base, "nu": nu_base},
+                           "mesh": {"block": {"corners": [[x0, 0], [x1, 0], [x1, top], [x0, top]], "nx": 1,
+                                              "ny": rows * max(1, cells // 2)}},
+                           "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}},
+                                        {"edge": side, "displacement": {"x": 0}}]})
+        for row in layout:
+            pair(f"{row[0][0]}.left", "abutment_left.right")
+            for (name, _, _), (right, _, _) in zip(row, row[1:]):
+                pair(f"{name}.right", f"{right}.left")
+            pair(f"{row[-1][0]}.right", "abutment_right.left")
     for name, _, _ in layout[-1]:
         next(b for b in bodies if b["name"] == name)["boundary"].append({"edge": "top", "traction": {"normal": pressure}})
 
-    return {"name": f"brick_wall_{rows}x{bricks}", "version": 1, "model": {"plane": "strain"},
+    return {"name": f"brick_wall_{rows}x{bricks}" + ("_abutments" if abutments else ""), "version": 1, "model": {"plane": "strain"},
             "bodies": bodies, "contacts": contacts,
             "solver": {"method": "interface_newton", "enforcement": "exact"}}
 
@@ -74,11 +88,13 @@ def main():
     p.add_argument("--rows", type=int, default=8)
     p.add_argument("--bricks", type=int, default=8, help="full bricks per row")
     p.add_argument("--cells", type=int, default=4, help="elements along a full brick (half as many across)")
+    p.add_argument("--abutments", action="store_true",
+                   help="no dowels: abutments and head-joint contacts hold the bricks sideways")
     p.add_argument("-o", "--output", default="-")
     a = p.parse_args()
     if a.rows < 1 or a.bricks < 1 or a.cells < 2:
         p.error("rows and bricks must be >= 1, cells >= 2")
-    job = wall(a.rows, a.bricks, a.cells)
+    job = wall(a.rows, a.bricks, a.cells, abutments=a.abutments)
     text = json.dumps(job, indent=1) + "\n"
     if a.output == "-":
         sys.stdout.write(text)

@@ -155,8 +155,10 @@ Eigen::VectorXd nested_initial_guess(const Eigen::MatrixXd& H, const Eigen::Vect
   return P * coarse.z.cwiseMax(0.0);
 }
 
-ActiveSetResult solve_active_set(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int max_steps,
-                                 const StepCallback& on_step, const Eigen::VectorXd* z0, const Equalities& eq) {
+namespace {
+
+ActiveSetResult solve_active_set_on(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int max_steps,
+                                    const StepCallback& on_step, const Eigen::VectorXd* z0, const Equalities& eq) {
   ActiveSetResult out;
   const Eigen::Index n = g.size();
   const Eigen::VectorXd c_over_D = H.diagonal().cwiseInverse();  // c_j / D_j = 1 / H_jj
@@ -265,6 +267,26 @@ ActiveSetResult solve_active_set(const Eigen::MatrixXd& H, const Eigen::VectorXd
      << step.complementarity << ", " << step.active << " of " << n << " contact nodes in contact)";
   out.message = os.str();
   return out;
+}
+
+}  // namespace
+
+ActiveSetResult solve_active_set(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int max_steps,
+                                 const StepCallback& on_step, const Eigen::VectorXd* z0, const Equalities& eq) {
+  if (eq.empty()) return solve_active_set_on(H, g, max_steps, on_step, z0, eq);
+  // With floating bodies H = B K^+ B^T uses a generalised inverse that fixes a few dofs per body; where those
+  // dofs lie on the contact (a body of one or two cells across, contact on two sides) the compliance of a contact
+  // node can vanish, and H_AA is singular although the problem is well posed: H is definite only on ker G_A.
+  // Solved instead with H + rho G^T G and g - rho G^T e, which has the same solution (the added terms are
+  // rho G^T (G z - e) = 0 wherever G z = e) and the same gaps h, and is definite exactly where the problem is.
+  const Eigen::MatrixXd GtG = eq.G.transpose() * eq.G;
+  const double h_scale = H.size() ? H.diagonal().cwiseAbs().maxCoeff() : 0.0;
+  const double g_scale = GtG.size() ? GtG.diagonal().maxCoeff() : 0.0;
+  if (!(h_scale > 0) || !(g_scale > 0)) return solve_active_set_on(H, g, max_steps, on_step, z0, eq);
+  const double rho = h_scale / g_scale;
+  const Eigen::MatrixXd H_rho = H + rho * GtG;
+  const Eigen::VectorXd g_rho = g - rho * (eq.G.transpose() * eq.e);
+  return solve_active_set_on(H_rho, g_rho, max_steps, on_step, z0, eq);
 }
 
 }  // namespace contact::ddm

@@ -20,6 +20,23 @@ namespace {
 
 void append_error(std::string& errors, const std::string& e) { errors += (errors.empty() ? "" : "; ") + e; }
 
+// The errors of the bodies that failed, the first few in full and the others by name (a wall of a hundred
+// bricks must not give a hundred copies of one message).
+std::string body_errors(const std::vector<std::pair<std::string, std::string>>& failed) {
+  constexpr size_t kInFull = 3;
+  std::string out;
+  for (size_t k = 0; k < failed.size() && k < kInFull; ++k) append_error(out, failed[k].second);
+  if (failed.size() > kInFull) {
+    constexpr size_t kNamed = 20;
+    std::string names;
+    for (size_t k = kInFull; k < failed.size() && k < kInFull + kNamed; ++k)
+      names += (k == kInFull ? "'" : ", '") + failed[k].first + "'";
+    if (failed.size() > kInFull + kNamed) names += ", ...";
+    out += "; " + std::to_string(failed.size() - kInFull) + " more bodies failed too: " + names;
+  }
+  return out;
+}
+
 }  // namespace
 
 ContactSystem::ContactSystem(const Problem& problem, TaskRunner& runner, Factorization factorization)
@@ -29,10 +46,12 @@ ContactSystem::ContactSystem(const Problem& problem, TaskRunner& runner, Factori
   discretize_pairs();
   bodies_.resize(problem.bodies.size());
   runner.run_bodies(bodies_.size(), [&](size_t a) { bodies_[a] = make_body(a, true); }, body_outcome_share());
-  for (const auto& b : bodies_) {
-    if (!b->ok()) append_error(error_, b->error());
-    factorization_seconds_ += b->factorization_seconds();
+  std::vector<std::pair<std::string, std::string>> failed;
+  for (size_t a = 0; a < bodies_.size(); ++a) {
+    if (!bodies_[a]->ok()) failed.emplace_back(problem.bodies[a].name, bodies_[a]->error());
+    factorization_seconds_ += bodies_[a]->factorization_seconds();
   }
+  append_error(error_, body_errors(failed));
   setup_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
@@ -101,10 +120,12 @@ void ContactSystem::rebuild(const std::vector<char>& changed, TaskRunner& runner
     bodies_[a].reset();  // free the old factorisation first
     bodies_[a] = make_body(a, true);
   }, body_outcome_share());
+  std::vector<std::pair<std::string, std::string>> failed;
   for (size_t a : todo) {
-    if (!bodies_[a]->ok()) append_error(error_, bodies_[a]->error());
+    if (!bodies_[a]->ok()) failed.emplace_back(problem_.bodies[a].name, bodies_[a]->error());
     factorization_seconds_ += bodies_[a]->factorization_seconds();
   }
+  append_error(error_, body_errors(failed));
 }
 
 Pressures ContactSystem::penalty_pressures(const Displacements& u) const {

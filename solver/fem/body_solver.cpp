@@ -71,23 +71,31 @@ void BodySolver::setup_constraints() {
     std::vector<char> avoid(static_cast<size_t>(constraints_.n_dofs()), 0);
     for (const auto& [node, c] : prescribed) avoid[static_cast<size_t>(2 * node + c)] = 1;
     for (const auto& [node, ends] : mesh::hanging_nodes(body_.mesh)) avoid[static_cast<size_t>(2 * node)] = avoid[static_cast<size_t>(2 * node + 1)] = 1;
-    std::vector<int> candidates;
-    for (int pass = 0; pass < 2 && static_cast<Eigen::Index>(candidates.size()) < modes.modes.cols(); ++pass) {
-      candidates.clear();
+    // A set of candidates is good only if the free motions restricted to it have full rank: away from the
+    // contact there may be enough dofs but all of one component (a brick whose top and bottom are both contact
+    // edges leaves only x dofs, which see no vertical translation), so the second pass takes every dof.
+    const Eigen::Index k = modes.modes.cols();
+    for (int pass = 0; pass < 2 && fixing_dofs_.empty(); ++pass) {
+      std::vector<int> candidates;
       std::vector<char> skip = avoid;
       if (pass == 0)
         for (int d : interface_dofs_) skip[static_cast<size_t>(d)] = 1;
       for (int d = 0; d < constraints_.n_dofs(); ++d)
         if (!skip[static_cast<size_t>(d)]) candidates.push_back(d);
+      if (static_cast<Eigen::Index>(candidates.size()) < k) continue;
+      Eigen::MatrixXd at(k, static_cast<Eigen::Index>(candidates.size()));
+      for (size_t j = 0; j < candidates.size(); ++j) at.col(static_cast<Eigen::Index>(j)) = modes.modes.row(candidates[j]).transpose();
+      Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(at);
+      qr.setThreshold(1e-8);
+      if (qr.rank() < k) continue;
+      for (Eigen::Index i = 0; i < k; ++i) fixing_dofs_.push_back(candidates[static_cast<size_t>(qr.colsPermutation().indices()[i])]);
     }
-    Eigen::MatrixXd at(modes.modes.cols(), static_cast<Eigen::Index>(candidates.size()));
-    for (size_t j = 0; j < candidates.size(); ++j) at.col(static_cast<Eigen::Index>(j)) = modes.modes.row(candidates[j]).transpose();
-    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(at);
-    for (Eigen::Index i = 0; i < modes.modes.cols(); ++i) {
-      const int dof = candidates[static_cast<size_t>(qr.colsPermutation().indices()[i])];
-      fixing_dofs_.push_back(dof);
-      constraints_.add_dirichlet(dof, 0.0);
+    if (fixing_dofs_.empty()) {
+      // Not reachable for a mesh with at least one cell (every free motion moves some unprescribed dof).
+      error_ = "body '" + body_.name + "': no set of its unknowns holds its free rigid motions";
+      return;
     }
+    for (int dof : fixing_dofs_) constraints_.add_dirichlet(dof, 0.0);
   }
   rigid_modes_ = std::move(modes.modes);
   rigid_mode_names_ = std::move(modes.names);
@@ -227,7 +235,8 @@ void BodySolver::factorize() {
   if (!factor_->ok()) {
     std::ostringstream os;
     os << "body '" << body_.name << "': the stiffness matrix (" << n_free() << " unknowns) could not be factorised: "
-       << factor_->error() << " (is the body restrained against rigid motion by its displacement conditions?)";
+       << factor_->error();
+    if (rigid_modes_.cols() == 0) os << " (is the body restrained against rigid motion by its displacement conditions?)";
     error_ = os.str();
   }
 }
