@@ -122,6 +122,19 @@ struct AugmentedLagrangianSettings {
   int max_updates = 100;
 };
 
+// How interface_newton solves its interface problem (docs/algorithm.md, "The interface solvers"): direct, the
+// active set on the sparse assembled interface matrix (CHOLMOD), one process; iterative, FETI-style projected
+// MPRGP with SMALBE for the floating bodies' equilibrium, each process applying its own bodies' blocks; automatic
+// picks by size. Both give the same discrete solution.
+enum class InterfaceSolverKind { automatic, direct, iterative };
+enum class InterfacePreconditioner { none, lumped, dirichlet };
+struct InterfaceSolverSettings {
+  InterfaceSolverKind solver = InterfaceSolverKind::automatic;
+  InterfacePreconditioner preconditioner = InterfacePreconditioner::dirichlet;  // iterative only
+  double tolerance = 1e-10;        // iterative: projected gradient and equilibrium, relative
+  long max_iterations = 100000;    // iterative: products with the interface operator, in all
+};
+
 // Defaults: exact contact by interface Newton. The job parser fills the defaults that depend on the method
 // (enforcement: exact for interface_newton and monolithic, penalty for neumann and robin); the paper's scheme is
 // method neumann, gamma 0.02, criterion paper, tolerance 0.0015, acceleration none
@@ -141,6 +154,7 @@ struct SolverSettings {
   RobinSettings robin;
   Enforcement enforcement = Enforcement::exact;
   AugmentedLagrangianSettings augmented_lagrangian;
+  InterfaceSolverSettings interface;
 };
 
 // h-adaptivity (paper section 3): indicator per cell, refine where it exceeds delta.

@@ -1,14 +1,14 @@
-// The primal-dual active set on the interface (solver/ddm/active_set.cpp) as pure linear algebra: on random
+// The primal-dual active set on the interface (solver/linalg/active_set.cpp) as pure linear algebra: on random
 // symmetric positive definite problems its answer satisfies the complementarity conditions and equals the
 // independent active-set QP method; the nested coarse guess is non-negative and saves steps.
-#include "ddm/active_set.hpp"
+#include "linalg/active_set.hpp"
 
 #include <Eigen/LU>
 #include <gtest/gtest.h>
 
 #include <random>
 
-using namespace contact::ddm;
+using namespace contact::linalg;
 
 namespace {
 
@@ -37,7 +37,7 @@ TEST(ActiveSet, SolutionSatisfiesComplementarityAndEqualsTheQpMethod) {
     const Eigen::MatrixXd H = A * A.transpose() + n * Eigen::MatrixXd::Identity(n, n);
     Eigen::VectorXd g(n);
     for (int i = 0; i < n; ++i) g[i] = normal(rng);
-    const ActiveSetResult r = solve_active_set(H, g, 100, always);
+    const ActiveSetResult r = solve_active_set(H.sparseView(), g, 100, always);
     ASSERT_TRUE(r.converged) << r.message;
     const Eigen::VectorXd h = g + H * r.z;
     const double scale = g.cwiseAbs().maxCoeff();
@@ -46,7 +46,7 @@ TEST(ActiveSet, SolutionSatisfiesComplementarityAndEqualsTheQpMethod) {
       EXPECT_GE(h[i], -1e-12 * scale);
       EXPECT_NEAR(r.z[i] * h[i], 0.0, 1e-12 * scale * std::max(1.0, r.z.cwiseAbs().maxCoeff()));
     }
-    const Eigen::VectorXd qp = solve_nonnegative_qp(H, g);
+    const Eigen::VectorXd qp = solve_nonnegative_qp(H.sparseView(), g);
     EXPECT_LE((qp - r.z).cwiseAbs().maxCoeff(), 1e-10 * std::max(1.0, r.z.cwiseAbs().maxCoeff())) << trial;
   }
 }
@@ -55,7 +55,7 @@ TEST(ActiveSet, NestedGuessIsNonNegativeAndLeavesAHandfulOfFineStepsAtEverySize)
   // A contact zone shrinking from a first guess that overestimates it: g = -(1 - (x / 0.8)^2) on a line of n
   // nodes (penetration where |x| < 0.8) pushed back by a softening compliance.
   for (int n : {65, 257, 1025}) {
-    const Eigen::MatrixXd H = compliance(n) / n;
+    const SparseMatrix H = (compliance(n) / n).sparseView();
     Eigen::VectorXd g(n), position(n);
     for (int i = 0; i < n; ++i) {
       const double x = -1.0 + 2.0 * i / (n - 1);

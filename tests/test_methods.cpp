@@ -1,6 +1,6 @@
 // The fast and exact methods (gamma auto, Anderson, Robin, interface Newton, augmented Lagrangian) against the
 // monolithic reference and against exact answers.
-#include "ddm/interface_problem.hpp"
+#include "ddm/interface/interface_problem.hpp"
 #include "job/job.hpp"
 #include "solve.hpp"
 #include "support.hpp"

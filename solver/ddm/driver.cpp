@@ -28,7 +28,7 @@ MethodOutcome MethodRunner::run(RunContext& context) {
       if (system_.pairs().empty()) return run_neumann(system_, settings_, context);
       int setup = 0;
       if (!interface_newton_) {
-        interface_newton_ = std::make_unique<InterfaceNewton>(system_, context.runner);
+        interface_newton_ = std::make_unique<InterfaceNewton>(system_, settings_, context.runner);
         setup = 1;  // the free response of every body
       }
       MethodOutcome out = interface_newton_->solve(settings_, context);

@@ -2,7 +2,7 @@
 // shared by solve() and the adaptive loop.
 #pragma once
 
-#include "interface_newton.hpp"
+#include "interface/interface_newton.hpp"
 #include "method.hpp"
 
 #include <memory>

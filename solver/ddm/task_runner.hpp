@@ -33,6 +33,16 @@ class TaskRunner {
   virtual bool distributed() const { return false; }
   // The process that reports progress and writes results.
   virtual bool is_root() const { return true; }
+
+  // Adds `values` over all processes, in place (one process: nothing to do). The iterative interface solver's
+  // one collective per iteration: each process applies its own bodies' blocks, then the sums meet. A distributed
+  // runner also carries the cancel requests with it and returns true when any process asked to stop (the same
+  // answer on every process); without one, false.
+  virtual bool sum(double* values, size_t count) {
+    (void)values;
+    (void)count;
+    return false;
+  }
 };
 
 // A fixed pool of worker threads (the calling thread works too). threads <= 1 runs everything inline.

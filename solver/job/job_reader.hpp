@@ -103,6 +103,7 @@ class JobReader {
   void read_adaptivity(const json& value, const std::string& pointer);
   void read_robin(const json& value, const std::string& pointer);
   void read_augmented_lagrangian(const json& value, const std::string& pointer);
+  void read_interface_solver(const json& value, const std::string& pointer);
   void read_penalty(const json& value, const std::string& pointer, json& out);
   void read_parallel(const Fields& top);
   void read_loading(const Fields& top);

@@ -14,7 +14,7 @@ void JobReader::read_solver(const Fields& top) {
   if (const json* v = top.find("solver")) {
     Fields f(*v, top.at("solver"), "solver",
              {"method", "penalty", "gamma", "tolerance", "criterion", "max_iterations", "initial_guess", "threads",
-              "acceleration", "anderson_depth", "robin", "enforcement", "augmented_lagrangian"},
+              "acceleration", "anderson_depth", "robin", "enforcement", "augmented_lagrangian", "interface"},
              errors_);
     if (const json* m = f.find("method")) {
       method_pointer_ = f.at("method");
@@ -79,6 +79,7 @@ void JobReader::read_solver(const Fields& top) {
       }
     }
     if (const json* a = f.find("augmented_lagrangian")) read_augmented_lagrangian(*a, f.at("augmented_lagrangian"));
+    if (const json* i = f.find("interface")) read_interface_solver(*i, f.at("interface"));
   }
   set_default(out, "penalty", json{{"c", 0.05}});
   set_default(out, "gamma", "auto");
@@ -94,6 +95,11 @@ void JobReader::read_solver(const Fields& top) {
   json& al = out["augmented_lagrangian"];
   set_default(al, "tolerance", 1e-6);
   set_default(al, "max_updates", 100);
+  json& in = sub_object(out, "interface");
+  set_default(in, "solver", "auto");
+  set_default(in, "preconditioner", "dirichlet");
+  set_default(in, "tolerance", 1e-10);
+  set_default(in, "max_iterations", 100000);
 }
 
 // The method and enforcement defaults depend on each other and on the adaptive strategy, so they are filled
@@ -225,6 +231,32 @@ void JobReader::read_augmented_lagrangian(const json& value, const std::string& 
     if (auto x = positive(*t, f.at("tolerance"), "tolerance", errors_)) al.tolerance = *x;
   if (const json* n = f.find("max_updates"))
     if (auto x = bounded_int(*n, f.at("max_updates"), "max_updates", 1, errors_)) al.max_updates = *x;
+}
+
+void JobReader::read_interface_solver(const json& value, const std::string& pointer) {
+  Fields f(value, pointer, "interface", {"solver", "preconditioner", "tolerance", "max_iterations"}, errors_);
+  if (!f.ok()) return;
+  auto& in = problem_.solver.interface;
+  if (const json* v = f.find("solver"))
+    if (auto x = choice(*v, f.at("solver"), "solver", {"auto", "direct", "iterative"}, errors_))
+      in.solver = *x == "direct"      ? InterfaceSolverKind::direct
+                  : *x == "iterative" ? InterfaceSolverKind::iterative
+                                      : InterfaceSolverKind::automatic;
+  if (const json* v = f.find("preconditioner"))
+    if (auto x = choice(*v, f.at("preconditioner"), "preconditioner", {"none", "lumped", "dirichlet"}, errors_))
+      in.preconditioner = *x == "none"     ? InterfacePreconditioner::none
+                          : *x == "lumped" ? InterfacePreconditioner::lumped
+                                           : InterfacePreconditioner::dirichlet;
+  if (const json* t = f.find("tolerance")) {
+    auto x = positive(*t, f.at("tolerance"), "tolerance", errors_);
+    if (x && *x >= 1e-2)
+      errors_.add(f.at("tolerance"), "tolerance = " + format_number(*x) +
+                                         " is not below 0.01: the interface solver's tolerance is relative (1e-10 by default)");
+    else if (x)
+      in.tolerance = *x;
+  }
+  if (const json* n = f.find("max_iterations"))
+    if (auto x = bounded_int(*n, f.at("max_iterations"), "max_iterations", 1, errors_)) in.max_iterations = *x;
 }
 
 void JobReader::read_penalty(const json& value, const std::string& pointer, json& out) {

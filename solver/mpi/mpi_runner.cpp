@@ -1,5 +1,6 @@
 #include "mpi_runner.hpp"
 
+#include <algorithm>
 #include <climits>
 #include <cstdlib>
 #include <map>
@@ -117,6 +118,19 @@ void MpiTaskRunner::run_bodies(const std::vector<size_t>& bodies, const std::fun
   }
   if (cancel && agreed_) agreed_->cancel();
   if (!errors.empty()) throw std::runtime_error(errors.begin()->second);
+}
+
+bool MpiTaskRunner::sum(double* values, size_t count) {
+  // One MPI_Allreduce with this rank's cancel request as an extra entry: every rank sees the same total, so all
+  // take the same decision and stop at the same iteration.
+  std::vector<double> buffer(values, values + count);
+  buffer.push_back(request_ && request_->load() ? 1.0 : 0.0);
+  if (buffer.size() > static_cast<size_t>(INT_MAX)) throw std::runtime_error("MpiTaskRunner::sum: too many values");
+  MPI_Allreduce(MPI_IN_PLACE, buffer.data(), static_cast<int>(buffer.size()), MPI_DOUBLE, MPI_SUM, comm_);
+  std::copy(buffer.begin(), buffer.end() - 1, values);
+  const bool stop = buffer.back() > 0;
+  if (stop && agreed_) agreed_->cancel();
+  return stop;
 }
 
 }  // namespace contact::mpi

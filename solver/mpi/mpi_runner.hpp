@@ -32,6 +32,7 @@ class MpiTaskRunner final : public ddm::TaskRunner {
   bool owns(size_t body) const override { return owner_.at(body) == rank_; }
   bool distributed() const override { return size_ > 1; }
   bool is_root() const override { return rank_ == 0; }
+  bool sum(double* values, size_t count) override;
 
   // request: this rank's wish to stop (set by a signal handler); agreed: the token solve() reads.
   void watch_cancel(const std::atomic<bool>* request, CancelToken* agreed) {

@@ -1,6 +1,5 @@
 #include "interface_newton.hpp"
 
-#include "active_set.hpp"
 
 #include <sstream>
 
@@ -35,70 +34,59 @@ std::vector<Eigen::VectorXd> InterfaceNewton::rigid_amplitudes(const Eigen::Vect
   return out;
 }
 
-MethodOutcome InterfaceNewton::solve(const SolverSettings& settings, RunContext& context) {
-  MethodOutcome out;
+InterfaceQp InterfaceNewton::make_qp(const SolverSettings& settings) const {
   const auto& pairs = system_.pairs();
-  const InterfaceProblem& ip = problem_;
-  const Eigen::Index m = ip.size();
-
+  const Eigen::Index m = problem_.size();
+  InterfaceQp qp{problem_, Eigen::VectorXd::Zero(m), problem_.free_gap(), problem_.equilibrium(), {}, {}};
   // H = F (+ theta D for the penalty), g = g_free (- theta D lambda under the augmented Lagrangian).
-  Eigen::MatrixXd H = ip.compliance();
-  Eigen::VectorXd g = ip.free_gap();
-  if (settings.enforcement != Enforcement::exact) {
+  if (settings.enforcement != Enforcement::exact)
     for (size_t k = 0; k < pairs.size(); ++k) {
       const auto& pair = pairs[k];
       for (Eigen::Index r = 0; r < pair.n_rows(); ++r) {
-        const Eigen::Index i = ip.offset(k) + r;
-        H(i, i) += pair.theta * pair.area[r];
-        if (pair.multiplier.size() == pair.n_rows()) g[i] -= pair.theta * pair.area[r] * pair.multiplier[r];
+        const Eigen::Index i = problem_.offset(k) + r;
+        qp.penalty[i] = pair.theta * pair.area[r];
+        if (pair.multiplier.size() == pair.n_rows()) qp.g[i] -= pair.theta * pair.area[r] * pair.multiplier[r];
       }
     }
-  }
+  qp.line.resize(static_cast<size_t>(m));
+  qp.position.resize(m);
+  for (size_t k = 0; k < pairs.size(); ++k)
+    for (Eigen::Index r = 0; r < pairs[k].n_rows(); ++r) {
+      qp.line[static_cast<size_t>(problem_.offset(k) + r)] = static_cast<int>(k);
+      qp.position[problem_.offset(k) + r] = pairs[k].node_arc[pairs[k].node_of_row[static_cast<size_t>(r)]];
+    }
+  return qp;
+}
 
-  const Equalities equilibrium = ip.equilibrium();
-  // The first active set: from the previous solve (augmented-Lagrangian updates), else from the nested coarse
-  // solves (active_set.hpp), which keeps the number of steps independent of the mesh.
-  std::string first_note;
-  Eigen::VectorXd z0 = last_z_;
-  if (z0.size() != m) {
-    std::vector<int> line(static_cast<size_t>(m));
-    Eigen::VectorXd position(m);
-    for (size_t k = 0; k < pairs.size(); ++k)
-      for (Eigen::Index r = 0; r < pairs[k].n_rows(); ++r) {
-        line[static_cast<size_t>(ip.offset(k) + r)] = static_cast<int>(k);
-        position[ip.offset(k) + r] = pairs[k].node_arc[pairs[k].node_of_row[static_cast<size_t>(r)]];
-      }
-    std::vector<std::pair<Eigen::Index, int>> levels;
-    z0 = nested_initial_guess(H, g, line, position, equilibrium, &levels);
-    if (!levels.empty()) {
-      std::ostringstream os;
-      os << "first active set from coarse solves:";
-      for (const auto& [size, steps] : levels) os << " " << size << " nodes/" << steps << " steps";
-      first_note = os.str();
-    }
-  }
+MethodOutcome InterfaceNewton::solve(const SolverSettings& settings, RunContext& context) {
+  MethodOutcome out;
+  const InterfaceProblem& ip = problem_;
+  const Eigen::Index m = ip.size();
+  const InterfaceQp qp = make_qp(settings);
 
   std::vector<std::vector<char>> previous_active;
-  const Eigen::VectorXd penalty_diagonal = H.diagonal() - ip.compliance().diagonal();  // theta area (0: exact)
-  const Eigen::VectorXd free_gap = ip.free_gap();
-  const Eigen::VectorXd shift = g - free_gap;                                           // -theta area lambda
-  auto on_step = [&](const Eigen::VectorXd& z, const Eigen::VectorXd& h, const ActiveSetStep& step) {
+  const Eigen::VectorXd& penalty_diagonal = qp.penalty;  // theta area (0: exact)
+  const Eigen::VectorXd shift = qp.g - ip.free_gap();     // -theta area lambda
+  const std::string* solver_note = nullptr;  // what the solver says of its start (coarse solves), on the first report
+  const linalg::StepCallback on_step = [&](const Eigen::VectorXd& z, const Eigen::VectorXd& h, const linalg::ActiveSetStep& step) {
     // The reported gaps are the physical ones: h without the penalty's theta area z and the multipliers' shift.
     const Eigen::VectorXd gap = h - penalty_diagonal.cwiseProduct(z) - shift;
     IterationReport r = system_.report_gaps(step.step, ip.split(z), ip.split(gap.cwiseQuotient(ip.weights())), previous_active);
     r.measure = Measure::complementarity;
     r.complementarity = step.complementarity;
     r.active_set_changes = step.changes;
-    if (step.step == 1) r.note = first_note;
+    if (step.step == 1)
+      r.note = std::string("interface solver ") + solver_->name() + (solver_note->empty() ? "" : "; ") + *solver_note;
     r.elapsed_seconds = context.elapsed();
     context.observer.on_iteration(r);
     out.history.push_back(std::move(r));
     return !context.cancel.cancelled();
   };
-  const int max_steps = std::max(1, settings.max_iterations);
-  const ActiveSetResult result = solve_active_set(H, g, max_steps, on_step,
-                                                  z0.size() == m && z0.cwiseAbs().maxCoeff() > 0 ? &z0 : nullptr,
-                                                  equilibrium);
+  InterfaceSolveContext ctx{context.runner, context.cancel, on_step, std::max(1, settings.max_iterations), {}};
+  solver_note = &ctx.note;
+  const Eigen::VectorXd* z0 = last_z_.size() == m && m > 0 && last_z_.cwiseAbs().maxCoeff() > 0 ? &last_z_ : nullptr;
+  const linalg::ActiveSetResult result = solver_->solve(qp, z0, ctx);
+  const int max_steps = ctx.max_steps;
   last_z_ = result.z;
   out.iterations = result.steps;
   if (result.cancelled) {

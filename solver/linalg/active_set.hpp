@@ -1,11 +1,10 @@
-// The contact problem on the interface, as a linear complementarity problem in the nodal pressures z:
+// A linear complementarity problem in nodal pressures z, solved by a primal-dual active set on sparse matrices:
 //
-//   h = g + H z + G^T alpha,   z >= 0,  h >= 0,  z_j h_j = 0  for every contact node j,   G z = e,
+//   h = g + H z + G^T alpha,   z >= 0,  h >= 0,  z_j h_j = 0  for every unknown j,   G z = e,
 //
-// with H symmetric positive definite (the interface compliance F, plus theta D for the penalty), g the weighted
-// gaps at z = 0, and, when some bodies float (held by their contacts alone), their rigid-mode amplitudes alpha
-// with the equilibrium of every floating body G z = e (FETI's coarse problem; G empty otherwise). It is the KKT
-// system of the convex QP  min 1/2 z^T H z + g^T z  over z >= 0 with G z = e.
+// with H symmetric positive definite (on ker G where there are equalities), g the gaps at z = 0, and optional
+// equalities G z = e with multipliers alpha (in the contact problem: the equilibrium of the floating bodies, FETI's
+// coarse problem). It is the KKT system of the convex QP  min 1/2 z^T H z + g^T z  over z >= 0 with G z = e.
 //
 // Solved by the primal-dual active set strategy (Hintermueller, Ito & Kunisch 2002), a semismooth Newton method
 // for the complementarity function
@@ -15,17 +14,25 @@
 // saddle-point system of A, by its Schur complement on alpha): the map is piecewise linear, so the step on the
 // right active set is exact, and the iteration stops when the set repeats. Should the sets ever cycle, a primal
 // active-set method for the QP (Lawson & Hanson's NNLS generalised; without G only) takes over: it ends in
-// finitely many steps. Pure linear algebra: nothing here knows of bodies or meshes.
+// finitely many steps.
+//
+// Every matrix is sparse: H_AA is factorised by CHOLMOD (supernodal) at every step, so a problem whose H couples
+// each unknown to a few others (the interface of many bodies) costs what its sparse factor costs, while a dense H
+// (two bodies with one contact zone) costs what a dense Cholesky costs. Pure linear algebra: nothing here knows
+// of bodies or meshes.
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 
 #include <functional>
 #include <string>
 #include <utility>
 #include <vector>
 
-namespace contact::ddm {
+namespace contact::linalg {
+
+using SparseMatrix = Eigen::SparseMatrix<double>;
 
 struct ActiveSetStep {
   int step = 0;             // 1-based
@@ -34,9 +41,9 @@ struct ActiveSetStep {
   double complementarity = 0.0;  // ||C(z)|| / max(||z||, tiny) after the step
 };
 
-// Equality constraints G z = e with multipliers alpha (G: r x n). Empty: none.
+// Equality constraints G z = e with multipliers alpha (G: r x n, sparse). Empty: none.
 struct Equalities {
-  Eigen::MatrixXd G;
+  SparseMatrix G;
   Eigen::VectorXd e;
   bool empty() const { return G.rows() == 0; }
 };
@@ -47,7 +54,8 @@ struct ActiveSetResult {
   Eigen::VectorXd h;        // g + H z + G^T alpha
   bool converged = false;
   bool cancelled = false;
-  int steps = 0;
+  int steps = 0;            // active-set steps (direct) or outer iterations (iterative solvers)
+  long inner_iterations = 0;  // iterative solvers: products with H (0 for the direct one)
   bool used_fallback = false;
   // The equalities could not be met by the active nodes (a floating body held by nothing): the rows of G that
   // the active set leaves unrestrained (empty otherwise).
@@ -60,12 +68,12 @@ using StepCallback = std::function<bool(const Eigen::VectorXd& z, const Eigen::V
 // on_step is called after every step with the current z and h; returning false cancels. `z0` (optional, same
 // size as g) gives the first active set {z0 - h(z0) / H_jj > 0} ({z0 > 0} with equalities: a floating body's
 // own position is not known before the solve); without it, the nodes where g < 0, or every node with equalities.
-ActiveSetResult solve_active_set(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int max_steps,
+ActiveSetResult solve_active_set(const SparseMatrix& H, const Eigen::VectorXd& g, int max_steps,
                                  const StepCallback& on_step, const Eigen::VectorXd* z0 = nullptr,
                                  const Equalities& equalities = {});
 
 // The QP method on its own (for the fallback and for tests): min 1/2 z^T H z + g^T z, z >= 0.
-Eigen::VectorXd solve_nonnegative_qp(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int max_steps = 0);
+Eigen::VectorXd solve_nonnegative_qp(const SparseMatrix& H, const Eigen::VectorXd& g, int max_steps = 0);
 
 // A first guess for the active set from the same problem on coarser multiplier spaces (nested iteration): the
 // unknowns lie on lines (line[j], consecutive and ordered by position[j] along each line, e.g. the contact nodes
@@ -76,9 +84,9 @@ Eigen::VectorXd solve_nonnegative_qp(const Eigen::MatrixXd& H, const Eigen::Vect
 // zone whose edge moves a few nodes per step from a cruder guess, this keeps the number of fine steps
 // independent of the mesh size. `levels` receives the size of every coarse problem solved and its active-set
 // steps (finest first).
-Eigen::VectorXd nested_initial_guess(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, const std::vector<int>& line,
+Eigen::VectorXd nested_initial_guess(const SparseMatrix& H, const Eigen::VectorXd& g, const std::vector<int>& line,
                                      const Eigen::VectorXd& position, const Equalities& equalities = {},
                                      std::vector<std::pair<Eigen::Index, int>>* levels = nullptr,
                                      Eigen::Index coarsest = 32);
 
-}  // namespace contact::ddm
+}  // namespace contact::linalg

@@ -1,5 +1,6 @@
-// Interface Newton: the contact problem solved on the interface (interface_problem.hpp) by the primal-dual active
-// set strategy (active_set.hpp), then one solve per body for the fields.
+// Interface Newton: the contact problem solved on the interface (interface_problem.hpp) by one of the interface
+// solvers (interface_solver.hpp: the sparse direct active set or the iterative FETI solver), then one solve per
+// body for the fields.
 //   exact:   find z >= 0 with g_free + F z >= 0, complementary;
 //   penalty: the same with F + theta D (z = max(0, -g / theta) at every node), and with the augmented-Lagrangian
 //            shift g_free - theta D lambda.
@@ -7,8 +8,9 @@
 // solve per body each.
 #pragma once
 
+#include "../method.hpp"
 #include "interface_problem.hpp"
-#include "method.hpp"
+#include "interface_solver.hpp"
 
 #include <memory>
 
@@ -16,10 +18,15 @@ namespace contact::ddm {
 
 class InterfaceNewton {
  public:
-  InterfaceNewton(const ContactSystem& system, TaskRunner& runner) : system_(system), problem_(system, runner) {}
+  InterfaceNewton(const ContactSystem& system, const SolverSettings& settings, TaskRunner& runner)
+      : system_(system),
+        kind_(choose_interface_solver(settings.interface, system, runner)),
+        problem_(system, runner, interface_options(kind_, settings.interface)),
+        solver_(make_interface_solver(kind_, settings.interface)) {}
   // Solves with the settings' enforcement on the pairs' current multipliers; reports every active-set step.
   MethodOutcome solve(const SolverSettings& settings, RunContext& context);
   const InterfaceProblem& problem() const { return problem_; }
+  const InterfaceSolver& solver() const { return *solver_; }
 
  private:
   // The error text for floating bodies that the active set leaves unheld (rows of G).
@@ -27,8 +34,13 @@ class InterfaceNewton {
   // Per body: its rigid-mode amplitudes (empty for a restrained body).
   std::vector<Eigen::VectorXd> rigid_amplitudes(const Eigen::VectorXd& alpha) const;
 
+  // The problem as the solver takes it: H = F + theta D, g shifted by the multipliers, where each row lies.
+  InterfaceQp make_qp(const SolverSettings& settings) const;
+
   const ContactSystem& system_;
+  InterfaceSolverKind kind_;
   InterfaceProblem problem_;
+  std::unique_ptr<InterfaceSolver> solver_;
   Eigen::VectorXd last_z_;  // warm start of the next solve (augmented-Lagrangian updates)
 };
 

@@ -1,5 +1,6 @@
 #include "active_set.hpp"
 
+#include <Eigen/CholmodSupport>
 #include <Eigen/Cholesky>
 
 #include <algorithm>
@@ -7,14 +8,42 @@
 #include <sstream>
 #include <vector>
 
-namespace contact::ddm {
+namespace contact::linalg {
 
 namespace {
 
+using Factor = Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower>;
+
+// H restricted to the rows and columns A (sorted or not): H_AA, with the order of A.
+SparseMatrix restrict_to(const SparseMatrix& H, const std::vector<Eigen::Index>& A) {
+  std::vector<Eigen::Index> position(static_cast<size_t>(H.rows()), -1);
+  for (size_t i = 0; i < A.size(); ++i) position[static_cast<size_t>(A[i])] = static_cast<Eigen::Index>(i);
+  std::vector<Eigen::Triplet<double>> entries;
+  for (size_t j = 0; j < A.size(); ++j)
+    for (SparseMatrix::InnerIterator it(H, A[j]); it; ++it) {
+      const Eigen::Index i = position[static_cast<size_t>(it.row())];
+      if (i >= 0) entries.emplace_back(i, static_cast<Eigen::Index>(j), it.value());
+    }
+  SparseMatrix out(static_cast<Eigen::Index>(A.size()), static_cast<Eigen::Index>(A.size()));
+  out.setFromTriplets(entries.begin(), entries.end());
+  return out;
+}
+
+// The columns A of G (r x |A|).
+SparseMatrix columns_of(const SparseMatrix& G, const std::vector<Eigen::Index>& A) {
+  std::vector<Eigen::Triplet<double>> entries;
+  for (size_t j = 0; j < A.size(); ++j)
+    for (SparseMatrix::InnerIterator it(G, A[j]); it; ++it) entries.emplace_back(it.row(), static_cast<Eigen::Index>(j), it.value());
+  SparseMatrix out(G.rows(), static_cast<Eigen::Index>(A.size()));
+  out.setFromTriplets(entries.begin(), entries.end());
+  return out;
+}
+
 // z (and alpha) with h_A = 0 on the index set A, z = 0 elsewhere, and G z = e: H_AA z_A + G_A^T alpha = -g_A,
-// solved by the Schur complement S = G_A H_AA^-1 G_A^T on alpha. `ok` is false when H_AA is not positive
-// definite; `unrestrained` receives the rows of G that A leaves without support (S singular there).
-Eigen::VectorXd solve_on(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, const std::vector<Eigen::Index>& A,
+// solved by the Schur complement S = G_A H_AA^-1 G_A^T on alpha (r x r, dense: r is three rows per floating body).
+// `ok` is false when H_AA is not positive definite; `unrestrained` receives the rows of G that A leaves without
+// support (S singular there).
+Eigen::VectorXd solve_on(const SparseMatrix& H, const Eigen::VectorXd& g, const std::vector<Eigen::Index>& A,
                          const Equalities& eq, Eigen::VectorXd& alpha, bool& ok, std::vector<Eigen::Index>& unrestrained) {
   Eigen::VectorXd z = Eigen::VectorXd::Zero(g.size());
   ok = true;
@@ -25,21 +54,17 @@ Eigen::VectorXd solve_on(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, con
     for (Eigen::Index i = 0; i < r; ++i) unrestrained.push_back(i);
     return z;
   }
-  Eigen::MatrixXd HA(na, na), GA(r, na);
   Eigen::VectorXd rhs(na);
-  for (Eigen::Index i = 0; i < na; ++i) {
-    for (Eigen::Index j = 0; j < na; ++j) HA(i, j) = H(A[i], A[j]);
-    rhs[i] = -g[A[i]];
-    if (r > 0) GA.col(i) = eq.G.col(A[i]);
-  }
-  Eigen::LLT<Eigen::MatrixXd> llt(HA);
+  for (Eigen::Index i = 0; i < na; ++i) rhs[i] = -g[A[static_cast<size_t>(i)]];
+  Factor llt(restrict_to(H, A));
   if (llt.info() != Eigen::Success) {
     ok = false;
     return z;
   }
   Eigen::VectorXd zA = llt.solve(rhs);
   if (r > 0) {
-    const Eigen::MatrixXd Y = llt.solve(GA.transpose());  // H_AA^-1 G_A^T
+    const SparseMatrix GA = columns_of(eq.G, A);
+    const Eigen::MatrixXd Y = llt.solve(Eigen::MatrixXd(GA.transpose()));  // H_AA^-1 G_A^T
     const Eigen::MatrixXd S = GA * Y;
     // A row of G the active nodes do not reach has a zero diagonal in S (relative to its size elsewhere).
     const double scale = std::max(S.diagonal().cwiseAbs().maxCoeff(), 1e-300);
@@ -55,13 +80,13 @@ Eigen::VectorXd solve_on(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, con
     alpha = ldlt.solve(GA * zA - eq.e);
     zA -= Y * alpha;
   }
-  for (Eigen::Index i = 0; i < na; ++i) z[A[i]] = zA[i];
+  for (Eigen::Index i = 0; i < na; ++i) z[A[static_cast<size_t>(i)]] = zA[i];
   return z;
 }
 
 }  // namespace
 
-Eigen::VectorXd solve_nonnegative_qp(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int max_steps) {
+Eigen::VectorXd solve_nonnegative_qp(const SparseMatrix& H, const Eigen::VectorXd& g, int max_steps) {
   const Eigen::Index n = g.size();
   if (max_steps <= 0) max_steps = static_cast<int>(10 * n + 10);
   Eigen::VectorXd z = Eigen::VectorXd::Zero(n);
@@ -108,7 +133,7 @@ Eigen::VectorXd solve_nonnegative_qp(const Eigen::MatrixXd& H, const Eigen::Vect
   return z;
 }
 
-Eigen::VectorXd nested_initial_guess(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, const std::vector<int>& line,
+Eigen::VectorXd nested_initial_guess(const SparseMatrix& H, const Eigen::VectorXd& g, const std::vector<int>& line,
                                      const Eigen::VectorXd& position, const Equalities& equalities,
                                      std::vector<std::pair<Eigen::Index, int>>* levels, Eigen::Index coarsest) {
   const Eigen::Index n = g.size();
@@ -122,28 +147,31 @@ Eigen::VectorXd nested_initial_guess(const Eigen::MatrixXd& H, const Eigen::Vect
   }
   const Eigen::Index nc = static_cast<Eigen::Index>(keep.size());
   if (nc >= n) return Eigen::VectorXd::Zero(n);
-  // P: n x nc, identity on the kept unknowns, linear interpolation between them.
-  Eigen::MatrixXd P = Eigen::MatrixXd::Zero(n, nc);
+  // P: n x nc, identity on the kept unknowns, linear interpolation between them (sparse: two entries a row).
+  std::vector<Eigen::Triplet<double>> p_entries;
   for (Eigen::Index c = 0; c < nc; ++c) {
-    P(keep[static_cast<size_t>(c)], c) = 1.0;
+    p_entries.emplace_back(keep[static_cast<size_t>(c)], c, 1.0);
     if (c + 1 == nc || line[static_cast<size_t>(keep[static_cast<size_t>(c) + 1])] != line[static_cast<size_t>(keep[static_cast<size_t>(c)])]) continue;
     const Eigen::Index a = keep[static_cast<size_t>(c)], b = keep[static_cast<size_t>(c) + 1];
     for (Eigen::Index j = a + 1; j < b; ++j) {
       const double t = (position[j] - position[a]) / (position[b] - position[a]);
-      P(j, c) = 1 - t;
-      P(j, c + 1) = t;
+      p_entries.emplace_back(j, c, 1 - t);
+      p_entries.emplace_back(j, c + 1, t);
     }
   }
+  SparseMatrix P(n, nc);
+  P.setFromTriplets(p_entries.begin(), p_entries.end());
   std::vector<int> line_c(static_cast<size_t>(nc));
   Eigen::VectorXd position_c(nc);
   for (Eigen::Index c = 0; c < nc; ++c) {
     line_c[static_cast<size_t>(c)] = line[static_cast<size_t>(keep[static_cast<size_t>(c)])];
     position_c[c] = position[keep[static_cast<size_t>(c)]];
   }
-  const Eigen::MatrixXd Hc = P.transpose() * H * P;
-  const Eigen::VectorXd gc = P.transpose() * g;
+  const SparseMatrix Pt = P.transpose();
+  const SparseMatrix Hc = Pt * H * P;
+  const Eigen::VectorXd gc = Pt * g;
   Equalities coarse_eq;
-  if (!equalities.empty()) coarse_eq = Equalities{equalities.G * P, equalities.e};
+  if (!equalities.empty()) coarse_eq = Equalities{SparseMatrix(equalities.G * P), equalities.e};
   const size_t at = levels ? levels->size() : 0;
   if (levels) levels->emplace_back(nc, 0);
   const Eigen::VectorXd guess = nested_initial_guess(Hc, gc, line_c, position_c, coarse_eq, levels, coarsest);
@@ -157,7 +185,7 @@ Eigen::VectorXd nested_initial_guess(const Eigen::MatrixXd& H, const Eigen::Vect
 
 namespace {
 
-ActiveSetResult solve_active_set_on(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int max_steps,
+ActiveSetResult solve_active_set_on(const SparseMatrix& H, const Eigen::VectorXd& g, int max_steps,
                                     const StepCallback& on_step, const Eigen::VectorXd* z0, const Equalities& eq) {
   ActiveSetResult out;
   const Eigen::Index n = g.size();
@@ -271,7 +299,7 @@ ActiveSetResult solve_active_set_on(const Eigen::MatrixXd& H, const Eigen::Vecto
 
 }  // namespace
 
-ActiveSetResult solve_active_set(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int max_steps,
+ActiveSetResult solve_active_set(const SparseMatrix& H, const Eigen::VectorXd& g, int max_steps,
                                  const StepCallback& on_step, const Eigen::VectorXd* z0, const Equalities& eq) {
   if (eq.empty()) return solve_active_set_on(H, g, max_steps, on_step, z0, eq);
   // With floating bodies H = B K^+ B^T uses a generalised inverse that fixes a few dofs per body; where those
@@ -279,14 +307,15 @@ ActiveSetResult solve_active_set(const Eigen::MatrixXd& H, const Eigen::VectorXd
   // node can vanish, and H_AA is singular although the problem is well posed: H is definite only on ker G_A.
   // Solved instead with H + rho G^T G and g - rho G^T e, which has the same solution (the added terms are
   // rho G^T (G z - e) = 0 wherever G z = e) and the same gaps h, and is definite exactly where the problem is.
-  const Eigen::MatrixXd GtG = eq.G.transpose() * eq.G;
-  const double h_scale = H.size() ? H.diagonal().cwiseAbs().maxCoeff() : 0.0;
-  const double g_scale = GtG.size() ? GtG.diagonal().maxCoeff() : 0.0;
+  const SparseMatrix Gt = eq.G.transpose();
+  const SparseMatrix GtG = Gt * eq.G;
+  const double h_scale = H.rows() ? H.diagonal().cwiseAbs().maxCoeff() : 0.0;
+  const double g_scale = GtG.rows() ? GtG.diagonal().maxCoeff() : 0.0;
   if (!(h_scale > 0) || !(g_scale > 0)) return solve_active_set_on(H, g, max_steps, on_step, z0, eq);
   const double rho = h_scale / g_scale;
-  const Eigen::MatrixXd H_rho = H + rho * GtG;
-  const Eigen::VectorXd g_rho = g - rho * (eq.G.transpose() * eq.e);
+  const SparseMatrix H_rho = H + rho * GtG;
+  const Eigen::VectorXd g_rho = g - rho * (Gt * eq.e);
   return solve_active_set_on(H_rho, g_rho, max_steps, on_step, z0, eq);
 }
 
-}  // namespace contact::ddm
+}  // namespace contact::linalg

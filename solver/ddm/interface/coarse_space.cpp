@@ -1,0 +1,90 @@
+#include "coarse_space.hpp"
+
+#include <Eigen/CholmodSupport>
+#include <Eigen/Eigenvalues>
+
+namespace contact::ddm {
+
+struct CoarseSpace::Factor {
+  Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> llt;
+};
+
+namespace {
+
+// The floating bodies' rows whose block of G G^T is rank-deficient: no pressures on its contact nodes can balance
+// every rigid motion of that body (a body with no contact, or contact at one point against a spin).
+std::vector<Eigen::Index> dependent_rows(const InterfaceProblem& problem, const SparseMatrix& GGt) {
+  std::vector<Eigen::Index> out;
+  for (const auto& f : problem.floating()) {
+    Eigen::MatrixXd block(f.count, f.count);
+    for (Eigen::Index i = 0; i < f.count; ++i)
+      for (Eigen::Index j = 0; j < f.count; ++j) block(i, j) = GGt.coeff(f.offset + i, f.offset + j);
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(block);
+    const double largest = eig.eigenvalues().cwiseAbs().maxCoeff();
+    if (!(eig.eigenvalues().minCoeff() > 1e-12 * largest) || !(largest > 0))
+      for (Eigen::Index i = 0; i < f.count; ++i) out.push_back(f.offset + i);
+  }
+  return out;
+}
+
+}  // namespace
+
+CoarseSpace::CoarseSpace(const InterfaceProblem& problem, const Equalities& equilibrium)
+    : problem_(problem), G_(equilibrium.G), Gt_(equilibrium.G.transpose()), e_(equilibrium.e), factor_(std::make_unique<Factor>()) {
+  if (empty()) return;
+  const SparseMatrix GGt = G_ * Gt_;
+  unheld_ = dependent_rows(problem, GGt);
+  if (!unheld_.empty()) return;
+  factor_->llt.compute(GGt);
+  if (factor_->llt.info() != Eigen::Success)  // dependent across bodies: name every floating body's rows
+    for (Eigen::Index i = 0; i < G_.rows(); ++i) unheld_.push_back(i);
+}
+
+CoarseSpace::~CoarseSpace() = default;
+
+Eigen::VectorXd CoarseSpace::range_part(const Eigen::VectorXd& x) const {
+  if (empty()) return Eigen::VectorXd::Zero(x.size());
+  const Eigen::VectorXd Gx = G_ * x;
+  return Gt_ * factor_->llt.solve(Gx);
+}
+
+Eigen::VectorXd CoarseSpace::project(const Eigen::VectorXd& x) const {
+  if (empty()) return x;
+  return x - range_part(x);
+}
+
+Eigen::VectorXd CoarseSpace::particular() const {
+  if (empty()) return Eigen::VectorXd::Zero(G_.cols());
+  return Gt_ * factor_->llt.solve(e_);
+}
+
+SparseMatrix CoarseSpace::columns_of(const std::vector<char>& columns) const {
+  std::vector<Eigen::Triplet<double>> entries;
+  for (Eigen::Index j = 0; j < G_.outerSize(); ++j) {
+    if (!columns[static_cast<size_t>(j)]) continue;
+    for (SparseMatrix::InnerIterator it(G_, j); it; ++it) entries.emplace_back(it.row(), it.col(), it.value());
+  }
+  SparseMatrix GA(G_.rows(), G_.cols());
+  GA.setFromTriplets(entries.begin(), entries.end());
+  return GA;
+}
+
+std::vector<Eigen::Index> CoarseSpace::unheld_by(const std::vector<char>& columns) const {
+  if (empty()) return {};
+  const SparseMatrix GA = columns_of(columns);
+  const SparseMatrix GAt = GA.transpose();
+  return dependent_rows(problem_, GA * GAt);
+}
+
+Eigen::VectorXd CoarseSpace::multipliers(const Eigen::VectorXd& r, const std::vector<char>& columns) const {
+  if (empty()) return Eigen::VectorXd();
+  const SparseMatrix GA = columns_of(columns);
+  const SparseMatrix GAt = GA.transpose();
+  const SparseMatrix GAGAt = GA * GAt;
+  if (!dependent_rows(problem_, GAGAt).empty()) return Eigen::VectorXd();
+  Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> llt(GAGAt);
+  if (llt.info() != Eigen::Success) return Eigen::VectorXd();
+  return llt.solve(-(GA * r));
+}
+
+}  // namespace contact::ddm

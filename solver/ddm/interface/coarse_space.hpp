@@ -1,0 +1,57 @@
+// FETI's natural coarse space: the equilibrium of the floating bodies, G z = e (interface_problem.hpp), three rows
+// (two in a body held sideways at a point) per body that only its contacts hold. G couples a body's rows to its
+// own contact nodes only, so G G^T is a sparse r x r matrix (a body to its neighbours), factorised once per
+// interface problem; it is the only thing every process holds whole.
+//
+//   Q = G^T (G G^T)^-1 G   the orthogonal projector onto the range of G^T (the rigid motions' gaps),
+//   P = I - Q              the projector onto ker G (pressures in equilibrium with no load),
+//   z_I = G^T (G G^T)^-1 e the least-squares pressures that balance the floating bodies' loads.
+// With them the iterative interface solver works in ker G, where the interface operator's spectrum is bounded
+// by the bodies' size over the mesh size and not by their number (Farhat, Mandel & Roux 1994; Dostal et al.'s
+// TFETI): the reason the iterations do not grow with the number of bodies.
+#pragma once
+
+#include "interface_problem.hpp"
+
+#include <memory>
+
+namespace contact::ddm {
+
+class CoarseSpace {
+ public:
+  // Factorises G G^T. ok() is false when some floating body's rows are dependent (its contacts cannot hold all of
+  // its rigid motions whatever the pressures): unheld() lists those rows.
+  CoarseSpace(const InterfaceProblem& problem, const Equalities& equilibrium);
+  ~CoarseSpace();
+  CoarseSpace(const CoarseSpace&) = delete;
+  CoarseSpace& operator=(const CoarseSpace&) = delete;
+
+  bool ok() const { return unheld_.empty(); }
+  const std::vector<Eigen::Index>& unheld() const { return unheld_; }
+  bool empty() const { return G_.rows() == 0; }
+  Eigen::Index rows() const { return G_.rows(); }
+
+  Eigen::VectorXd project(const Eigen::VectorXd& x) const;        // P x
+  Eigen::VectorXd range_part(const Eigen::VectorXd& x) const;     // Q x
+  Eigen::VectorXd particular() const;                             // z_I
+  // The least-squares multipliers alpha of G^T alpha = -r on the columns `columns` (the active contact nodes):
+  // (G_A G_A^T)^-1 G_A (-r_A). Empty when G_A G_A^T is singular (the active set leaves a body unheld).
+  Eigen::VectorXd multipliers(const Eigen::VectorXd& r, const std::vector<char>& columns) const;
+  // The rows of the floating bodies that the columns `columns` alone cannot hold (their block of G_A G_A^T is
+  // singular): the bodies an active set leaves unheld.
+  std::vector<Eigen::Index> unheld_by(const std::vector<char>& columns) const;
+  const SparseMatrix& G() const { return G_; }
+  const Eigen::VectorXd& e() const { return e_; }
+
+ private:
+  struct Factor;
+  SparseMatrix columns_of(const std::vector<char>& columns) const;
+
+  const InterfaceProblem& problem_;
+  SparseMatrix G_, Gt_;
+  Eigen::VectorXd e_;
+  std::unique_ptr<Factor> factor_;
+  std::vector<Eigen::Index> unheld_;
+};
+
+}  // namespace contact::ddm

@@ -1,0 +1,253 @@
+#include "interface_problem.hpp"
+
+#include <stdexcept>
+
+namespace contact::ddm {
+
+namespace {
+
+// One body's rows of B (sign +1: master, -1: slave), each a list of (full dof, value).
+struct BodyRows {
+  std::vector<Eigen::Index> rows;  // global row numbers
+  std::vector<std::vector<std::pair<int, double>>> entries;
+};
+
+BodyRows body_rows(const ContactSystem& system, size_t a, const std::vector<Eigen::Index>& offset) {
+  BodyRows out;
+  const auto& pairs = system.pairs();
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    const auto& pair = pairs[k];
+    auto add = [&](const mortar::SparseRows& G, double sign) {
+      for (int r = 0; r < G.outerSize(); ++r) {
+        std::vector<std::pair<int, double>> e;
+        for (mortar::SparseRows::InnerIterator it(G, r); it; ++it) e.emplace_back(static_cast<int>(it.col()), sign * it.value());
+        out.rows.push_back(offset[k] + r);
+        out.entries.push_back(std::move(e));
+      }
+    };
+    if (static_cast<size_t>(pair.slave_body) == a) add(pair.Gs, -1.0);
+    if (static_cast<size_t>(pair.master_body) == a) add(pair.Gm, 1.0);
+  }
+  return out;
+}
+
+}  // namespace
+
+struct InterfaceProblem::BodyParts {
+  BodyRows rows;
+  Eigen::MatrixXd F, preconditioner, G;  // G: rigid modes x rows (floating bodies)
+  Eigen::VectorXd g, e, diagonal;
+};
+
+// One body's share: its free response's gaps, its rigid modes' equilibrium rows, and its compliance (and
+// preconditioner) block on its rows.
+void InterfaceProblem::compute_body(size_t a, BodyParts& out) const {
+  const BodyRows& R = out.rows;
+  const auto& body = system_.body(a);
+  const Eigen::Index k = static_cast<Eigen::Index>(R.rows.size());
+  if (body.floating()) {
+    // G_a = (B_a R_a)^T over this body's rows, e_a = -R_a^T f_a.
+    const Eigen::MatrixXd& modes = body.rigid_modes();
+    out.G = Eigen::MatrixXd::Zero(modes.cols(), k);
+    for (size_t i = 0; i < R.rows.size(); ++i)
+      for (const auto& [dof, value] : R.entries[i]) out.G.col(static_cast<Eigen::Index>(i)) += value * modes.row(dof).transpose();
+    out.e = -modes.transpose() * body.external_load();
+  }
+  // Free response: the body under its own loads only.
+  const Eigen::VectorXd u_free = body.solve(Eigen::VectorXd());
+  out.g = Eigen::VectorXd::Zero(k);
+  for (size_t i = 0; i < R.rows.size(); ++i)
+    for (const auto& [dof, value] : R.entries[i]) out.g[static_cast<Eigen::Index>(i)] += value * u_free[dof];
+  if (R.rows.empty()) return;
+  // B_Z^T in the trailing order of the factor: reduced rows (B T) restricted to Z.
+  const auto& Z = body.interface_unknowns();
+  const Eigen::MatrixXd& L = body.interface_factor();
+  std::vector<Eigen::Index> position(static_cast<size_t>(body.n_free()), -1);
+  for (size_t i = 0; i < Z.size(); ++i) position[static_cast<size_t>(Z[i])] = static_cast<Eigen::Index>(i);
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> T = body.constraints().T();
+  Eigen::MatrixXd BzT = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(Z.size()), k);
+  for (size_t i = 0; i < R.rows.size(); ++i)
+    for (const auto& [dof, value] : R.entries[i])
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(T, dof); it; ++it) {
+        const Eigen::Index p = position[static_cast<size_t>(it.col())];
+        if (p < 0) throw std::logic_error("interface problem: a contact dof depends on an unknown outside the interface");
+        BzT(p, static_cast<Eigen::Index>(i)) += value * it.value();
+      }
+  if (Z.empty()) {  // every contact dof of this body is prescribed: it adds no compliance
+    out.F = Eigen::MatrixXd::Zero(k, k);
+    out.diagonal = Eigen::VectorXd::Zero(k);
+    if (options_.preconditioner != InterfacePreconditioner::none) out.preconditioner = Eigen::MatrixXd::Zero(k, k);
+    return;
+  }
+  const Eigen::MatrixXd W = L.triangularView<Eigen::Lower>().solve(BzT);
+  out.F = W.transpose() * W;
+  out.diagonal = out.F.diagonal();
+  if (options_.preconditioner == InterfacePreconditioner::dirichlet) {
+    // S = L_ZZ L_ZZ^T (the Schur complement on Z): B S B^T = (L^T B_Z^T)^T (L^T B_Z^T).
+    const Eigen::MatrixXd V = L.transpose().triangularView<Eigen::Upper>() * BzT;
+    out.preconditioner = V.transpose() * V;
+  } else if (options_.preconditioner == InterfacePreconditioner::lumped) {
+    // K_ZZ: the reduced stiffness on Z alone (no interior elimination).
+    const auto& K = body.reduced_stiffness();
+    Eigen::MatrixXd Kzz = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(Z.size()), static_cast<Eigen::Index>(Z.size()));
+    for (size_t j = 0; j < Z.size(); ++j)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(K, Z[j]); it; ++it) {
+        const Eigen::Index p = position[static_cast<size_t>(it.row())];
+        if (p >= 0) Kzz(p, static_cast<Eigen::Index>(j)) = it.value();
+      }
+    out.preconditioner = BzT.transpose() * Kzz * BzT;
+  }
+}
+
+InterfaceProblem::InterfaceProblem(const ContactSystem& system, TaskRunner& runner, const Options& options)
+    : system_(system), options_(options) {
+  const auto& pairs = system.pairs();
+  offset_.assign(pairs.size() + 1, 0);
+  for (size_t k = 0; k < pairs.size(); ++k) offset_[k + 1] = offset_[k] + pairs[k].n_rows();
+  const Eigen::Index m = offset_.back();
+  D_.resize(m);
+  gap0_.resize(m);
+  factor_ = system.load_factor();
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    D_.segment(offset_[k], pairs[k].n_rows()) = pairs[k].area;
+    gap0_.segment(offset_[k], pairs[k].n_rows()) = pairs[k].gap0;
+  }
+  // The preconditioner's scaling (feti.hpp): with B_a ~ D on both sides of a contact node, F ~ D (S_s^-1 +
+  // S_m^-1) D, whose inverse for S_s ~ S_m is (D^-2 / 2) (B_s S_s B_s^T + B_m S_m B_m^T) (D^-2 / 2).
+  inverse_weight_ = (2.0 * D_.cwiseAbs2()).cwiseInverse();
+  const size_t n_bodies = system.n_bodies();
+  std::vector<BodyParts> parts(n_bodies);
+  for (size_t a = 0; a < n_bodies; ++a) parts[a].rows = body_rows(system, a, offset_);
+  // Each body's part on its owner; the blocks move to every process only when they are replicated.
+  const bool replicate = options_.replicate_blocks;
+  const BodyShare share{[&](size_t a, Packer& out) {
+                          out.put(replicate ? parts[a].F : Eigen::MatrixXd());
+                          out.put(replicate ? parts[a].preconditioner : Eigen::MatrixXd());
+                          out.put(parts[a].G);
+                          out.put(parts[a].g);
+                          out.put(parts[a].e);
+                          out.put(parts[a].diagonal);
+                        },
+                        [&](size_t a, Unpacker& in) {
+                          parts[a].F = in.get_matrix();
+                          parts[a].preconditioner = in.get_matrix();
+                          parts[a].G = in.get_matrix();
+                          parts[a].g = in.get_vector();
+                          parts[a].e = in.get_vector();
+                          parts[a].diagonal = in.get_vector();
+                        }};
+  runner.run_bodies(n_bodies, [&](size_t a) { compute_body(a, parts[a]); }, share);
+  g_loads_ = Eigen::VectorXd::Zero(m);
+  diagonal_ = Eigen::VectorXd::Zero(m);
+  blocks_.resize(n_bodies);
+  for (size_t a = 0; a < n_bodies; ++a) {
+    const BodyRows& R = parts[a].rows;
+    for (size_t i = 0; i < R.rows.size(); ++i) {
+      g_loads_[R.rows[i]] += parts[a].g[static_cast<Eigen::Index>(i)];
+      if (parts[a].diagonal.size()) diagonal_[R.rows[i]] += parts[a].diagonal[static_cast<Eigen::Index>(i)];
+    }
+    blocks_[a].rows = R.rows;
+    blocks_[a].F = std::move(parts[a].F);
+    blocks_[a].preconditioner = std::move(parts[a].preconditioner);
+  }
+  assemble_equilibrium(parts);
+}
+
+void InterfaceProblem::assemble_equilibrium(const std::vector<BodyParts>& parts) {
+  Eigen::Index r = 0;
+  for (size_t a = 0; a < parts.size(); ++a)
+    if (parts[a].G.rows() > 0) {
+      floating_.push_back({a, r, parts[a].G.rows()});
+      r += parts[a].G.rows();
+    }
+  std::vector<Eigen::Triplet<double>> entries;
+  equilibrium_.e = Eigen::VectorXd::Zero(r);
+  for (const auto& f : floating_) {
+    const BodyParts& p = parts[f.body];
+    for (size_t i = 0; i < p.rows.rows.size(); ++i)
+      for (Eigen::Index q = 0; q < f.count; ++q)
+        if (p.G(q, static_cast<Eigen::Index>(i)) != 0.0)
+          entries.emplace_back(f.offset + q, p.rows.rows[i], p.G(q, static_cast<Eigen::Index>(i)));
+    equilibrium_.e.segment(f.offset, f.count) = p.e;
+  }
+  equilibrium_.G = SparseMatrix(r, size());
+  equilibrium_.G.setFromTriplets(entries.begin(), entries.end());
+}
+
+SparseMatrix InterfaceProblem::assemble() const {
+  if (!options_.replicate_blocks) throw std::logic_error("interface problem: the blocks are not held here to assemble");
+  std::vector<Eigen::Triplet<double>> entries;
+  size_t count = 0;
+  for (const auto& b : blocks_) count += b.rows.size() * b.rows.size();
+  entries.reserve(count);
+  for (const auto& b : blocks_)
+    for (size_t j = 0; j < b.rows.size(); ++j)
+      for (size_t i = 0; i < b.rows.size(); ++i)
+        entries.emplace_back(b.rows[i], b.rows[j], b.F(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)));
+  SparseMatrix F(size(), size());
+  F.setFromTriplets(entries.begin(), entries.end());  // sums the two bodies' parts of a shared row
+  return F;
+}
+
+bool InterfaceProblem::apply_blocks(const Eigen::VectorXd& x, Eigen::VectorXd& y, TaskRunner& runner,
+                                    bool preconditioner) const {
+  y = Eigen::VectorXd::Zero(size());
+  Eigen::VectorXd local, product;
+  for (size_t a = 0; a < blocks_.size(); ++a) {
+    const Block& b = blocks_[a];
+    const Eigen::MatrixXd& X = preconditioner ? b.preconditioner : b.F;
+    if (X.rows() == 0 || (!options_.replicate_blocks && !runner.owns(a))) continue;
+    const Eigen::Index k = static_cast<Eigen::Index>(b.rows.size());
+    local.resize(k);
+    for (Eigen::Index i = 0; i < k; ++i) local[i] = x[b.rows[static_cast<size_t>(i)]];
+    product.noalias() = X.selfadjointView<Eigen::Lower>() * local;
+    for (Eigen::Index i = 0; i < k; ++i) y[b.rows[static_cast<size_t>(i)]] += product[i];
+  }
+  // Replicated blocks: every process has the whole product already (the sum would count it once per process);
+  // the sum still runs, on zeros, to carry the cancel requests at the same point on every process.
+  if (options_.replicate_blocks && runner.distributed()) {
+    double nothing = 0.0;
+    return runner.sum(&nothing, 1);
+  }
+  return runner.sum(y.data(), static_cast<size_t>(y.size()));
+}
+
+bool InterfaceProblem::apply(const Eigen::VectorXd& x, Eigen::VectorXd& y, TaskRunner& runner) const {
+  return apply_blocks(x, y, runner, false);
+}
+
+bool InterfaceProblem::apply_preconditioner(const Eigen::VectorXd& x, Eigen::VectorXd& y, TaskRunner& runner) const {
+  const bool stop = apply_blocks(inverse_weight_.cwiseProduct(x), y, runner, true);
+  y = inverse_weight_.cwiseProduct(y);
+  return stop;
+}
+
+Eigen::VectorXd InterfaceProblem::free_gap() const {
+  return gap0_ + (system_.load_factor() / factor_) * g_loads_;
+}
+
+Equalities InterfaceProblem::equilibrium() const {
+  return Equalities{equilibrium_.G, (system_.load_factor() / factor_) * equilibrium_.e};
+}
+
+Pressures InterfaceProblem::split(const Eigen::VectorXd& stacked) const {
+  Pressures out(offset_.size() - 1);
+  for (size_t k = 0; k + 1 < offset_.size(); ++k) out[k] = stacked.segment(offset_[k], offset_[k + 1] - offset_[k]);
+  return out;
+}
+
+Eigen::VectorXd InterfaceProblem::stack(const Pressures& per_pair) const {
+  Eigen::VectorXd out(offset_.back());
+  for (size_t k = 0; k + 1 < offset_.size(); ++k) out.segment(offset_[k], offset_[k + 1] - offset_[k]) = per_pair[k];
+  return out;
+}
+
+Displacements InterfaceProblem::displacements(const Eigen::VectorXd& z, const Eigen::VectorXd& alpha,
+                                              TaskRunner& runner) const {
+  Displacements u = system_.solve_bodies(system_.loads_from_pressures(split(z)), runner);
+  if (alpha.size() == equilibrium_.G.rows())
+    for (const auto& f : floating_) u[f.body] += system_.body(f.body).rigid_modes() * alpha.segment(f.offset, f.count);
+  return u;
+}
+
+}  // namespace contact::ddm

@@ -1,0 +1,43 @@
+#include "interface_solver.hpp"
+
+#include "feti.hpp"
+#include "sparse_direct.hpp"
+
+namespace contact::ddm {
+
+namespace {
+
+// Beyond these sizes the direct solver's costs outgrow the iterative one's (bench/bench_walls measures both):
+// its Schur complement on the floating bodies' rows is dense (r x r, and |A| x r for H_AA^-1 G_A^T), and every
+// active-set step refactorises the active block.
+constexpr Eigen::Index max_direct_floating_rows = 1200;
+constexpr Eigen::Index max_direct_rows = 40000;
+
+}  // namespace
+
+InterfaceSolverKind choose_interface_solver(const InterfaceSolverSettings& settings, const ContactSystem& system,
+                                            const TaskRunner& runner) {
+  if (settings.solver != InterfaceSolverKind::automatic) return settings.solver;
+  if (runner.distributed()) return InterfaceSolverKind::iterative;
+  Eigen::Index rows = 0, floating_rows = 0;
+  for (const auto& pair : system.pairs()) rows += pair.n_rows();
+  for (size_t a = 0; a < system.n_bodies(); ++a) floating_rows += system.body(a).rigid_modes().cols();
+  return floating_rows > max_direct_floating_rows || rows > max_direct_rows ? InterfaceSolverKind::iterative
+                                                                            : InterfaceSolverKind::direct;
+}
+
+InterfaceProblem::Options interface_options(InterfaceSolverKind kind, const InterfaceSolverSettings& settings) {
+  InterfaceProblem::Options options;
+  if (kind == InterfaceSolverKind::iterative) {
+    options.preconditioner = settings.preconditioner;
+    options.replicate_blocks = false;  // each process applies its own bodies' blocks
+  }
+  return options;
+}
+
+std::unique_ptr<InterfaceSolver> make_interface_solver(InterfaceSolverKind kind, const InterfaceSolverSettings& settings) {
+  if (kind == InterfaceSolverKind::iterative) return std::make_unique<FetiSolver>(settings);
+  return std::make_unique<SparseDirectSolver>();
+}
+
+}  // namespace contact::ddm

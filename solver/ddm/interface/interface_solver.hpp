@@ -1,0 +1,60 @@
+// The solvers of the interface problem (interface_problem.hpp) behind one interface: find the nodal pressures z
+// and the floating bodies' rigid amplitudes alpha with
+//
+//   h = g + H z + G^T alpha >= 0,  z >= 0,  z h = 0,  G z = e,     H = F + diag(penalty),
+//
+// the KKT system of  min 1/2 z^T H z + g^T z  over z >= 0 with G z = e. Two solvers give the same discrete
+// solution (to the iterative one's tolerance):
+//   direct    (sparse_direct.hpp): the primal-dual active set on F assembled as a sparse matrix, CHOLMOD at every
+//             step; first active set from nested coarse solves. Exact in finitely many steps; one process holds
+//             every block.
+//   iterative (feti.hpp): FETI-style projected MPRGP inside SMALBE, applying F block by block where the blocks
+//             live (MPI ranks: each its own bodies), with the coarse space of the floating bodies.
+// make_interface_solver picks one from the settings and the size of the problem; a new solver is a new class here.
+#pragma once
+
+#include "../../problem.hpp"
+#include "../../result.hpp"
+#include "interface_problem.hpp"
+
+#include <memory>
+#include <string>
+
+namespace contact::ddm {
+
+struct InterfaceQp {
+  const InterfaceProblem& problem;
+  Eigen::VectorXd penalty;  // theta D per row (zeros: exact contact)
+  Eigen::VectorXd g;        // weighted gaps at z = 0 (shifted by the augmented Lagrangian's multipliers)
+  Equalities equilibrium;   // the floating bodies' G z = e
+  // Where each row lies (its pair and its arc length along the slave edge): the direct solver's coarse guesses.
+  std::vector<int> line;
+  Eigen::VectorXd position;
+};
+
+struct InterfaceSolveContext {
+  TaskRunner& runner;
+  const CancelToken& cancel;
+  const linalg::StepCallback& on_step;  // after every active-set step / outer iteration; false cancels
+  int max_steps = 100;                  // active-set steps / outer iterations
+  std::string note;                     // out: what the first report says (coarse solves, solver chosen)
+};
+
+class InterfaceSolver {
+ public:
+  virtual ~InterfaceSolver() = default;
+  virtual const char* name() const = 0;  // "direct" or "iterative": the job's and the result's word
+  // z0: the warm start (the previous load step's or update's pressures), or null.
+  virtual linalg::ActiveSetResult solve(const InterfaceQp& qp, const Eigen::VectorXd* z0, InterfaceSolveContext& context) = 0;
+};
+
+// The solver to use for `system` under `settings`: the one asked for, or, automatically, the iterative solver on
+// several processes or where the direct one's dense Schur complement on the floating bodies' rows (r x r) or its
+// sparse factor would be large, the direct one otherwise.
+InterfaceSolverKind choose_interface_solver(const InterfaceSolverSettings& settings, const ContactSystem& system,
+                                            const TaskRunner& runner);
+// How the interface problem must be built for that solver (blocks replicated or not, preconditioner).
+InterfaceProblem::Options interface_options(InterfaceSolverKind kind, const InterfaceSolverSettings& settings);
+std::unique_ptr<InterfaceSolver> make_interface_solver(InterfaceSolverKind kind, const InterfaceSolverSettings& settings);
+
+}  // namespace contact::ddm

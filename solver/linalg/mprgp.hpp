@@ -1,0 +1,64 @@
+// MPRGP: modified proportioning with reduced gradient projections (Dostal & Schoeberl 2005; Dostal, "Optimal
+// Quadratic Programming Algorithms", 2009, algorithm 5.8), for the bound-constrained QP
+//
+//   min f(x) = 1/2 x^T A x - b^T x   subject to   x >= l,        A symmetric positive definite,
+//
+// given only products with A (and, optionally, a preconditioner). With the free set F = {i : x_i > l_i}, the
+// gradient g = A x - b splits into the free gradient phi (g on F, 0 elsewhere) and the chopped gradient beta
+// (min(g_i, 0) off F): their sum, the projected gradient, vanishes exactly at the solution. Each iteration is one
+// of three steps:
+//   - conjugate gradients in the face F while x stays feasible and the chopped gradient is small against the
+//     reduced free gradient (the iterate is "proportional": ||beta||^2 <= Gamma^2 phi~^T phi);
+//   - an expansion step when the CG step would leave the feasible set: the longest feasible step along the CG
+//     direction, then a projected gradient step of fixed length alpha_bar in (0, 2 / ||A||], which adds
+//     constraints to the face several at a time;
+//   - a proportioning step along beta when the chopped gradient dominates, which releases constraints.
+// The rate of convergence depends on the spectrum of A only (Dostal's bound), so on a family of problems with a
+// bounded condition number the iterations stay bounded: the property FETI relies on.
+//
+// Preconditioning in face: the CG directions use M phi restricted to F, with M an SPD approximation of A^-1
+// (applied to the whole vector, then cut to the face); the expansion and proportioning steps are unchanged.
+// Pure linear algebra: nothing here knows of contact.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <functional>
+
+namespace contact::linalg {
+
+struct BoundQp {
+  // y = A x; returns true to stop (cancelled).
+  std::function<bool(const Eigen::VectorXd& x, Eigen::VectorXd& y)> apply;
+  // y = M r (an approximation of A^-1); empty: no preconditioner. Returns true to stop (cancelled).
+  std::function<bool(const Eigen::VectorXd& r, Eigen::VectorXd& y)> precondition;
+  Eigen::VectorXd b, lower;
+};
+
+struct MprgpSettings {
+  double alpha_bar = 0.0;  // the expansion step length: 1.9 / ||A|| is the usual choice (must be in (0, 2/||A||])
+  double gamma = 1.0;      // the proportioning constant Gamma
+  long max_iterations = 10000;
+};
+
+struct MprgpResult {
+  Eigen::VectorXd x, gradient;  // the last iterate and its gradient A x - b
+  double projected_gradient = 0.0;  // ||g^P(x)||
+  long iterations = 0;          // products with A
+  long cg_steps = 0, expansion_steps = 0, proportioning_steps = 0;
+  bool converged = false, cancelled = false;
+};
+
+// Starts from x0 (projected onto x >= l) and stops when `done(x, g, ||g^P||)` says so (converged), after
+// max_iterations, or when a product asks to stop.
+MprgpResult solve_mprgp(const BoundQp& qp, const Eigen::VectorXd& x0, const MprgpSettings& settings,
+                        const std::function<bool(const Eigen::VectorXd& x, const Eigen::VectorXd& g, double norm_gp)>& done);
+
+// The projected gradient g^P of x (free gradient plus chopped gradient).
+Eigen::VectorXd projected_gradient(const Eigen::VectorXd& x, const Eigen::VectorXd& g, const Eigen::VectorXd& lower);
+
+// An estimate of ||A|| (the largest eigenvalue) by `iterations` steps of the power method from a fixed start.
+double estimate_norm(const std::function<bool(const Eigen::VectorXd&, Eigen::VectorXd&)>& apply, Eigen::Index n,
+                     int iterations = 30);
+
+}  // namespace contact::linalg
