@@ -146,6 +146,8 @@ void JobQueue::mark_settled(const std::shared_ptr<Job>& job) {
 contact::job::ParseResult JobQueue::validate(const std::string& body) const {
   contact::job::Limits limits;
   limits.max_dofs = settings_.max_dofs;
+  limits.max_bodies = settings_.max_bodies;
+  limits.max_contacts = settings_.max_contacts;
   limits.max_ranks = settings_.mpi.launcher.empty() ? 1 : settings_.mpi.max_ranks;
   limits.ranks_hint = settings_.mpi.launcher.empty()
                           ? "this server solves every job in its own process: it was started without --mpi-launcher"

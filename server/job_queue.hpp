@@ -54,6 +54,8 @@ struct QueueSettings {
   int workers = 1;                     // jobs solved at once
   std::size_t max_queued = 100;        // QUEUED jobs beyond which submissions are refused (503)
   long max_dofs = 2'000'000;           // job::Limits::max_dofs
+  int max_bodies = 512;                // job::Limits::max_bodies: a server's share of the machine, a setting
+  int max_contacts = 2048;             // job::Limits::max_contacts
   double time_limit_seconds = 3600.0;  // per run; 0 = none
   int max_attempts = 3;                // runs cut short by the server dying, after which a job ends FAILED
   std::uint64_t max_event_log_bytes = 256u << 20;  // per job; iteration events beyond are not recorded

@@ -67,6 +67,14 @@ void add_flags(CLI::App& app, Config& c) {
       ->envname("CONTACTD_MAX_DOFS")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  app.add_option("--max-bodies", c.queue.max_bodies, "most bodies a job may have (the command line takes 16384)")
+      ->envname("CONTACTD_MAX_BODIES")
+      ->check(CLI::Range(1, 1000000))
+      ->capture_default_str();
+  app.add_option("--max-contacts", c.queue.max_contacts, "most contact pairs a job may have (the command line takes 65536)")
+      ->envname("CONTACTD_MAX_CONTACTS")
+      ->check(CLI::Range(1, 4000000))
+      ->capture_default_str();
   app.add_option("--mpi-launcher", c.mpi_launcher,
                  "run jobs with parallel.ranks > 1 through this launcher, {ranks} replaced, e.g. 'mpirun -n {ranks}' "
                  "(docs/parallel.md; empty: every job runs in this process)")

@@ -131,7 +131,7 @@ enum class InterfacePreconditioner { none, lumped, dirichlet };
 struct InterfaceSolverSettings {
   InterfaceSolverKind solver = InterfaceSolverKind::automatic;
   InterfacePreconditioner preconditioner = InterfacePreconditioner::dirichlet;  // iterative only
-  double tolerance = 1e-10;        // iterative: projected gradient and equilibrium, relative
+  double tolerance = 1e-12;        // iterative: projected gradient and equilibrium, relative
   long max_iterations = 100000;    // iterative: products with the interface operator, in all
 };
 

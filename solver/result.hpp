@@ -118,6 +118,8 @@ struct Result {
   double gamma = 0.0;   // relaxation used (0 for monolithic)
   int subdomain_solves = 0;  // back-substitutions per body (the DDM's unit of work), initial guess included
   int updates = 0;           // augmented-Lagrangian updates (0 for the pure penalty method)
+  std::string interface_solver;   // interface_newton: "direct" or "iterative" (solver.interface.solver)
+  long interface_iterations = 0;  // the iterative interface solver's MPRGP iterations, all solves together
   std::vector<IterationReport> history;
   std::vector<Step> steps;  // the last one is the final solution
   double wall_seconds = 0.0;

@@ -103,6 +103,8 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
     result.iterations = outcome.iterations;
     result.gamma = outcome.gamma;
     result.subdomain_solves = outcome.solves_per_body;
+    result.interface_solver = outcome.interface_solver;
+    result.interface_iterations = outcome.interface_iterations;
     result.updates = updates;
     result.indicator_seconds = outcome.indicator_seconds;
     result.history = std::move(outcome.history);

@@ -118,7 +118,7 @@ ddm::MethodOutcome converge_then_refine(Problem& working, ddm::ContactSystem& sy
       total.history.push_back(std::move(r));
     }
     total.iterations += o.iterations;
-    total.solves_per_body += o.solves_per_body;
+    total.add_work(o);
     total.gamma = o.gamma;
     total.u = o.u;
     total.z = o.z;

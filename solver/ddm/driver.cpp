@@ -75,7 +75,7 @@ MethodOutcome run_augmented_lagrangian(ContactSystem& system, const SolverSettin
       total.history.push_back(std::move(r));
     }
     total.iterations += o.iterations;
-    total.solves_per_body += o.solves_per_body;
+    total.add_work(o);
     total.gamma = o.gamma;
     total.u = std::move(o.u);
     total.z = std::move(o.z);

@@ -20,7 +20,7 @@ MethodOutcome run_load_steps(ContactSystem& system, const SolverSettings& settin
       total.history.push_back(std::move(r));
     }
     total.iterations += o.iterations;
-    total.solves_per_body += o.solves_per_body;
+    total.add_work(o);
     total.gamma = o.gamma;
     total.reason = o.reason;
     total.converged = o.converged;

@@ -90,6 +90,8 @@ void write_provenance(hid_t file, const Result& result, const WriteInfo& info) {
   h5::write_attribute(prov, "host", info.host);
   h5::write_attribute(prov, "method", result.method);
   h5::write_attribute(prov, "enforcement", result.enforcement);
+  h5::write_attribute(prov, "interface_solver", result.interface_solver);
+  h5::write_attribute<std::int64_t>(prov, "interface_iterations", result.interface_iterations);
   h5::write_attribute<double>(prov, "gamma", result.gamma);
   h5::write_attribute<double>(prov, "setup_seconds", result.setup_seconds);
   h5::write_attribute<double>(prov, "factorization_seconds", result.factorization_seconds);

@@ -22,8 +22,10 @@ struct ValidationError {
 // A job over any of them is rejected with an error at the field's pointer, before anything is built.
 struct Limits {
   long max_dofs = 2'000'000;  // total over all bodies; larger jobs are rejected, not attempted
-  int max_bodies = 512;
-  int max_contacts = 2048;
+  // Bodies and pairs: the iterative interface solver handles thousands (a 64 x 64 brick wall has 4,129 bodies and
+  // 8,128 pairs); validation and pair set-up are linear in them. contactd sets its own (--max-bodies, --max-contacts).
+  int max_bodies = 16384;
+  int max_contacts = 65536;
   int max_threads = 64;                // solver.threads
   int max_iterations = 100'000;        // solver.max_iterations
   int max_updates = 1'000;             // solver.augmented_lagrangian.max_updates

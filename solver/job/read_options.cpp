@@ -98,7 +98,7 @@ void JobReader::read_solver(const Fields& top) {
   json& in = sub_object(out, "interface");
   set_default(in, "solver", "auto");
   set_default(in, "preconditioner", "dirichlet");
-  set_default(in, "tolerance", 1e-10);
+  set_default(in, "tolerance", 1e-12);
   set_default(in, "max_iterations", 100000);
 }
 
@@ -251,7 +251,7 @@ void JobReader::read_interface_solver(const json& value, const std::string& poin
     auto x = positive(*t, f.at("tolerance"), "tolerance", errors_);
     if (x && *x >= 1e-2)
       errors_.add(f.at("tolerance"), "tolerance = " + format_number(*x) +
-                                         " is not below 0.01: the interface solver's tolerance is relative (1e-10 by default)");
+                                         " is not below 0.01: the interface solver's tolerance is relative (1e-12 by default)");
     else if (x)
       in.tolerance = *x;
   }

@@ -37,7 +37,7 @@ class Smalbe {
   CoarseSpace coarse_;
   const Eigen::Index m_;
   Eigen::VectorXd z_I_, Pc_, diagonal_;
-  double rho_ = 1.0, norm_A_ = 1.0;
+  double rho_ = 1.0, norm_A_ = 1.0, norm_PHP_ = 1.0;
   linalg::BoundQp bound_;
   std::vector<char> previous_active_;
 };
@@ -83,7 +83,7 @@ void Smalbe::setup() {
       },
       m_);
   rho_ = norm_PHP > 0 ? norm_PHP : 1.0;
-  norm_A_ = rho_;
+  norm_A_ = norm_PHP_ = rho_;
   diagonal_ = qp_.problem.diagonal();
   if (qp_.penalty.size() == m_) diagonal_ += qp_.penalty;
   bound_.apply = [this](const Eigen::VectorXd& x, Eigen::VectorXd& y) { return apply_A(x, y); };
@@ -135,7 +135,7 @@ bool Smalbe::report(int step, ActiveSetResult& out) {
 // non-negative pressures balance some floating body (its loads pull it off its contacts).
 bool Smalbe::stagnating(const std::vector<double>& violation) const {
   const size_t k = violation.size();
-  return k >= 8 && violation[k - 1] > 0.5 * violation[k - 4];
+  return k >= 8 && violation[k - 1] > 0.5 * violation[k - 4] && rho_ >= 1e6 * norm_PHP_;
 }
 
 // The rows of the floating bodies whose equilibrium G_b z = e_b is violated by more than a thousandth of the
@@ -158,17 +158,21 @@ ActiveSetResult Smalbe::run(const Eigen::VectorXd* z0) {
     return out;
   }
   setup();
-  const double scale_g = std::max(Pc_.norm(), 1e-300);
+  // The gradient's scale: the free response's penetration (where the contact acts), not its open gaps, which can
+  // be orders of magnitude larger on a curved surface and would make the tolerance meaningless.
+  const double penetration = Pc_.cwiseMin(0.0).norm();
+  const double scale_g = penetration > 0 ? penetration : std::max(Pc_.norm(), 1e-300);
   const double eta = 0.1 * scale_g;
+  const double norm_PHP = norm_PHP_;
   double M = norm_A_;
   Eigen::VectorXd x = z0 && z0->size() == m_ ? Eigen::VectorXd(*z0 - z_I_) : Eigen::VectorXd::Zero(m_);
   Eigen::VectorXd nu = Eigen::VectorXd::Zero(m_);
   double previous_L = -std::numeric_limits<double>::infinity();
   std::vector<double> violation;
   linalg::MprgpSettings inner;
-  inner.alpha_bar = 1.9 / (1.05 * norm_A_);  // the power method underestimates ||A|| a little
   const int max_outer = std::max(1, ctx_.max_steps);
   for (int outer = 1; outer <= max_outer; ++outer) {
+    inner.alpha_bar = 1.9 / (1.05 * norm_A_);  // the power method underestimates ||A|| a little
     bound_.b = -(Pc_ + nu);
     inner.max_iterations = std::max<long>(1, s_.max_iterations - out.inner_iterations);
     bool global = false;
@@ -196,6 +200,7 @@ ActiveSetResult Smalbe::run(const Eigen::VectorXd* z0) {
       out.message = out.converged ? os.str() : "the contact nodes in contact do not hold every floating body";
       return out;
     }
+    if (out.inner_iterations >= s_.max_iterations || !r.converged) break;
     // SMALBE's update: the multipliers, and M halved when the Lagrangian did not grow by rho/2 ||Q x||^2.
     const Eigen::VectorXd Qx = coarse_.range_part(x);
     const double L = 0.5 * x.dot(r.gradient - bound_.b);
@@ -203,11 +208,18 @@ ActiveSetResult Smalbe::run(const Eigen::VectorXd* z0) {
     if (outer > 1 && L < previous_L + 0.5 * rho_ * Qx.squaredNorm()) M /= 2;
     previous_L = L;
     violation.push_back(Qx.norm());
-    if (out.inner_iterations >= s_.max_iterations || !r.converged) break;
     if (stagnating(violation)) {
       if (out.unrestrained.empty()) out.unrestrained = unbalanced_rows(out.z);
       out.message = "the contact nodes in contact do not hold every floating body";
       return out;
+    }
+    // On a face much smaller than the contact surface (a cylinder on a block) rho Q acts there only through the
+    // face's share of the rigid modes' gaps, and the multiplier updates crawl: raise rho (A's spectrum on ker G
+    // is unchanged; the expansion step shortens with ||A||) while the violation falls by less than 10x.
+    const size_t k = violation.size();
+    if (k >= 2 && violation[k - 1] > 0.1 * violation[k - 2] && rho_ < 1e6 * norm_PHP) {
+      rho_ *= 10;
+      norm_A_ = std::max(norm_PHP, rho_);
     }
   }
   std::ostringstream os;

@@ -89,6 +89,8 @@ MethodOutcome InterfaceNewton::solve(const SolverSettings& settings, RunContext&
   const int max_steps = ctx.max_steps;
   last_z_ = result.z;
   out.iterations = result.steps;
+  out.interface_solver = solver_->name();
+  out.interface_iterations = result.inner_iterations;
   if (result.cancelled) {
     out.reason = StopReason::cancelled;
     out.message = "cancelled";

@@ -10,7 +10,7 @@ namespace {
 // Beyond these sizes the direct solver's costs outgrow the iterative one's (bench/bench_walls measures both):
 // its Schur complement on the floating bodies' rows is dense (r x r, and |A| x r for H_AA^-1 G_A^T), and every
 // active-set step refactorises the active block.
-constexpr Eigen::Index max_direct_floating_rows = 1200;
+constexpr Eigen::Index max_direct_floating_rows = 256;
 constexpr Eigen::Index max_direct_rows = 40000;
 
 }  // namespace

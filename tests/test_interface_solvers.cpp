@@ -1,0 +1,175 @@
+// The two interface solvers (solver/ddm/interface/): the sparse direct active set and the iterative FETI solver
+// (projected MPRGP in SMALBE) give the discrete solution of the monolithic reference, an independent algebra, on
+// every example and on brick walls of many floating bodies; MPRGP alone solves bound-constrained QPs like the
+// active-set QP method; the iterative solver's iterations do not grow with the number of bodies (the FETI property).
+#include "linalg/active_set.hpp"
+#include "linalg/mprgp.hpp"
+#include "support.hpp"
+
+#include <Eigen/Eigenvalues>
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <random>
+
+using namespace contact;
+using nlohmann::json;
+using contact::testing::example;
+using contact::testing::run;
+
+namespace {
+
+double max_abs(const Eigen::MatrixXd& m) { return m.size() ? m.cwiseAbs().maxCoeff() : 0.0; }
+
+void expect_same_solution(const Result& a, const Result& b, double rel, const std::string& what) {
+  ASSERT_FALSE(a.steps.empty()) << what << ": " << a.message;
+  ASSERT_FALSE(b.steps.empty()) << what << ": " << b.message;
+  const Step& sa = a.steps.back();
+  const Step& sb = b.steps.back();
+  double u_scale = 0, p_scale = 0;
+  for (const auto& body : sb.bodies) u_scale = std::max(u_scale, max_abs(body.displacement));
+  for (const auto& pair : sb.pairs) p_scale = std::max(p_scale, max_abs(pair.pressure));
+  for (size_t i = 0; i < sa.bodies.size(); ++i)
+    EXPECT_LE(max_abs(sa.bodies[i].displacement - sb.bodies[i].displacement), rel * u_scale)
+        << what << ", body " << sa.bodies[i].name;
+  for (size_t k = 0; k < sa.pairs.size(); ++k)
+    EXPECT_LE(max_abs(sa.pairs[k].pressure - sb.pairs[k].pressure), rel * p_scale) << what << ", pair " << sa.pairs[k].name;
+}
+
+json with_solver(json job, const std::string& interface_solver) {
+  job["solver"] = {{"method", "interface_newton"}, {"interface", {{"solver", interface_solver}}}};
+  return job;
+}
+
+json monolithic(json job) {
+  job["solver"] = {{"method", "monolithic"}};
+  return job;
+}
+
+// A wall from the project's generator (scripts/make_brick_wall.py).
+json wall(int rows, int bricks, int cells, bool abutments) {
+  const std::string path = std::string(CONTACT_BINARY_DIR) + "/test_wall_" + std::to_string(rows) + "x" +
+                           std::to_string(bricks) + "_" + std::to_string(cells) + (abutments ? "_a" : "") + ".json";
+  const std::string command = "/usr/bin/python3 " + std::string(CONTACT_SOURCE_DIR) + "/scripts/make_brick_wall.py --rows " +
+                              std::to_string(rows) + " --bricks " + std::to_string(bricks) + " --cells " +
+                              std::to_string(cells) + (abutments ? " --abutments" : "") + " -o " + path + " > /dev/null 2>&1";
+  EXPECT_EQ(std::system(command.c_str()), 0) << command;
+  std::ifstream in(path);
+  json job = json::parse(in);
+  std::remove(path.c_str());
+  return job;
+}
+
+}  // namespace
+
+TEST(Mprgp, SolvesBoundConstrainedQpsLikeTheActiveSetQpMethod) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (int trial = 0; trial < 12; ++trial) {
+    const int n = 10 + 7 * trial;
+    Eigen::MatrixXd A(n, n);
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) A(i, j) = normal(rng);
+    const Eigen::MatrixXd H = A * A.transpose() / n + Eigen::MatrixXd::Identity(n, n);
+    Eigen::VectorXd g(n);
+    for (int i = 0; i < n; ++i) g[i] = normal(rng);
+    const Eigen::VectorXd reference = linalg::solve_nonnegative_qp(H.sparseView(), g);
+    for (bool jacobi : {false, true}) {
+      linalg::BoundQp qp;
+      qp.apply = [&](const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+        y = H * x;
+        return false;
+      };
+      if (jacobi)
+        qp.precondition = [&](const Eigen::VectorXd& r, Eigen::VectorXd& y) {
+          y = r.cwiseQuotient(H.diagonal());
+          return false;
+        };
+      qp.b = -g;
+      qp.lower = Eigen::VectorXd::Zero(n);
+      linalg::MprgpSettings settings;
+      settings.alpha_bar = 1.9 / H.eigenvalues().real().maxCoeff();
+      const auto r = linalg::solve_mprgp(qp, Eigen::VectorXd::Zero(n), settings,
+                                         [&](const Eigen::VectorXd&, const Eigen::VectorXd&, double gp) { return gp <= 1e-12 * g.norm(); });
+      ASSERT_TRUE(r.converged) << trial;
+      EXPECT_GE(r.x.minCoeff(), 0.0);
+      EXPECT_LE((r.x - reference).cwiseAbs().maxCoeff(), 1e-9 * std::max(1.0, reference.cwiseAbs().maxCoeff()))
+          << "trial " << trial << (jacobi ? " (Jacobi)" : "");
+    }
+  }
+}
+
+TEST(InterfaceSolvers, BothAgreeWithTheMonolithicReferenceOnEveryExample) {
+  for (const char* name : {"stack3.json", "stack3_floating.json", "flat_patch.json", "flat_patch_nonmatching.json",
+                           "hertz.json", "hertz_force.json", "hertz_cylinder.json", "punch.json", "punch_force.json",
+                           "seed_layers.json", "seed_layers_curved.json", "seed_layers_steps.json", "brick_wall.json",
+                           "flat_patch_gmsh.json", "hertz_cylinder_gmsh.json", "punch_rounded_gmsh.json"}) {
+    const json job = example(name);
+    const Result reference = run(monolithic(job));
+    ASSERT_TRUE(reference.converged) << name << ": " << reference.message;
+    for (const char* solver : {"direct", "iterative"}) {
+      const Result r = run(with_solver(job, solver));
+      ASSERT_TRUE(r.converged) << name << " " << solver << ": " << r.message;
+      EXPECT_EQ(r.interface_solver, solver);
+      expect_same_solution(r, reference, 1e-8, std::string(name) + " " + solver);
+      for (const auto& pair : r.steps.back().pairs) EXPECT_LE(pair.penetration.maxCoeff(), 1e-10 * max_abs(pair.pressure));
+    }
+  }
+}
+
+TEST(InterfaceSolvers, BothAgreeWithTheMonolithicReferenceOnDowelledAndAbutmentWalls) {
+  for (bool abutments : {false, true})
+    for (int n : {8, 16}) {
+      const json job = wall(n, n, 4, abutments);
+      const std::string what = std::to_string(n) + " x " + std::to_string(n) + (abutments ? " abutments" : " dowelled");
+      const Result reference = run(monolithic(job));
+      ASSERT_TRUE(reference.converged) << what << ": " << reference.message;
+      for (const char* solver : {"direct", "iterative"}) {
+        const Result r = run(with_solver(job, solver));
+        ASSERT_TRUE(r.converged) << what << " " << solver << ": " << r.message;
+        expect_same_solution(r, reference, 1e-8, what + " " + solver);
+      }
+    }
+}
+
+TEST(InterfaceSolvers, TheAutomaticChoiceTakesTheDirectSolverForFewBodiesAndTheIterativeOneForMany) {
+  json few = example("stack3.json");
+  few["solver"] = {{"method", "interface_newton"}};
+  EXPECT_EQ(run(few).interface_solver, "direct");
+  json many = wall(16, 16, 2, false);
+  many["solver"] = {{"method", "interface_newton"}};
+  const Result r = run(many);
+  ASSERT_TRUE(r.converged) << r.message;
+  EXPECT_EQ(r.interface_solver, "iterative");
+  EXPECT_GT(r.interface_iterations, 0);
+  ASSERT_FALSE(r.history.empty());
+  EXPECT_NE(r.history.front().note.find("interface solver iterative"), std::string::npos) << r.history.front().note;
+}
+
+TEST(InterfaceSolvers, IterationsOfTheIterativeSolverDoNotGrowWithTheNumberOfBricks) {
+  // The same bricks (same H/h) in walls of 69 to 4,129 bodies: FETI's iterations are bounded by H/h.
+  std::vector<long> iterations;
+  for (int n : {8, 16, 32, 64}) {
+    json job = with_solver(wall(n, n, 4, false), "iterative");
+    const Result r = run(job);
+    ASSERT_TRUE(r.converged) << n << ": " << r.message;
+    iterations.push_back(r.interface_iterations);
+  }
+  EXPECT_LE(static_cast<double>(iterations.back()), 1.5 * static_cast<double>(iterations.front()))
+      << iterations[0] << ", " << iterations[1] << ", " << iterations[2] << ", " << iterations[3];
+  for (long k : iterations) EXPECT_GT(k, 0);
+}
+
+TEST(InterfaceSolvers, AnUnheldFloatingBodyIsNamedByTheIterativeSolverToo) {
+  json job = with_solver(example("punch_force.json"), "iterative");
+  job["bodies"][1]["boundary"][1]["force"] = {0, 200};  // upwards: nothing holds the punch
+  Result r = run(job);
+  EXPECT_EQ(r.stop_reason, StopReason::error);
+  EXPECT_NE(r.message.find("body 'punch' floats (translation in y"), std::string::npos) << r.message;
+  job = with_solver(example("punch_force.json"), "iterative");
+  job["bodies"][1]["boundary"] = {{{"edge", "top"}, {"force", {0, -200}}}};  // frictionless: slides sideways
+  r = run(job);
+  EXPECT_EQ(r.stop_reason, StopReason::error);
+  EXPECT_NE(r.message.find("body 'punch' floats (translation in x"), std::string::npos) << r.message;
+}
