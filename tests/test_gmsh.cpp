@@ -541,3 +541,27 @@ TEST(GmshJob, AMissingSurfaceAmongManyNamesIsReportedFastWithAShortList) {
   EXPECT_NE(message.find("'extra_17' ... and 199982 more"), std::string::npos) << message;
   EXPECT_EQ(message.find("'extra_18'"), std::string::npos) << message;
 }
+
+// Issue 22, defect 6: node coordinates are bounded like the job's JSON numbers (1e30); 1e40 and 1e100 used to
+// solve as "converged", 1e150 failed with a misleading message and 1e308 was called "zero area".
+TEST(GmshJob, NodeCoordinatesAreBoundedLikeJsonNumbers) {
+  for (const double x : {1e40, 1e100, 1e150, 1e308, -1e40}) {
+    Msh m = square();
+    m.nodes[1][0] = x;  // node 2
+    const std::string text = m.text();
+    std::ostringstream written;
+    written.precision(17);
+    written << x << " 0 0\n";
+    const std::string line = std::to_string(1 + std::count(text.begin(), text.begin() + text.find(written.str()), '\n'));
+    json job = flat_patch_gmsh();
+    job["bodies"].erase(1);
+    job["contacts"] = json::array();
+    job["bodies"][0]["mesh"]["gmsh"] = {{"data", text}, {"surface", "sq"}};
+    job["bodies"][0]["boundary"] = {{{"edge", "bottom"}, {"displacement", {{"x", 0}, {"y", 0}}}}};
+    std::ostringstream shown;
+    shown << x;
+    expect_only_error(job::parse(job), "/bodies/0/mesh/gmsh/data",
+                      "the mesh data (MSH text): line " + line + ": node 2: x = " + shown.str() +
+                          " is too large in magnitude (at most 1e+30)");
+  }
+}

@@ -48,7 +48,9 @@ std::string read_bytes(const fs::path& path, std::size_t max_bytes, std::string&
 std::unique_ptr<GmshMeshes::Parsed> GmshMeshes::parse(const std::string& text) const {
   auto p = std::make_unique<Parsed>();
   try {
-    p->file = mesh::gmsh::parse(text, static_cast<std::size_t>(std::max(0L, limits_.max_dofs / 2)));
+    // Node coordinates are bounded like every number of the job.
+    p->file = mesh::gmsh::parse(text, static_cast<std::size_t>(std::max(0L, limits_.max_dofs / 2)),
+                                read::kMaxMagnitude);
   } catch (const mesh::gmsh::ParseError& e) {
     p->error = e.what();
   }
