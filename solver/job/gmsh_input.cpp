@@ -92,6 +92,8 @@ std::optional<GmshBody> GmshMeshes::read(const json& value, const std::string& p
   std::optional<std::string> surface;
   if (const json* s = f.require("surface", "the name of the physical surface that is this body"))
     surface = read::string(*s, f.at("surface"), "surface", errors);
+  if (surface)
+    if (auto problem = read::control_character_problem(*surface, "surface")) errors.add(f.at("surface"), *problem);
   if (f.has("file") == f.has("data")) {
     errors.add(pointer, "give exactly one of file (the .msh file's path, relative to the job file) or data (the "
                         ".msh file's text)");
