@@ -192,7 +192,9 @@ class Client:
         """The job serialised with every {"gmsh": {"file": f}} of its bodies as {"gmsh": {"data": <f's text>}}
         (f relative to `directory`); None when it names no mesh file."""
         bodies = doc.get("bodies") if isinstance(doc, dict) else None
-        meshes = [b["mesh"]["gmsh"] for b in bodies or [] if isinstance(b, dict) and isinstance(b.get("mesh"), dict)
+        if not isinstance(bodies, list):  # {"bodies": 3}: sent as it is, for the server to name /bodies
+            return None
+        meshes = [b["mesh"]["gmsh"] for b in bodies if isinstance(b, dict) and isinstance(b.get("mesh"), dict)
                   and isinstance(b["mesh"].get("gmsh"), dict) and isinstance(b["mesh"]["gmsh"].get("file"), str)
                   and "data" not in b["mesh"]["gmsh"]]  # both: left for the server to refuse
         for gmsh in meshes:
