@@ -357,7 +357,7 @@ class Client:
             except UnicodeDecodeError:
                 text = None
             if kind not in ("application/xml", "text/xml") or text is None or "<Xdmf" not in text:
-                raise BadAnswer(f"the XDMF sidecar of {job_id} is not XDMF ({kind or 'no Content-Type'})")
+                raise BadAnswer(f"the XDMF sidecar of {one_line(job_id)} is not XDMF ({kind or 'no Content-Type'})")
             name = os.path.basename(path)
             text = text.replace('result.hdf:/', name + ":/")
             side = os.path.splitext(path)[0] + ".xmf"
@@ -380,26 +380,16 @@ class Client:
                 raise BadAnswer(f"the result of {api_path} is not an HDF5 file ({kind or 'no Content-Type'}) - "
                                 "is a proxy in the way?")
             expected = content_length(resp)
-            size = 0
-            head = b""
-            try:
-                f = open(tmp, "wb")
-            except OSError as exc:
-                raise ClientError(f"cannot write {tmp}: {exc.strerror or exc}") from None
-            with f:
-                while True:
-                    chunk = resp.read(1 << 16)
-                    if not chunk:
-                        break
-                    if len(head) < 8:
-                        head += chunk[:8 - len(head)]
-                    f.write(chunk)
-                    size += len(chunk)
-            if expected is not None and size != expected:
-                raise ConnectionFailed(f"download of {api_path} cut short ({size} of {expected} bytes)")
+            if expected is None:
+                raise BadAnswer(f"the result of {api_path} does not announce its size (no Content-Length; contactd "
+                                "always does) - is a proxy in the way? Not saved")
+            head = resp.read(min(len(HDF5_SIGNATURE), expected))
             if head != HDF5_SIGNATURE:
-                raise BadAnswer(f"the result of {api_path} does not start with the HDF5 signature ({size} bytes): "
-                                "not saved")
+                raise BadAnswer(f"the result of {api_path} does not start with the HDF5 signature "
+                                f"({one_line(repr(head))[:40]}): not saved")
+            size = self._write_body(resp, head, tmp, expected)
+            if size != expected:
+                raise ConnectionFailed(f"download of {api_path} cut short ({size} of {expected} bytes)")
             os.replace(tmp, path)
         except socket.timeout:
             raise RequestTimeout(f"download from {self.url} stalled for {self.timeout:g} s (timeout)") from None
@@ -411,6 +401,26 @@ class Client:
             conn.close()
             if os.path.exists(tmp):
                 os.remove(tmp)
+
+
+    @staticmethod
+    def _write_body(resp, head, tmp, expected):
+        """Writes `head` and the rest of the body to tmp, never more than `expected` bytes in all (the announced
+        Content-Length); returns the number of bytes written."""
+        try:
+            f = open(tmp, "wb")
+        except OSError as exc:
+            raise ClientError(f"cannot write {tmp}: {exc.strerror or exc}") from None
+        with f:
+            f.write(head)
+            size = len(head)
+            while size < expected:
+                chunk = resp.read(min(1 << 16, expected - size))
+                if not chunk:
+                    break
+                f.write(chunk)
+                size += len(chunk)
+        return size
 
 
 def _retry_after(headers):
