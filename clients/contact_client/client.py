@@ -213,7 +213,7 @@ class Client:
     def _check_id(job_id):
         job_id = str(job_id).strip()
         if not job_id or "/" in job_id or "?" in job_id or "#" in job_id:
-            raise BadInput(f"'{job_id}' is not a job id")
+            raise BadInput(f"'{one_line(job_id)}' is not a job id")
         return urllib.parse.quote(job_id)
 
     # -- the API ----------------------------------------------------------------------------------------------
@@ -298,7 +298,7 @@ class Client:
                 try:
                     kind = media_type({k.lower(): v for k, v in resp.getheaders()})
                     if kind != "text/event-stream":
-                        raise BadAnswer(f"the progress stream of {job_id} is not an event stream "
+                        raise BadAnswer(f"the progress stream of {one_line(job_id)} is not an event stream "
                                         f"({kind or 'no Content-Type'}) - is a proxy in the way?")
                     for event in read_sse(resp):
                         seq = event.get("seq")
@@ -325,7 +325,7 @@ class Client:
                 problem = f"connection lost ({one_line(exc)[:200] or type(exc).__name__})"
             failures += 1
             if failures > max_retries:
-                raise ConnectionFailed(f"progress stream of {job_id} lost after {max_retries} reconnections: "
+                raise ConnectionFailed(f"progress stream of {one_line(job_id)} lost after {max_retries} reconnections: "
                                        f"{problem}")
             delay = min(0.5 * 2 ** (failures - 1), 10.0)
             if wait:
@@ -343,8 +343,9 @@ class Client:
         return self.status(job_id)
 
     def download(self, job_id, path, xmf=False):
-        """Downloads the HDF5 result to path (written to path + '.part' then renamed, only once it is whole and
-        starts with the HDF5 signature). With xmf=True the XDMF sidecar is saved next to it (same name, .xmf)
+        """Downloads the HDF5 result to path (written to path + '.part' then renamed, only once it is whole). The
+        answer must announce its size (Content-Length) and start with the HDF5 signature, checked on its first 8
+        bytes before anything is written; nothing beyond the announced size is written. With xmf=True the XDMF sidecar is saved next to it (same name, .xmf)
         with its data references renamed to the file's name. Returns path."""
         base = f"/v1/jobs/{self._check_id(job_id)}"
         path = os.fspath(path)

@@ -306,6 +306,38 @@ for name, answer, expect_file in (
     check(f"download, {name}: within seconds", time.time() - begin < 10, time.time() - begin)
 client_module.open = open
 
+# Issue 22, defect 9: escape sequences in what a server sends reached the terminal. Every string field of every
+# answer carries ESC (a colour, a clear screen, a window title), BEL, the one-byte C1 CSI and a bidi override.
+EVIL = "x\x1b[31m\x1b[2J\x1b]0;owned\x07\x9b1m\u202e"
+evil_job = {"id": EVIL, "state": "FAILED" + EVIL, "name": EVIL, "message": EVIL, "stop_reason": EVIL,
+            "error": {"message": EVIL}, "created": EVIL, "iterations": EVIL, "progress": {"note": EVIL}}
+evil_event = {"seq": 1, "type": "state", "state": EVIL, "message": EVIL}
+evil_end = {"seq": 2, "type": "end", "state": EVIL, "stop_reason": EVIL, "message": EVIL}
+EVIL_ANSWERS = {
+    "job resource": http(200, json.dumps({**evil_job, "jobs": [evil_job], "next_page_token": EVIL})),
+    "problem document": http(400, json.dumps({"type": "/problems/" + EVIL, "title": EVIL, "detail": EVIL,
+                                              "state": EVIL}), "application/problem+json"),
+    "invalid-job errors": http(400, json.dumps({"type": "/problems/invalid-job", "errors": [
+        {"pointer": "/" + EVIL, "message": EVIL}]}), "application/problem+json"),
+    "events": sse(json.dumps(evil_event), json.dumps({"seq": 2, "type": "iteration", "iteration": 1, "note": EVIL,
+                                                      "pairs": [{"name": EVIL}], "bodies": [{"name": EVIL}]}),
+                  json.dumps({"seq": 3, "type": "step", "bodies": [{"name": EVIL}]}), json.dumps(evil_end)),
+    "redirect": http(302, "", None, extra=b"Location: http://x/\x1b[2J\r\n"),
+}
+for name, answer in EVIL_ANSWERS.items():
+    server.answer = answer
+    for command in COMMANDS:
+        code, out, err, escaped = run_main(command + ["--url", server.url, "--timeout", "2"])
+        shown = out + err
+        label = f"control characters in the {name}: {' '.join(command[:2])}"
+        check(f"{label}: none printed raw", not any(c in shown for c in "\x1b\x07\x9b\u202e"),
+              repr(shown[-400:]))
+        if (name, command[0]) in (("job resource", "status"), ("job resource", "list"), ("events", "watch"),
+                                  ("invalid-job errors", "validate"), ("problem document", "status")) \
+                and "--json" not in command:  # JSON output escapes them itself (\\u001b)
+            check(f"{label}: shown escaped", "x\\x1b[31m\\x1b[2J\\x1b]0;owned\\x07\\x9b1m\\u202e" in shown,
+                  repr(shown[-400:]))
+
 check("python3 -m contact_client works", subprocess.run(
     [sys.executable, "-m", "contact_client", "--help"], capture_output=True, text=True,
     cwd=os.path.join(SRC, "clients")).returncode == 0)
