@@ -3,6 +3,7 @@
 #include "adapt/adaptive.hpp"
 #include "ddm/driver.hpp"
 #include "ddm/load_steps.hpp"
+#include "held_bodies.hpp"
 
 #include <chrono>
 #include <exception>
@@ -39,6 +40,22 @@ double max_penetration(const Step& step) {
   for (const auto& p : step.pairs)
     if (p.penetration.size()) m = std::max(m, p.penetration.maxCoeff());
   return m;
+}
+
+// The monolithic reference solves the coupled system however little holds a floating body (its rigid motion
+// then comes out zero, one of many solutions): a solution at which the contacts in contact do not hold every
+// floating body is refused as interface Newton refuses it, with no result.
+void refuse_unheld_bodies(const Problem& problem, Result& result) {
+  if (result.stop_reason != StopReason::converged && result.stop_reason != StopReason::max_iterations) return;
+  for (const auto& step : result.steps) {
+    const std::string unheld = unheld_floating_bodies(problem, step);
+    if (unheld.empty()) continue;
+    result.stop_reason = StopReason::error;
+    result.converged = false;
+    result.message = "monolithic: " + unheld;
+    result.steps.clear();
+    return;
+  }
 }
 
 }  // namespace
@@ -110,6 +127,7 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
     result.history = std::move(outcome.history);
     result.factorization_seconds = system.total_factorization_seconds();
     result.steps = std::move(steps);
+    if (problem.solver.method == Method::monolithic) refuse_unheld_bodies(active, result);
     if (updates > 0 && !result.steps.empty()) {
       std::ostringstream os;
       os << "; remaining penetration " << max_penetration(result.steps.back());

@@ -175,6 +175,41 @@ TEST(FloatingErrors, ABodyThatSlidesFreelyOnAFlatContactIsNamed) {
   EXPECT_NE(r.message.find("body 'punch' floats (translation in x"), std::string::npos) << r.message;
 }
 
+// Issue 22, defect 11: the monolithic method returned a zero displacement (exit 0) for a floating body nothing
+// holds; it must refuse every such job as the default method does, naming the body, with no result. (A punch pulled
+// away from its contact is not among the cases: the monolithic active set cycles to max_iterations there, 13 s,
+// and is refused only then.)
+TEST(FloatingErrors, TheMonolithicMethodRefusesAnUnheldBodyLikeTheDefaultMethod) {
+  // A cap with no supports and no load resting on a base held at its bottom.
+  const json cap = json::parse(R"({
+    "name": "cap",
+    "bodies": [
+      {"name": "cap", "material": {"E": 1000, "nu": 0.3},
+       "mesh": {"block": {"corners": [[0, 1], [1, 1], [1, 2], [0, 2]], "nx": 4, "ny": 4}}},
+      {"name": "base", "material": {"E": 1000, "nu": 0.3},
+       "mesh": {"block": {"corners": [[0, 0], [1, 0], [1, 1], [0, 1]], "nx": 4, "ny": 4}},
+       "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]}
+    ],
+    "contacts": [{"slave": "cap.bottom", "master": "base.top"}]
+  })");
+  json sliding = example("punch_force.json");
+  sliding["bodies"][1]["boundary"] = {{{"edge", "top"}, {"force", {0, -200}}}};  // pressed, nothing holds x
+  const std::vector<std::pair<json, std::string>> cases = {
+      {cap, "body 'cap' floats (translation in x, translation in y, rotation free) and no contact holds it: its "
+            "contact 'cap.bottom-base.top'"},
+      {sliding, "body 'punch' floats (translation in x"}};
+  for (const auto& [base_job, phrase] : cases)
+    for (const std::string method : {"interface_newton", "monolithic"}) {
+      json job = base_job;
+      job["solver"]["method"] = method;
+      const Result r = run(job);
+      EXPECT_EQ(r.stop_reason, StopReason::error) << method << ": " << r.message;
+      EXPECT_FALSE(r.converged) << method;
+      EXPECT_TRUE(r.steps.empty()) << method << ": a refused job has no result";
+      EXPECT_NE(r.message.find(phrase), std::string::npos) << method << ": " << r.message;
+    }
+}
+
 TEST(FloatingErrors, AForceOnAFullyHeldEdgeAndAFloatingBodyWithTheNeumannSchemeAreValidationErrors) {
   json job = example("punch_force.json");
   job["bodies"][0]["boundary"].push_back({{"vertex", "bottom_left"}, {"force", {1, 0}}});

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -486,4 +487,81 @@ TEST(GmshJob, APointLoadAtAPhysicalPointIsCarriedByTheSupports) {
   job["bodies"][0]["boundary"][1]["vertex"] = "far";
   expect_only_error(job::parse(job), "/bodies/0/boundary/1/vertex",
                     "physical point 'far' is not on surface 'sq'; the physical points on it are corner");
+}
+
+namespace {
+
+// The flat patch's mesh with `count` more physical names of dimension `dims[k % dims.size()]` (tags from 100 on,
+// names extra_0, extra_1, ...), given as data to both bodies: a large but valid file.
+json flat_patch_with_names(std::size_t count, const std::vector<int>& dims) {
+  std::string text = read_text(kExamples + "flat_patch_gmsh.msh");
+  std::ostringstream extra;
+  for (std::size_t k = 0; k < count; ++k)
+    extra << dims[k % dims.size()] << ' ' << 100 + k << " \"extra_" << k << "\"\n";
+  const std::string header = "$PhysicalNames\n7\n";
+  text.replace(text.find(header), header.size(), "$PhysicalNames\n" + std::to_string(7 + count) + "\n" + extra.str());
+  json job = flat_patch_gmsh();
+  for (auto& body : job["bodies"]) body["mesh"]["gmsh"] = {{"data", text}, {"surface", body["name"]}};
+  return job;
+}
+
+double seconds_to_parse(const json& job, job::ParseResult& r) {
+  const auto start = std::chrono::steady_clock::now();
+  r = job::parse(job);
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+// Issue 22, defect 2: the names were grouped by a search over the list being built (150k names: 57 s).
+TEST(GmshJob, ManyPhysicalNamesValidateInWellUnderASecond) {
+  const json job = flat_patch_with_names(150'000, {0, 1, 2});  // points, curves and surfaces of no entity
+  job::ParseResult r;
+  const double seconds = seconds_to_parse(job, r);
+  ASSERT_TRUE(r.ok()) << job::format_errors(r.errors);
+  EXPECT_EQ(r.problem->bodies[0].mesh.num_nodes() + r.problem->bodies[1].mesh.num_nodes(), 115);
+  EXPECT_LT(seconds, 1.0) << "150k physical names took " << seconds << " s";
+}
+
+// ... and a missing surface among 200k surface names was listed by the same search (130 s) and all of them.
+TEST(GmshJob, AMissingSurfaceAmongManyNamesIsReportedFastWithAShortList) {
+  json job = flat_patch_with_names(200'000, {2});
+  job["bodies"][0]["mesh"]["gmsh"]["surface"] = "missing";
+  job::ParseResult r;
+  const double seconds = seconds_to_parse(job, r);
+  EXPECT_LT(seconds, 1.0) << "a missing surface among 200k names took " << seconds << " s";
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.errors[0].pointer, "/bodies/0/mesh/gmsh/surface");
+  const std::string& message = r.errors[0].message;
+  // 200002 surfaces (lower, upper and the 200000 extra), in the order of their tags; the first 20 are named.
+  EXPECT_NE(message.find("the file has no physical surface 'missing'; its physical surfaces are 'lower', 'upper', "
+                         "'extra_0', 'extra_1'"),
+            std::string::npos)
+      << message;
+  EXPECT_NE(message.find("'extra_17' ... and 199982 more"), std::string::npos) << message;
+  EXPECT_EQ(message.find("'extra_18'"), std::string::npos) << message;
+}
+
+// Issue 22, defect 6: node coordinates are bounded like the job's JSON numbers (1e30); 1e40 and 1e100 used to
+// solve as "converged", 1e150 failed with a misleading message and 1e308 was called "zero area".
+TEST(GmshJob, NodeCoordinatesAreBoundedLikeJsonNumbers) {
+  for (const double x : {1e40, 1e100, 1e150, 1e308, -1e40}) {
+    Msh m = square();
+    m.nodes[1][0] = x;  // node 2
+    const std::string text = m.text();
+    std::ostringstream written;
+    written.precision(17);
+    written << x << " 0 0\n";
+    const std::string line = std::to_string(1 + std::count(text.begin(), text.begin() + text.find(written.str()), '\n'));
+    json job = flat_patch_gmsh();
+    job["bodies"].erase(1);
+    job["contacts"] = json::array();
+    job["bodies"][0]["mesh"]["gmsh"] = {{"data", text}, {"surface", "sq"}};
+    job["bodies"][0]["boundary"] = {{{"edge", "bottom"}, {"displacement", {{"x", 0}, {"y", 0}}}}};
+    std::ostringstream shown;
+    shown << x;
+    expect_only_error(job::parse(job), "/bodies/0/mesh/gmsh/data",
+                      "the mesh data (MSH text): line " + line + ": node 2: x = " + shown.str() +
+                          " is too large in magnitude (at most 1e+30)");
+  }
 }

@@ -953,3 +953,30 @@ TEST(JobLimits, ErrorListsAreBoundedWhateverTheDocument) {
     EXPECT_LE(e.message.size(), 1030u);
   }
 }
+
+// Issue 22, defect 7: a job name with a NUL was accepted, and the result file's name attribute was cut at it.
+// Control characters in any name are refused at their pointer, and messages show them escaped.
+TEST(JobErrors, ControlCharactersInNamesAreRefusedAtTheirPointer) {
+  json job = small_job();
+  job["name"] = std::string("seed\0layers", 11);
+  expect_only_error(parse(job), "/name", "name 'seed\\u0000layers' contains the control character U+0000 at byte 4");
+  job["name"] = "red \x1b[31m";
+  expect_only_error(parse(job), "/name", "contains the control character U+001B at byte 4");
+  job["name"] = "tab\there";
+  expect_only_error(parse(job), "/name", "U+0009");
+  job["name"] = "c1 \xc2\x9b";  // U+009B, the one-byte CSI of C1
+  expect_only_error(parse(job), "/name", "U+009B");
+  job["name"] = "Grenzfläche 2 (ü)";  // printable non-ASCII stays allowed
+  EXPECT_TRUE(parse(job).ok()) << listing(parse(job));
+  // Names that the job refers to are identifiers, which cannot hold control characters either.
+  job = small_job();
+  job["bodies"][0]["name"] = std::string("up\0per", 6);
+  job["contacts"] = json::array();
+  expect_only_error(parse(job), "/bodies/0/name", "body name 'up\\u0000per' must consist of letters, digits");
+  job = small_job();
+  job["contacts"][0]["name"] = "pair\x07";
+  expect_only_error(parse(job), "/contacts/0/name", "contact name 'pair\\u0007' must consist of letters");
+  job = small_job();
+  job["bodies"][0]["boundary"][1]["edge"] = "top\x1b";
+  expect_only_error(parse(job), "/bodies/0/boundary/1/edge", "the body has no edge 'top\\u001B'");
+}

@@ -17,7 +17,7 @@ def _cmd_submit(c, a):
     if (a.output or a.events_out or a.xmf) and not a.wait:
         raise BadInput("-o, --xmf and --events-out need --wait")
     job = c.submit(a.file, idempotency_key=a.idempotency_key)
-    print(job["id"], flush=True)  # submit() checked that it is there
+    print(one_line(job["id"]), flush=True)  # submit() checked that it is there
     if not a.wait:
         return EXIT_OK
     return _follow(c, job["id"], a)
@@ -58,7 +58,7 @@ def _follow(c, job_id, a):
     if state != "SUCCEEDED":
         reason = word(end.get("stop_reason")) if end else ""
         message = word(end.get("message"), 500) if end and end.get("message") else ""
-        sys.stderr.write(f"error: job {job_id} ended {state}" + (f" ({reason})" if reason else "")
+        sys.stderr.write(f"error: job {one_line(job_id)} ended {state}" + (f" ({reason})" if reason else "")
                          + (f": {message}" if message else "") + "\n")
         return EXIT_JOB
     return EXIT_OK

@@ -192,7 +192,9 @@ class Client:
         """The job serialised with every {"gmsh": {"file": f}} of its bodies as {"gmsh": {"data": <f's text>}}
         (f relative to `directory`); None when it names no mesh file."""
         bodies = doc.get("bodies") if isinstance(doc, dict) else None
-        meshes = [b["mesh"]["gmsh"] for b in bodies or [] if isinstance(b, dict) and isinstance(b.get("mesh"), dict)
+        if not isinstance(bodies, list):  # {"bodies": 3}: sent as it is, for the server to name /bodies
+            return None
+        meshes = [b["mesh"]["gmsh"] for b in bodies if isinstance(b, dict) and isinstance(b.get("mesh"), dict)
                   and isinstance(b["mesh"].get("gmsh"), dict) and isinstance(b["mesh"]["gmsh"].get("file"), str)
                   and "data" not in b["mesh"]["gmsh"]]  # both: left for the server to refuse
         for gmsh in meshes:
@@ -211,7 +213,7 @@ class Client:
     def _check_id(job_id):
         job_id = str(job_id).strip()
         if not job_id or "/" in job_id or "?" in job_id or "#" in job_id:
-            raise BadInput(f"'{job_id}' is not a job id")
+            raise BadInput(f"'{one_line(job_id)}' is not a job id")
         return urllib.parse.quote(job_id)
 
     # -- the API ----------------------------------------------------------------------------------------------
@@ -296,7 +298,7 @@ class Client:
                 try:
                     kind = media_type({k.lower(): v for k, v in resp.getheaders()})
                     if kind != "text/event-stream":
-                        raise BadAnswer(f"the progress stream of {job_id} is not an event stream "
+                        raise BadAnswer(f"the progress stream of {one_line(job_id)} is not an event stream "
                                         f"({kind or 'no Content-Type'}) - is a proxy in the way?")
                     for event in read_sse(resp):
                         seq = event.get("seq")
@@ -323,7 +325,7 @@ class Client:
                 problem = f"connection lost ({one_line(exc)[:200] or type(exc).__name__})"
             failures += 1
             if failures > max_retries:
-                raise ConnectionFailed(f"progress stream of {job_id} lost after {max_retries} reconnections: "
+                raise ConnectionFailed(f"progress stream of {one_line(job_id)} lost after {max_retries} reconnections: "
                                        f"{problem}")
             delay = min(0.5 * 2 ** (failures - 1), 10.0)
             if wait:
@@ -341,8 +343,9 @@ class Client:
         return self.status(job_id)
 
     def download(self, job_id, path, xmf=False):
-        """Downloads the HDF5 result to path (written to path + '.part' then renamed, only once it is whole and
-        starts with the HDF5 signature). With xmf=True the XDMF sidecar is saved next to it (same name, .xmf)
+        """Downloads the HDF5 result to path (written to path + '.part' then renamed, only once it is whole). The
+        answer must announce its size (Content-Length) and start with the HDF5 signature, checked on its first 8
+        bytes before anything is written; nothing beyond the announced size is written. With xmf=True the XDMF sidecar is saved next to it (same name, .xmf)
         with its data references renamed to the file's name. Returns path."""
         base = f"/v1/jobs/{self._check_id(job_id)}"
         path = os.fspath(path)
@@ -355,7 +358,7 @@ class Client:
             except UnicodeDecodeError:
                 text = None
             if kind not in ("application/xml", "text/xml") or text is None or "<Xdmf" not in text:
-                raise BadAnswer(f"the XDMF sidecar of {job_id} is not XDMF ({kind or 'no Content-Type'})")
+                raise BadAnswer(f"the XDMF sidecar of {one_line(job_id)} is not XDMF ({kind or 'no Content-Type'})")
             name = os.path.basename(path)
             text = text.replace('result.hdf:/', name + ":/")
             side = os.path.splitext(path)[0] + ".xmf"
@@ -378,26 +381,16 @@ class Client:
                 raise BadAnswer(f"the result of {api_path} is not an HDF5 file ({kind or 'no Content-Type'}) - "
                                 "is a proxy in the way?")
             expected = content_length(resp)
-            size = 0
-            head = b""
-            try:
-                f = open(tmp, "wb")
-            except OSError as exc:
-                raise ClientError(f"cannot write {tmp}: {exc.strerror or exc}") from None
-            with f:
-                while True:
-                    chunk = resp.read(1 << 16)
-                    if not chunk:
-                        break
-                    if len(head) < 8:
-                        head += chunk[:8 - len(head)]
-                    f.write(chunk)
-                    size += len(chunk)
-            if expected is not None and size != expected:
-                raise ConnectionFailed(f"download of {api_path} cut short ({size} of {expected} bytes)")
+            if expected is None:
+                raise BadAnswer(f"the result of {api_path} does not announce its size (no Content-Length; contactd "
+                                "always does) - is a proxy in the way? Not saved")
+            head = resp.read(min(len(HDF5_SIGNATURE), expected))
             if head != HDF5_SIGNATURE:
-                raise BadAnswer(f"the result of {api_path} does not start with the HDF5 signature ({size} bytes): "
-                                "not saved")
+                raise BadAnswer(f"the result of {api_path} does not start with the HDF5 signature "
+                                f"({one_line(repr(head))[:40]}): not saved")
+            size = self._write_body(resp, head, tmp, expected)
+            if size != expected:
+                raise ConnectionFailed(f"download of {api_path} cut short ({size} of {expected} bytes)")
             os.replace(tmp, path)
         except socket.timeout:
             raise RequestTimeout(f"download from {self.url} stalled for {self.timeout:g} s (timeout)") from None
@@ -409,6 +402,26 @@ class Client:
             conn.close()
             if os.path.exists(tmp):
                 os.remove(tmp)
+
+
+    @staticmethod
+    def _write_body(resp, head, tmp, expected):
+        """Writes `head` and the rest of the body to tmp, never more than `expected` bytes in all (the announced
+        Content-Length); returns the number of bytes written."""
+        try:
+            f = open(tmp, "wb")
+        except OSError as exc:
+            raise ClientError(f"cannot write {tmp}: {exc.strerror or exc}") from None
+        with f:
+            f.write(head)
+            size = len(head)
+            while size < expected:
+                chunk = resp.read(min(1 << 16, expected - size))
+                if not chunk:
+                    break
+                f.write(chunk)
+                size += len(chunk)
+        return size
 
 
 def _retry_after(headers):

@@ -2,6 +2,7 @@
 server or a proxy sends can make them fail: every field of a problem document is checked before it is used."""
 import errno
 import http.client
+import re
 import socket
 
 EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_JOB = 0, 1, 2, 3
@@ -60,8 +61,20 @@ def text(value, limit=2000):
     return s if len(s) <= limit else s[:limit] + "..."
 
 
+# Control characters (C0, DEL, C1) and the bidirectional overrides: what a terminal obeys rather than shows.
+_CONTROL = re.compile("[\x00-\x1f\x7f-\x9f\u202a-\u202e\u2066-\u2069]")
+
+
+def printable(s):
+    """The text with each control character written as an escape (ESC as \\x1b, U+202E as \\u202e): nothing
+    a server sends reaches the terminal as a command."""
+    return _CONTROL.sub(lambda m: m.group().encode("unicode_escape").decode("ascii"), s)
+
+
 def one_line(value):
-    return " ".join(text(value).split())
+    """A value from an answer as one line of printable text: runs of white space become one space, any other
+    control character is escaped. Everything the client prints from a server goes through here."""
+    return printable(" ".join(text(value).split()))
 
 
 def problem_lines(status, problem, headers):

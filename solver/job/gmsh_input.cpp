@@ -48,7 +48,9 @@ std::string read_bytes(const fs::path& path, std::size_t max_bytes, std::string&
 std::unique_ptr<GmshMeshes::Parsed> GmshMeshes::parse(const std::string& text) const {
   auto p = std::make_unique<Parsed>();
   try {
-    p->file = mesh::gmsh::parse(text, static_cast<std::size_t>(std::max(0L, limits_.max_dofs / 2)));
+    // Node coordinates are bounded like every number of the job.
+    p->file = mesh::gmsh::parse(text, static_cast<std::size_t>(std::max(0L, limits_.max_dofs / 2)),
+                                read::kMaxMagnitude);
   } catch (const mesh::gmsh::ParseError& e) {
     p->error = e.what();
   }
@@ -90,6 +92,8 @@ std::optional<GmshBody> GmshMeshes::read(const json& value, const std::string& p
   std::optional<std::string> surface;
   if (const json* s = f.require("surface", "the name of the physical surface that is this body"))
     surface = read::string(*s, f.at("surface"), "surface", errors);
+  if (surface)
+    if (auto problem = read::control_character_problem(*surface, "surface")) errors.add(f.at("surface"), *problem);
   if (f.has("file") == f.has("data")) {
     errors.add(pointer, "give exactly one of file (the .msh file's path, relative to the job file) or data (the "
                         ".msh file's text)");

@@ -84,7 +84,9 @@ ParseResult JobReader::finish() {
 void JobReader::read_header(const Fields& top) {
   if (const json* v = top.find("name")) {
     if (auto s = read::string(*v, top.at("name"), "name", errors_)) {
-      if (s->size() > limits_.max_job_name_length)
+      if (auto problem = read::control_character_problem(*s, "name"))
+        errors_.add(top.at("name"), *problem);
+      else if (s->size() > limits_.max_job_name_length)
         errors_.add(top.at("name"), "name '" + read::shown(*s) + "' is too long: at most " +
                                         std::to_string(limits_.max_job_name_length) + " characters");
       else

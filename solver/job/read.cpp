@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <iomanip>
 #include <limits>
 #include <sstream>
@@ -57,9 +58,50 @@ std::string utf8_prefix(const std::string& text, size_t max) {
 }
 }  // namespace
 
+namespace {
+// The code point of the control character (U+0000-U+001F, U+007F-U+009F) at byte `k` of UTF-8 text and its
+// length in bytes, or length 0 when there is none there.
+std::pair<unsigned, size_t> control_at(const std::string& text, size_t k) {
+  const auto c = static_cast<unsigned char>(text[k]);
+  if (c < 0x20 || c == 0x7F) return {c, 1};
+  const auto next = k + 1 < text.size() ? static_cast<unsigned char>(text[k + 1]) : 0u;
+  if (c == 0xC2 && next >= 0x80 && next <= 0x9F) return {next, 2};
+  return {0, 0};
+}
+
+// The text with each control character written \u00XX, so that a message shows it rather than obeys it.
+std::string escape_controls(const std::string& text) {
+  std::string out;
+  for (size_t k = 0; k < text.size(); ++k) {
+    const auto [code, length] = control_at(text, k);
+    if (length == 0) {
+      out += text[k];
+      continue;
+    }
+    char buffer[8];
+    std::snprintf(buffer, sizeof buffer, "\\u%04X", code);
+    out += buffer;
+    k += length - 1;
+  }
+  return out;
+}
+}  // namespace
+
 std::string shown(const std::string& text, size_t max) {
-  if (text.size() <= max) return text;
-  return utf8_prefix(text, max) + "... (" + std::to_string(text.size()) + " bytes)";
+  if (text.size() <= max) return escape_controls(text);
+  return escape_controls(utf8_prefix(text, max)) + "... (" + std::to_string(text.size()) + " bytes)";
+}
+
+std::optional<std::string> control_character_problem(const std::string& s, const std::string& what) {
+  for (size_t k = 0; k < s.size(); ++k) {
+    const auto [code, length] = control_at(s, k);
+    if (length == 0) continue;
+    char buffer[8];
+    std::snprintf(buffer, sizeof buffer, "U+%04X", code);
+    return what + " '" + shown(s) + "' contains the control character " + buffer + " at byte " + std::to_string(k) +
+           ": it must be printable text (no control characters U+0000 to U+001F or U+007F to U+009F)";
+  }
+  return std::nullopt;
 }
 
 void Errors::add(std::string pointer, std::string message) {

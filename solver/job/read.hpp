@@ -32,8 +32,13 @@ std::string join_names(const std::vector<std::string>& names);
 std::string type_name(const json& value);
 
 // A value from the job for a message: itself when short, else its first `max` bytes (whole UTF-8 characters)
-// and how long it is, so that an error never echoes a huge input back.
+// and how long it is, so that an error never echoes a huge input back; control characters written \u00XX.
 std::string shown(const std::string& text, size_t max = 64);
+
+// Why `s` (the `what` of the job, e.g. "name") is not printable text: the first control character it holds
+// (U+0000-U+001F, U+007F-U+009F: a NUL cuts the name short in the result file, an escape sequence drives the
+// terminal that prints it), or nullopt.
+std::optional<std::string> control_character_problem(const std::string& s, const std::string& what);
 
 // The errors found so far, in the order found. Each message and pointer is cut to kMaxErrorText bytes, and only
 // the first kMaxErrors are kept (take() then adds one line saying how many more were found): a hostile document

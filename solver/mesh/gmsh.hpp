@@ -15,6 +15,7 @@
 #include "mesh.hpp"
 
 #include <cstddef>
+#include <limits>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -52,8 +53,10 @@ struct File {
 // Reads MSH 4.1 ASCII text (what `gmsh -2 x.geo -format msh41` writes). Throws ParseError for anything else:
 // another version (2.2, 4.0), a binary file, a partitioned mesh, malformed sections, an element on an unknown
 // node or with the wrong number of nodes for its type, more than max_nodes nodes or 4 max_nodes + 16 elements
-// (checked from the sections' headers, before they are read).
-File parse(const std::string& text, std::size_t max_nodes);
+// (checked from the sections' headers, before they are read), a node coordinate larger than max_magnitude in
+// magnitude (the job reader passes its bound on every number, read::kMaxMagnitude).
+File parse(const std::string& text, std::size_t max_nodes,
+           double max_magnitude = std::numeric_limits<double>::max());
 
 // The name of a Gmsh element type for messages ("6-node second-order triangle").
 std::string element_type_name(int type);

@@ -8,6 +8,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <sstream>
 #include <string_view>
 
 namespace contact::mesh::gmsh {
@@ -162,7 +163,19 @@ void read_entities(Lexer& in, File& f) {
   expect(in, "$EndEntities");
 }
 
-void read_nodes(Lexer& in, File& f, std::size_t max_nodes) {
+// A node's coordinate, at most `max_magnitude` in magnitude.
+double coordinate(Lexer& in, const File::Node& node, const char* axis, double max_magnitude) {
+  const double value = real(in, (std::string("a node's ") + axis).c_str());
+  if (std::abs(value) > max_magnitude) {
+    std::ostringstream os;
+    os << "node " << node.tag << ": " << axis << " = " << value << " is too large in magnitude (at most "
+       << max_magnitude << ")";
+    in.fail(os.str());
+  }
+  return value;
+}
+
+void read_nodes(Lexer& in, File& f, std::size_t max_nodes, double max_magnitude) {
   const long blocks = integer<long>(in, "the number of node blocks");
   const auto total = integer<std::size_t>(in, "the number of nodes");
   integer<std::size_t>(in, "the smallest node tag");
@@ -187,9 +200,9 @@ void read_nodes(Lexer& in, File& f, std::size_t max_nodes) {
     const int extra = parametric ? dim : 0;  // u, (v, (w)) after x y z
     for (size_t k = 0; k < n; ++k) {
       File::Node& node = f.nodes[first + k];
-      node.xy.x() = real(in, "a node's x");
-      node.xy.y() = real(in, "a node's y");
-      node.z = real(in, "a node's z");
+      node.xy.x() = coordinate(in, node, "x", max_magnitude);
+      node.xy.y() = coordinate(in, node, "y", max_magnitude);
+      node.z = coordinate(in, node, "z", max_magnitude);
       for (int e = 0; e < extra; ++e) real(in, "a node's parametric coordinate");
     }
   }
@@ -286,7 +299,7 @@ std::string element_type_name(int type) {
   }
 }
 
-File parse(const std::string& text, std::size_t max_nodes) {
+File parse(const std::string& text, std::size_t max_nodes, double max_magnitude) {
   Lexer in(text);
   File f;
   if (in.at_end()) throw ParseError("the file is empty");
@@ -305,7 +318,7 @@ File parse(const std::string& text, std::size_t max_nodes) {
       in.fail("partitioned meshes are not supported: save the mesh without partitions");
     } else if (section == "$Nodes") {
       if (nodes) in.fail("a second $Nodes section");
-      read_nodes(in, f, max_nodes);
+      read_nodes(in, f, max_nodes, max_magnitude);
       nodes = true;
     } else if (section == "$Elements") {
       if (!nodes) in.fail("$Elements before $Nodes");

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <set>
 #include <sstream>
+#include <unordered_set>
 
 namespace contact::mesh::gmsh {
 
@@ -29,11 +30,14 @@ std::string element_list(const std::vector<std::size_t>& tags) {
 
 const char* is_are(const std::vector<std::size_t>& tags) { return tags.size() == 1 ? "is" : "are"; }
 
-std::string quoted_list(std::vector<std::string> names) {
+// "'a', 'b' and 'c'"; beyond `max` names, the first `max` and "... and N more" (a file may hold 10^5 names).
+std::string quoted_list(const std::vector<std::string>& names, size_t max = 20) {
   if (names.empty()) return "(none)";
+  const size_t shown = std::min(names.size(), max);
   std::string out;
-  for (size_t k = 0; k < names.size(); ++k)
+  for (size_t k = 0; k < shown; ++k)
     out += (k == 0 ? "" : k + 1 == names.size() ? " and " : ", ") + ("'" + names[k] + "'");
+  if (shown < names.size()) out += " ... and " + std::to_string(names.size() - shown) + " more";
   return out;
 }
 
@@ -45,23 +49,46 @@ std::set<int> groups_named(const File& f, int dim, const std::string& name) {
   return out;
 }
 
-// Every name of the physical groups of dimension `dim`, in the order of their (first) physical tags, with its
-// physical tags.
-std::vector<std::pair<std::string, std::set<int>>> named_groups(const File& f, int dim) {
-  std::vector<std::pair<std::string, std::set<int>>> out;
+// A named physical group of one dimension: its name, and the element blocks on its entities (in file order).
+struct NamedGroup {
+  std::string name;
+  std::vector<const File::ElementBlock*> blocks;
+};
+
+// Every name of the physical groups of dimension `dim`, in the order of their (first) physical tags, with the
+// blocks on its entities. One pass over the names and one over the entities and blocks, each step a lookup: a
+// file with 10^5 names or blocks costs linear time, not names x names or names x blocks.
+std::vector<NamedGroup> named_groups(const File& f, int dim) {
+  std::vector<NamedGroup> out;
+  std::unordered_map<std::string, size_t> by_name;
+  std::unordered_map<int, size_t> by_tag;  // physical tag -> index into out
   for (const auto& [group, n] : f.physical_names) {
     if (group.first != dim) continue;
-    auto it = std::find_if(out.begin(), out.end(), [&, name = n](const auto& g) { return g.first == name; });
-    if (it == out.end()) it = out.insert(out.end(), {n, {}});
-    it->second.insert(group.second);
+    const auto [it, added] = by_name.emplace(n, out.size());
+    if (added) out.push_back({n, {}});
+    by_tag[group.second] = it->second;
+  }
+  std::map<int, std::set<size_t>> of_entity;  // entity -> the groups it is in
+  for (const auto& [entity, tags] : f.entity_groups) {
+    if (entity.first != dim) continue;
+    for (int tag : tags)
+      if (auto g = by_tag.find(tag); g != by_tag.end()) of_entity[entity.second].insert(g->second);
+  }
+  for (const auto& b : f.blocks) {
+    if (b.dim != dim) continue;
+    if (auto e = of_entity.find(b.entity); e != of_entity.end())
+      for (size_t g : e->second) out[g].blocks.push_back(&b);
   }
   return out;
 }
 
-bool in_groups(const File& f, int dim, int entity, const std::set<int>& groups) {
-  auto it = f.entity_groups.find({dim, entity});
-  if (it == f.entity_groups.end()) return false;
-  return std::any_of(it->second.begin(), it->second.end(), [&](int g) { return groups.count(g) > 0; });
+// The entities of dimension `dim` in any of the physical groups `groups`.
+std::set<int> entities_in(const File& f, int dim, const std::set<int>& groups) {
+  std::set<int> out;
+  for (const auto& [entity, tags] : f.entity_groups)
+    if (entity.first == dim && std::any_of(tags.begin(), tags.end(), [&](int g) { return groups.count(g) > 0; }))
+      out.insert(entity.second);
+  return out;
 }
 
 // The cells of the surface: node tags per cell and element tags, with the problems of element types.
@@ -74,8 +101,9 @@ RawCells collect_cells(const File& f, const std::set<int>& groups, const std::st
                        std::vector<std::string>& errors) {
   RawCells raw;
   std::map<int, std::vector<std::size_t>> unsupported;  // type -> element tags
+  const std::set<int> entities = entities_in(f, 2, groups);
   for (const auto& b : f.blocks) {
-    if (b.dim != 2 || !in_groups(f, 2, b.entity, groups)) continue;
+    if (b.dim != 2 || !entities.count(b.entity)) continue;
     if (b.type != kTriangle && b.type != kQuadrangle) {
       auto& list = unsupported[b.type];
       list.insert(list.end(), b.tags.begin(), b.tags.end());
@@ -173,11 +201,11 @@ std::map<std::pair<int, int>, int> check_topology(const Mesh& m, const std::vect
 // Physical curves: their 2-node lines on this surface's boundary become edge sets.
 void add_curves(const File& f, const std::unordered_map<std::size_t, int>& local,
                 const std::map<std::pair<int, int>, int>& side_count, const std::string& name, Surface& out) {
-  for (const auto& [curve, tags] : named_groups(f, 1)) {
+  for (const auto& [curve, blocks] : named_groups(f, 1)) {
     std::vector<std::array<int, 2>> pairs;
     std::vector<std::size_t> interior, second_order;
-    for (const auto& b : f.blocks) {
-      if (b.dim != 1 || !in_groups(f, 1, b.entity, tags)) continue;
+    for (const File::ElementBlock* block : blocks) {
+      const auto& b = *block;
       for (size_t k = 0; k < b.tags.size(); ++k) {
         const auto& nodes = b.nodes[k];  // a line's two end nodes come first, whatever its order
         if (nodes.size() < 2) continue;
@@ -216,11 +244,10 @@ void add_curves(const File& f, const std::unordered_map<std::size_t, int>& local
 // Physical points: one whose point lies on this surface (a node of its mesh) becomes a named vertex.
 void add_points(const File& f, const std::unordered_map<std::size_t, int>& local, const std::string& name,
                 Surface& out) {
-  for (const auto& [point, tags] : named_groups(f, 0)) {
+  for (const auto& [point, blocks] : named_groups(f, 0)) {
     std::set<int> nodes;  // this surface's nodes among the point's
-    for (const auto& b : f.blocks) {
-      if (b.dim != 0 || !in_groups(f, 0, b.entity, tags)) continue;
-      for (const auto& element : b.nodes)
+    for (const File::ElementBlock* b : blocks) {
+      for (const auto& element : b->nodes)
         for (std::size_t tag : element) {
           auto it = local.find(tag);
           if (it != local.end()) nodes.insert(it->second);
@@ -292,10 +319,11 @@ Surface surface(const File& f, const std::string& name) {
   Surface out;
   const std::set<int> groups = groups_named(f, 2, name);
   if (groups.empty()) {
-    std::vector<std::string> surfaces;
+    std::vector<std::string> surfaces;  // each name once, in the order of its first physical tag
+    std::unordered_set<std::string> seen;
     std::string other_kind;
     for (const auto& [group, n] : f.physical_names) {
-      if (group.first == 2 && std::find(surfaces.begin(), surfaces.end(), n) == surfaces.end()) surfaces.push_back(n);
+      if (group.first == 2 && seen.insert(n).second) surfaces.push_back(n);
       if (group.first != 2 && n == name) other_kind = group.first == 1 ? "curve" : group.first == 0 ? "point" : "volume";
     }
     out.errors.push_back(

@@ -241,6 +241,103 @@ for name in ("problem with non-string fields", "JSON null", "SSE data not JSON",
     check(f"as a command, {name}: exit 1 and no traceback", r.returncode == 1 and "Traceback" not in r.stderr and
           r.stderr.startswith("error: "), (r.returncode, r.stderr[-400:]))
 
+
+# Issue 22, defect 8: the download wrote 1.7 GB of a broken server's endless zeros (no Content-Length) before it
+# checked the HDF5 signature at the end. Now the first bytes are checked and nothing beyond the announced size is
+# written. What the client writes is counted through its module's open().
+class Endless:
+    """Answers a download with `head` (status line and headers), then `body_start` and zeros, up to `limit`
+    bytes (so that a client that does not stop fails the test instead of filling the disk)."""
+
+    def __init__(self, head, body_start=b"", limit=64 << 20):
+        self.head, self.body_start, self.limit = head, body_start, limit
+
+    def __call__(self, sock):
+        sock.sendall(self.head + b"\r\n" + self.body_start)
+        block, sent = b"\x00" * 65536, 0
+        try:
+            while sent < self.limit:
+                sock.sendall(block)
+                sent += len(block)
+        except OSError:  # the client closed the connection
+            pass
+
+
+written = []
+
+
+def counting_open(path, mode="r", *args, **kwargs):
+    f = open(path, mode, *args, **kwargs)
+    if "w" in mode and path.endswith(".part"):
+        write = f.write
+        written.append(0)
+
+        def counted(data):
+            written[-1] += len(data)
+            return write(data)
+        f.write = counted
+    return f
+
+
+client_module = sys.modules["contact_client.client"]
+client_module.open = counting_open
+HDF5_HEAD = b"HTTP/1.1 200 OK\r\nContent-Type: application/x-hdf5\r\nConnection: close\r\n"
+for name, answer, expect_file in (
+        ("no Content-Length, endless zeros", Endless(HDF5_HEAD), False),
+        ("no Content-Length, the HDF5 signature then endless zeros", Endless(HDF5_HEAD, cc.client.HDF5_SIGNATURE),
+         False),
+        ("1 MB announced, zeros", Endless(HDF5_HEAD + b"Content-Length: 1000000\r\n"), False),
+        ("1000 bytes announced, the signature then endless zeros",
+         Endless(HDF5_HEAD + b"Content-Length: 1000\r\n", cc.client.HDF5_SIGNATURE), True)):
+    server.answer = answer
+    written.clear()
+    if os.path.exists(download_to):
+        os.remove(download_to)
+    begin = time.time()
+    code, out, err, escaped = run_main(["download", JOB_ID, "-o", download_to, "--url", server.url, "--timeout", "5"])
+    total = sum(written)
+    if expect_file:
+        check(f"download, {name}: saves exactly the announced 1000 bytes", code == 0 and total == 1000 and
+              os.path.getsize(download_to) == 1000, (code, total, err[-300:]))
+    else:
+        check(f"download, {name}: exit 1 with a message, no file", code == 1 and err.startswith("error: ") and
+              not os.path.exists(download_to), (code, err[-300:], escaped))
+        check(f"download, {name}: at most a few KB written before the error", total <= 4096, total)
+    check(f"download, {name}: within seconds", time.time() - begin < 10, time.time() - begin)
+client_module.open = open
+
+# Issue 22, defect 9: escape sequences in what a server sends reached the terminal. Every string field of every
+# answer carries ESC (a colour, a clear screen, a window title), BEL, the one-byte C1 CSI and a bidi override.
+EVIL = "x\x1b[31m\x1b[2J\x1b]0;owned\x07\x9b1m\u202e"
+evil_job = {"id": EVIL, "state": "FAILED" + EVIL, "name": EVIL, "message": EVIL, "stop_reason": EVIL,
+            "error": {"message": EVIL}, "created": EVIL, "iterations": EVIL, "progress": {"note": EVIL}}
+evil_event = {"seq": 1, "type": "state", "state": EVIL, "message": EVIL}
+evil_end = {"seq": 2, "type": "end", "state": EVIL, "stop_reason": EVIL, "message": EVIL}
+EVIL_ANSWERS = {
+    "job resource": http(200, json.dumps({**evil_job, "jobs": [evil_job], "next_page_token": EVIL})),
+    "problem document": http(400, json.dumps({"type": "/problems/" + EVIL, "title": EVIL, "detail": EVIL,
+                                              "state": EVIL}), "application/problem+json"),
+    "invalid-job errors": http(400, json.dumps({"type": "/problems/invalid-job", "errors": [
+        {"pointer": "/" + EVIL, "message": EVIL}]}), "application/problem+json"),
+    "events": sse(json.dumps(evil_event), json.dumps({"seq": 2, "type": "iteration", "iteration": 1, "note": EVIL,
+                                                      "pairs": [{"name": EVIL}], "bodies": [{"name": EVIL}]}),
+                  json.dumps({"seq": 3, "type": "step", "bodies": [{"name": EVIL}]}), json.dumps(evil_end)),
+    "redirect": http(302, "", None, extra=b"Location: http://x/\x1b[2J\r\n"),
+}
+for name, answer in EVIL_ANSWERS.items():
+    server.answer = answer
+    for command in COMMANDS:
+        code, out, err, escaped = run_main(command + ["--url", server.url, "--timeout", "2"])
+        shown = out + err
+        label = f"control characters in the {name}: {' '.join(command[:2])}"
+        check(f"{label}: none printed raw", not any(c in shown for c in "\x1b\x07\x9b\u202e"),
+              repr(shown[-400:]))
+        if (name, command[0]) in (("job resource", "status"), ("job resource", "list"), ("events", "watch"),
+                                  ("invalid-job errors", "validate"), ("problem document", "status")) \
+                and "--json" not in command:  # JSON output escapes them itself (\\u001b)
+            check(f"{label}: shown escaped", "x\\x1b[31m\\x1b[2J\\x1b]0;owned\\x07\\x9b1m\\u202e" in shown,
+                  repr(shown[-400:]))
+
 check("python3 -m contact_client works", subprocess.run(
     [sys.executable, "-m", "contact_client", "--help"], capture_output=True, text=True,
     cwd=os.path.join(SRC, "clients")).returncode == 0)

@@ -104,6 +104,34 @@ with tempfile.TemporaryDirectory() as tmp:
     r = run(os.path.join(tmp, "missing.json"))
     check("missing file exits 2", r.returncode == 2 and "cannot open" in r.stderr, r.stderr)
 
+    # A floating body that its contacts cannot hold (issue 22, defect 12): a cap with no supports and no load on a
+    # base. A solver error, as README's table and docs/job-format.md say: exit 1, the body named, no result file
+    # (exit 3 is a run stopped without converging, whose result is written). Both methods that take floating bodies.
+    cap = {"name": "cap", "bodies": [
+        {"name": "cap", "material": {"E": 1000, "nu": 0.3},
+         "mesh": {"block": {"corners": [[0, 1], [1, 1], [1, 2], [0, 2]], "nx": 4, "ny": 4}}},
+        {"name": "base", "material": {"E": 1000, "nu": 0.3},
+         "mesh": {"block": {"corners": [[0, 0], [1, 0], [1, 1], [0, 1]], "nx": 4, "ny": 4}},
+         "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]}],
+        "contacts": [{"slave": "cap.bottom", "master": "base.top"}]}
+    for method in ("interface_newton", "monolithic"):
+        cap["solver"] = {"method": method}
+        cap_job, cap_out = os.path.join(tmp, f"cap_{method}.json"), os.path.join(tmp, f"cap_{method}.hdf")
+        with open(cap_job, "w") as f:
+            json.dump(cap, f)
+        r = run(cap_job, "-o", cap_out)
+        check(f"{method}: an unheld floating body exits 1 naming it", r.returncode == 1 and
+              "error: " in r.stderr and "body 'cap' floats" in r.stderr, f"{r.returncode} {r.stderr[-300:]}")
+        check(f"{method}: an unheld floating body writes no result", not os.path.exists(cap_out))
+    with open(os.path.join(SRC, "docs", "job-format.md"), encoding="utf-8") as f:
+        doc = " ".join(f.read().split())
+    check("docs/job-format.md gives the unheld floating body's exit code as 1",
+          "no contact holds it" in doc and "CLI exit code 1" in doc and "CLI exit code 3" not in doc)
+    with open(os.path.join(SRC, "README.md"), encoding="utf-8") as f:
+        readme = " ".join(f.read().split())
+    check("README's exit-code table puts the unheld floating body under 1",
+          "1 solver or I/O error (also a floating body that its contacts cannot hold" in readme)
+
     # The DOF limit is enforced from the command line.
     r = run(EXAMPLE, "--validate", "--max-dofs", "10")
     check("--max-dofs rejects", r.returncode == 2 and "/bodies" in r.stderr, r.stderr)

@@ -132,6 +132,8 @@ rejected_at("a number that overflows a double",
             lambda d: d["bodies"][0]["material"].update(E=float("inf")), ["bodies", 0, "material", "E"])
 rejected_at("a body name with a dot", lambda d: d["bodies"][0].update(name="up.per"),
             ["bodies", 0, "name"], "pattern")
+rejected_at("a job name with a NUL (issue 22)", lambda d: d.update(name="seed\x00layers"), ["name"], "pattern")
+rejected_at("a job name with an escape sequence", lambda d: d.update(name="red \x1b[31m"), ["name"], "pattern")
 rejected_at("a malformed contact reference", lambda d: d["contacts"][0].update(slave="upper"),
             ["contacts", 0, "slave"], "pattern")
 rejected_at("an unknown adaptivity indicator", lambda d: d.update(adaptivity={"indicator": "residual"}),
