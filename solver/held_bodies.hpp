@@ -1,5 +1,5 @@
 // Whether the contacts in contact at a solution hold every floating body: the check that interface Newton makes
-// on its active set (ddm/active_set.cpp: the equilibrium rows its contact nodes leave without support), made on a
+// on its active set (linalg/active_set.cpp: the equilibrium rows its contact nodes leave without support), made on a
 // finished result, for the methods that do not make it themselves (the monolithic reference, which otherwise
 // returns a zero displacement for a body whose rigid motion the solution leaves undetermined).
 #pragma once
