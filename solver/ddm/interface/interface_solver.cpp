@@ -17,8 +17,10 @@ constexpr Eigen::Index max_direct_rows = 40000;
 
 InterfaceSolverKind choose_interface_solver(const InterfaceSolverSettings& settings, const ContactSystem& system,
                                             const TaskRunner& runner) {
+  // By size only, not by the number of processes: the same job takes the same solver on any number of ranks, so
+  // its answer does not depend on them (the direct solver runs replicated on every rank; docs/parallel.md).
+  (void)runner;
   if (settings.solver != InterfaceSolverKind::automatic) return settings.solver;
-  if (runner.distributed()) return InterfaceSolverKind::iterative;
   Eigen::Index rows = 0, floating_rows = 0;
   for (const auto& pair : system.pairs()) rows += pair.n_rows();
   for (size_t a = 0; a < system.n_bodies(); ++a) floating_rows += system.body(a).rigid_modes().cols();

@@ -48,9 +48,9 @@ class InterfaceSolver {
   virtual linalg::ActiveSetResult solve(const InterfaceQp& qp, const Eigen::VectorXd* z0, InterfaceSolveContext& context) = 0;
 };
 
-// The solver to use for `system` under `settings`: the one asked for, or, automatically, the iterative solver on
-// several processes or where the direct one's dense Schur complement on the floating bodies' rows (r x r) or its
-// sparse factor would be large, the direct one otherwise.
+// The solver to use for `system` under `settings`: the one asked for, or, automatically, the iterative solver
+// where the direct one's dense Schur complement on the floating bodies' rows (r x r) or its sparse factor would be
+// large, the direct one otherwise (by size alone: the same on any number of processes).
 InterfaceSolverKind choose_interface_solver(const InterfaceSolverSettings& settings, const ContactSystem& system,
                                             const TaskRunner& runner);
 // How the interface problem must be built for that solver (blocks replicated or not, preconditioner).
