@@ -164,7 +164,12 @@ Handle create_file(const std::string& path) {
   Handle fapl = check(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "create a file access property list");
   // Strong: closing the file closes anything still open in it, so the file is complete once closed.
   if (H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG) < 0) fail("set the file close degree");
-  return check(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl), H5Fclose, "create the file");
+  // Attributes larger than an object header (64 KiB: the names of thousands of bodies or pairs) need dense
+  // attribute storage, which the file format of HDF5 1.8 has: every HDF5 reader since 2008 reads it.
+  if (H5Pset_libver_bounds(fapl, H5F_LIBVER_V18, H5F_LIBVER_LATEST) < 0) fail("set the file format bounds");
+  Handle fcpl = check(H5Pcreate(H5P_FILE_CREATE), H5Pclose, "create a file creation property list");
+  if (H5Pset_attr_phase_change(fcpl, 0, 0) < 0) fail("set dense attribute storage");
+  return check(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, fcpl, fapl), H5Fclose, "create the file");
 }
 
 Handle open_file(const std::string& path) {
@@ -172,7 +177,10 @@ Handle open_file(const std::string& path) {
 }
 
 Handle create_group(hid_t loc, const std::string& name) {
-  return check(H5Gcreate2(loc, name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose,
+  // Dense attribute storage (create_file): a group's attributes may exceed its object header.
+  Handle gcpl = check(H5Pcreate(H5P_GROUP_CREATE), H5Pclose, "create a group creation property list");
+  if (H5Pset_attr_phase_change(gcpl, 0, 0) < 0) fail("set dense attribute storage");
+  return check(H5Gcreate2(loc, name.c_str(), H5P_DEFAULT, gcpl, H5P_DEFAULT), H5Gclose,
                "create group '" + join_path(loc, name) + "'");
 }
 

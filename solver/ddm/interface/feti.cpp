@@ -3,6 +3,7 @@
 #include "../../linalg/mprgp.hpp"
 #include "coarse_space.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -38,12 +39,20 @@ class Smalbe {
   const Eigen::Index m_;
   Eigen::VectorXd z_I_, Pc_, diagonal_;
   double rho_ = 1.0, norm_A_ = 1.0, norm_PHP_ = 1.0;
+  double seconds_F_ = 0.0, seconds_coarse_ = 0.0;  // products with F (and their sum over processes), P and Q
   linalg::BoundQp bound_;
   std::vector<char> previous_active_;
 };
 
+// Seconds since `start`, added to `total` (the per-iteration costs that docs/parallel.md's model is built from).
+void add_seconds(double& total, std::chrono::steady_clock::time_point start) {
+  total += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 bool Smalbe::apply_H(const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+  const auto start = std::chrono::steady_clock::now();
   bool stop = qp_.problem.apply(x, y, ctx_.runner);
+  add_seconds(seconds_F_, start);
   if (qp_.penalty.size() == m_) y += qp_.penalty.cwiseProduct(x);
   // One process: the token directly; several: only the agreed answer of the sum, the same on every process.
   if (!ctx_.runner.distributed()) stop = stop || ctx_.cancel.cancelled();
@@ -51,10 +60,14 @@ bool Smalbe::apply_H(const Eigen::VectorXd& x, Eigen::VectorXd& y) {
 }
 
 bool Smalbe::apply_A(const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+  auto start = std::chrono::steady_clock::now();
   const Eigen::VectorXd Px = coarse_.project(x);
+  add_seconds(seconds_coarse_, start);
   Eigen::VectorXd HPx;
   const bool stop = apply_H(Px, HPx);
+  start = std::chrono::steady_clock::now();
   y = coarse_.project(HPx) + rho_ * (x - Px);
+  add_seconds(seconds_coarse_, start);
   return stop;
 }
 
@@ -196,7 +209,8 @@ ActiveSetResult Smalbe::run(const Eigen::VectorXd* z0) {
       std::ostringstream os;
       os << "FETI (projected MPRGP, SMALBE) converged: " << out.inner_iterations << " MPRGP iterations in " << outer
          << " outer iterations (" << r.cg_steps << " CG, " << r.expansion_steps << " expansion, "
-         << r.proportioning_steps << " proportioning steps in the last)";
+         << r.proportioning_steps << " proportioning steps in the last; F products " << seconds_F_
+         << " s, coarse projections " << seconds_coarse_ << " s)";
       out.message = out.converged ? os.str() : "the contact nodes in contact do not hold every floating body";
       return out;
     }
