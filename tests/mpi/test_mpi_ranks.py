@@ -102,39 +102,46 @@ with tempfile.TemporaryDirectory() as tmp:
     check("every course of the wall carries pressure x width (1e-10)", len(per_course) == 8 and worst < 1e-10,
           f"{per_course} vs {expected}")
 
-    # The interface solvers on ranks: each equals the monolithic reference (one process) to 1e-8 on walls whose
-    # bricks float (dowelled: two rigid motions each; abutments: all three), on 1, 2 and 3 ranks.
-    for flags, label in (([], "dowelled"), (["--abutments"], "abutments")):
-        wall_path = os.path.join(tmp, f"wall_{label}.json")
-        subprocess.run(["/usr/bin/python3", os.path.join(SRC, "scripts", "make_brick_wall.py"), "--rows", "6",
-                        "--bricks", "6", "--cells", "4", *flags, "-o", wall_path], check=True, capture_output=True)
-        with open(wall_path) as f:
-            wall_job = json.load(f)
-        reference = os.path.join(tmp, f"wall_{label}.mono.hdf")
-        wall_job["solver"] = {"method": "monolithic"}
-        with open(wall_path, "w") as f:
-            json.dump(wall_job, f)
-        r = subprocess.run([CLI, wall_path, "-o", reference, "-q"], capture_output=True, text=True, timeout=300)
-        check(f"wall {label}: monolithic reference", r.returncode == 0, r.stdout[-300:])
+    # The interface solvers on ranks: each equals the monolithic reference (one process) to 1e-8, on 1, 2 and 3
+    # ranks, on the examples with floating bodies and on walls whose bricks float (dowelled: two rigid motions
+    # each; abutments: all three) up to 16 x 16.
+    cases = []
+    for n, flags, label in ((8, [], "wall 8x8 dowelled"), (16, [], "wall 16x16 dowelled"),
+                            (8, ["--abutments"], "wall 8x8 abutments"), (16, ["--abutments"], "wall 16x16 abutments")):
+        path = os.path.join(tmp, label.replace(" ", "_") + ".json")
+        subprocess.run(["/usr/bin/python3", os.path.join(SRC, "scripts", "make_brick_wall.py"), "--rows", str(n),
+                        "--bricks", str(n), "--cells", "2", *flags, "-o", path], check=True, capture_output=True)
+        cases.append((label, path))
+    for name in ("stack3_floating", "hertz_force", "punch_force", "flat_patch_nonmatching"):
+        cases.append((name, os.path.join(EXAMPLES, name + ".json")))
+    for label, source in cases:
+        with open(source) as f:
+            job = json.load(f)
+        path = os.path.join(tmp, "case.json")
+        reference = os.path.join(tmp, "case.mono.hdf")
+        job["solver"] = {"method": "monolithic"}
+        with open(path, "w") as f:
+            json.dump(job, f)
+        r = subprocess.run([CLI, path, "-o", reference, "-q"], capture_output=True, text=True, timeout=300)
+        check(f"{label}: monolithic reference", r.returncode == 0, r.stdout[-300:])
         for solver in ("direct", "iterative"):
-            wall_job["solver"] = {"method": "interface_newton", "interface": {"solver": solver}}
-            with open(wall_path, "w") as f:
-                json.dump(wall_job, f)
+            job["solver"] = {"method": "interface_newton", "interface": {"solver": solver}}
+            with open(path, "w") as f:
+                json.dump(job, f)
             for ranks in (1, 2, 3):
-                out = os.path.join(tmp, f"wall_{label}.{solver}.{ranks}.hdf")
-                r = mpirun(ranks, wall_path, "-o", out, "-q")
-                check(f"wall {label} {solver} on {ranks} ranks exits 0", r.returncode == 0, r.stdout[-400:])
+                out = os.path.join(tmp, f"case.{solver}.{ranks}.hdf")
+                r = mpirun(ranks, path, "-o", out, "-q")
+                check(f"{label} {solver} on {ranks} ranks exits 0", r.returncode == 0, r.stdout[-400:])
                 try:
                     worst, where, _, _ = max_relative_difference(reference, out)
                 except Exception as e:  # noqa: BLE001 - a missing file is a failure, reported
-                    check(f"wall {label} {solver} on {ranks} ranks readable", False, str(e))
+                    check(f"{label} {solver} on {ranks} ranks readable", False, str(e))
                     continue
-                check(f"wall {label} {solver} on {ranks} ranks = monolithic to 1e-8", worst <= 1e-8,
-                      f"{worst:.3e} at {where}")
+                check(f"{label} {solver} on {ranks} ranks = monolithic to 1e-8", worst <= 1e-8, f"{worst:.3e} at {where}")
                 with h5py.File(out, "r") as f:
                     used = f["provenance"].attrs["interface_solver"]
                     used = used.decode() if isinstance(used, bytes) else used
-                check(f"wall {label} {solver} on {ranks} ranks: the result names the solver", used == solver, used)
+                check(f"{label} {solver} on {ranks} ranks: the result names the solver", used == solver, used)
 
     # A failure on rank 1 (injected into the task of body 2, which rank 1 owns): every rank stops with the
     # message, exit code 1, and no result file.
