@@ -1,9 +1,8 @@
 #include "fixed_point.hpp"
 
-#include <Eigen/QR>
+#include "../linalg/anderson.hpp"
 
 #include <cmath>
-#include <deque>
 #include <random>
 #include <sstream>
 
@@ -125,8 +124,7 @@ MethodOutcome run_fixed_point(const ContactSystem& system, const SolverSettings&
   for (size_t a = 0; a < n; ++a) zone_per_body[a] = system.zone_normals(a, u[a]);
 
   // Anderson history: iterate and residual differences (full bodies) and interface-residual differences.
-  std::deque<Displacements> dX, dR;
-  std::deque<Eigen::VectorXd> dr;
+  linalg::AndersonHistory<std::pair<Displacements, Displacements>> history(depth);
   Displacements previous_u, previous_R;
   Eigen::VectorXd previous_r;
   int failed_restarts = 0, growth = 0, backoffs = 0;
@@ -182,50 +180,22 @@ MethodOutcome run_fixed_point(const ContactSystem& system, const SolverSettings&
                     gamma, smallest_residual, residual);
       best_iteration = k;
       next = best_u;
-      dX.clear();
-      dR.clear();
-      dr.clear();
+      history.clear();
       previous_u.clear();
       growth = 0;
     } else if (anderson) {
-      if (!previous_u.empty()) {
-        dX.push_back(difference(u, previous_u));
-        dR.push_back(difference(R, previous_R));
-        dr.push_back(r - previous_r);
-        if (dr.size() > depth) {
-          dX.pop_front();
-          dR.pop_front();
-          dr.pop_front();
-        }
-      }
+      if (!previous_u.empty()) history.push(r - previous_r, {difference(u, previous_u), difference(R, previous_R)});
       previous_u = u;
       previous_R = R;
       previous_r = r;
       next = axpy(u, gamma, R);
-      if (!dr.empty()) {
-        // min || r - dr c || by QR; columns that make it ill-conditioned are dropped (oldest first).
-        while (!dr.empty()) {
-          Eigen::MatrixXd A(r.size(), static_cast<Eigen::Index>(dr.size()));
-          for (size_t i = 0; i < dr.size(); ++i) A.col(static_cast<Eigen::Index>(i)) = dr[i];
-          Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A);
-          const auto& Rm = qr.matrixR();
-          const double d0 = std::abs(Rm(0, 0)), dmin = std::abs(Rm(A.cols() - 1, A.cols() - 1));
-          if (qr.rank() == A.cols() && dmin > 1e-10 * d0) {
-            const Eigen::VectorXd c = qr.solve(r);
-            for (size_t i = 0; i < dr.size(); ++i) {
-              const double ci = c[static_cast<Eigen::Index>(i)];
-              for (size_t a = 0; a < n; ++a) next[a] -= ci * (dX[i][a] + gamma * dR[i][a]);
-            }
-            break;
-          }
-          dX.pop_front();
-          dR.pop_front();
-          dr.pop_front();
-        }
-      }
+      // min || r - dr c || by QR; columns that make it ill-conditioned are dropped (oldest first).
+      history.mix(r, [&](double c, const std::pair<Displacements, Displacements>& d) {
+        for (size_t a = 0; a < n; ++a) next[a] -= c * (d.first[a] + gamma * d.second[a]);
+      });
       // Safeguard: an accelerated residual ten times the best restarts the history from the best iterate;
       // four restarts in a row without a 10 % improvement of the best in between fall back to plain relaxation.
-      if (residual > 10.0 * smallest_residual && dr.size() >= 1) {
+      if (residual > 10.0 * smallest_residual && !history.empty()) {
         failed_restarts = smallest_residual < 0.9 * best_at_restart ? 0 : failed_restarts + 1;
         best_at_restart = smallest_residual;
         note = "Anderson restarted (residual " + format("%.3g", residual) + " above ten times the best)";
@@ -233,9 +203,7 @@ MethodOutcome run_fixed_point(const ContactSystem& system, const SolverSettings&
           anderson = false;
           note = "Anderson acceleration abandoned after 4 restarts without progress: plain relaxation";
         }
-        dX.clear();
-        dR.clear();
-        dr.clear();
+        history.clear();
         previous_u.clear();
         next = axpy(best_u, gamma, difference(map.apply(best_u), best_u));
         ++solves;

@@ -1,0 +1,13 @@
+// The augmented Lagrangian around a penalty method: Uzawa updates of the contact multipliers, Anderson-mixed.
+#pragma once
+
+#include "driver.hpp"
+
+namespace contact::ddm {
+
+// Augmented Lagrangian (Uzawa): solve the penalty problem on the gaps shifted by theta lambda, then set lambda to
+// the resulting pressures; repeat until the pressures settle (augmented_lagrangian.cpp). updates receives how many.
+MethodOutcome run_augmented_lagrangian(ContactSystem& system, const SolverSettings& settings, RunContext& context,
+                                       MethodRunner& runner, int& updates);
+
+}  // namespace contact::ddm
