@@ -104,15 +104,15 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
       return result;
     }
     ddm::RunContext context{observer, cancel, runner, start};
-    ddm::MethodRunner method(system, active.solver);
+    const std::unique_ptr<ddm::ContactMethod> method = ddm::make_method(system, active.solver);
     int updates = 0;
     std::vector<Step> steps;
     ddm::MethodOutcome outcome;
     if (adaptive) {
       system.set_load_factor(problem.loading.factors.back());
-      outcome = adapt::run_adaptive(working, system, context, method, steps, updates);
+      outcome = adapt::run_adaptive(working, system, context, *method, steps, updates);
     } else {
-      outcome = ddm::run_load_steps(system, problem.solver, problem.loading.factors, context, method, steps, updates);
+      outcome = ddm::run_load_steps(system, problem.solver, problem.loading.factors, context, *method, steps, updates);
     }
     result.converged = outcome.converged;
     result.stop_reason = outcome.reason;

@@ -99,7 +99,7 @@ Step make_step(const ddm::ContactSystem& system, const ddm::Displacements& u, co
 }
 
 ddm::MethodOutcome converge_then_refine(Problem& working, ddm::ContactSystem& system, ddm::RunContext& context,
-                                        ddm::MethodRunner& method, std::vector<Step>& steps, int& updates) {
+                                        ddm::ContactMethod& method, std::vector<Step>& steps, int& updates) {
   const auto& s = working.adaptivity;
   ddm::MethodOutcome total;
   std::vector<int> refined_last;
@@ -253,7 +253,7 @@ ddm::MethodOutcome paper_interleaving(Problem& working, ddm::ContactSystem& syst
 }  // namespace
 
 ddm::MethodOutcome run_adaptive(Problem& working, ddm::ContactSystem& system, ddm::RunContext& context,
-                                ddm::MethodRunner& method, std::vector<Step>& steps, int& updates) {
+                                ddm::ContactMethod& method, std::vector<Step>& steps, int& updates) {
   updates = 0;
   if (working.adaptivity.strategy == AdaptStrategy::paper) return paper_interleaving(working, system, context, steps);
   return converge_then_refine(working, system, context, method, steps, updates);

@@ -14,6 +14,6 @@ namespace contact::adapt {
 
 // `working` is the problem the system was built from; its meshes are refined in place.
 ddm::MethodOutcome run_adaptive(Problem& working, ddm::ContactSystem& system, ddm::RunContext& context,
-                                ddm::MethodRunner& method, std::vector<Step>& steps, int& updates);
+                                ddm::ContactMethod& method, std::vector<Step>& steps, int& updates);
 
 }  // namespace contact::adapt

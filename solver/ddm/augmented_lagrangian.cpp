@@ -15,7 +15,7 @@ namespace contact::ddm {
 // multiplier near zero (100 updates on stack3), so the multiplier fixed point is Anderson-mixed (depth 5,
 // projected onto lambda >= 0, restarted when a mixed update makes the residual ten times worse).
 MethodOutcome run_augmented_lagrangian(ContactSystem& system, const SolverSettings& settings, RunContext& context,
-                                       MethodRunner& runner, int& updates) {
+                                       ContactMethod& method, int& updates) {
   MethodOutcome total;
   Displacements warm;
   const auto& al = settings.augmented_lagrangian;
@@ -32,7 +32,7 @@ MethodOutcome run_augmented_lagrangian(ContactSystem& system, const SolverSettin
   for (int update = 1; update <= al.max_updates; ++update) {
     OffsetObserver observer(context.observer, total.iterations, update);
     RunContext inner{observer, context.cancel, context.runner, context.start, warm.empty() ? nullptr : &warm};
-    MethodOutcome o = runner.run(inner);
+    MethodOutcome o = method.run(inner);
     updates = update;
     for (auto& r : o.history) {
       r.iteration += total.iterations;

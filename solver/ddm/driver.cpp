@@ -17,28 +17,8 @@ void OffsetObserver::on_iteration(const IterationReport& r) {
   inner_.on_iteration(copy);
 }
 
-MethodOutcome MethodRunner::run(RunContext& context) {
-  switch (settings_.method) {
-    case Method::monolithic: return run_monolithic(system_, settings_, context);
-    case Method::robin: return run_robin(system_, settings_, context);
-    case Method::interface_newton: {
-      if (system_.pairs().empty()) return run_neumann(system_, settings_, context);
-      int setup = 0;
-      if (!interface_newton_) {
-        interface_newton_ = std::make_unique<InterfaceNewton>(system_, settings_, context.runner);
-        setup = 1;  // the free response of every body
-      }
-      MethodOutcome out = interface_newton_->solve(settings_, context);
-      out.solves_per_body += setup;
-      return out;
-    }
-    case Method::neumann: break;
-  }
-  return run_neumann(system_, settings_, context);
-}
-
 MethodOutcome run_enforced(ContactSystem& system, const SolverSettings& settings, RunContext& context,
-                           MethodRunner& runner, int& updates) {
+                           ContactMethod& method, int& updates) {
   updates = 0;
   if (settings.enforcement == Enforcement::exact &&
       (settings.method == Method::neumann || settings.method == Method::robin)) {
@@ -50,8 +30,8 @@ MethodOutcome run_enforced(ContactSystem& system, const SolverSettings& settings
     return out;
   }
   if (settings.enforcement == Enforcement::augmented_lagrangian)
-    return run_augmented_lagrangian(system, settings, context, runner, updates);
-  return runner.run(context);
+    return run_augmented_lagrangian(system, settings, context, method, updates);
+  return method.run(context);
 }
 
 }  // namespace contact::ddm

@@ -1,8 +1,7 @@
-// Runs one contact method, with or without augmented-Lagrangian updates, on a ContactSystem: the dispatch
-// shared by solve() and the adaptive loop.
+// Runs one contact method, with or without augmented-Lagrangian updates, on a ContactSystem: what solve(), the
+// load steps and the adaptive loop call.
 #pragma once
 
-#include "interface/interface_newton.hpp"
 #include "method.hpp"
 
 #include <memory>
@@ -23,22 +22,8 @@ class OffsetObserver final : public Observer {
   std::vector<int> refined_;
 };
 
-// Runs the chosen method once on the pairs' current (possibly multiplier-shifted) gaps. Keeps interface
-// Newton's interface problem between calls; reset() forgets it (after the meshes changed).
-class MethodRunner {
- public:
-  MethodRunner(const ContactSystem& system, const SolverSettings& settings) : system_(system), settings_(settings) {}
-  MethodOutcome run(RunContext& context);
-  void reset() { interface_newton_.reset(); }
-
- private:
-  const ContactSystem& system_;
-  const SolverSettings& settings_;
-  std::unique_ptr<InterfaceNewton> interface_newton_;
-};
-
 // The method, inside augmented-Lagrangian updates if the settings ask for them (updates receives how many).
 MethodOutcome run_enforced(ContactSystem& system, const SolverSettings& settings, RunContext& context,
-                           MethodRunner& runner, int& updates);
+                           ContactMethod& method, int& updates);
 
 }  // namespace contact::ddm

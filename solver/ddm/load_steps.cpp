@@ -4,7 +4,7 @@
 namespace contact::ddm {
 
 MethodOutcome run_load_steps(ContactSystem& system, const SolverSettings& settings, const std::vector<double>& factors,
-                             RunContext& context, MethodRunner& runner, std::vector<Step>& steps, int& updates) {
+                             RunContext& context, ContactMethod& method, std::vector<Step>& steps, int& updates) {
   MethodOutcome total;
   Displacements warm;
   updates = 0;
@@ -13,7 +13,7 @@ MethodOutcome run_load_steps(ContactSystem& system, const SolverSettings& settin
     OffsetObserver observer(context.observer, total.iterations);
     RunContext inner{observer, context.cancel, context.runner, context.start, warm.empty() ? nullptr : &warm};
     int step_updates = 0;
-    MethodOutcome o = run_enforced(system, settings, inner, runner, step_updates);
+    MethodOutcome o = run_enforced(system, settings, inner, method, step_updates);
     updates += step_updates;
     for (auto& r : o.history) {
       r.iteration += total.iterations;

@@ -10,6 +10,6 @@
 namespace contact::ddm {
 
 MethodOutcome run_load_steps(ContactSystem& system, const SolverSettings& settings, const std::vector<double>& factors,
-                             RunContext& context, MethodRunner& runner, std::vector<Step>& steps, int& updates);
+                             RunContext& context, ContactMethod& method, std::vector<Step>& steps, int& updates);
 
 }  // namespace contact::ddm

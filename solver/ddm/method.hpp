@@ -1,11 +1,13 @@
-// What every contact method (interface Newton, Neumann DDM, Robin, monolithic reference) takes and returns, so
-// that solve() only dispatches.
+// What every contact method (interface Newton, Neumann DDM, Robin, monolithic reference) takes and returns, and
+// the one interface they share (ContactMethod, made by make_method), so that the outer loops (augmented
+// Lagrangian, load steps, adaptivity) and solve() know no method by name.
 #pragma once
 
 #include "../result.hpp"
 #include "contact_system.hpp"
 
 #include <chrono>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -43,6 +45,28 @@ struct MethodOutcome {
     if (!inner.interface_solver.empty()) interface_solver = inner.interface_solver;
   }
 };
+
+// A contact method on a ContactSystem: run() solves once on the pairs' current gaps (and augmented-Lagrangian
+// multipliers); without contact pairs every method's answer is each body solved once, which run() gives for all.
+// A method may keep what it built for the system between runs (interface Newton: its interface problem); reset()
+// forgets it after the meshes changed. A new method is a class here and a case in make_method (method.cpp).
+class ContactMethod {
+ public:
+  ContactMethod(const ContactSystem& system, const SolverSettings& settings) : system_(system), settings_(settings) {}
+  virtual ~ContactMethod() = default;
+  ContactMethod(const ContactMethod&) = delete;
+  ContactMethod& operator=(const ContactMethod&) = delete;
+
+  MethodOutcome run(RunContext& context);
+  virtual void reset() {}
+
+ protected:
+  virtual MethodOutcome solve(RunContext& context) = 0;
+  const ContactSystem& system_;
+  const SolverSettings& settings_;
+};
+
+std::unique_ptr<ContactMethod> make_method(const ContactSystem& system, const SolverSettings& settings);
 
 // The paper's parallel Neumann scheme (16)-(17) on fixed meshes.
 MethodOutcome run_neumann(const ContactSystem& system, const SolverSettings& settings, RunContext& context);

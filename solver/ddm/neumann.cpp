@@ -8,23 +8,6 @@
 namespace contact::ddm {
 
 MethodOutcome run_neumann(const ContactSystem& system, const SolverSettings& settings, RunContext& context) {
-  const size_t n = system.n_bodies();
-  // Without contact pairs the bodies are independent: one solve each is the answer.
-  if (system.pairs().empty()) {
-    MethodOutcome out;
-    std::vector<std::vector<char>> active;
-    out.u = system.solve_bodies(Displacements(n), context.runner);
-    out.iterations = 1;
-    out.solves_per_body = 1;
-    IterationReport r = system.report(1, out.u, active);
-    r.elapsed_seconds = context.elapsed();
-    context.observer.on_iteration(r);
-    out.history.push_back(std::move(r));
-    out.converged = true;
-    out.reason = StopReason::converged;
-    out.message = "no contact pairs: each body solved once";
-    return out;
-  }
   int initial_solves = 0;
   Displacements u0 = initial_iterate(system, settings, context, initial_solves);
   NeumannMap map(system, context.runner);

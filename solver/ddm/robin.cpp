@@ -130,7 +130,6 @@ class RobinMap final : public BodyMap {
 }  // namespace
 
 MethodOutcome run_robin(const ContactSystem& system, const SolverSettings& settings, RunContext& context) {
-  if (system.pairs().empty()) return run_neumann(system, settings, context);
   int initial_solves = 0;
   Displacements u0 = initial_iterate(system, settings, context, initial_solves);
   RobinMap map(system, settings, context.runner);
