@@ -140,184 +140,240 @@ std::vector<size_t> multiplier_partition(const SegmentMesh& segments, const std:
 
 }  // namespace
 
-PairDiscretization discretize_pair(const Problem& problem, int pair_index, double theta) {
-  const ContactPair& pair = problem.contacts[static_cast<size_t>(pair_index)];
-  const Body& slave = problem.bodies[static_cast<size_t>(pair.slave_body)];
-  const Body& master = problem.bodies[static_cast<size_t>(pair.master_body)];
-  const double thickness = problem.model.plane == Plane::stress ? problem.model.thickness : 1.0;
+namespace {
 
-  PairDiscretization d;
-  d.name = pair.name;
-  d.slave_body = pair.slave_body;
-  d.master_body = pair.master_body;
-  d.theta = theta;
-  d.slave_nodes = slave.mesh.edge_set_nodes(pair.slave_edge);
-  d.master_nodes = master.mesh.edge_set_nodes(pair.master_edge);
-  const auto S = coordinates(slave.mesh, d.slave_nodes);
-  const auto Mx = coordinates(master.mesh, d.master_nodes);
-  const size_t n = S.size();
-  const SegmentMesh segments = build_segment_mesh(S, Mx);
-  const size_t n_segments = n < 2 ? 0 : n - 1;
-  std::vector<double> master_length;
-  for (size_t j = 0; j + 1 < Mx.size(); ++j) master_length.push_back((Mx[j + 1] - Mx[j]).norm());
+// discretize_pair in its phases (the mortar segment mesh's geometry first, then the algebra on it):
+// cut the slave edge against the master edge, build each multiplier run's dual basis, classify the multiplier
+// nodes, number the rows, integrate over the mortar segments, assemble the sparse operators.
+class PairBuilder {
+ public:
+  PairBuilder(const Problem& problem, int pair_index, double theta)
+      : pair_(problem.contacts[static_cast<size_t>(pair_index)]),
+        slave_(problem.bodies[static_cast<size_t>(pair_.slave_body)]),
+        master_(problem.bodies[static_cast<size_t>(pair_.master_body)]),
+        thickness_(problem.model.plane == Plane::stress ? problem.model.thickness : 1.0) {
+    d_.name = pair_.name;
+    d_.slave_body = pair_.slave_body;
+    d_.master_body = pair_.master_body;
+    d_.theta = theta;
+  }
 
-  d.node_arc = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
-  for (size_t k = 1; k < n; ++k) d.node_arc[static_cast<Eigen::Index>(k)] = d.node_arc[static_cast<Eigen::Index>(k) - 1] + (S[k] - S[k - 1]).norm();
-  auto arc = [&](size_t i) { return d.node_arc[static_cast<Eigen::Index>(i)]; };
+  PairDiscretization build() {
+    cut_segments();
+    dual_bases();
+    classify_nodes();
+    number_rows();
+    integrate();
+    assemble_operators();
+    return std::move(d_);
+  }
 
-  std::vector<std::vector<const MortarSegment*>> on_segment(n_segments);
-  for (const auto& s : segments.segments) {
-    on_segment[static_cast<size_t>(s.slave)].push_back(&s);
-    d.covered_length += (s.xi1 - s.xi0) * segments.slave_length[static_cast<size_t>(s.slave)];
+ private:
+  using VectorEntries = std::map<std::pair<int, int>, Eigen::Vector2d>;  // (row, node) -> vector coefficient
+
+  double arc(size_t i) const { return d_.node_arc[static_cast<Eigen::Index>(i)]; }
+
+  // The slave and master nodes, the segment mesh, arc lengths, and which mortar segments lie on each slave segment.
+  void cut_segments() {
+    d_.slave_nodes = slave_.mesh.edge_set_nodes(pair_.slave_edge);
+    d_.master_nodes = master_.mesh.edge_set_nodes(pair_.master_edge);
+    S_ = coordinates(slave_.mesh, d_.slave_nodes);
+    const auto Mx = coordinates(master_.mesh, d_.master_nodes);
+    n_ = S_.size();
+    segments_ = build_segment_mesh(S_, Mx);
+    const size_t n_segments = n_ < 2 ? 0 : n_ - 1;
+    for (size_t j = 0; j + 1 < Mx.size(); ++j) master_length_.push_back((Mx[j + 1] - Mx[j]).norm());
+    d_.node_arc = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n_));
+    for (size_t k = 1; k < n_; ++k)
+      d_.node_arc[static_cast<Eigen::Index>(k)] = d_.node_arc[static_cast<Eigen::Index>(k) - 1] + (S_[k] - S_[k - 1]).norm();
+    on_segment_.assign(n_segments, {});
+    for (const auto& s : segments_.segments) {
+      on_segment_[static_cast<size_t>(s.slave)].push_back(&s);
+      d_.covered_length += (s.xi1 - s.xi0) * segments_.slave_length[static_cast<size_t>(s.slave)];
+    }
   }
 
   // Multiplier segments (runs of slave segments between consecutive multiplier nodes), each with its dual basis
   // on its covered part, in the arc-length parameter s of the run.
-  d.multiplier_nodes = n_segments ? multiplier_partition(segments, master_length) : std::vector<size_t>{};
-  const size_t n_runs = d.multiplier_nodes.empty() ? 0 : d.multiplier_nodes.size() - 1;
-  std::vector<std::optional<DualBasis>> basis(n_runs);
-  for (size_t m = 0; m < n_runs; ++m) {
-    const size_t a = d.multiplier_nodes[m], b = d.multiplier_nodes[m + 1];
-    const double L = arc(b) - arc(a);
-    std::vector<std::pair<double, double>> covered;
-    for (size_t k = a; k < b; ++k)
-      for (const auto* s : on_segment[k])
-        covered.emplace_back((arc(k) + s->xi0 * segments.slave_length[k] - arc(a)) / L,
-                             (arc(k) + s->xi1 * segments.slave_length[k] - arc(a)) / L);
-    if (L > 0) basis[m] = dual_basis(covered, L);
+  void dual_bases() {
+    d_.multiplier_nodes = on_segment_.empty() ? std::vector<size_t>{} : multiplier_partition(segments_, master_length_);
+    n_runs_ = d_.multiplier_nodes.empty() ? 0 : d_.multiplier_nodes.size() - 1;
+    basis_.assign(n_runs_, std::nullopt);
+    for (size_t m = 0; m < n_runs_; ++m) {
+      const size_t a = d_.multiplier_nodes[m], b = d_.multiplier_nodes[m + 1];
+      const double L = arc(b) - arc(a);
+      std::vector<std::pair<double, double>> covered;
+      for (size_t k = a; k < b; ++k)
+        for (const auto* s : on_segment_[k])
+          covered.emplace_back((arc(k) + s->xi0 * segments_.slave_length[k] - arc(a)) / L,
+                               (arc(k) + s->xi1 * segments_.slave_length[k] - arc(a)) / L);
+      if (L > 0) basis_[m] = dual_basis(covered, L);
+    }
   }
 
   // Which multiplier nodes carry a multiplier: covered enough, and not a crosspoint. The other slave nodes lie
   // inside a multiplier segment.
-  d.status.assign(n, NodeStatus::inner);
-  const auto prescribed = prescribed_components(slave);
-  for (size_t m = 0; m <= n_runs && n_runs > 0; ++m) {
-    const size_t i = d.multiplier_nodes[m];
-    double support = 0, covered = 0;
-    Eigen::Vector2d nu = Eigen::Vector2d::Zero();
-    for (size_t run : {m - 1, m}) {  // the runs before and after node i (m - 1 wraps for m = 0: skipped)
-      if (run >= n_runs) continue;
-      const size_t a = d.multiplier_nodes[run], b = d.multiplier_nodes[run + 1];
-      support += 0.5 * (arc(b) - arc(a));
-      if (!basis[run]) continue;
-      const double Dk = basis[run]->D[run == m ? 0 : 1];
-      covered += Dk;
-      const size_t k = run == m ? a : b - 1;  // the slave segment next to node i
-      nu += Dk * segments.slave_normal[k];
-    }
-    if (!(covered > 0)) {
-      d.status[i] = NodeStatus::uncovered;
-    } else if (covered < kDropCoverage * support) {
-      d.status[i] = NodeStatus::barely_covered;
-    } else if (auto p = prescribed.find(d.slave_nodes[i]); p != prescribed.end() && normal_is_prescribed(p->second, nu.normalized())) {
-      d.status[i] = NodeStatus::crosspoint;
-    } else {
-      d.status[i] = NodeStatus::contact;
-    }
-  }
-  d.row_of_node.assign(n, -1);
-  for (size_t i = 0; i < n; ++i)
-    if (d.status[i] == NodeStatus::contact) {
-      d.row_of_node[i] = static_cast<int>(d.node_of_row.size());
-      d.node_of_row.push_back(static_cast<int>(i));
-    }
-  // Every slave node's value from the rows: a multiplier node's own; inside a run the linear interpolation in s of
-  // its two ends, where a dropped end takes the other end's value (its function was added to the other's).
-  d.node_from_rows.assign(n, {});
-  for (size_t m = 0; m < n_runs; ++m) {
-    const size_t a = d.multiplier_nodes[m], b = d.multiplier_nodes[m + 1];
-    const int ra = d.row_of_node[a], rb = d.row_of_node[b];
-    for (size_t i = a; i <= b; ++i) {
-      if ((i == a && ra >= 0) || (i == b && rb >= 0)) {
-        d.node_from_rows[i] = {{i == a ? ra : rb, 1.0}};
-        continue;
+  void classify_nodes() {
+    d_.status.assign(n_, NodeStatus::inner);
+    const auto prescribed = prescribed_components(slave_);
+    for (size_t m = 0; m <= n_runs_ && n_runs_ > 0; ++m) {
+      const size_t i = d_.multiplier_nodes[m];
+      double support = 0, covered = 0;
+      Eigen::Vector2d nu = Eigen::Vector2d::Zero();
+      for (size_t run : {m - 1, m}) {  // the runs before and after node i (m - 1 wraps for m = 0: skipped)
+        if (run >= n_runs_) continue;
+        const size_t a = d_.multiplier_nodes[run], b = d_.multiplier_nodes[run + 1];
+        support += 0.5 * (arc(b) - arc(a));
+        if (!basis_[run]) continue;
+        const double Dk = basis_[run]->D[run == m ? 0 : 1];
+        covered += Dk;
+        const size_t k = run == m ? a : b - 1;  // the slave segment next to node i
+        nu += Dk * segments_.slave_normal[k];
       }
-      if ((i == a || i == b) && d.status[i] != NodeStatus::inner) continue;  // a multiplier node without a row
-      const double t = (arc(i) - arc(a)) / (arc(b) - arc(a));
-      if (ra >= 0 && rb >= 0)
-        d.node_from_rows[i] = {{ra, 1 - t}, {rb, t}};
-      else if (ra >= 0 || rb >= 0)
-        d.node_from_rows[i] = {{ra >= 0 ? ra : rb, 1.0}};
+      if (!(covered > 0)) {
+        d_.status[i] = NodeStatus::uncovered;
+      } else if (covered < kDropCoverage * support) {
+        d_.status[i] = NodeStatus::barely_covered;
+      } else if (auto p = prescribed.find(d_.slave_nodes[i]); p != prescribed.end() && normal_is_prescribed(p->second, nu.normalized())) {
+        d_.status[i] = NodeStatus::crosspoint;
+      } else {
+        d_.status[i] = NodeStatus::contact;
+      }
     }
   }
-  const Eigen::Index rows = static_cast<Eigen::Index>(d.node_of_row.size());
-  d.D = Eigen::VectorXd::Zero(rows);
-  d.area = Eigen::VectorXd::Zero(rows);
-  d.gap0 = Eigen::VectorXd::Zero(rows);
-  std::vector<Eigen::Vector2d> nu(static_cast<size_t>(rows), Eigen::Vector2d::Zero());
 
-  // Integrals over every mortar segment (three-point Gauss: the integrands are at most cubic in xi).
-  std::map<std::pair<int, int>, Eigen::Vector2d> gs, gm;  // (row, node) -> vector coefficient
-  std::map<std::pair<int, int>, double> mm;              // (row, master edge position) -> scalar M
-  auto add = [](std::map<std::pair<int, int>, Eigen::Vector2d>& to, std::pair<int, int> key, const Eigen::Vector2d& v) {
+  // One row per contact node; every slave node's value from the rows: a multiplier node's own; inside a run the
+  // linear interpolation in s of its two ends, where a dropped end takes the other end's value (its function was
+  // added to the other's).
+  void number_rows() {
+    d_.row_of_node.assign(n_, -1);
+    for (size_t i = 0; i < n_; ++i)
+      if (d_.status[i] == NodeStatus::contact) {
+        d_.row_of_node[i] = static_cast<int>(d_.node_of_row.size());
+        d_.node_of_row.push_back(static_cast<int>(i));
+      }
+    d_.node_from_rows.assign(n_, {});
+    for (size_t m = 0; m < n_runs_; ++m) {
+      const size_t a = d_.multiplier_nodes[m], b = d_.multiplier_nodes[m + 1];
+      const int ra = d_.row_of_node[a], rb = d_.row_of_node[b];
+      for (size_t i = a; i <= b; ++i) {
+        if ((i == a && ra >= 0) || (i == b && rb >= 0)) {
+          d_.node_from_rows[i] = {{i == a ? ra : rb, 1.0}};
+          continue;
+        }
+        if ((i == a || i == b) && d_.status[i] != NodeStatus::inner) continue;  // a multiplier node without a row
+        const double t = (arc(i) - arc(a)) / (arc(b) - arc(a));
+        if (ra >= 0 && rb >= 0)
+          d_.node_from_rows[i] = {{ra, 1 - t}, {rb, t}};
+        else if (ra >= 0 || rb >= 0)
+          d_.node_from_rows[i] = {{ra >= 0 ? ra : rb, 1.0}};
+      }
+    }
+    const Eigen::Index rows = static_cast<Eigen::Index>(d_.node_of_row.size());
+    d_.D = Eigen::VectorXd::Zero(rows);
+    d_.area = Eigen::VectorXd::Zero(rows);
+    d_.gap0 = Eigen::VectorXd::Zero(rows);
+    nu_.assign(static_cast<size_t>(rows), Eigen::Vector2d::Zero());
+  }
+
+  static void add(VectorEntries& to, std::pair<int, int> key, const Eigen::Vector2d& v) {
     auto it = to.emplace(key, Eigen::Vector2d::Zero()).first;  // Eigen's default constructor leaves it unset
     it->second += v;
-  };
-  for (size_t m = 0; m < n_runs; ++m) {
-    if (!basis[m]) continue;
-    const size_t a = d.multiplier_nodes[m], b_node = d.multiplier_nodes[m + 1];
-    const int r0 = d.row_of_node[a], r1 = d.row_of_node[b_node];
-    if (r0 < 0 && r1 < 0) continue;
-    DualBasis b = *basis[m];
+  }
+
+  // Integrals over every mortar segment of one run (three-point Gauss: the integrands are at most cubic in xi).
+  void integrate_run(size_t m) {
+    const size_t a = d_.multiplier_nodes[m], b_node = d_.multiplier_nodes[m + 1];
+    const int r0 = d_.row_of_node[a], r1 = d_.row_of_node[b_node];
+    if (r0 < 0 && r1 < 0) return;
+    DualBasis b = *basis_[m];
     if (r0 < 0) b = drop_node(b, 0);
     if (r1 < 0) b = drop_node(b, 1);
     const double Lrun = arc(b_node) - arc(a);
     for (size_t k = a; k < b_node; ++k) {
-      const Eigen::Vector2d nk = segments.slave_normal[k];
-      const double L = segments.slave_length[k];
-      for (const auto* s : on_segment[k]) {
-        const int m0 = d.master_nodes[static_cast<size_t>(s->master)], m1 = d.master_nodes[static_cast<size_t>(s->master) + 1];
+      const Eigen::Vector2d nk = segments_.slave_normal[k];
+      const double L = segments_.slave_length[k];
+      for (const auto* s : on_segment_[k]) {
+        const int m0 = d_.master_nodes[static_cast<size_t>(s->master)], m1 = d_.master_nodes[static_cast<size_t>(s->master) + 1];
         for (size_t q = 0; q < kGaussX.size(); ++q) {
           const double u = kGaussX[q];
           const double xi = s->xi0 + u * (s->xi1 - s->xi0);
-          const double w = kGaussW[q] * (s->xi1 - s->xi0) * L * thickness;
+          const double w = kGaussW[q] * (s->xi1 - s->xi0) * L * thickness_;
           const double eta = s->eta0 + u * (s->eta1 - s->eta0);
           const double t = s->gap0 + u * (s->gap1 - s->gap0);
           const double sr = (arc(k) + xi * L - arc(a)) / Lrun;  // parameter along the run
-          const Eigen::Vector2d x = S[k] + xi * (S[k + 1] - S[k]);
-          const double gap = (pair.gap.geometric ? t : 0.0) + analytic_gap(pair.gap, x);
+          const Eigen::Vector2d x = S_[k] + xi * (S_[k + 1] - S_[k]);
+          const double gap = (pair_.gap.geometric ? t : 0.0) + analytic_gap(pair_.gap, x);
           const double Ns[2] = {1 - xi, xi}, Nm[2] = {1 - eta, eta}, Nrun[2] = {1 - sr, sr};
           for (int i = 0; i < 2; ++i) {
             const int r = i == 0 ? r0 : r1;
             if (r < 0) continue;
             const double phi = b.phi(i, sr);
-            d.gap0[r] += w * phi * gap;
-            d.D[r] += w * phi * Nrun[i];
-            d.area[r] += w * phi;
-            nu[static_cast<size_t>(r)] += w * phi * nk;
+            d_.gap0[r] += w * phi * gap;
+            d_.D[r] += w * phi * Nrun[i];
+            d_.area[r] += w * phi;
+            nu_[static_cast<size_t>(r)] += w * phi * nk;
             for (int l = 0; l < 2; ++l) {
-              add(gs, {r, d.slave_nodes[k + static_cast<size_t>(l)]}, w * phi * Ns[l] * nk);
-              add(gm, {r, l == 0 ? m0 : m1}, w * phi * Nm[l] * nk);
-              mm[{r, s->master + l}] += w * phi * Nm[l];
+              add(gs_, {r, d_.slave_nodes[k + static_cast<size_t>(l)]}, w * phi * Ns[l] * nk);
+              add(gm_, {r, l == 0 ? m0 : m1}, w * phi * Nm[l] * nk);
+              mm_[{r, s->master + l}] += w * phi * Nm[l];
             }
           }
         }
       }
     }
   }
-  for (Eigen::Index r = 0; r < rows; ++r) d.normal.push_back(nu[static_cast<size_t>(r)].normalized());
+
+  void integrate() {
+    for (size_t m = 0; m < n_runs_; ++m)
+      if (basis_[m]) integrate_run(m);
+    for (const auto& v : nu_) d_.normal.push_back(v.normalized());
+  }
 
   // Sparse operators. Exact zeros (an axis-aligned normal touches one component only) are left out, which keeps
   // each body's interface unknowns minimal; tiny off-diagonal remainders of biorthogonality are dropped too.
-  auto build = [&](const std::map<std::pair<int, int>, Eigen::Vector2d>& entries, int n_dofs) {
+  SparseRows sparse_rows(const VectorEntries& entries, int n_dofs) const {
     std::vector<Eigen::Triplet<double>> t;
     for (const auto& [key, v] : entries) {
-      const double scale = d.D[key.first];
+      const double scale = d_.D[key.first];
       for (int c = 0; c < 2; ++c)
         if (std::abs(v[c]) > 1e-14 * scale) t.emplace_back(key.first, 2 * key.second + c, v[c]);
     }
-    SparseRows out(rows, n_dofs);
+    SparseRows out(d_.D.size(), n_dofs);
     out.setFromTriplets(t.begin(), t.end());
     return out;
-  };
-  d.Gs = build(gs, 2 * slave.mesh.num_nodes());
-  d.Gm = build(gm, 2 * master.mesh.num_nodes());
-  std::vector<Eigen::Triplet<double>> tm;
-  for (const auto& [key, v] : mm)
-    if (v != 0.0) tm.emplace_back(key.first, key.second, v);
-  d.M.resize(rows, static_cast<Eigen::Index>(d.master_nodes.size()));
-  d.M.setFromTriplets(tm.begin(), tm.end());
-  return d;
+  }
+
+  void assemble_operators() {
+    d_.Gs = sparse_rows(gs_, 2 * slave_.mesh.num_nodes());
+    d_.Gm = sparse_rows(gm_, 2 * master_.mesh.num_nodes());
+    std::vector<Eigen::Triplet<double>> tm;
+    for (const auto& [key, v] : mm_)
+      if (v != 0.0) tm.emplace_back(key.first, key.second, v);
+    d_.M.resize(d_.D.size(), static_cast<Eigen::Index>(d_.master_nodes.size()));
+    d_.M.setFromTriplets(tm.begin(), tm.end());
+  }
+
+  const ContactPair& pair_;
+  const Body& slave_;
+  const Body& master_;
+  const double thickness_;
+  PairDiscretization d_;
+  std::vector<Eigen::Vector2d> S_;
+  size_t n_ = 0, n_runs_ = 0;
+  SegmentMesh segments_;
+  std::vector<double> master_length_;
+  std::vector<std::vector<const MortarSegment*>> on_segment_;
+  std::vector<std::optional<DualBasis>> basis_;
+  std::vector<Eigen::Vector2d> nu_;
+  VectorEntries gs_, gm_;
+  std::map<std::pair<int, int>, double> mm_;  // (row, master edge position) -> scalar M
+};
+
+}  // namespace
+
+PairDiscretization discretize_pair(const Problem& problem, int pair_index, double theta) {
+  return PairBuilder(problem, pair_index, theta).build();
 }
 
 }  // namespace contact::mortar
