@@ -185,116 +185,148 @@ Eigen::VectorXd nested_initial_guess(const SparseMatrix& H, const Eigen::VectorX
 
 namespace {
 
-ActiveSetResult solve_active_set_on(const SparseMatrix& H, const Eigen::VectorXd& g, int max_steps,
-                                    const StepCallback& on_step, const Eigen::VectorXd* z0, const Equalities& eq) {
-  ActiveSetResult out;
-  const Eigen::Index n = g.size();
-  const Eigen::VectorXd c_over_D = H.diagonal().cwiseInverse();  // c_j / D_j = 1 / H_jj
-  auto predict = [&](const Eigen::VectorXd& z, const Eigen::VectorXd& h) {
-    std::vector<char> a(static_cast<size_t>(n), 0);
-    for (Eigen::Index j = 0; j < n; ++j) a[static_cast<size_t>(j)] = z[j] - c_over_D[j] * h[j] > 0;
-    return a;
-  };
-  auto complementarity = [&](const Eigen::VectorXd& z, const Eigen::VectorXd& h) {
-    Eigen::VectorXd C(n);
-    for (Eigen::Index j = 0; j < n; ++j) C[j] = z[j] - std::max(0.0, z[j] - c_over_D[j] * h[j]);
-    return C.norm() / std::max(z.norm(), 1e-300);
-  };
-  auto gap = [&](const Eigen::VectorXd& z, const Eigen::VectorXd& alpha) {
-    Eigen::VectorXd h = g + H * z;
-    if (!eq.empty()) h.noalias() += eq.G.transpose() * alpha;
-    return h;
-  };
+// The primal-dual active set in its phases: the first set, one step (solve on the set, gaps, next set), the
+// settling test, and the QP method should the sets cycle.
+class PrimalDualActiveSet {
+ public:
+  PrimalDualActiveSet(const SparseMatrix& H, const Eigen::VectorXd& g, const Equalities& eq)
+      : H_(H), g_(g), eq_(eq), n_(g.size()), c_over_D_(H.diagonal().cwiseInverse()) {}  // c_j / D_j = 1 / H_jj
 
-  out.alpha = Eigen::VectorXd::Zero(eq.G.rows());
-  Eigen::VectorXd z = z0 && z0->size() == n ? *z0 : Eigen::VectorXd::Zero(n);
-  Eigen::VectorXd h = g + H * z;
-  std::vector<char> active = predict(z, h);
-  // A floating body's position is part of the answer (alpha), so the gaps of a guess z0 alone predict nothing:
-  // start from the nodes the guess presses, or from every node in contact without a guess.
-  if (!eq.empty()) {
-    if (z0 && z0->size() == n)
-      for (Eigen::Index j = 0; j < n; ++j) active[static_cast<size_t>(j)] = (*z0)[j] > 0;
-    else
-      active.assign(static_cast<size_t>(n), 1);
+  ActiveSetResult run(int max_steps, const StepCallback& on_step, const Eigen::VectorXd* z0);
+
+ private:
+  std::vector<char> predict(const Eigen::VectorXd& z, const Eigen::VectorXd& h) const {
+    std::vector<char> a(static_cast<size_t>(n_), 0);
+    for (Eigen::Index j = 0; j < n_; ++j) a[static_cast<size_t>(j)] = z[j] - c_over_D_[j] * h[j] > 0;
+    return a;
   }
-  std::set<std::vector<char>> seen;
-  out.z = z;
-  out.h = h;
-  if (n == 0 && eq.empty()) {
-    out.converged = true;
-    out.message = "no contact nodes";
-    return out;
+  double complementarity(const Eigen::VectorXd& z, const Eigen::VectorXd& h) const {
+    Eigen::VectorXd C(n_);
+    for (Eigen::Index j = 0; j < n_; ++j) C[j] = z[j] - std::max(0.0, z[j] - c_over_D_[j] * h[j]);
+    return C.norm() / std::max(z.norm(), 1e-300);
   }
-  for (int k = 1; k <= max_steps; ++k) {
-    seen.insert(active);
+  Eigen::VectorXd gap(const Eigen::VectorXd& z, const Eigen::VectorXd& alpha) const {
+    Eigen::VectorXd h = g_ + H_ * z;
+    if (!eq_.empty()) h.noalias() += eq_.G.transpose() * alpha;
+    return h;
+  }
+  // The first active set. A floating body's position is part of the answer (alpha), so with equalities the gaps of
+  // a guess z0 predict nothing: start from the nodes the guess presses, or from every node without a guess.
+  std::vector<char> first_set(const Eigen::VectorXd* z0) const {
+    const bool guessed = z0 && z0->size() == n_;
+    const Eigen::VectorXd z = guessed ? *z0 : Eigen::VectorXd::Zero(n_);
+    if (eq_.empty()) return predict(z, g_ + H_ * z);
+    if (!guessed) return std::vector<char>(static_cast<size_t>(n_), 1);
+    std::vector<char> active(static_cast<size_t>(n_));
+    for (Eigen::Index j = 0; j < n_; ++j) active[static_cast<size_t>(j)] = (*z0)[j] > 0;
+    return active;
+  }
+  // Solves on `active`, fills out's z, alpha, h and the step's report; `next` receives the predicted set. False
+  // when the step cannot be taken (out.message says why).
+  bool step(int k, const std::vector<char>& active, ActiveSetResult& out, ActiveSetStep& report, std::vector<char>& next) const {
     std::vector<Eigen::Index> A;
-    for (Eigen::Index j = 0; j < n; ++j)
+    for (Eigen::Index j = 0; j < n_; ++j)
       if (active[static_cast<size_t>(j)]) A.push_back(j);
     bool ok = true;
     Eigen::VectorXd alpha;
-    z = solve_on(H, g, A, eq, alpha, ok, out.unrestrained);
+    const Eigen::VectorXd z = solve_on(H_, g_, A, eq_, alpha, ok, out.unrestrained);
     if (!ok) {
       out.message = "the active-set system is not positive definite";
-      return out;
+      return false;
     }
     if (!out.unrestrained.empty()) {
       out.message = "the contact nodes in contact do not hold every floating body";
-      return out;
+      return false;
     }
-    h = gap(z, alpha);
-    std::vector<char> next = predict(z, h);
-    ActiveSetStep step;
-    step.step = k;
-    step.active = static_cast<int>(A.size());
-    for (Eigen::Index j = 0; j < n; ++j) step.changes += next[static_cast<size_t>(j)] != active[static_cast<size_t>(j)];
-    step.complementarity = complementarity(z, h);
+    const Eigen::VectorXd h = gap(z, alpha);
+    next = predict(z, h);
+    report.step = k;
+    report.active = static_cast<int>(A.size());
+    for (Eigen::Index j = 0; j < n_; ++j) report.changes += next[static_cast<size_t>(j)] != active[static_cast<size_t>(j)];
+    report.complementarity = complementarity(z, h);
     out.z = z;
     out.alpha = alpha;
     out.h = h;
     out.steps = k;
-    if (!on_step(z, h, step)) {
+    return true;
+  }
+  void fallback(const StepCallback& on_step, ActiveSetResult& out) const;
+
+  const SparseMatrix& H_;
+  const Eigen::VectorXd& g_;
+  const Equalities& eq_;
+  const Eigen::Index n_;
+  const Eigen::VectorXd c_over_D_;
+};
+
+// Cycling or max_steps: the primal active-set QP method, which terminates.
+void PrimalDualActiveSet::fallback(const StepCallback& on_step, ActiveSetResult& out) const {
+  out.used_fallback = true;
+  out.z = solve_nonnegative_qp(H_, g_);
+  out.h = g_ + H_ * out.z;
+  ActiveSetStep step;
+  step.step = out.steps + 1;
+  for (Eigen::Index j = 0; j < n_; ++j) step.active += out.z[j] > 0;
+  step.complementarity = complementarity(out.z, out.h);
+  out.steps = step.step;
+  if (!on_step(out.z, out.h, step)) {
+    out.cancelled = true;
+    out.message = "cancelled";
+    return;
+  }
+  out.converged = step.complementarity <= 1e-10;
+  std::ostringstream os;
+  os << "the primal-dual active set cycled or did not settle; the active-set QP method "
+     << (out.converged ? "solved" : "did not solve") << " the interface problem (complementarity "
+     << step.complementarity << ", " << step.active << " of " << n_ << " contact nodes in contact)";
+  out.message = os.str();
+}
+
+ActiveSetResult PrimalDualActiveSet::run(int max_steps, const StepCallback& on_step, const Eigen::VectorXd* z0) {
+  ActiveSetResult out;
+  out.alpha = Eigen::VectorXd::Zero(eq_.G.rows());
+  out.z = z0 && z0->size() == n_ ? *z0 : Eigen::VectorXd::Zero(n_);
+  out.h = g_ + H_ * out.z;
+  if (n_ == 0 && eq_.empty()) {
+    out.converged = true;
+    out.message = "no contact nodes";
+    return out;
+  }
+  std::vector<char> active = first_set(z0);
+  std::set<std::vector<char>> seen;
+  for (int k = 1; k <= max_steps; ++k) {
+    seen.insert(active);
+    ActiveSetStep report;
+    std::vector<char> next;
+    if (!step(k, active, out, report, next)) return out;
+    if (!on_step(out.z, out.h, report)) {
       out.cancelled = true;
       out.message = "cancelled";
       return out;
     }
     // Settled: the set repeats, or the complementarity function vanishes to round-off (a grazing node, with
     // z = 0 and h = 0 up to rounding, may flip without changing the solution).
-    if (step.changes == 0 || step.complementarity <= 1e-13) {
+    if (report.changes == 0 || report.complementarity <= 1e-13) {
       out.converged = true;
       std::ostringstream os;
-      os << "active set settled (" << A.size() << " of " << n << " contact nodes in contact)";
+      os << "active set settled (" << report.active << " of " << n_ << " contact nodes in contact)";
       out.message = os.str();
       return out;
     }
     if (seen.count(next)) break;  // a cycle: hand over to the QP method
     active = std::move(next);
   }
-  if (!eq.empty()) {
+  if (!eq_.empty()) {
     out.message = "the primal-dual active set cycled or did not settle with floating bodies";
     return out;
   }
-  // Cycling or max_steps: the primal active-set QP method, which terminates.
-  out.used_fallback = true;
-  out.z = solve_nonnegative_qp(H, g);
-  out.h = g + H * out.z;
-  ActiveSetStep step;
-  step.step = out.steps + 1;
-  for (Eigen::Index j = 0; j < n; ++j) step.active += out.z[j] > 0;
-  step.complementarity = complementarity(out.z, out.h);
-  out.steps = step.step;
-  if (!on_step(out.z, out.h, step)) {
-    out.cancelled = true;
-    out.message = "cancelled";
-    return out;
-  }
-  out.converged = step.complementarity <= 1e-10;
-  std::ostringstream os;
-  os << "the primal-dual active set cycled or did not settle; the active-set QP method "
-     << (out.converged ? "solved" : "did not solve") << " the interface problem (complementarity "
-     << step.complementarity << ", " << step.active << " of " << n << " contact nodes in contact)";
-  out.message = os.str();
+  fallback(on_step, out);
   return out;
+}
+
+ActiveSetResult solve_active_set_on(const SparseMatrix& H, const Eigen::VectorXd& g, int max_steps,
+                                    const StepCallback& on_step, const Eigen::VectorXd* z0, const Equalities& eq) {
+  return PrimalDualActiveSet(H, g, eq).run(max_steps, on_step, z0);
 }
 
 }  // namespace
