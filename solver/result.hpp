@@ -27,6 +27,7 @@ struct BodyReport {
 struct PairReport {
   std::string name;
   double force = 0.0;          // total normal contact force (per unit thickness in plane strain)
+  Eigen::Vector2d resultant = Eigen::Vector2d::Zero();  // the force vector on the slave (PairField::resultant)
   double max_pressure = 0.0;
   double extent_begin = 0.0;   // arc length along the slave edge of the first and last active node
   double extent_end = 0.0;     // (both 0 when nothing is in contact)
@@ -71,6 +72,14 @@ struct BodyField {
   Eigen::VectorXd von_mises_cell;
   Eigen::VectorXd indicator_cell; // error indicator per cell (empty without adaptivity)
   Eigen::MatrixX2d reaction;      // per node: force the supports exert (zero where nothing is prescribed)
+  // Per displacement condition (edge or vertex, in the job's order): the sum of the reactions at its nodes (a
+  // corner node shared by two supported edges counts in both); and the sum over all nodes, each once.
+  struct SupportReaction {
+    std::string where;            // the edge or vertex name
+    Eigen::Vector2d force = Eigen::Vector2d::Zero();
+  };
+  std::vector<SupportReaction> support_reactions;
+  Eigen::Vector2d reaction_total = Eigen::Vector2d::Zero();
   // A floating body (held by its contacts alone): its free rigid motions, and the rigid part of its displacement
   // as the translation (x, y) of rigid_center (the nodes' centroid) and a rotation (radians) about it.
   std::vector<std::string> free_motions;
@@ -96,7 +105,12 @@ struct PairField {
   Eigen::VectorXd penetration;   // max(0, -normal_gap) (0 where no multiplier)
   Eigen::VectorXi active;        // 1 where the pressure is positive
   Eigen::VectorXi status;        // 0 contact node, 1 not opposite the master, 2 crosspoint, 3 barely covered
-  double force = 0.0;            // sum of weight x pressure: the total normal force
+  double force = 0.0;            // sum of weight x pressure: the total normal force (a scalar sum of normal
+                                 // pressures: on a curved slave more than the load it carries)
+  // The resultant contact force vector on the slave body (the master exerts it; the master receives its
+  // opposite): the sum over the slave's nodes of its discrete contact forces -Gs^T z. Equal and opposite to the
+  // slave's other loads and reactions in equilibrium.
+  Eigen::Vector2d resultant = Eigen::Vector2d::Zero();
 };
 
 // One mesh state of the adaptive loop, or one load step; without either there is a single step.

@@ -170,11 +170,21 @@ int solve_and_write(contact::cli::Session& session, contact::Problem& problem, c
       penetration = std::max(penetration, p.penetration[j]);
     }
     if (p.enforcement == "exact")
-      std::printf("pair %s: exact contact, force %.8g, max pressure %.8g, max penetration %.4g\n", p.name.c_str(),
-                  p.force, p_max, penetration);
+      std::printf("pair %s: exact contact, force %.8g, resultant (%.8g, %.8g), max pressure %.8g, max penetration %.4g\n",
+                  p.name.c_str(), p.force, p.resultant.x(), p.resultant.y(), p_max, penetration);
     else
-      std::printf("pair %s: %s, theta %.4g, force %.8g, max pressure %.8g, max penetration %.4g\n", p.name.c_str(),
-                  p.enforcement.c_str(), p.theta, p.force, p_max, penetration);
+      std::printf("pair %s: %s, theta %.4g, force %.8g, resultant (%.8g, %.8g), max pressure %.8g, max penetration %.4g\n",
+                  p.name.c_str(), p.enforcement.c_str(), p.theta, p.force, p.resultant.x(), p.resultant.y(), p_max,
+                  penetration);
+  }
+  // Support reactions: per displacement condition and the body's total (a corner shared by two supported edges
+  // counts in both of theirs, once in the total).
+  for (const auto& b : result.steps.back().bodies) {
+    if (ndjson || b.support_reactions.empty()) continue;
+    std::printf("body %s: reactions total (%.8g, %.8g)", b.name.c_str(), b.reaction_total.x(), b.reaction_total.y());
+    for (const auto& s : b.support_reactions)
+      std::printf("; %s (%.8g, %.8g)", s.where.c_str(), s.force.x(), s.force.y());
+    std::printf("\n");
   }
   try {
     contact::io::WriteInfo info;

@@ -67,6 +67,14 @@ void PairDiscretization::add_forces(const Eigen::VectorXd& z, Eigen::VectorXd& f
   fm.noalias() += Gm.transpose() * z;
 }
 
+Eigen::Vector2d PairDiscretization::resultant(const Eigen::VectorXd& z) const {
+  Eigen::Vector2d out = Eigen::Vector2d::Zero();
+  if (z.size() != Gs.rows()) return out;
+  for (int r = 0; r < Gs.outerSize(); ++r)
+    for (SparseRows::InnerIterator it(Gs, r); it; ++it) out[it.col() % 2] -= it.value() * z[r];
+  return out;
+}
+
 Eigen::VectorXd PairDiscretization::to_nodes(const Eigen::VectorXd& rows, double fill) const {
   Eigen::VectorXd out = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(slave_nodes.size()), fill);
   for (size_t i = 0; i < node_from_rows.size(); ++i) {

@@ -75,6 +75,8 @@ struct PairDiscretization {
   void add_forces(const Eigen::VectorXd& z, Eigen::VectorXd& fs, Eigen::VectorXd& fm) const;
   // Total normal force sum_r area_r z_r (the integral of the pressure field; per unit thickness in plane strain).
   double total_force(const Eigen::VectorXd& z) const { return area.dot(z); }
+  // The resultant force vector on the slave for pressures z: the x and y sums of its nodal forces -Gs^T z.
+  Eigen::Vector2d resultant(const Eigen::VectorXd& z) const;
   // Row values at every slave node: a multiplier node's own, inside a multiplier segment the linear
   // interpolation of its ends (`fill` where no row reaches a node).
   Eigen::VectorXd to_nodes(const Eigen::VectorXd& rows, double fill) const;

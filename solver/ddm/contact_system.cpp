@@ -225,6 +225,7 @@ IterationReport ContactSystem::report_gaps(int iteration, const Pressures& z, co
     pr.name = pair.name;
     pr.theta = problem_.solver.enforcement == Enforcement::exact ? 0.0 : pair.theta;
     pr.force = pair.total_force(p);
+    pr.resultant = pair.resultant(p);
     auto& prev = previous_active[k];
     const bool had_previous = prev.size() == static_cast<size_t>(p.size());
     prev.resize(static_cast<size_t>(p.size()), 0);
@@ -288,6 +289,13 @@ Step ContactSystem::fields(const Displacements& u, const Pressures& z, int itera
     f.von_mises_cell = stress[a].von_mises_cell;
     const Eigen::VectorXd& R = reaction[a];
     f.reaction = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>(R.data(), n, 2);
+    f.reaction_total = f.reaction.colwise().sum().transpose();
+    for (const auto& bc : body.boundary) {
+      if (!prescribes_displacement(bc)) continue;
+      BodyField::SupportReaction s{bc.vertex.empty() ? bc.edge : bc.vertex, Eigen::Vector2d::Zero()};
+      for (int node : condition_nodes(body.mesh, bc)) s.force += f.reaction.row(node).transpose();
+      f.support_reactions.push_back(std::move(s));
+    }
     if (bodies_[a]->floating()) {
       f.free_motions = bodies_[a]->rigid_mode_names();
       // The rigid part R alpha as a translation of the nodes' centroid and a rotation about it (exact fit).
@@ -354,6 +362,7 @@ Step ContactSystem::fields(const Displacements& u, const Pressures& z, int itera
       f.status[j] = static_cast<int>(pair.status[static_cast<size_t>(j)]);
     }
     f.force = pair.total_force(z[k]);
+    f.resultant = pair.resultant(z[k]);
     step.pairs.push_back(std::move(f));
   }
   return step;

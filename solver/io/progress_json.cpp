@@ -11,6 +11,7 @@ nlohmann::json iteration_json(const IterationReport& report, bool with_profiles)
   for (const auto& p : report.pairs) {
     nlohmann::json pair = {{"name", p.name},
                            {"force", p.force},
+                           {"resultant", {p.resultant.x(), p.resultant.y()}},
                            {"max_pressure", p.max_pressure},
                            {"extent_begin", p.extent_begin},
                            {"extent_end", p.extent_end},

@@ -154,6 +154,16 @@ BodyField read_body(hid_t bodies, const std::string& name) {
   b.von_mises_cell = read_column<double>(g, "von_mises");
   if (h5::has_link(g, "indicator")) b.indicator_cell = read_column<double>(g, "indicator");
   b.reaction = read_matrix<double>(g, "reaction", 2);
+  if (h5::has_attribute(g, "reaction_total")) {  // since the resultants (older files: absent)
+    const auto t = h5::read_attribute_array<double>(g, "reaction_total");
+    if (t.size() == 2) b.reaction_total = Eigen::Vector2d(t[0], t[1]);
+  }
+  if (h5::has_link(g, "support_reactions")) {
+    const auto names = h5::read_strings_attribute(g, "support_names");
+    const Eigen::MatrixXd sums = read_matrix<double>(g, "support_reactions", 2);
+    for (size_t i = 0; i < names.size() && static_cast<Eigen::Index>(i) < sums.rows(); ++i)
+      b.support_reactions.push_back({names[i], sums.row(static_cast<Eigen::Index>(i)).transpose()});
+  }
   if (h5::has_attribute(g, "free_motions")) {
     b.free_motions = h5::read_strings_attribute(g, "free_motions");
     const auto c = h5::read_attribute_array<double>(g, "rigid_center");
@@ -175,6 +185,10 @@ PairField read_pair(hid_t contacts, const std::string& name) {
   p.enforcement = h5::read_string_attribute(g, "enforcement");
   p.theta = h5::read_attribute<double>(g, "theta");
   p.force = h5::read_attribute<double>(g, "force");
+  if (h5::has_attribute(g, "resultant")) {
+    const auto r = h5::read_attribute_array<double>(g, "resultant");
+    if (r.size() == 2) p.resultant = Eigen::Vector2d(r[0], r[1]);
+  }
   p.node = read_column<int>(g, "node");
   p.position = read_matrix<double>(g, "position", 2);
   p.normal = read_matrix<double>(g, "normal", 2);

@@ -306,6 +306,17 @@ void write_body(hid_t bodies, const BodyField& b, const std::string& where) {
   write_column(g, "von_mises", b.von_mises_cell);
   if (b.indicator_cell.size() > 0) write_column(g, "indicator", b.indicator_cell);
   write_matrix(g, "reaction", b.reaction);
+  h5::write_attribute_array<double>(g, "reaction_total", {b.reaction_total.x(), b.reaction_total.y()});
+  if (!b.support_reactions.empty()) {
+    std::vector<std::string> names;
+    Eigen::MatrixX2d sums(static_cast<Eigen::Index>(b.support_reactions.size()), 2);
+    for (size_t i = 0; i < b.support_reactions.size(); ++i) {
+      names.push_back(b.support_reactions[i].where);
+      sums.row(static_cast<Eigen::Index>(i)) = b.support_reactions[i].force.transpose();
+    }
+    write_matrix(g, "support_reactions", sums);
+    h5::write_attribute(g, "support_names", names);
+  }
   if (!b.free_motions.empty()) {
     h5::write_attribute(g, "free_motions", b.free_motions);
     h5::write_attribute_array<double>(g, "rigid_center", {b.rigid_center.x(), b.rigid_center.y()});
@@ -340,6 +351,7 @@ void write_pair(hid_t contacts, const PairField& p, const std::string& where) {
   h5::write_attribute(g, "enforcement", p.enforcement);
   h5::write_attribute<double>(g, "theta", p.theta);
   h5::write_attribute<double>(g, "force", p.force);
+  h5::write_attribute_array<double>(g, "resultant", {p.resultant.x(), p.resultant.y()});
   write_column(g, "node", p.node.cast<std::int64_t>().eval());
   write_matrix(g, "position", p.position);
   write_matrix(g, "normal", p.normal);
