@@ -17,8 +17,8 @@ std::size_t hash_body(const std::string& body) { return std::hash<std::string_vi
 
 }  // namespace
 
-JobQueue::JobQueue(JobStore& store, Metrics& metrics, QueueSettings settings)
-    : store_(store), metrics_(metrics), settings_(settings) {}
+JobQueue::JobQueue(JobStore& store, Metrics& metrics, BodyBudget& budget, QueueSettings settings)
+    : store_(store), metrics_(metrics), budget_(budget), settings_(settings) {}
 
 JobQueue::~JobQueue() {
   shutdown(std::chrono::milliseconds(0));
