@@ -123,7 +123,7 @@ void HttpServer::handle_submit(const Request& req, Response& res, const ContentR
   std::string body;
   BodyBudget::Slot body_slot;
   if (!read_json_body(req, res, reader, body, body_slot)) return;
-  BodyBudget::Slot validation = budget_.for_validation();
+  BodyBudget::Slot validation = budget_.for_validation(body.size());
   if (!validation) return send_busy(res, "jobs being validated at once", req.path);
   auto parsed = queue_.validate(body);
   using Outcome = JobQueue::Submission::Outcome;
@@ -170,7 +170,7 @@ void HttpServer::handle_validate(const Request& req, Response& res, const Conten
   std::string body;
   BodyBudget::Slot body_slot;
   if (!read_json_body(req, res, reader, body, body_slot)) return;
-  BodyBudget::Slot validation = budget_.for_validation();
+  BodyBudget::Slot validation = budget_.for_validation(body.size());
   if (!validation) return send_busy(res, "jobs being validated at once", req.path);
   const auto parsed = queue_.validate(body);
   if (!parsed.ok()) return send_invalid_job(res, parsed.errors, req.path);

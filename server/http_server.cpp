@@ -45,21 +45,15 @@ GuardSettings guard_settings(const HttpSettings& s) {
   return g;
 }
 
-std::size_t validation_slots(std::size_t configured) {
-  if (configured > 0) return configured;
-  return std::max<std::size_t>(2, std::thread::hardware_concurrency());
-}
-
 }  // namespace
 
-HttpServer::HttpServer(HttpSettings settings, JobQueue& queue, JobStore& store, Metrics& metrics)
+HttpServer::HttpServer(HttpSettings settings, JobQueue& queue, JobStore& store, Metrics& metrics, BodyBudget& budget)
     : settings_(std::move(settings)),
       guard_(guard_settings(settings_)),
       queue_(queue),
       store_(store),
       metrics_(metrics),
-      budget_(settings_.max_large_bodies, validation_slots(settings_.max_validations), 256 * 1024,
-              std::chrono::seconds(10)) {
+      budget_(budget) {
   core_.set_tcp_nodelay(true);
   core_.set_keep_alive_max_count(100);
   core_.set_keep_alive_timeout(static_cast<time_t>(std::max(1.0, settings_.idle_timeout_seconds)));

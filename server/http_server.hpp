@@ -56,7 +56,8 @@ struct HttpSettings {
 
 class HttpServer {
  public:
-  HttpServer(HttpSettings settings, JobQueue& queue, JobStore& store, Metrics& metrics);
+  // `budget` bounds the job bodies read and validated at once; the queue's workers share its validation slots.
+  HttpServer(HttpSettings settings, JobQueue& queue, JobStore& store, Metrics& metrics, BodyBudget& budget);
   ~HttpServer();
 
   // Binds the listening socket. Returns the port, or -1 if it cannot bind (`error` says why).
@@ -128,7 +129,7 @@ class HttpServer {
   JobQueue& queue_;
   JobStore& store_;
   Metrics& metrics_;
-  BodyBudget budget_;
+  BodyBudget& budget_;
   HttplibCore core_;
   std::unique_ptr<Transport> transport_;
   std::vector<Route> routes_;

@@ -69,6 +69,7 @@ struct Job {
   std::atomic<bool> settled{false};  // done and its `end` event written: it may be deleted
   std::atomic<bool> stored{false};   // its files exist: visible to the API (a submission is stored first)
   std::int64_t disk_bytes = 0;       // what its directory holds once finished (retention); the queue's mutex
+  bool cancelling_queued = false;    // a cancel is storing this QUEUED job as CANCELLED; the queue's mutex
 
   // Called with the queue's mutex held.
   bool request_cancel(CancelReason reason) {

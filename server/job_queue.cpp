@@ -17,8 +17,8 @@ std::size_t hash_body(const std::string& body) { return std::hash<std::string_vi
 
 }  // namespace
 
-JobQueue::JobQueue(JobStore& store, Metrics& metrics, QueueSettings settings)
-    : store_(store), metrics_(metrics), settings_(settings) {}
+JobQueue::JobQueue(JobStore& store, Metrics& metrics, BodyBudget& budget, QueueSettings settings)
+    : store_(store), metrics_(metrics), budget_(budget), settings_(settings) {}
 
 JobQueue::~JobQueue() {
   shutdown(std::chrono::milliseconds(0));
@@ -286,10 +286,14 @@ JobQueue::CancelOutcome JobQueue::cancel(const std::string& id) {
           job->request_cancel(CancelReason::user);
           return CancelOutcome::cancelling;
         }
+        // Another cancel is storing CANCELLED: one request stores it (a second write could come after a DELETE
+        // that followed the first, into a directory that is gone).
+        if (job->cancelling_queued) return CancelOutcome::cancelling;
         break;
     }
     // Queued: it never starts. (A worker only takes a job it finds QUEUED under this same lock.)
     queue_.erase(std::remove(queue_.begin(), queue_.end(), job), queue_.end());
+    job->cancelling_queued = true;
   }
   const std::int64_t now = now_unix_us();
   const bool stored = commit(job, [now](JobRecord& r) {
@@ -301,6 +305,7 @@ JobQueue::CancelOutcome JobQueue::cancel(const std::string& id) {
   }, /*durable=*/true);
   if (!stored) {
     std::lock_guard<std::mutex> lock(mutex_);
+    job->cancelling_queued = false;
     if (job->record.state == JobState::queued && !stopping_) {  // still queued, in its place by creation time
       const auto later = std::find_if(queue_.begin(), queue_.end(), [&](const std::shared_ptr<Job>& other) {
         return other->record.created_us > job->record.created_us;
@@ -329,16 +334,20 @@ JobQueue::RemoveOutcome JobQueue::remove(const std::string& id, std::string& det
     std::unique_lock<std::mutex> lock(mutex_);
     const auto damaged = damaged_.find(id);
     if (damaged != damaged_.end() && jobs_.count(id) == 0) {
-      // A job whose state cannot be read: deleting it is the way to clear it.
+      // A job whose state cannot be read: deleting it is the way to clear it. Taken out of the registry first,
+      // so that a concurrent DELETE finds nothing to remove (404) rather than a directory already gone.
+      const std::string problem = damaged->second;
+      damaged_.erase(damaged);
       lock.unlock();
       try {
         store_.remove(id);
       } catch (const std::exception& e) {
         detail = public_message(e.what(), store_.data_dir());
+        lock.lock();
+        damaged_.emplace(id, problem);
         return RemoveOutcome::store_error;
       }
       lock.lock();
-      damaged_.erase(id);
       for (auto it = by_key_.begin(); it != by_key_.end();)
         it = it->second == id ? by_key_.erase(it) : std::next(it);
       log_line("job " + id + ": deleted (it was damaged)");
@@ -352,6 +361,9 @@ JobQueue::RemoveOutcome JobQueue::remove(const std::string& id, std::string& det
     // wait for it briefly rather than answer 409.
     if (!settled_.wait_for(lock, std::chrono::seconds(5), [&] { return job->settled.load(); }))
       return RemoveOutcome::not_done;
+    // The wait let go of the lock: another DELETE (or retention) may have removed the job meanwhile.
+    const auto still = jobs_.find(id);
+    if (still == jobs_.end() || still->second != job) return RemoveOutcome::not_found;
     unregister_locked(job);
     damaged_.erase(id);
   }

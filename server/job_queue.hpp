@@ -25,6 +25,7 @@
 // job's record; it is never held while solving, writing result files or waiting for a client.
 #pragma once
 
+#include "body_budget.hpp"
 #include "job.hpp"
 #include "job_store.hpp"
 #include "metrics.hpp"
@@ -76,7 +77,8 @@ struct QueueHealth {
 
 class JobQueue {
  public:
-  JobQueue(JobStore& store, Metrics& metrics, QueueSettings settings);
+  // A worker parses its job again under one of `budget`'s validation slots (shared with the HTTP server).
+  JobQueue(JobStore& store, Metrics& metrics, BodyBudget& budget, QueueSettings settings);
   ~JobQueue();
   JobQueue(const JobQueue&) = delete;
   JobQueue& operator=(const JobQueue&) = delete;
@@ -147,6 +149,9 @@ class JobQueue {
   void watch_running_locked(std::chrono::steady_clock::time_point now);
   void apply_retention();
   void run(const std::shared_ptr<Job>& job);
+  // The job parsed again (it was valid when submitted) under a validation slot, as a submission is. A cancel or
+  // the time limit while it waits for the slot or is parsed ends it before any solve: nullopt, `result` says why.
+  std::optional<contact::Problem> parse_for_run(Job& job, contact::Result& result);
   // Sets job->settled under the queue lock and wakes remove() calls waiting for it.
   void mark_settled(const std::shared_ptr<Job>& job);
   void finish(const std::shared_ptr<Job>& job, JobRecord outcome);
@@ -165,6 +170,7 @@ class JobQueue {
 
   JobStore& store_;
   Metrics& metrics_;
+  BodyBudget& budget_;
   const QueueSettings settings_;
 
   mutable std::mutex mutex_;

@@ -131,6 +131,25 @@ void JobQueue::worker_loop() {
   idle_.notify_all();
 }
 
+std::optional<contact::Problem> JobQueue::parse_for_run(Job& job, contact::Result& result) {
+  const std::string body = store_.read_job(job.record.id);
+  BodyBudget::Slot slot = budget_.for_validation_until(body.size(), [&job] { return job.cancel.cancelled(); });
+  if (slot) {
+    auto parsed = validate(body);
+    slot.release();
+    if (!parsed.ok()) {
+      // Valid when submitted; invalid now (a smaller --max-dofs since, or another solver version).
+      result.stop_reason = contact::StopReason::error;
+      result.message = "the job is no longer valid: " + contact::job::format_errors(parsed.errors);
+      return std::nullopt;
+    }
+    if (!job.cancel.cancelled()) return std::move(parsed.problem);
+  }
+  result.stop_reason = contact::StopReason::cancelled;
+  result.message = "cancelled before the solve started";
+  return std::nullopt;
+}
+
 void JobQueue::run(const std::shared_ptr<Job>& job) {
   const std::string id = job->record.id;
   int attempt = 0;
@@ -147,13 +166,8 @@ void JobQueue::run(const std::shared_ptr<Job>& job) {
   std::optional<contact::Problem> problem;
   std::optional<MpiOutcome> mpi;  // a job run on MPI ranks: the child wrote the result file
   try {
-    auto parsed = validate(store_.read_job(id));
-    if (!parsed.ok()) {
-      // Valid when submitted; invalid now (a smaller --max-dofs since, or another solver version).
-      result.stop_reason = contact::StopReason::error;
-      result.message = "the job is no longer valid: " + contact::job::format_errors(parsed.errors);
-    } else {
-      problem = std::move(parsed.problem);
+    problem = parse_for_run(*job, result);
+    if (problem) {
       EventObserver observer(*job, mutex_, metrics_);
       if (problem->ranks > 1) {
         mpi = run_mpi_job(settings_.mpi, problem->ranks, store_.job_path(id), store_.result_path(id), id,

@@ -251,8 +251,10 @@ int main(int argc, char** argv) {
   try {
     JobStore store(config.data_dir);
     Metrics metrics;
-    JobQueue queue(store, metrics, config.queue);
-    HttpServer server(config.http, queue, store, metrics);
+    BodyBudget budget(config.http.max_large_bodies, BodyBudget::validation_slots(config.http.max_validations),
+                      256 * 1024, std::chrono::seconds(10));
+    JobQueue queue(store, metrics, budget, config.queue);
+    HttpServer server(config.http, queue, store, metrics, budget);
 
     std::string error;
     const int port = server.bind(error);

@@ -117,7 +117,11 @@ MpiOutcome run_mpi_job(const MpiSettings& settings, int ranks, const std::string
     }
     const std::string type = j.value("type", "");
     j.erase("type");
-    if (type == "iteration") on_iteration(j);
+    if (type == "iteration") {
+      // The iterations done so far, also for a run that ends without its result object.
+      if (j.contains("iteration") && j["iteration"].is_number_integer()) outcome.iterations = j["iteration"].get<int>();
+      on_iteration(j);
+    }
     if (type == "result") result = std::move(j);
   };
   char buffer[65536];

@@ -26,10 +26,18 @@ namespace {
 // next iteration, on every rank at the same point (cli/session.hpp).
 // One process: the request is the cancel token itself.
 std::atomic<bool> g_stop_request{false};
-contact::CancelToken* g_direct_cancel = nullptr;
-extern "C" void on_interrupt(int) {  // atomic stores only: async-signal-safe
+std::atomic<contact::CancelToken*> g_direct_cancel{nullptr};
+extern "C" void on_interrupt(int) {  // atomic loads and stores only: async-signal-safe
   g_stop_request.store(true);
-  if (g_direct_cancel) g_direct_cancel->cancel();
+  if (contact::CancelToken* token = g_direct_cancel.load()) token->cancel();
+}
+
+// From the first instruction of main: a stop that comes while the job is read, parsed or set up (SIGUSR1 would
+// otherwise end the process at once, with no result) is kept and stops the solve at its first iteration.
+void catch_stop_signals() {
+  std::signal(SIGINT, on_interrupt);
+  std::signal(SIGTERM, on_interrupt);
+  std::signal(SIGUSR1, on_interrupt);
 }
 
 const char* method_name(contact::Method m) {
@@ -111,10 +119,10 @@ int solve_and_write(contact::cli::Session& session, contact::Problem& problem, c
                     const std::string& job_id, bool quiet, bool ndjson) {
   const bool root = session.root();
   contact::CancelToken cancel;
-  if (session.size() == 1) g_direct_cancel = &cancel;
-  std::signal(SIGINT, on_interrupt);
-  std::signal(SIGTERM, on_interrupt);
-  std::signal(SIGUSR1, on_interrupt);
+  if (session.size() == 1) {
+    g_direct_cancel = &cancel;
+    if (g_stop_request) cancel.cancel();  // asked before the token existed
+  }
 
   const bool fixed_point = problem.solver.method == contact::Method::neumann || problem.solver.method == contact::Method::robin;
   const bool adaptive_paper = problem.adaptivity.enabled && problem.adaptivity.strategy == contact::AdaptStrategy::paper;
@@ -227,6 +235,7 @@ bool read_job(const contact::cli::Session& session, const std::string& path, std
 }  // namespace
 
 int main(int argc, char** argv) {
+  catch_stop_signals();
   contact::cli::Session session(&argc, &argv);
   CLI::App app{
       "contact-solve: frictionless contact of elastic bodies by domain decomposition (each body solved on its own).\n"

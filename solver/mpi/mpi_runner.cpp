@@ -95,7 +95,10 @@ void MpiTaskRunner::run_bodies(const std::vector<size_t>& bodies, const std::fun
   bool cancel = false;
   for (int r = 0; r < size_; ++r) {
     ddm::Unpacker in(all.data() + displs[static_cast<size_t>(r)], static_cast<size_t>(sizes[static_cast<size_t>(r)]));
-    cancel = cancel || in.get_int() != 0;
+    // Read whatever the flags before said: every message starts with its flag, and a flag left unread would be
+    // taken for the message's entry count (its bodies' outputs lost, or read from the wrong bytes).
+    const bool asked = in.get_int() != 0;
+    cancel = cancel || asked;
     const std::int64_t entries = in.get_int();
     for (std::int64_t e = 0; e < entries; ++e) {
       const auto body = static_cast<size_t>(in.get_int());

@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """contactd running jobs on MPI ranks (--mpi-launcher): a job with parallel.ranks = 2 streams its iterations live,
 ends SUCCEEDED and its result equals the same job solved in the server's own process (to 1e-12); a running MPI
-job is cancelled like any other; a server without a launcher, or a job over --max-ranks, is refused at
-/parallel/ranks. Exits 77 (skipped) without mpirun or without an MPI build of contact-solve."""
+job is cancelled like any other (CANCELLED with the iterations done and the result of its last iterate); a
+server without a launcher, or a job over --max-ranks, is refused at /parallel/ranks. Exits 77 (skipped) without
+mpirun or without an MPI build of contact-solve."""
 import os
 import shutil
 import subprocess
@@ -13,6 +14,8 @@ from harness import CONTACT_SOLVE, EXAMPLES, Checks, Server, Stream, example, lo
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "mpi"))
 from compare_results import max_relative_difference  # noqa: E402
+
+import h5py  # noqa: E402
 
 checks = Checks()
 check = checks.check
@@ -78,6 +81,19 @@ with tempfile.TemporaryDirectory() as tmp, \
     check("cancel of a running MPI job is accepted", r.status in (200, 202), r)
     done = server.wait_done(long_id, timeout=60)
     check("the cancelled MPI job ends CANCELLED", done.get("state") == "CANCELLED", done)
+    # With the iterations it did and the result of its last iterate (docs/parallel.md, "Cancellation").
+    check("the cancelled MPI job reports the iterations done", done.get("iterations", 0) >= 20
+          and f"after {done.get('iterations')} iterations" in done.get("message", ""), done)
+    check("the cancelled MPI job's result is available", done.get("result_available") is True, done)
+    cancelled_file = os.path.join(tmp, "cancelled.hdf")
+    check("the cancelled MPI job's result downloads", download(server, long_id, cancelled_file) == 200)
+    try:
+        with h5py.File(cancelled_file, "r") as f:
+            readable = (f.attrs["stop_reason"], int(f.attrs["iterations"]), len(f["steps"]))
+    except (OSError, KeyError) as e:
+        readable = str(e)
+    check("the cancelled MPI job's result is readable and says so",
+          readable == ("cancelled", done.get("iterations"), 1), readable)
 
     over = example("stack3.json")
     over["parallel"] = {"ranks": 4}
