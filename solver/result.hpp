@@ -72,8 +72,9 @@ struct BodyField {
   Eigen::VectorXd von_mises_cell;
   Eigen::VectorXd indicator_cell; // error indicator per cell (empty without adaptivity)
   Eigen::MatrixX2d reaction;      // per node: force the supports exert (zero where nothing is prescribed)
-  // Per displacement condition (edge or vertex, in the job's order): the sum of the reactions at its nodes (a
-  // corner node shared by two supported edges counts in both); and the sum over all nodes, each once.
+  // Per displacement condition (edge or vertex, in the job's order): the sum of the reactions at its nodes in the
+  // components it prescribes (a corner component prescribed by two conditions counts in both); and the sum over
+  // all nodes, each once.
   struct SupportReaction {
     std::string where;            // the edge or vertex name
     Eigen::Vector2d force = Eigen::Vector2d::Zero();

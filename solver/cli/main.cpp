@@ -185,8 +185,7 @@ int solve_and_write(contact::cli::Session& session, contact::Problem& problem, c
                   p.name.c_str(), p.enforcement.c_str(), p.theta, p.force, p.resultant.x(), p.resultant.y(), p_max,
                   penetration);
   }
-  // Support reactions: per displacement condition and the body's total (a corner shared by two supported edges
-  // counts in both of theirs, once in the total).
+  // Support reactions: per displacement condition (the components it prescribes) and the body's total.
   for (const auto& b : result.steps.back().bodies) {
     if (ndjson || b.support_reactions.empty()) continue;
     std::printf("body %s: reactions total (%.8g, %.8g)", b.name.c_str(), b.reaction_total.x(), b.reaction_total.y());

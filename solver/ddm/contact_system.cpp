@@ -293,7 +293,11 @@ Step ContactSystem::fields(const Displacements& u, const Pressures& z, int itera
     for (const auto& bc : body.boundary) {
       if (!prescribes_displacement(bc)) continue;
       BodyField::SupportReaction s{bc.vertex.empty() ? bc.edge : bc.vertex, Eigen::Vector2d::Zero()};
-      for (int node : condition_nodes(body.mesh, bc)) s.force += f.reaction.row(node).transpose();
+      // Only the components this condition prescribes: a corner node's other component is another support's.
+      for (int node : condition_nodes(body.mesh, bc)) {
+        if (bc.ux) s.force.x() += f.reaction(node, 0);
+        if (bc.uy) s.force.y() += f.reaction(node, 1);
+      }
       f.support_reactions.push_back(std::move(s));
     }
     if (bodies_[a]->floating()) {
