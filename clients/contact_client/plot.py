@@ -9,6 +9,7 @@ from .results import read_events, read_result
 # coordinate of the events' profiles, of the web page, of contact_begin/contact_end; it also serves edges that are
 # not horizontal), or "x".
 COORDINATES = ("arc", "x")
+AXIS_LABELS = {"arc": "arc length along the slave edge", "x": "x of the slave edge node"}  # the web page's: "arc"
 # By default a pressure panel shows the contact zone plus ZOOM_MARGIN of its width on each side, and at least
 # ZOOM_NODES slave nodes beyond each end (so that the opening of the contact shows on a coarse mesh).
 ZOOM_MARGIN = 0.15
@@ -210,7 +211,7 @@ def _draw_pressure(fig, ax, pair, curves, c_final, final_iteration, what, total,
     limits = pressure_range(solutions, xlim) if solutions else None
     if limits is not None:
         ax.set_xlim(*limits)
-    ax.set_xlabel("arc length along the slave edge" if along == "arc" else "x of the slave edge node")
+    ax.set_xlabel(AXIS_LABELS[along])
     ax.set_ylabel("contact pressure")
     shown = f"{len(curves)} of {total}" if len(curves) < total else f"all {total}"
     ax.set_title(pair + (f" ({shown} {what}s)" if len(curves) > 1 else ""), fontsize=10)
