@@ -299,23 +299,35 @@ def _fit(fig, ax, box):
     return (cx - hx, cx + hx, cy - hy, cy + hy), scale
 
 
-def _edge_colours(verts, pixels_per_unit):
-    """Black cell edges whose opacity grows with the cell's size on screen: none below 2 px, full (0.7) from 8 px.
-    A drawn edge is about half a pixel wide, so on a cell of 2 px the edges would cover half of it and on a
-    refined region they would merge into a black blob (the colours lost); faded with the size, coarse cells show
-    their edges, fine ones their colour, and the zoom panel shows the fine cells large enough to have edges."""
+def _edge_opacity(verts, pixels_per_unit):
+    """The opacity of black cell edges, growing with the cell's size on screen, its narrower side (area / longest
+    edge): none up to 2 px, full (0.7) from 8 px. A drawn edge is about half a pixel wide, so on a cell of 2 px
+    the edges would cover half of it and on a refined region they would merge into a black blob (the colours
+    lost); faded with the size, coarse cells show their edges, fine ones their colour, and the zoom panel shows
+    the fine cells large enough to have edges."""
     import numpy as np
     x, y = verts[..., 0], verts[..., 1]
+    dx, dy = np.roll(x, -1, axis=1) - x, np.roll(y, -1, axis=1) - y
     area = 0.5 * np.abs(np.sum(x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y, axis=1))
-    size = np.sqrt(area) * pixels_per_unit
-    colours = np.zeros((len(verts), 4))
-    colours[:, 3] = 0.7 * np.clip((size - 2.0) / 6.0, 0.0, 1.0)
-    return colours
+    longest = np.hypot(dx, dy).max(axis=1)
+    size = np.divide(area, longest, out=np.zeros_like(area), where=longest > 0) * pixels_per_unit
+    return 0.7 * np.clip((size - 2.0) / 6.0, 0.0, 1.0)
+
+
+def _edge_colours(faces, opacity):
+    """Each cell's edge: its face colour darkened by `opacity` (black at 1), opaque. Edges of the face colour
+    rather than transparent ones, so that the seams between antialiased cells do not let the white through."""
+    import numpy as np
+    edges = faces.copy()
+    edges[:, :3] *= (1.0 - opacity)[:, None]
+    edges[:, 3] = np.maximum(edges[:, 3], opacity)
+    return edges
 
 
 def _draw_mesh(fig, ax, meshes, edges, box, norm, labels):
     """The meshes in ax, showing box (x0, x1, y0, y1) at equal aspect (_fit): cells coloured by von Mises stress
-    with _edge_colours, each pair's slave edge in red, and the bodies' names when `labels`."""
+    with _edge_opacity, each pair's slave edge in red, and the bodies' names when `labels`."""
+    import matplotlib.pyplot as plt
     import numpy as np
     from matplotlib.collections import PolyCollection
     box, scale = _fit(fig, ax, box)
@@ -324,8 +336,9 @@ def _draw_mesh(fig, ax, meshes, edges, box, norm, labels):
     ax.set_aspect("equal")
     verts = np.concatenate([m["verts"] for m in meshes]) if meshes else np.zeros((0, 4, 2))
     values = np.concatenate([m["values"] for m in meshes]) if meshes else np.zeros(0)
-    ax.add_collection(PolyCollection(verts, array=values, cmap="viridis", norm=norm, linewidths=0.4,
-                                     edgecolors=_edge_colours(verts, scale)), autolim=False)
+    faces = plt.get_cmap("viridis")(norm(values))  # NaN: transparent
+    ax.add_collection(PolyCollection(verts, facecolors=faces, linewidths=0.4,
+                                     edgecolors=_edge_colours(faces, _edge_opacity(verts, scale))), autolim=False)
     for xy, _ in edges.values():
         ax.plot(xy[:, 0], xy[:, 1], color="red", lw=1.2, zorder=4, scalex=False, scaley=False)
     for m in meshes if labels else []:
@@ -370,7 +383,8 @@ def _mesh_row(fig, spec, final, warp, ranges, along):
     whole = _whole_box(meshes)
     marked = _zoom_box(edges, ranges, along, whole)
     true_warp = 1.0 if warp else 0.0
-    zoom = marked and _zoom_box(_slave_edges(final, true_warp), ranges, along, _whole_box(_meshes(final, true_warp)))
+    true_edges = _slave_edges(final, true_warp) if marked else {}
+    zoom = _zoom_box(true_edges, ranges, along, whole) if marked else None
     ratios = [1.0, 1.0, 0.05] if zoom else [1.0, 0.03]
     row = spec.subgridspec(1, len(ratios), width_ratios=ratios, wspace=0.2 if zoom else 0.04)
     norm = _stress_norm(meshes)
@@ -382,7 +396,7 @@ def _mesh_row(fig, spec, final, warp, ranges, along):
         ax.add_patch(Rectangle((marked[0], marked[2]), marked[1] - marked[0], marked[3] - marked[2], fill=False,
                                edgecolor="black", ls="--", lw=1.0, zorder=6))
         zax = fig.add_subplot(row[0, 1])
-        _draw_mesh(fig, zax, _meshes(final, true_warp), _slave_edges(final, true_warp), zoom, norm, labels=False)
+        _draw_mesh(fig, zax, _meshes(final, true_warp), true_edges, zoom, norm, labels=False)
         zax.set_title("around the contact (the dashed box), " + ("true displacement" if warp else "undeformed"),
                       fontsize=9)
         zax.set_xlabel("x")
@@ -408,7 +422,7 @@ def plot_result(result, png, events=None, warp=None, title=None, max_curves=12, 
          end, within the slave edge (the whole edge without contact); xlim=(lo, hi) for every pair's panel;
          xlim="full": the whole slave edge;
     bottom: each body's final mesh, deformed, cells coloured by von Mises stress, cell edges drawn where the cells
-         are large enough on screen to show them (_edge_colours), the slave edge of each pair
+         are large enough on screen to show them (_edge_opacity), the slave edge of each pair
          in red; next to it, when the pressure panels are zoomed, the mesh around the part of the slave edges
          they show, with the same colours (the fine cells there with their edges); one colour bar. The mesh is
          drawn displaced by warp x displacement: warp=None picks the scale that makes the largest displacement 4 %

@@ -116,9 +116,14 @@ def test_cli(hdf, tmp):
 def test_edges():
     square = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=float)
     cells = np.stack([square * size for size in (1.0, 2.0, 5.0, 8.0, 20.0)])
-    alpha = cc.plot._edge_colours(cells, pixels_per_unit=1.0)[:, 3]
+    alpha = cc.plot._edge_opacity(cells, pixels_per_unit=1.0)
     check("cell edges: none on cells up to 2 px, growing to 0.7 from 8 px",
           np.allclose(alpha, [0, 0, 0.35, 0.7, 0.7]), alpha)
+    strip = square * [2.0, 40.0]  # 2 px wide, 40 px tall
+    triangle = np.array([[0, 0], [20, 0], [0, 20], [0, 0]], dtype=float)  # a triangle repeats its first corner
+    alpha = cc.plot._edge_opacity(np.stack([strip, triangle]), pixels_per_unit=1.0)
+    check("cell edges: a cell's size is its narrower side (a 2 px strip has none), triangles included",
+          alpha[0] == 0 and 0 < alpha[1] <= 0.7, alpha)
 
 
 def main():
