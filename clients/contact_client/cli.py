@@ -129,6 +129,21 @@ def _cmd_validate(c, a):
     return EXIT_OK
 
 
+def _xlim(words):
+    """plot --xlim: None (the default zoom), "full", or (lo, hi) with lo < hi."""
+    if words is None:
+        return None
+    if words == ["full"]:
+        return "full"
+    try:
+        lo, hi = (float(w) for w in words)
+    except ValueError:
+        lo = hi = None
+    if lo is None or not lo < hi:
+        raise BadInput(f"--xlim {' '.join(words)}: give two numbers LO < HI, or 'full'")
+    return lo, hi
+
+
 def _cmd_plot(c, a):
     if not os.path.exists(a.file):
         raise BadInput(f"cannot read {a.file}: no such file")
@@ -150,8 +165,15 @@ def _cmd_plot(c, a):
             events = read_events(a.events)
         except (OSError, ValueError) as exc:
             raise BadInput(f"cannot read events from {a.events}: {one_line(exc)}") from None
-    warp = plot_result(result, a.output, events=events, warp=a.warp, title=a.title)
+    drawn = plot_result(result, a.output, events=events, warp=a.warp, title=a.title, xlim=_xlim(a.xlim),
+                        along=a.along)
+    warp = drawn["warp"]
     print(f"wrote {a.output} (1000 x 800 px; " + (f"mesh displaced x {warp:g})" if warp else "undeformed mesh)"))
+    coordinate = "arc length" if a.along == "arc" else "x"
+    for pair, (lo, hi) in drawn["pressure_xlim"].items():
+        zone = drawn["contact_zone"].get(pair)
+        print(f"  {pair}: pressure drawn from {coordinate} {lo:g} to {hi:g}, "
+              + (f"contact from {zone[0]:g} to {zone[1]:g}" if zone else "no contact"))
     return EXIT_OK
 
 
@@ -237,6 +259,14 @@ def build_parser():
     s.add_argument("--warp", type=float, default=None,
                    help="draw the mesh displaced by this factor times the displacement (default: the factor that "
                         "makes the largest displacement 4%% of the mesh; 0: undeformed)")
+    s.add_argument("--xlim", nargs="+", metavar=("LO", "HI"),
+                   help="--xlim LO HI: the pressure panels' horizontal range; --xlim full: the whole slave edge "
+                        "(default: the contact zone, the nodes with "
+                        "pressure > 0, plus 15%% of its width and at least 3 nodes on each side; the mesh is "
+                        "drawn whole and zoomed on that stretch)")
+    s.add_argument("--along", choices=["arc", "x"], default="arc",
+                   help="the pressure panels' horizontal coordinate: arc (default) the arc length along the "
+                        "slave edge from its first node, as on the web page; x the nodes' x")
     s.add_argument("--title")
     s.set_defaults(func=_cmd_plot)
     return p

@@ -251,7 +251,7 @@ def test_module(server, tmp):
           and hist.get("pair_names") == [pair], hist.get("pair_names"))
 
     png = os.path.join(tmp, "module_seed.png")
-    warp = cc.plot_result(r, png, events=events)
+    warp = cc.plot_result(r, png, events=events)["warp"]
     check_png("module plot", png)
     u = np.concatenate([b["displacement"] for b in r["steps"][-1]["bodies"].values()])
     check("module plot: the mesh drawn deformed, the largest displacement 2 to 4 % of the mesh's 4 cm",

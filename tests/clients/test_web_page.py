@@ -23,6 +23,8 @@ import urllib.request
 HERE = os.path.dirname(os.path.abspath(__file__))
 SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(HERE, "..", ".."))
 sys.path.insert(0, os.path.join(SRC, "tests", "server"))
+sys.path.insert(0, os.path.join(SRC, "clients"))
+from contact_client.plot import AXIS_LABELS  # noqa: E402
 from harness import EXAMPLES, Checks, Server, example, long_job  # noqa: E402
 
 checks = Checks()
@@ -128,8 +130,22 @@ def points(b):
     return int(b.attr("convergence", "data-points") or 0)
 
 
+# Records the text drawn into the pressure plots' canvases (uPlot draws its axis labels there, not in the DOM).
+RECORD_PRESSURE_TEXT = """
+(() => {
+  const texts = window.pressureCanvasTexts = [];
+  const fillText = CanvasRenderingContext2D.prototype.fillText;
+  CanvasRenderingContext2D.prototype.fillText = function (text, ...rest) {
+    if (this.canvas.closest && this.canvas.closest("#pressure")) texts.push(String(text));
+    return fillText.call(this, text, ...rest);
+  };
+})();
+"""
+
+
 def test_without_token(server, b, downloads):
     base = f"http://127.0.0.1:{server.port}/"
+    b.driver.execute_cdp_cmd("Page.addScriptToEvaluateOnNewDocument", {"source": RECORD_PRESSURE_TEXT})
     b.driver.get(base)
     check("page: title", b.driver.title == "contactd", b.driver.title)
     check("page: the empty job list says so", b.wait(lambda: b.text("jobs-status") == "no jobs yet"),
@@ -162,6 +178,9 @@ def test_without_token(server, b, downloads):
           len(b.driver.find_elements(By.CSS_SELECTOR, "#pressure .pair canvas")) == 1
           and int(b.attr("pressure", "data-iteration")) > 0
           and "upper.bottom-lower.top" in b.text("pressure"), b.text("pressure"))
+    labels = b.driver.execute_script("return window.pressureCanvasTexts || null;")
+    check("running: the pressure is plotted against the client plot's default coordinate (arc length)",
+          labels is not None and AXIS_LABELS["arc"] in labels, (labels and sorted(set(labels))[:20], AXIS_LABELS))
     rows = b.rows("mesh")
     progress = server.job(job_id)["progress"]
     expected = [[x["name"], str(x["elements"]), str(x["dofs"])] for x in progress["bodies"]]
