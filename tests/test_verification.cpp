@@ -1,5 +1,6 @@
 // Verification on the job examples (api/examples): the DDM against the monolithic reference, equilibrium,
 // Hertz, symmetry, and the paper's run. Every expected number comes from mathematics, not from a past run.
+#include "contact/extent.hpp"
 #include "job/job.hpp"
 #include "solve.hpp"
 #include "support.hpp"
@@ -281,4 +282,32 @@ TEST(PaperScheme, NodalMortarPenaltyReproducesTheRemovedGaussPointSchemeOnMatchi
   ASSERT_TRUE(converged.converged) << converged.message;
   EXPECT_NEAR(converged.steps.back().pairs[0].pressure[0], 187.307, 0.005 * 187.307);
   EXPECT_NEAR(converged.steps.back().pairs[0].force, 145.407, 0.005 * 145.407);
+}
+
+TEST(Hertz, InterpolatedContactEdgeIsCloserToTheFormulaThanTheLastNodeInContact) {
+  // The result's contact_end (contact/extent.hpp: p^2 extrapolated linearly from the last two nodes in contact)
+  // against Hertz's half-width a, on two meshes: within a third of the node spacing there, and closer than the
+  // last node in contact (the quantised edge reported before).
+  for (int nx : {80, 160}) {
+    json job = load_example("hertz.json");
+    for (auto& body : job["bodies"]) body["mesh"]["block"]["nx"] = nx;
+    const Problem p = parse_or_fail(job);
+    const Result r = run(p);
+    ASSERT_TRUE(r.converged) << r.message;
+    const auto& pair = r.steps.back().pairs.at(0);
+    const double P = 2.0 * pair.force;
+    const double R = 1.0 / (2.0 * job["bodies"][1]["mesh"]["block"]["edges"]["bottom"]["parabola"]["a"].get<double>());
+    double inv_E_star = 0;
+    for (const auto& b : p.bodies) inv_E_star += (1 - b.material.nu * b.material.nu) / b.material.E;
+    const double a = std::sqrt(4 * P * R * inv_E_star / M_PI);
+    Eigen::Index last = -1;
+    for (Eigen::Index j = 0; j < pair.pressure.size(); ++j)
+      if (pair.pressure[j] > 0) last = j;
+    ASSERT_GT(last, 0);
+    ASSERT_LT(last + 1, pair.pressure.size());
+    const double h = pair.arc_length[last + 1] - pair.arc_length[last];
+    const double edge = mortar::contact_extent(pair.arc_length, pair.pressure).end;
+    EXPECT_LE(std::abs(edge - a), h / 3) << nx;
+    EXPECT_LT(std::abs(edge - a), std::abs(pair.arc_length[last] - a)) << nx;
+  }
 }

@@ -1,5 +1,6 @@
 #include "contact_system.hpp"
 
+#include "../contact/extent.hpp"
 #include "../contact/segments.hpp"
 #include "../fem/blas_threads.hpp"
 
@@ -229,7 +230,6 @@ IterationReport ContactSystem::report_gaps(int iteration, const Pressures& z, co
     auto& prev = previous_active[k];
     const bool had_previous = prev.size() == static_cast<size_t>(p.size());
     prev.resize(static_cast<size_t>(p.size()), 0);
-    bool first = true;
     for (Eigen::Index row = 0; row < p.size(); ++row) {
       pr.max_penetration = std::max(pr.max_penetration, -g[row]);
       const char active = p[row] > 0 ? 1 : 0;
@@ -237,13 +237,12 @@ IterationReport ContactSystem::report_gaps(int iteration, const Pressures& z, co
       prev[static_cast<size_t>(row)] = active;
       if (!active) continue;
       ++pr.active_nodes;
-      const double arc = pair.node_arc[pair.node_of_row[static_cast<size_t>(row)]];
-      if (first) pr.extent_begin = arc;
-      pr.extent_end = arc;
-      first = false;
       pr.max_pressure = std::max(pr.max_pressure, p[row]);
     }
     const Eigen::VectorXd pn = pair.to_nodes(p, 0.0);
+    const mortar::ContactExtent extent = mortar::contact_extent(pair.node_arc, pn);
+    pr.extent_begin = extent.begin;
+    pr.extent_end = extent.end;
     pr.positions.assign(pair.node_arc.data(), pair.node_arc.data() + pair.node_arc.size());
     pr.pressures.assign(pn.data(), pn.data() + pn.size());
     r.active_nodes += pr.active_nodes;

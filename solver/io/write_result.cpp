@@ -1,6 +1,7 @@
 // write_result: Result -> HDF5 file in the layout of docs/results-format.md.
 #include "result_file.hpp"
 
+#include "../contact/extent.hpp"
 #include "../solve.hpp"
 #include "view_layout.hpp"
 #include "file_util.hpp"
@@ -233,15 +234,10 @@ void write_step_history(hid_t history, const Result& result) {
     for (Eigen::Index p = 0; p < np; ++p) {
       const PairField& pair = s.pairs[static_cast<size_t>(p)];
       force(k, p) = pair.force;
-      // The contact zone along the slave edge: arc length of the first and last node in contact (0, 0 if none).
-      contact_begin(k, p) = contact_end(k, p) = 0.0;
-      bool first = true;
-      for (Eigen::Index j = 0; j < pair.active.size(); ++j) {
-        if (!pair.active[j]) continue;
-        if (first) contact_begin(k, p) = pair.arc_length[j];
-        contact_end(k, p) = pair.arc_length[j];
-        first = false;
-      }
+      // The contact zone along the slave edge, interpolated between nodes (contact/extent.hpp; 0, 0 if none).
+      const mortar::ContactExtent extent = mortar::contact_extent(pair.arc_length, pair.pressure);
+      contact_begin(k, p) = extent.begin;
+      contact_end(k, p) = extent.end;
     }
   }
   h5::write_attribute(g, "body_names", names);

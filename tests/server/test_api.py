@@ -20,7 +20,7 @@ check = checks.check
 ITERATION_FIELDS = {"iteration", "measure", "paper_criterion", "fixed_point_residual", "complementarity",
                     "active_nodes", "active_set_changes", "elapsed_seconds", "gamma", "update", "note", "bodies", "pairs"}
 BODY_FIELDS = {"name", "elements", "dofs", "elements_refined"}
-PAIR_FIELDS = {"name", "force", "max_pressure", "extent_begin", "extent_end", "active_nodes", "changed_nodes",
+PAIR_FIELDS = {"name", "force", "resultant", "max_pressure", "extent_begin", "extent_end", "active_nodes", "changed_nodes",
                "theta", "max_penetration", "positions", "pressures"}
 END_FIELDS = {"state", "stop_reason", "message", "converged"}
 
