@@ -166,13 +166,16 @@ TEST(FloatingErrors, AFloatingBodyPulledAwayFromItsContactIsNamedWithItsFreeMoti
   EXPECT_NE(r.message.find("'punch.bottom-block.top'"), std::string::npos) << r.message;
 }
 
-TEST(FloatingErrors, ABodyThatSlidesFreelyOnAFlatContactIsNamed) {
-  // Frictionless flat contact cannot hold a horizontal translation.
+TEST(FloatingErrors, ABodyThatSlidesFreelyOnAFlatContactIsNamedAtValidation) {
+  // Frictionless flat contact cannot hold a horizontal translation, whatever the loads: the job check says so
+  // (before issue 23 the solve found it and blamed the loads).
   json job = example("punch_force.json");
   job["bodies"][1]["boundary"] = {{{"edge", "top"}, {"force", {0, -200}}}};
-  const Result r = run(job);
-  EXPECT_EQ(r.stop_reason, StopReason::error);
-  EXPECT_NE(r.message.find("body 'punch' floats (translation in x"), std::string::npos) << r.message;
+  const auto parsed = job::parse(job);
+  ASSERT_FALSE(parsed.ok());
+  const std::string text = job::format_errors(parsed.errors);
+  EXPECT_NE(text.find("/bodies/1/boundary: body 'punch' floats (translation in x"), std::string::npos) << text;
+  EXPECT_NE(text.find("translation in x (it slides along them)"), std::string::npos) << text;
 }
 
 // Issue 22, defect 11: the monolithic method returned a zero displacement (exit 0) for a floating body nothing
@@ -180,24 +183,23 @@ TEST(FloatingErrors, ABodyThatSlidesFreelyOnAFlatContactIsNamed) {
 // away from its contact is not among the cases: the monolithic active set cycles to max_iterations there, 13 s,
 // and is refused only then.)
 TEST(FloatingErrors, TheMonolithicMethodRefusesAnUnheldBodyLikeTheDefaultMethod) {
-  // A cap with no supports and no load resting on a base held at its bottom.
+  // A cap held sideways at one corner and pulled off a base held at its bottom: its flat contact could hold it
+  // (the job is valid), but the load pulls it away, so nothing holds it at the solution.
   const json cap = json::parse(R"({
     "name": "cap",
     "bodies": [
       {"name": "cap", "material": {"E": 1000, "nu": 0.3},
-       "mesh": {"block": {"corners": [[0, 1], [1, 1], [1, 2], [0, 2]], "nx": 4, "ny": 4}}},
+       "mesh": {"block": {"corners": [[0, 1], [1, 1], [1, 2], [0, 2]], "nx": 4, "ny": 4}},
+       "boundary": [{"vertex": "bottom_left", "displacement": {"x": 0}}, {"edge": "top", "force": [0, 10]}]},
       {"name": "base", "material": {"E": 1000, "nu": 0.3},
        "mesh": {"block": {"corners": [[0, 0], [1, 0], [1, 1], [0, 1]], "nx": 4, "ny": 4}},
        "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]}
     ],
     "contacts": [{"slave": "cap.bottom", "master": "base.top"}]
   })");
-  json sliding = example("punch_force.json");
-  sliding["bodies"][1]["boundary"] = {{{"edge", "top"}, {"force", {0, -200}}}};  // pressed, nothing holds x
   const std::vector<std::pair<json, std::string>> cases = {
-      {cap, "body 'cap' floats (translation in x, translation in y, rotation free) and no contact holds it: its "
-            "contact 'cap.bottom-base.top'"},
-      {sliding, "body 'punch' floats (translation in x"}};
+      {cap, "body 'cap' floats (translation in y, rotation free) and no contact holds it: its contact "
+            "'cap.bottom-base.top'"}};
   for (const auto& [base_job, phrase] : cases)
     for (const std::string method : {"interface_newton", "monolithic"}) {
       json job = base_job;

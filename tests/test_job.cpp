@@ -511,14 +511,58 @@ TEST(JobErrors, SamePairTwiceIsRejectedEvenWithSlaveAndMasterSwapped) {
 
 TEST(JobErrors, FloatingBodyWithTheNeumannSchemeNamesTheBodyItsFreeMotionAndTheMethodsThatTakeIt) {
   json job = small_job();
-  job["bodies"][1]["boundary"].erase(0);  // only {"y": 0} on the bottom remains
+  job["bodies"][1]["boundary"].erase(1);  // only {"x": 0} on the left remains: the flat contact holds y
   job["solver"] = {{"method", "neumann"}};
-  expect_only_error(parse(job), "/solver/method", "body 'lower' floats (translation in x is free");
+  expect_only_error(parse(job), "/solver/method", "body 'lower' floats (translation in y is free");
   EXPECT_NE(listing(parse(job)).find("\"interface_newton\""), std::string::npos) << listing(parse(job));
   // With the default method a floating body in contact is a valid job (whether its contacts hold it is decided by
   // the solve).
   job.erase("solver");
   EXPECT_TRUE(parse(job).ok()) << listing(parse(job));
+}
+
+TEST(JobErrors, AFloatingBodyThatSlidesAlongItsFlatFrictionlessContactIsRefusedAtValidation) {
+  // Only {"y": 0} on the bottom: x is free, and a flat contact pushes along y only, whatever the loads.
+  json job = small_job();
+  job["bodies"][1]["boundary"].erase(0);
+  expect_only_error(parse(job), "/bodies/1/boundary",
+                    "body 'lower' floats (translation in x is free) and its frictionless contacts "
+                    "'upper.bottom-lower.top' cannot hold it");
+  EXPECT_NE(listing(parse(job)).find("translation in x (it slides along them)"), std::string::npos) << listing(parse(job));
+}
+
+TEST(JobErrors, TheNaiveRollerNamesThePlatesSlidingAndTheRollersSpinNotTheLoads) {
+  // A roller between two plates, a force on the top plate and nothing else: the top plate can slide along its
+  // flat contact, and the roller spin about its centre (0, 1), where all its contact normals meet.
+  const json job = json::parse(R"({
+    "name": "roller_naive",
+    "bodies": [
+      {"name": "base", "material": {"E": 2.1e5, "nu": 0.3},
+       "mesh": {"block": {"corners": [[-2, -1], [2, -1], [2, 0], [-2, 0]], "nx": 16, "ny": 4}},
+       "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]},
+      {"name": "roller", "material": {"E": 2.1e5, "nu": 0.3},
+       "mesh": {"block": {"corners": [[-0.5, 0.1339745962155614], [0.5, 0.1339745962155614],
+                                      [0.5, 1.8660254037844386], [-0.5, 1.8660254037844386]], "nx": 8, "ny": 8,
+                          "edges": {"bottom": {"arc": {"center": [0, 1], "radius": 1}},
+                                    "top": {"arc": {"center": [0, 1], "radius": 1}}}}}},
+      {"name": "plate", "material": {"E": 2.1e5, "nu": 0.3},
+       "mesh": {"block": {"corners": [[-2, 2], [2, 2], [2, 3], [-2, 3]], "nx": 16, "ny": 4}},
+       "boundary": [{"edge": "top", "force": [0, -100]}]}
+    ],
+    "contacts": [{"slave": "roller.bottom", "master": "base.top"}, {"slave": "roller.top", "master": "plate.bottom"}]
+  })");
+  const ParseResult r = parse(job);
+  ASSERT_EQ(r.errors.size(), 2u) << listing(r);
+  EXPECT_EQ(r.errors[0].pointer, "/bodies/1/boundary");
+  EXPECT_NE(r.errors[0].message.find("body 'roller'"), std::string::npos) << listing(r);
+  EXPECT_NE(r.errors[0].message.find("rotation about (0, 1) (it spins"), std::string::npos) << listing(r);
+  EXPECT_EQ(r.errors[1].pointer, "/bodies/2/boundary");
+  EXPECT_NE(r.errors[1].message.find("body 'plate'"), std::string::npos) << listing(r);
+  EXPECT_NE(r.errors[1].message.find("translation in x (it slides along them)"), std::string::npos) << listing(r);
+  for (const auto& e : r.errors) {
+    EXPECT_EQ(e.message.find("pull"), std::string::npos) << e.message;
+    EXPECT_EQ(e.message.find("loads move it"), std::string::npos) << e.message;
+  }
 }
 
 TEST(JobErrors, BodyWithoutDisplacementConditionsAndWithoutContactHasAllThreeRigidMotionsFree) {

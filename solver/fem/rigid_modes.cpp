@@ -35,10 +35,12 @@ std::vector<std::string> free_rigid_motions(const mesh::Mesh& mesh, const std::v
   return free_rigid_modes(mesh, prescribed).names;
 }
 
-RigidModes free_rigid_modes(const mesh::Mesh& mesh, const std::vector<PrescribedDof>& prescribed) {
-  // Centroid of the body (area-weighted cell centres) and the distance to its farthest node, which scales the
-  // rotation mode to unit size so that the three modes are comparable in the SVD.
-  Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
+namespace {
+
+// The body's centroid (area-weighted cell centres) and the distance to its farthest node, which scales the
+// rotation mode to unit size so that the three modes are comparable in the SVD.
+void centroid_and_radius(const mesh::Mesh& mesh, Eigen::Vector2d& centroid, double& radius) {
+  centroid = Eigen::Vector2d::Zero();
   double area = 0.0;
   for (int c = 0; c < mesh.num_cells(); ++c) {
     Eigen::Vector2d centre = Eigen::Vector2d::Zero();
@@ -49,24 +51,35 @@ RigidModes free_rigid_modes(const mesh::Mesh& mesh, const std::vector<Prescribed
     area += a;
   }
   if (area > 0) centroid /= area;
-  double radius = 0.0;
+  radius = 0.0;
   for (const auto& p : mesh.nodes) radius = std::max(radius, (p - centroid).norm());
   if (!(radius > 0)) radius = 1.0;
+}
 
-  // Rows: prescribed components; columns: the modes tx, ty, rot evaluated there.
-  Eigen::MatrixXd modes(static_cast<Eigen::Index>(prescribed.size()), 3);
-  for (size_t k = 0; k < prescribed.size(); ++k) {
-    const Eigen::Vector2d r = (mesh.nodes[static_cast<size_t>(prescribed[k][0])] - centroid) / radius;
+}  // namespace
+
+RigidModes free_rigid_modes(const mesh::Mesh& mesh, const std::vector<PrescribedDof>& prescribed) {
+  std::vector<HeldDirection> held;
+  for (const auto& p : prescribed)
+    held.push_back({p[0], p[1] == 0 ? Eigen::Vector2d(1, 0) : Eigen::Vector2d(0, 1)});
+  return free_rigid_modes_along(mesh, held);
+}
+
+RigidModes free_rigid_modes_along(const mesh::Mesh& mesh, const std::vector<HeldDirection>& held) {
+  Eigen::Vector2d centroid;
+  double radius = 1.0;
+  centroid_and_radius(mesh, centroid, radius);
+  // Rows: the held directions; columns: the modes tx, ty, rot evaluated there along them.
+  Eigen::MatrixXd modes(static_cast<Eigen::Index>(held.size()), 3);
+  for (size_t k = 0; k < held.size(); ++k) {
+    const Eigen::Vector2d r = (mesh.nodes[static_cast<size_t>(held[k].node)] - centroid) / radius;
     const Eigen::Vector2d rotation(-r.y(), r.x());
-    const auto row = static_cast<Eigen::Index>(k);
-    const int component = prescribed[k][1];
-    modes(row, 0) = component == 0 ? 1.0 : 0.0;
-    modes(row, 1) = component == 1 ? 1.0 : 0.0;
-    modes(row, 2) = rotation(component);
+    const Eigen::Vector2d d = held[k].direction;
+    modes.row(static_cast<Eigen::Index>(k)) << d.x(), d.y(), rotation.dot(d);
   }
-
+  const bool none_held = held.empty();
   Eigen::MatrixXd null_space;  // 3 x k, orthonormal columns
-  if (prescribed.empty()) {
+  if (none_held) {
     null_space = Eigen::MatrixXd::Identity(3, 3);
   } else {
     Eigen::JacobiSVD<Eigen::MatrixXd> svd(modes, Eigen::ComputeFullV);

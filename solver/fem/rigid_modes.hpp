@@ -36,4 +36,12 @@ struct RigidModes {
 };
 RigidModes free_rigid_modes(const mesh::Mesh& mesh, const std::vector<PrescribedDof>& prescribed);
 
+// The same for motions held along arbitrary directions at nodes (a support's component, or a frictionless
+// contact's normal, which stops a node only along it).
+struct HeldDirection {
+  int node = 0;
+  Eigen::Vector2d direction = Eigen::Vector2d::UnitX();
+};
+RigidModes free_rigid_modes_along(const mesh::Mesh& mesh, const std::vector<HeldDirection>& held);
+
 }  // namespace contact::fem

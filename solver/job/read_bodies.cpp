@@ -253,6 +253,60 @@ void JobReader::check_loads_reach_the_body(const BodyInput& in) {
   }
 }
 
+namespace {
+
+// The directions in which body i is held whatever the loads, at best: its prescribed components, and the normal of
+// every node of its contact edges (a frictionless contact pushes only along it).
+std::vector<fem::HeldDirection> best_held_directions(const Body& body, const std::vector<ContactPair>& contacts, size_t i) {
+  std::vector<fem::HeldDirection> held;
+  for (const auto& bc : body.boundary) {
+    if (!prescribes_displacement(bc)) continue;
+    for (int node : condition_nodes(body.mesh, bc)) {
+      if (bc.ux) held.push_back({node, Eigen::Vector2d(1, 0)});
+      if (bc.uy) held.push_back({node, Eigen::Vector2d(0, 1)});
+    }
+  }
+  for (const auto& c : contacts) {
+    std::vector<std::string> edges;
+    if (c.slave_body == static_cast<int>(i)) edges.push_back(c.slave_edge);
+    if (c.master_body == static_cast<int>(i)) edges.push_back(c.master_edge);
+    for (const auto& edge : edges) {
+      // A node's normal: perpendicular to the chord through its neighbours (on a uniformly divided arc, exactly
+      // radial). An end node has one neighbour: its one-sided normal is kept where the edge is straight there (it
+      // equals its neighbour's), not where it is curved (it would hold a roller's spin that its end nodes, far
+      // from the contact, never do).
+      const std::vector<int> nodes = body.mesh.edge_set_nodes(edge);
+      const size_t n = nodes.size();
+      const auto at = [&](size_t j) { return body.mesh.nodes[static_cast<size_t>(nodes[j])]; };
+      const auto normal = [&](size_t j) {
+        const Eigen::Vector2d t = at(std::min(j + 1, n - 1)) - at(j == 0 ? 0 : j - 1);
+        return t.norm() > 0 ? Eigen::Vector2d(Eigen::Vector2d(-t.y(), t.x()).normalized()) : Eigen::Vector2d::Zero();
+      };
+      for (size_t j = 0; j < n && n > 1; ++j) {
+        const Eigen::Vector2d nu = normal(j);
+        if (!(nu.norm() > 0)) continue;
+        const bool end = j == 0 || j + 1 == n;
+        if (end && n > 2) {
+          const Eigen::Vector2d inner = normal(j == 0 ? 1 : n - 2);
+          if (std::abs(nu.x() * inner.y() - nu.y() * inner.x()) > 1e-9) continue;  // curved at the end
+        }
+        held.push_back({nodes[j], nu});
+      }
+    }
+  }
+  return held;
+}
+
+std::string contact_names(const Problem& problem, size_t i) {
+  std::string out;
+  for (const auto& c : problem.contacts)
+    if (c.slave_body == static_cast<int>(i) || c.master_body == static_cast<int>(i))
+      out += (out.empty() ? "'" : ", '") + c.name + "'";
+  return out;
+}
+
+}  // namespace
+
 // A floating body (free rigid motions) is accepted when it touches another body and the method solves the
 // interface problem with its equilibrium (interface_newton, monolithic); the fixed-point schemes solve every
 // body alone with Neumann data on its contact zone, which a floating body cannot take.
@@ -270,6 +324,22 @@ void JobReader::check_floating_bodies() {
                   "body '" + in.body.name + "' is not restrained against rigid motion (" + free +
                       ") and touches no other body: prescribe a displacement component on one of its edges or "
                       "vertices, or give it a contact that can hold it");
+    } else if (const auto loose = fem::free_rigid_modes_along(in.body.mesh, best_held_directions(in.body, problem_.contacts, i)).names;
+               !loose.empty()) {
+      // Frictionless contacts push only along their normals: a motion no normal resists is free whatever the
+      // loads (a plate sliding along a flat contact, a roller spinning about its centre, where all its normals
+      // meet). The solve could only fail later and blame the loads.
+      std::string modes;
+      for (const auto& m : loose)
+        modes += (modes.empty() ? "" : "; ") + m +
+                 (m.rfind("translation", 0) == 0    ? " (it slides along them)"
+                  : m.rfind("rotation about", 0) == 0 ? " (it spins: every contact normal passes through that point)"
+                                                      : "");
+      errors_.add(child(in.pointer, "boundary"),
+                  "body '" + in.body.name + "' floats (" + free + ") and its frictionless contacts " +
+                      contact_names(problem_, i) + " cannot hold it whatever the loads, since they push only along "
+                      "their normals: nothing resists its " + modes + "; prescribe a displacement component that "
+                      "stops it, on an edge or a named vertex");
     } else if (method == Method::neumann || method == Method::robin) {
       errors_.add(method_pointer_.empty() ? child(in.pointer, "boundary") : method_pointer_,
                   "body '" + in.body.name + "' floats (" + free + ": only its contacts hold it), and method \"" +

@@ -104,12 +104,15 @@ with tempfile.TemporaryDirectory() as tmp:
     r = run(os.path.join(tmp, "missing.json"))
     check("missing file exits 2", r.returncode == 2 and "cannot open" in r.stderr, r.stderr)
 
-    # A floating body that its contacts cannot hold (issue 22, defect 12): a cap with no supports and no load on a
-    # base. A solver error, as README's table and docs/job-format.md say: exit 1, the body named, no result file
-    # (exit 3 is a run stopped without converging, whose result is written). Both methods that take floating bodies.
+    # A floating body that its contacts cannot hold (issue 22, defect 12): a cap held sideways at a corner and
+    # pulled off a base. A solver error, as README's table and docs/job-format.md say: exit 1, the body named, no
+    # result file (exit 3 is a run stopped without converging, whose result is written). Both methods that take
+    # floating bodies. (Without the corner support the cap could slide along its flat frictionless contact whatever
+    # the loads: the job check refuses that, exit 2, checked below.)
     cap = {"name": "cap", "bodies": [
         {"name": "cap", "material": {"E": 1000, "nu": 0.3},
-         "mesh": {"block": {"corners": [[0, 1], [1, 1], [1, 2], [0, 2]], "nx": 4, "ny": 4}}},
+         "mesh": {"block": {"corners": [[0, 1], [1, 1], [1, 2], [0, 2]], "nx": 4, "ny": 4}},
+         "boundary": [{"vertex": "bottom_left", "displacement": {"x": 0}}, {"edge": "top", "force": [0, 10]}]},
         {"name": "base", "material": {"E": 1000, "nu": 0.3},
          "mesh": {"block": {"corners": [[0, 0], [1, 0], [1, 1], [0, 1]], "nx": 4, "ny": 4}},
          "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]}],
@@ -123,6 +126,15 @@ with tempfile.TemporaryDirectory() as tmp:
         check(f"{method}: an unheld floating body exits 1 naming it", r.returncode == 1 and
               "error: " in r.stderr and "body 'cap' floats" in r.stderr, f"{r.returncode} {r.stderr[-300:]}")
         check(f"{method}: an unheld floating body writes no result", not os.path.exists(cap_out))
+    sliding = json.loads(json.dumps(cap))
+    sliding["bodies"][0]["boundary"] = []
+    sliding_job = os.path.join(tmp, "cap_sliding.json")
+    with open(sliding_job, "w") as f:
+        json.dump(sliding, f)
+    r = run(sliding_job, "--validate")
+    check("a cap that can slide along its frictionless contact is refused at validation (exit 2, the sliding named)",
+          r.returncode == 2 and "translation in x (it slides along them)" in r.stdout + r.stderr,
+          f"{r.returncode} {(r.stdout + r.stderr)[-300:]}")
     with open(os.path.join(SRC, "docs", "job-format.md"), encoding="utf-8") as f:
         doc = " ".join(f.read().split())
     check("docs/job-format.md gives the unheld floating body's exit code as 1",
