@@ -201,7 +201,7 @@ IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fe
   }
   IndicatorResult r;
   try {
-    const bem::BoundarySolution sol = bem::solve(bp);
+    const bem::BoundarySolution sol = bem::solve_auto(bp);
     std::vector<Eigen::Vector2d> points;
     std::vector<size_t> first(static_cast<size_t>(m.num_cells()) + 1, 0);  // cell c's points start at first[c]
     points.reserve(static_cast<size_t>(m.num_cells()) * 4);
@@ -210,7 +210,7 @@ IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fe
       for (int p = 0; p < q.size; ++p) points.push_back(q.point[static_cast<size_t>(p)]);
       first[static_cast<size_t>(c) + 1] = points.size();
     }
-    const Eigen::MatrixX3d sb = bem::interior_stresses(bp, sol, points);
+    const Eigen::MatrixX3d sb = bem::interior_stresses_auto(bp, sol, points);
     CellStresses ref(static_cast<size_t>(m.num_cells()));
     for (size_t c = 0; c < ref.size(); ++c) {
       ref[c].resize(3, static_cast<Eigen::Index>(first[c + 1] - first[c]));
