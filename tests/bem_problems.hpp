@@ -155,4 +155,26 @@ inline BoundaryProblem quarter_ring(const Lame& lame, int m) {
 }
 
 
+// The disc of radius 1 as a polygon of n nodes with the quadratic field: displacements on the first quarter of
+// the boundary, tractions on the rest (docs/bem.md's timings and bench/bench_hbem).
+inline BoundaryProblem disc_problem(int n) {
+  const Field field = quadratic_field(kSteel);
+  std::vector<Vector2d> corners;
+  for (int k = 0; k < n; ++k) corners.emplace_back(std::cos(2 * kPi * k / n), std::sin(2 * kPi * k / n));
+  std::vector<SideCondition> sides(static_cast<std::size_t>(n), kTraction);
+  for (int k = 0; k < n / 4; ++k) sides[static_cast<std::size_t>(k)] = kDisplacement;
+  return polygon_problem(corners, sides, 10.0, field, kSteel);
+}
+
+// n points spread over the disc r <= 0.95 (a sunflower pattern: uniform density, no two alike).
+inline std::vector<Vector2d> interior_points(int n) {
+  std::vector<Vector2d> points;
+  const double golden = kPi * (3.0 - std::sqrt(5.0));
+  for (int k = 0; k < n; ++k) {
+    const double r = 0.95 * std::sqrt((k + 0.5) / n);
+    points.emplace_back(r * std::cos(golden * k), r * std::sin(golden * k));
+  }
+  return points;
+}
+
 }  // namespace contact::bem::test_problems

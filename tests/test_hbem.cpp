@@ -6,9 +6,12 @@
 
 #include <Eigen/LU>
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "bem/aca.hpp"
@@ -315,4 +318,57 @@ TEST(HBemInput, SelfOverlapOutsidePointsAndCancellationAreReported) {
   int polls = 0;
   cancelled.cancelled = [&] { return ++polls > 3; };
   EXPECT_THROW(solve_hierarchical(square, cancelled), Cancelled);
+}
+
+TEST(HBemCancel, PollsOftenEnoughAndStopsWithinASecondOfACancelInTheSolveAndTheEvaluation) {
+  // A disc of 8192 boundary nodes (a few seconds of work). First the longest time between two polls of the
+  // cancellation callback, from the call to its return, in the solve and in the evaluation at 8192 points.
+  const BoundaryProblem problem = disc_problem(8192);
+  const std::vector<Vector2d> points = interior_points(8192);
+  using Clock = std::chrono::steady_clock;
+  Clock::time_point last;
+  double longest = 0.0;
+  HierarchicalOptions options;
+  options.cancelled = [&] {
+    const Clock::time_point now = Clock::now();
+    longest = std::max(longest, std::chrono::duration<double>(now - last).count());
+    last = now;
+    return false;
+  };
+  last = Clock::now();
+  const BoundarySolution solution = solve_hierarchical(problem, options);
+  longest = std::max(longest, std::chrono::duration<double>(Clock::now() - last).count());
+  const double solve_gap = longest;
+  longest = 0.0;
+  last = Clock::now();
+  interior_stresses_hierarchical(problem, solution, points, options);
+  longest = std::max(longest, std::chrono::duration<double>(Clock::now() - last).count());
+  std::printf("  longest time without a poll: solve %.3f s, evaluation %.3f s\n", solve_gap, longest);
+  EXPECT_LT(solve_gap, 0.5);
+  EXPECT_LT(longest, 0.5);
+
+  // Then a real cancel from another thread, 0.3 s into each call.
+  for (const bool evaluation : {false, true}) {
+    std::atomic<bool> flag{false};
+    Clock::time_point cancelled_at;
+    HierarchicalOptions cancellable;
+    cancellable.cancelled = [&] { return flag.load(); };
+    std::thread canceller([&] {
+      std::this_thread::sleep_for(std::chrono::milliseconds(300));
+      cancelled_at = Clock::now();
+      flag.store(true);
+    });
+    try {
+      if (evaluation)
+        interior_stresses_hierarchical(problem, solution, points, cancellable);
+      else
+        solve_hierarchical(problem, cancellable);
+      ADD_FAILURE() << "not cancelled";
+    } catch (const Cancelled&) {
+    }
+    const double latency = std::chrono::duration<double>(Clock::now() - cancelled_at).count();
+    canceller.join();
+    std::printf("  %s stopped %.3f s after the cancel\n", evaluation ? "evaluation" : "solve", latency);
+    EXPECT_LT(latency, 1.0);
+  }
 }

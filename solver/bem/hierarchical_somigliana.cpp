@@ -201,7 +201,8 @@ Eigen::MatrixX3d interior_stresses_hierarchical(const BoundaryProblem& problem, 
 Eigen::MatrixX3d interior_stresses_auto(const BoundaryProblem& problem, const BoundarySolution& solution,
                                         const std::vector<Eigen::Vector2d>& points,
                                         const HierarchicalOptions& options) {
-  return problem.nodes.size() >= kHierarchicalFromNodes
+  const double pairs = static_cast<double>(problem.nodes.size()) * static_cast<double>(points.size());
+  return problem.nodes.size() >= kHierarchicalFromNodes || pairs > kDenseInteriorPairs
              ? interior_stresses_hierarchical(problem, solution, points, options)
              : interior_stresses(problem, solution, points);
 }

@@ -86,6 +86,40 @@ class ProgressPrinter final : public contact::Observer {
     std::fflush(stdout);
   }
 
+  // One line per adaptive step: cells and unknowns per body (and the cells refined after the step), the global
+  // estimate, force and peak pressure with their relative changes over the step (what the stop test compares),
+  // the estimate's own time and the elapsed time.
+  void on_adaptive_step(const contact::AdaptiveStepReport& r) override {
+    if (ndjson_) {
+      nlohmann::json bodies = nlohmann::json::array();
+      for (const auto& b : r.bodies)
+        bodies.push_back({{"name", b.name}, {"cells", b.elements}, {"unknowns", b.dofs}, {"refined", b.elements_refined}});
+      const nlohmann::json line = {{"type", "adaptive_step"},       {"step", r.step},
+                                   {"bodies", bodies},              {"estimate", r.estimate},
+                                   {"force", r.force},              {"peak_pressure", r.peak_pressure},
+                                   {"estimate_change", r.estimate_change}, {"force_change", r.force_change},
+                                   {"peak_change", r.peak_change},  {"indicator_seconds", r.indicator_seconds},
+                                   {"elapsed_seconds", r.elapsed_seconds}};
+      std::printf("%s\n", line.dump().c_str());
+      std::fflush(stdout);
+      return;
+    }
+    if (quiet_) return;
+    std::printf("adaptive step %2d", r.step);
+    for (const auto& b : r.bodies) {
+      std::printf("  | %s: %d cells, %d unknowns", b.name.c_str(), b.elements, b.dofs);
+      if (b.elements_refined > 0) std::printf(" (refining %d)", b.elements_refined);
+    }
+    std::printf("  | estimate %.3e", r.estimate);
+    if (r.step > 0)
+      std::printf(" (change %.2g %%)  force %.6g (%.2g %%)  p_max %.6g (%.2g %%)", 100 * r.estimate_change, r.force,
+                  100 * r.force_change, r.peak_pressure, 100 * r.peak_change);
+    else
+      std::printf("  force %.6g  p_max %.6g", r.force, r.peak_pressure);
+    std::printf("  | estimating %.2fs  %.2fs\n", r.indicator_seconds, r.elapsed_seconds);
+    std::fflush(stdout);
+  }
+
  private:
   bool quiet_, ndjson_;
 };
