@@ -1,7 +1,8 @@
 // The hierarchical BEM (solver/bem: cluster_tree, aca, gmres, hmatrix, hierarchical_*): its parts against their
 // definitions, and the whole against the dense BEM (the reference) on the Lame ring and on exact polynomial fields,
 // on quadrilateral and triangular boundaries, graded and adaptively refined ones. docs/bem.md quotes the numbers.
-// The leaf size is 8 here (32 by default) so that boundaries of a few hundred nodes already have a far field.
+// The leaf size is 8 here (32 by default) so that boundaries of a few hundred nodes already have a far field, and
+// every admissible block of the interior evaluation is compressed (by default leaf-sized ones are summed exactly).
 #include <gtest/gtest.h>
 
 #include <Eigen/LU>
@@ -28,6 +29,7 @@ namespace {
 HierarchicalOptions small_leaves() {
   HierarchicalOptions options;
   options.leaf_size = 8;
+  options.break_even = 0.0;  // compress every admissible block of the evaluation too
   return options;
 }
 

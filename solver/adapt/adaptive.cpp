@@ -240,6 +240,7 @@ ddm::MethodOutcome converge_then_refine(Problem& working, ddm::ContactSystem& sy
       return total;
     };
     if (context.cancel.cancelled() || any_cancelled(eta)) {
+      if (any_cancelled(eta)) report.estimate = report.estimate_change = std::nan("");  // only partly estimated
       total.reason = StopReason::cancelled;
       total.converged = false;
       return finish("cancelled during adaptive step " + std::to_string(step) +

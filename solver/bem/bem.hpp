@@ -108,6 +108,9 @@ struct HierarchicalOptions {
   int restart = 60;                    // GMRES Krylov dimension
   int max_iterations = 2000;           // GMRES matrix products
   std::function<bool()> cancelled;     // polled between blocks and per GMRES iteration; true throws Cancelled
+  // Interior evaluation: a far block of P points x E elements is compressed only if P E > break_even (P + E)
+  // (ACA costs ~20 (P + E) kernel evaluations, the exact sum P E); smaller ones are summed exactly. 0: always ACA.
+  double break_even = 20.0;
 };
 
 // What a hierarchical solve or evaluation did (for benchmarks and logs).

@@ -148,23 +148,40 @@ class HierarchicalSomigliana {
     ++near_blocks_;
   }
 
-  // ACA of the block (3 rows per point); false if it does not compress (then it is summed exactly).
+  // ACA of the block (3 rows per point); false if it is not worth it or does not compress (then it is summed
+  // exactly). ACA costs about (rank + samples) x (points + elements) coefficient evaluations (~20 x, rows and
+  // columns cached per point and per element), the exact sum points x elements: options.break_even.
   bool add_far_block(const BlockPair& pair) {
     const auto& rows = targets_.clusters()[static_cast<std::size_t>(pair.row_cluster)];
     const auto& columns = sources_.clusters()[static_cast<std::size_t>(pair.column_cluster)];
+    if (static_cast<double>(rows.size()) * columns.size() <= options_.break_even * (rows.size() + columns.size()))
+      return false;
     const int m = 3 * rows.size(), n = kColumnsPerElement * columns.size();
     const int max_rank = std::min(m, n) / 2;
+    // The 3 x 8 coefficients of a point with every element of the block (a row strip), and of an element with
+    // every point (a column strip), computed once when first asked for.
+    std::vector<Eigen::MatrixXd> row_strips(static_cast<std::size_t>(rows.size()));
+    std::vector<Eigen::MatrixXd> column_strips(static_cast<std::size_t>(columns.size()));
     LowRank block = adaptive_cross_approximation(
         m, n,
         [&](int i, Eigen::Ref<Eigen::VectorXd> out) {
-          for (int p = columns.begin; p < columns.end; ++p)
-            out.segment<kColumnsPerElement>(kColumnsPerElement * (p - columns.begin)) =
-                coefficients(target_at(rows.begin + i / 3), element_at(p)).row(i % 3).transpose();
+          Eigen::MatrixXd& strip = row_strips[static_cast<std::size_t>(i / 3)];
+          if (strip.size() == 0) {
+            strip.resize(3, n);
+            for (int p = columns.begin; p < columns.end; ++p)
+              strip.middleCols<kColumnsPerElement>(kColumnsPerElement * (p - columns.begin)) =
+                  coefficients(target_at(rows.begin + i / 3), element_at(p));
+          }
+          out = strip.row(i % 3).transpose();
         },
         [&](int j, Eigen::Ref<Eigen::VectorXd> out) {
-          const int e = element_at(columns.begin + j / kColumnsPerElement);
-          for (int t = 0; t < rows.size(); ++t)
-            out.segment<3>(3 * t) = coefficients(target_at(rows.begin + t), e).col(j % kColumnsPerElement);
+          Eigen::MatrixXd& strip = column_strips[static_cast<std::size_t>(j / kColumnsPerElement)];
+          if (strip.size() == 0) {
+            strip.resize(m, kColumnsPerElement);
+            const int e = element_at(columns.begin + j / kColumnsPerElement);
+            for (int t = 0; t < rows.size(); ++t) strip.middleRows<3>(3 * t) = coefficients(target_at(rows.begin + t), e);
+          }
+          out = strip.col(j % kColumnsPerElement);
         },
         options_.tolerance, max_rank);
     if (block.rank() >= max_rank) return false;

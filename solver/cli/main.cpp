@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include <atomic>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -110,12 +111,13 @@ class ProgressPrinter final : public contact::Observer {
       std::printf("  | %s: %d cells, %d unknowns", b.name.c_str(), b.elements, b.dofs);
       if (b.elements_refined > 0) std::printf(" (refining %d)", b.elements_refined);
     }
-    std::printf("  | estimate %.3e", r.estimate);
-    if (r.step > 0)
-      std::printf(" (change %.2g %%)  force %.6g (%.2g %%)  p_max %.6g (%.2g %%)", 100 * r.estimate_change, r.force,
-                  100 * r.force_change, r.peak_pressure, 100 * r.peak_change);
+    if (!std::isfinite(r.estimate))  // cancelled while estimating
+      std::printf("  | estimate cancelled  force %.6g  p_max %.6g", r.force, r.peak_pressure);
+    else if (r.step == 0)
+      std::printf("  | estimate %.3e  force %.6g  p_max %.6g", r.estimate, r.force, r.peak_pressure);
     else
-      std::printf("  force %.6g  p_max %.6g", r.force, r.peak_pressure);
+      std::printf("  | estimate %.3e (change %.2g %%)  force %.6g (%.2g %%)  p_max %.6g (%.2g %%)", r.estimate,
+                  100 * r.estimate_change, r.force, 100 * r.force_change, r.peak_pressure, 100 * r.peak_change);
     std::printf("  | estimating %.2fs  %.2fs\n", r.indicator_seconds, r.elapsed_seconds);
     std::fflush(stdout);
   }
