@@ -178,6 +178,9 @@ struct AdaptivitySettings {
   long max_dofs = 400000;   // per body; refinement that would exceed it is cut back (and reported)
   AdaptStrategy strategy = AdaptStrategy::converge_then_refine;
   int max_steps = 20;       // refinement steps (converge_then_refine)
+  // converge_then_refine stops once a step changed the total contact force, the peak contact pressure and the
+  // global estimate each by less than this, relatively (0: never stop for that reason).
+  double stop_tolerance = 0.005;
 };
 
 // Load steps: every prescribed displacement, traction, force and body force is scaled by each factor in turn;

@@ -143,11 +143,25 @@ struct Result {
   double indicator_seconds = 0.0;   // adaptivity: estimating (for fem_bem: the boundary-element work)
 };
 
+// One step of the adaptive loop (converge_then_refine), reported once its mesh is solved and estimated.
+// Relative changes are against the previous step: |now - before| / max(|now|, |before|) (0 at step 0).
+struct AdaptiveStepReport {
+  int step = 0;                    // 0: the initial meshes
+  std::vector<BodyReport> bodies;  // cells (elements), unknowns (dofs) and cells refined after this step, per body
+  double estimate = 0.0;   // global: sqrt(sum ||sigma_R - sigma_F||^2 / sum ||sigma_R||^2) over the adaptive bodies
+  double force = 0.0;      // total normal contact force, all pairs
+  double peak_pressure = 0.0;  // largest contact pressure, all pairs
+  double force_change = 0.0, peak_change = 0.0, estimate_change = 0.0;
+  double indicator_seconds = 0.0;  // this step's estimate (for fem_bem: the boundary-element work)
+  double elapsed_seconds = 0.0;    // since solve() started
+};
+
 // Receives progress. Called from the thread that runs solve(), once per iteration, in order.
 class Observer {
  public:
   virtual ~Observer() = default;
   virtual void on_iteration(const IterationReport&) {}
+  virtual void on_adaptive_step(const AdaptiveStepReport&) {}
 };
 
 // Set from any thread; solve() checks it once per iteration and stops with StopReason::cancelled.

@@ -15,6 +15,7 @@ using nlohmann::json;
 using contact::testing::example;
 using contact::testing::body;
 using contact::testing::run;
+using contact::testing::parse_or_fail;
 
 namespace {
 
@@ -94,6 +95,7 @@ TEST(Adaptivity, MaxDofsIsNeverExceededAndIsReported) {
   json job = example("seed_layers_adaptive.json");
   job["adaptivity"]["strategy"] = "converge_then_refine";
   job["adaptivity"]["max_dofs"] = 200;
+  job["adaptivity"]["stop_tolerance"] = 0;  // the cut-back steps change little: only the limit is tested here
   job["solver"] = {{"method", "interface_newton"}, {"enforcement", "penalty"}};
   const Result r = run(job);
   ASSERT_FALSE(r.steps.empty()) << r.message;
@@ -139,4 +141,87 @@ TEST(Adaptivity, CycleTranscriptMatchesTheCheckedInExpectedOutput) {
   std::stringstream expected;
   expected << in.rdbuf();
   EXPECT_EQ(os.str(), expected.str());
+}
+
+namespace {
+
+// Records the adaptive step reports; cancels the token at the report of step `cancel_at` (never if < 0).
+class StepRecorder final : public Observer {
+ public:
+  StepRecorder(CancelToken& cancel, int cancel_at) : cancel_(cancel), cancel_at_(cancel_at) {}
+  void on_adaptive_step(const AdaptiveStepReport& r) override {
+    reports.push_back(r);
+    if (r.step == cancel_at_) cancel_.cancel();
+  }
+  std::vector<AdaptiveStepReport> reports;
+
+ private:
+  CancelToken& cancel_;
+  int cancel_at_;
+};
+
+json converge_then_refine_job() {
+  json job = example("seed_layers_adaptive.json");
+  job["adaptivity"]["strategy"] = "converge_then_refine";
+  job["solver"] = {{"method", "interface_newton"}, {"enforcement", "penalty"}, {"penalty", {{"c", 0.05}, {"length", 1}}}};
+  return job;
+}
+
+Result run_recorded(const json& job, StepRecorder& recorder, CancelToken& cancel) {
+  return solve(parse_or_fail(job), recorder, cancel);
+}
+
+}  // namespace
+
+TEST(AdaptiveStop, StopsOnceTheLastStepChangedForcePeakPressureAndEstimateByLessThanTheTolerance) {
+  for (const double tolerance : {0.05, 0.005}) {
+    json job = converge_then_refine_job();
+    job["adaptivity"]["stop_tolerance"] = tolerance;
+    CancelToken cancel;
+    StepRecorder recorder(cancel, -1);
+    const Result r = run_recorded(job, recorder, cancel);
+    ASSERT_TRUE(r.converged) << r.message;
+    // One report per mesh state, in order, with that state's cells.
+    ASSERT_EQ(recorder.reports.size(), r.steps.size());
+    for (size_t k = 0; k < r.steps.size(); ++k) {
+      EXPECT_EQ(recorder.reports[k].step, static_cast<int>(k));
+      EXPECT_EQ(recorder.reports[k].bodies[1].elements, body(r.steps[k], "lower").mesh.num_cells());
+      EXPECT_GT(recorder.reports[k].bodies[1].dofs, 0);
+      EXPECT_GT(recorder.reports[k].estimate, 0.0);
+    }
+    // The stop: the last step's three changes are below the tolerance, and no earlier step had all three below.
+    const AdaptiveStepReport& last = recorder.reports.back();
+    ASSERT_NE(r.message.find("all below stop_tolerance"), std::string::npos) << tolerance << ": " << r.message;
+    EXPECT_LT(std::max({last.force_change, last.peak_change, last.estimate_change}), tolerance);
+    for (size_t k = 1; k + 1 < recorder.reports.size(); ++k) {
+      const AdaptiveStepReport& s = recorder.reports[k];
+      EXPECT_GE(std::max({s.force_change, s.peak_change, s.estimate_change}), tolerance) << "step " << k;
+    }
+    // The changes are those of the recorded steps.
+    const double peak_before = recorder.reports[recorder.reports.size() - 2].peak_pressure;
+    EXPECT_NEAR(last.peak_change, std::abs(last.peak_pressure - peak_before) / std::max(last.peak_pressure, peak_before),
+                1e-12);
+  }
+}
+
+TEST(AdaptiveStop, SaysWhenNothingMarkedCanBeRefined) {
+  json job = converge_then_refine_job();
+  job["adaptivity"]["max_level"] = 0;  // every cell over delta is at the level limit
+  job["adaptivity"]["stop_tolerance"] = 0;
+  const Result r = run(job);
+  ASSERT_TRUE(r.converged) << r.message;
+  EXPECT_EQ(r.steps.size(), 1u);
+  EXPECT_NE(r.message.find("nothing marked can be refined after 0 refinement steps"), std::string::npos) << r.message;
+}
+
+TEST(AdaptiveStop, ACancelBetweenStepsStopsWithTheStepsSoFar) {
+  json job = converge_then_refine_job();
+  job["adaptivity"]["stop_tolerance"] = 0;
+  CancelToken cancel;
+  StepRecorder recorder(cancel, 1);  // cancelled once step 1 is reported, while its refinement proceeds
+  const Result r = run_recorded(job, recorder, cancel);
+  EXPECT_EQ(r.stop_reason, StopReason::cancelled) << r.message;
+  // Steps 0 and 1 complete, and the solve on step 2's mesh as far as it got.
+  ASSERT_EQ(r.steps.size(), 3u) << r.message;
+  EXPECT_GT(body(r.steps[2], "lower").mesh.num_cells(), body(r.steps[1], "lower").mesh.num_cells());
 }

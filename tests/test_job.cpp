@@ -415,6 +415,20 @@ TEST(JobErrors, AdaptivityWithAnUnknownIndicatorListsTheChoices) {
   expect_only_error(parse(job), "/adaptivity/indicator", "\"fem_bem\"");
 }
 
+TEST(JobErrors, AdaptivityStopToleranceMustBeARelativeChangeBelowOne) {
+  for (const double bad : {-0.1, 1.0, 2.5}) {
+    json job = small_job();
+    job["adaptivity"] = {{"stop_tolerance", bad}};
+    expect_only_error(parse(job), "/adaptivity/stop_tolerance", "must lie in [0, 1)");
+  }
+  json job = small_job();
+  job["adaptivity"] = {{"stop_tolerance", 0}};
+  const ParseResult r = parse(job);
+  ASSERT_TRUE(r.ok()) << listing(r);
+  EXPECT_EQ(r.problem->adaptivity.stop_tolerance, 0.0);
+  EXPECT_EQ(r.problem->normalized["adaptivity"]["stop_tolerance"], 0.0);
+}
+
 TEST(JobDefaults, AdaptivityDefaultsToAllBodiesAndTheFemBemIndicator) {
   json job = small_job();
   job["adaptivity"] = json::object();

@@ -3,8 +3,11 @@
 #include "../ddm/fixed_point.hpp"
 #include "indicator.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <sstream>
+#include <string>
 
 namespace contact::adapt {
 
@@ -17,24 +20,32 @@ bool adapts(const AdaptivitySettings& s, size_t body) {
 // Indicator of every adaptive body (empty vector for the others).
 std::vector<IndicatorResult> estimate(const Problem& problem, const ddm::ContactSystem& system,
                                       const ddm::Displacements& u, const ddm::Displacements& contact_loads,
-                                      ddm::TaskRunner& runner) {
+                                      ddm::TaskRunner& runner, const CancelToken* cancel = nullptr) {
   std::vector<IndicatorResult> out(problem.bodies.size());
   const ddm::BodyShare share{[&](size_t a, ddm::Packer& p) {
                                p.put(out[a].eta);
                                p.put(out[a].note);
                                p.put(out[a].seconds);
+                               p.put(out[a].error2);
+                               p.put(out[a].reference2);
+                               p.put(out[a].cancelled ? 1.0 : 0.0);
                              },
                              [&](size_t a, ddm::Unpacker& in) {
                                out[a].eta = in.get_vector();
                                out[a].note = in.get_string();
                                out[a].seconds = in.get_double();
+                               out[a].error2 = in.get_double();
+                               out[a].reference2 = in.get_double();
+                               out[a].cancelled = in.get_double() != 0.0;
                              }};
+  std::function<bool()> cancelled;
+  if (cancel) cancelled = [cancel] { return cancel->cancelled(); };
   runner.run_bodies(problem.bodies.size(), [&](size_t a) {
     if (!adapts(problem.adaptivity, a)) return;
     const Body& body = problem.bodies[a];
     const Normalization norm = problem.adaptivity.normalization;
     out[a] = problem.adaptivity.indicator == Indicator::fem_bem
-                 ? fem_bem_indicator(body, problem.model, system.body(a), u[a], contact_loads[a], norm)
+                 ? fem_bem_indicator(body, problem.model, system.body(a), u[a], contact_loads[a], norm, cancelled)
                  : zz_indicator(body, system.body(a), u[a], norm);
   }, share);
   return out;
@@ -46,6 +57,7 @@ struct RefineOutcome {
   std::vector<mesh::RefinementResult> refinements;
   std::string note;
   bool any = false;
+  bool blocked = false;  // cells over delta were left unrefined by max_level or max_dofs
 };
 
 // Notes are joined by "; " (none before the first or after the last).
@@ -68,6 +80,7 @@ RefineOutcome mark_and_refine(Problem& problem, const std::vector<IndicatorResul
     const Marking m = mark(mesh, eta[a].eta, s.delta, s.max_level, s.max_dofs);
     if (m.dof_limit_hit) add_note(out.note, "body '" + problem.bodies[a].name + "': max_dofs reached, refinement cut back");
     if (m.level_limit_hit) add_note(out.note, "body '" + problem.bodies[a].name + "': cells at max_level not refined");
+    out.blocked = out.blocked || m.dof_limit_hit || m.level_limit_hit;
     add_note(out.note, eta[a].note);
     if (m.cells.empty()) continue;
     out.refinements[a] = mesh::refine(mesh, m.cells, s.max_level);
@@ -98,50 +111,155 @@ Step make_step(const ddm::ContactSystem& system, const ddm::Displacements& u, co
   return st;
 }
 
+// The quantities the stop test compares between steps.
+struct StepMeasures {
+  double force = 0.0, peak = 0.0, estimate = 0.0;
+};
+
+StepMeasures measure(const Step& step, const std::vector<IndicatorResult>& eta) {
+  StepMeasures m;
+  for (const PairField& p : step.pairs) {
+    m.force += p.force;
+    for (Eigen::Index j = 0; j < p.pressure.size(); ++j)
+      if (std::isfinite(p.pressure[j])) m.peak = std::max(m.peak, p.pressure[j]);
+  }
+  double error2 = 0.0, reference2 = 0.0;
+  for (const auto& e : eta) {
+    error2 += e.error2;
+    reference2 += e.reference2;
+  }
+  m.estimate = reference2 > 0.0 ? std::sqrt(error2 / reference2) : 0.0;
+  return m;
+}
+
+double relative_change(double now, double before) {
+  const double scale = std::max(std::abs(now), std::abs(before));
+  return scale > 0.0 ? std::abs(now - before) / scale : 0.0;
+}
+
+AdaptiveStepReport step_report(int step, const Problem& working, const ddm::MethodOutcome& total,
+                               const StepMeasures& now, const StepMeasures* before,
+                               const std::vector<IndicatorResult>& eta, double elapsed) {
+  AdaptiveStepReport r;
+  r.step = step;
+  if (!total.history.empty()) r.bodies = total.history.back().bodies;
+  for (auto& b : r.bodies) b.elements_refined = 0;
+  if (r.bodies.size() != working.bodies.size()) {
+    r.bodies.assign(working.bodies.size(), BodyReport{});
+    for (size_t a = 0; a < r.bodies.size(); ++a) {
+      r.bodies[a].name = working.bodies[a].name;
+      r.bodies[a].elements = working.bodies[a].mesh.num_cells();
+    }
+  }
+  r.estimate = now.estimate;
+  r.force = now.force;
+  r.peak_pressure = now.peak;
+  if (before) {
+    r.force_change = relative_change(now.force, before->force);
+    r.peak_change = relative_change(now.peak, before->peak);
+    r.estimate_change = relative_change(now.estimate, before->estimate);
+  }
+  for (const auto& e : eta) r.indicator_seconds += e.seconds;
+  r.elapsed_seconds = elapsed;
+  return r;
+}
+
+// The stop test on the last step's changes; the message when it holds, else "".
+std::string stalled(const AdaptiveStepReport& r, double tolerance) {
+  if (r.step == 0 || tolerance <= 0.0) return "";
+  if (r.force_change >= tolerance || r.peak_change >= tolerance || r.estimate_change >= tolerance) return "";
+  std::ostringstream os;
+  os.precision(2);
+  os << "adaptive: stopped after " << r.step << " refinement steps: the last one changed the contact force by "
+     << 100 * r.force_change << " %, the peak pressure by " << 100 * r.peak_change << " % and the estimate by "
+     << 100 * r.estimate_change << " %, all below stop_tolerance = " << 100 * tolerance << " %";
+  return os.str();
+}
+
+bool any_cancelled(const std::vector<IndicatorResult>& eta) {
+  for (const auto& e : eta)
+    if (e.cancelled) return true;
+  return false;
+}
+
+// One solve on the current meshes (run_enforced), its iterations appended to `total`.
+ddm::MethodOutcome solve_step(ddm::ContactSystem& system, const Problem& working, ddm::RunContext& context,
+                              ddm::MethodRunner& method, ddm::MethodOutcome& total, std::vector<int>& refined_last,
+                              const ddm::Displacements& warm, int& updates) {
+  ddm::OffsetObserver observer(context.observer, total.iterations, 0, refined_last);
+  ddm::RunContext inner{observer, context.cancel, context.runner, context.start, warm.empty() ? nullptr : &warm};
+  int step_updates = 0;
+  ddm::MethodOutcome o = ddm::run_enforced(system, working.solver, inner, method, step_updates);
+  updates += step_updates;
+  for (auto& r : o.history) {
+    r.iteration += total.iterations;
+    if (!refined_last.empty())
+      for (size_t a = 0; a < r.bodies.size(); ++a) r.bodies[a].elements_refined = refined_last[a];
+    refined_last.clear();
+    total.history.push_back(std::move(r));
+  }
+  total.iterations += o.iterations;
+  total.add_work(o);
+  total.gamma = o.gamma;
+  total.u = o.u;
+  total.z = o.z;
+  total.reason = o.reason;
+  total.converged = o.converged;
+  total.message = o.message;
+  return o;
+}
+
+// Solve, estimate, report the step, and stop (stop test, max_steps, nothing refinable, cancellation) or refine.
 ddm::MethodOutcome converge_then_refine(Problem& working, ddm::ContactSystem& system, ddm::RunContext& context,
                                         ddm::ContactMethod& method, std::vector<Step>& steps, int& updates) {
   const auto& s = working.adaptivity;
   ddm::MethodOutcome total;
   std::vector<int> refined_last;
   ddm::Displacements warm;
+  StepMeasures previous;
   for (int step = 0;; ++step) {
-    ddm::OffsetObserver observer(context.observer, total.iterations, 0, refined_last);
-    ddm::RunContext inner{observer, context.cancel, context.runner, context.start, warm.empty() ? nullptr : &warm};
-    int step_updates = 0;
-    ddm::MethodOutcome o = ddm::run_enforced(system, working.solver, inner, method, step_updates);
-    updates += step_updates;
-    for (auto& r : o.history) {
-      r.iteration += total.iterations;
-      if (!refined_last.empty())
-        for (size_t a = 0; a < r.bodies.size(); ++a) r.bodies[a].elements_refined = refined_last[a];
-      refined_last.clear();
-      total.history.push_back(std::move(r));
-    }
-    total.iterations += o.iterations;
-    total.add_work(o);
-    total.gamma = o.gamma;
-    total.u = o.u;
-    total.z = o.z;
-    total.reason = o.reason;
-    total.converged = o.converged;
-    total.message = o.message;
+    const ddm::MethodOutcome o = solve_step(system, working, context, method, total, refined_last, warm, updates);
     if (o.u.empty()) return total;
-    const ddm::Displacements loads = o.z.empty() ? system.contact_loads(o.u) : system.loads_from_pressures(o.z);
-    const auto eta = estimate(working, system, o.u, loads, context.runner);
-    for (const auto& e : eta) total.indicator_seconds += e.seconds;
-    steps.push_back(make_step(system, o.u, o.z, total.iterations, step, eta));
-    if (!o.converged) return total;
-    if (step >= s.max_steps) {
-      total.message = "adaptive: max_steps = " + std::to_string(s.max_steps) + " refinement steps done; " + o.message;
+    if (context.cancel.cancelled()) {  // stopped inside the solve: keep what it reached, skip the estimate
+      steps.push_back(make_step(system, o.u, o.z, total.iterations, step, {}));
+      total.reason = StopReason::cancelled;
+      total.converged = false;
       return total;
     }
+    const ddm::Displacements loads = o.z.empty() ? system.contact_loads(o.u) : system.loads_from_pressures(o.z);
+    const auto eta = estimate(working, system, o.u, loads, context.runner, &context.cancel);
+    for (const auto& e : eta) total.indicator_seconds += e.seconds;
+    steps.push_back(make_step(system, o.u, o.z, total.iterations, step, eta));
+    const StepMeasures now = measure(steps.back(), eta);
+    AdaptiveStepReport report =
+        step_report(step, working, total, now, step > 0 ? &previous : nullptr, eta, context.elapsed());
+    previous = now;
+    const auto finish = [&](const std::string& message) {
+      if (!message.empty()) total.message = message;
+      context.observer.on_adaptive_step(report);
+      return total;
+    };
+    if (context.cancel.cancelled() || any_cancelled(eta)) {
+      if (any_cancelled(eta)) report.estimate = report.estimate_change = std::nan("");  // only partly estimated
+      total.reason = StopReason::cancelled;
+      total.converged = false;
+      return finish("cancelled during adaptive step " + std::to_string(step) +
+                    " (the result holds that step's solution)");
+    }
+    if (!o.converged) return finish("");
+    if (const std::string stop = stalled(report, s.stop_tolerance); !stop.empty()) return finish(stop);
+    if (step >= s.max_steps)
+      return finish("adaptive: max_steps = " + std::to_string(s.max_steps) + " refinement steps done; " + o.message);
     RefineOutcome r = mark_and_refine(working, eta);
     if (!r.any) {
       std::ostringstream os;
-      os << "adaptive: no cell marked after " << step << " refinement steps (" << (r.note.empty() ? "" : r.note + "; ") << "last solve: " << o.message << ")";
-      total.message = os.str();
-      return total;
+      os << "adaptive: " << (r.blocked ? "nothing marked can be refined" : "no cell marked") << " after " << step
+         << " refinement steps (" << (r.note.empty() ? "" : r.note + "; ") << "last solve: " << o.message << ")";
+      return finish(os.str());
     }
+    for (size_t a = 0; a < report.bodies.size() && a < r.refined.size(); ++a)
+      report.bodies[a].elements_refined = r.refined[a];
+    context.observer.on_adaptive_step(report);
     warm = o.u;
     transfer(warm, working, r);
     system.rebuild(r.changed, context.runner);

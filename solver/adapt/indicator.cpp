@@ -23,8 +23,9 @@ double squared_norm(const Eigen::Vector3d& s) { return s[0] * s[0] + s[1] * s[1]
 using CellStresses = std::vector<fem::PointStresses>;
 
 // eta from FE and reference stresses at the quadrature points of every cell.
+// Also fills result.error2 and result.reference2 (the global estimate's parts).
 Eigen::VectorXd normalised(const mesh::Mesh& m, const CellStresses& fe, const CellStresses& ref,
-                           Normalization normalization) {
+                           Normalization normalization, IndicatorResult& result) {
   const int n = m.num_cells();
   Eigen::VectorXd diff2(n), area(n);
   double ref2 = 0.0, total_area = 0.0;
@@ -42,6 +43,8 @@ Eigen::VectorXd normalised(const mesh::Mesh& m, const CellStresses& fe, const Ce
     }
     total_area += area[c];
   }
+  result.error2 = diff2.sum();
+  result.reference2 = ref2;
   const bool rms = normalization == Normalization::rms;
   const double scale = std::sqrt(ref2) / (rms ? std::sqrt(total_area) : total_area);
   Eigen::VectorXd eta(n);
@@ -115,14 +118,14 @@ IndicatorResult zz_indicator(const Body& body, const fem::BodySolver& solver, co
         r.col(p) += q.shape(p, k) * recovered.row(cell[static_cast<size_t>(k)]).head<3>().transpose();
   }
   IndicatorResult r;
-  r.eta = normalised(m, fe, ref, normalization);
+  r.eta = normalised(m, fe, ref, normalization, r);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }
 
 IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fem::BodySolver& solver,
                                   const Eigen::VectorXd& u, const Eigen::VectorXd& contact_load,
-                                  Normalization normalization) {
+                                  Normalization normalization, const std::function<bool()>& cancelled) {
   const auto t0 = std::chrono::steady_clock::now();
   const auto& m = body.mesh;
   const std::vector<int> loop = boundary_loop(m);
@@ -201,7 +204,9 @@ IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fe
   }
   IndicatorResult r;
   try {
-    const bem::BoundarySolution sol = bem::solve(bp);
+    bem::HierarchicalOptions options;
+    options.cancelled = cancelled;
+    const bem::BoundarySolution sol = bem::solve_auto(bp, options);
     std::vector<Eigen::Vector2d> points;
     std::vector<size_t> first(static_cast<size_t>(m.num_cells()) + 1, 0);  // cell c's points start at first[c]
     points.reserve(static_cast<size_t>(m.num_cells()) * 4);
@@ -210,14 +215,18 @@ IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fe
       for (int p = 0; p < q.size; ++p) points.push_back(q.point[static_cast<size_t>(p)]);
       first[static_cast<size_t>(c) + 1] = points.size();
     }
-    const Eigen::MatrixX3d sb = bem::interior_stresses(bp, sol, points);
+    const Eigen::MatrixX3d sb = bem::interior_stresses_auto(bp, sol, points, options);
     CellStresses ref(static_cast<size_t>(m.num_cells()));
     for (size_t c = 0; c < ref.size(); ++c) {
       ref[c].resize(3, static_cast<Eigen::Index>(first[c + 1] - first[c]));
       for (size_t p = first[c]; p < first[c + 1]; ++p)
         ref[c].col(static_cast<Eigen::Index>(p - first[c])) = sb.row(static_cast<Eigen::Index>(p)).transpose();
     }
-    r.eta = normalised(m, fe_point_stresses(body, solver, u), ref, normalization);
+    r.eta = normalised(m, fe_point_stresses(body, solver, u), ref, normalization, r);
+  } catch (const bem::Cancelled&) {
+    r = IndicatorResult{};
+    r.cancelled = true;
+    r.note = "body '" + body.name + "': the boundary-element estimate was cancelled";
   } catch (const std::exception& e) {
     r = zz_indicator(body, solver, u, normalization);
     r.note = "body '" + body.name + "': the boundary-element solve failed (" + e.what() + "); zz indicator used";

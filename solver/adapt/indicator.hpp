@@ -16,6 +16,7 @@
 #include "../fem/body_solver.hpp"
 #include "../problem.hpp"
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,9 @@ struct IndicatorResult {
   Eigen::VectorXd eta;   // per cell
   std::string note;      // e.g. why fem_bem fell back to zz
   double seconds = 0.0;  // time spent (BEM solve and interior evaluations for fem_bem)
+  double error2 = 0.0;      // ||sigma_R - sigma_F||^2 over the body (the global estimate's numerator)
+  double reference2 = 0.0;  // ||sigma_R||^2 over the body
+  bool cancelled = false;   // the estimate was stopped by `cancelled` (eta is then empty)
 };
 
 // Zienkiewicz-Zhu recovery indicator of body displacements u (all dofs).
@@ -33,13 +37,16 @@ IndicatorResult zz_indicator(const Body& body, const fem::BodySolver& solver, co
 
 // The paper's FEM-BEM indicator. contact_load: the body's contact forces (all dofs) of the current iterate,
 // turned into boundary tractions by lumping over the boundary sides. Falls back to zz (with a note) where the
-// BEM cannot be set up (a body with a hole: its boundary is not one closed polygon).
+// BEM cannot be set up (a body with a hole: its boundary is not one closed polygon). `cancelled` is polled inside
+// the boundary-element work (between blocks and GMRES iterations of the hierarchical path): true stops it and
+// returns a result with cancelled set.
 IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fem::BodySolver& solver,
                                   const Eigen::VectorXd& u, const Eigen::VectorXd& contact_load,
-                                  Normalization normalization = Normalization::rms);
+                                  Normalization normalization = Normalization::rms,
+                                  const std::function<bool()>& cancelled = {});
 
 struct Marking {
-  std::vector<int> cells;  // to refine
+  std::vector<int> cells;  // to refine (cells over delta that max_level and max_dofs leave refinable)
   bool dof_limit_hit = false;
   bool level_limit_hit = false;
 };

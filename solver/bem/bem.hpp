@@ -16,6 +16,9 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cstddef>
+#include <functional>
+#include <stdexcept>
 #include <vector>
 
 namespace contact::bem {
@@ -82,5 +85,66 @@ Eigen::Vector2d interior_displacement(const BoundaryProblem& problem, const Boun
 // once. Row k of the result holds point k's (sxx, syy, sxy).
 Eigen::MatrixX3d interior_stresses(const BoundaryProblem& problem, const BoundarySolution& solution,
                                    const std::vector<Eigen::Vector2d>& points);
+
+// ---- The hierarchical BEM (docs/bem.md, "Hierarchical BEM") -------------------------------------------------
+// The same collocation equations as solve() and the same Somigliana sums as interior_stresses(), evaluated
+// through a cluster tree on the boundary nodes: far-field blocks by adaptive cross approximation (recompressed),
+// near-field blocks exactly, the system solved by restarted GMRES preconditioned by the near-field diagonal
+// blocks. Time and memory O(N log N) in the boundary nodes instead of O(N^3) and O(N^2).
+
+// Thrown when HierarchicalOptions::cancelled() returns true (checked between blocks and GMRES iterations).
+struct Cancelled : std::runtime_error {
+  Cancelled() : std::runtime_error("bem: cancelled") {}
+};
+
+struct HierarchicalOptions {
+  // Relative accuracy of every compressed block (ACA stop and recompression, Frobenius norm). The solve
+  // amplifies it (by ~20 at 2k nodes, more on larger boundaries); 1e-8 keeps the hierarchical result within
+  // ~1e-6 of the dense one, far below the 1e-4 of the stresses the indicator resolves (docs/bem.md).
+  double tolerance = 1e-8;
+  double eta = 1.0;                    // admissibility: min(diam) <= eta dist
+  int leaf_size = 32;                  // boundary nodes (or targets) per leaf cluster at most
+  double solver_tolerance = 1e-10;     // GMRES: relative residual
+  int restart = 60;                    // GMRES Krylov dimension
+  int max_iterations = 2000;           // GMRES matrix products
+  std::function<bool()> cancelled;     // polled between blocks and per GMRES iteration; true throws Cancelled
+  // Interior evaluation: a far block of P points x E elements is compressed only if P E > break_even (P + E)
+  // (ACA costs ~20 (P + E) kernel evaluations, the exact sum P E); smaller ones are summed exactly. 0: always ACA.
+  double break_even = 20.0;
+};
+
+// What a hierarchical solve or evaluation did (for benchmarks and logs).
+struct HierarchicalStats {
+  int unknowns = 0;
+  int near_blocks = 0, far_blocks = 0;
+  int largest_rank = 0;
+  double mean_rank = 0.0;
+  std::size_t matrix_bytes = 0;          // the compressed matrix (near + far blocks)
+  std::size_t preconditioner_bytes = 0;  // the LU factors of the diagonal blocks
+  int iterations = 0;                    // GMRES matrix products
+  double relative_residual = 0.0;
+  double setup_seconds = 0.0, solve_seconds = 0.0;
+};
+
+// solve() through the hierarchical matrix. The same checks as solve() (the self-overlap test by the cluster
+// tree in O(N log N)); throws std::runtime_error if GMRES does not reach options.solver_tolerance.
+BoundarySolution solve_hierarchical(const BoundaryProblem& problem, const HierarchicalOptions& options = {},
+                                    HierarchicalStats* stats = nullptr);
+
+// interior_stresses() through a second cluster tree, on the points; the inside test by the boundary's tree.
+Eigen::MatrixX3d interior_stresses_hierarchical(const BoundaryProblem& problem, const BoundarySolution& solution,
+                                                const std::vector<Eigen::Vector2d>& points,
+                                                const HierarchicalOptions& options = {},
+                                                HierarchicalStats* stats = nullptr);
+
+// The automatic choice: the dense path below this many boundary nodes (exact to round-off and faster there),
+// the hierarchical one from there on (docs/bem.md, "Which path"). The dense interior evaluation costs
+// ~0.2 us per (node, point) pair, so above kDenseInteriorPairs pairs (~1 s) the points go through the tree too.
+constexpr std::size_t kHierarchicalFromNodes = 1000;
+constexpr double kDenseInteriorPairs = 4e6;
+BoundarySolution solve_auto(const BoundaryProblem& problem, const HierarchicalOptions& options = {});
+Eigen::MatrixX3d interior_stresses_auto(const BoundaryProblem& problem, const BoundarySolution& solution,
+                                        const std::vector<Eigen::Vector2d>& points,
+                                        const HierarchicalOptions& options = {});
 
 }  // namespace contact::bem

@@ -97,7 +97,6 @@ BoundaryGeometry check_problem(const BoundaryProblem& problem, bool self_overlap
   }
 
   // Self-overlap: adjacent elements that fold back, non-adjacent elements that touch or cross.
-  const double tolerance = kOrientationTolerance * geometry.diameter * geometry.diameter;
   for (std::size_t e = 0; e < n; ++e) {
     const BoundaryElement& a = geometry.elements[e];
     const BoundaryElement& b = geometry.elements[(e + 1) % n];
@@ -105,21 +104,8 @@ BoundaryGeometry check_problem(const BoundaryProblem& problem, bool self_overlap
       fail("the polygon is self-overlapping: elements " + std::to_string(e) + " and " + std::to_string((e + 1) % n) +
            " fold back onto each other at node " + std::to_string((e + 1) % n));
   }
-  for (std::size_t i = 0; self_overlap && i < n; ++i) {
-    const BoundaryElement& a = geometry.elements[i];
-    const Eigen::Vector2d a_lo = a.start.cwiseMin(a.end), a_hi = a.start.cwiseMax(a.end);
-    for (std::size_t j = i + 2; j < n; ++j) {
-      if (i == 0 && j == n - 1) continue;  // adjacent through the closing element
-      const BoundaryElement& b = geometry.elements[j];
-      const Eigen::Vector2d b_lo = b.start.cwiseMin(b.end), b_hi = b.start.cwiseMax(b.end);
-      if ((b_lo.array() > a_hi.array() + 1e-12 * geometry.diameter).any() ||
-          (a_lo.array() > b_hi.array() + 1e-12 * geometry.diameter).any())
-        continue;
-      if (segments_touch(a.start, a.end, b.start, b.end, tolerance))
-        fail("the polygon is self-overlapping: elements " + std::to_string(i) + " and " + std::to_string(j) +
-             " intersect near " + point_text(0.5 * (a.start + a.end)));
-    }
-  }
+  for (std::size_t i = 0; self_overlap && i < n; ++i)
+    for (std::size_t j = i + 2; j < n; ++j) check_elements_apart(geometry, i, j);
 
   // Orientation: the shoelace area is positive for a counter-clockwise polygon.
   double twice_area = 0.0;
@@ -150,6 +136,22 @@ BoundaryGeometry check_problem(const BoundaryProblem& problem, bool self_overlap
     }
   }
   return geometry;
+}
+
+void check_elements_apart(const BoundaryGeometry& geometry, std::size_t i, std::size_t j) {
+  const std::size_t n = geometry.elements.size();
+  if (i == j || (i + 1) % n == j || (j + 1) % n == i) return;  // the same or adjacent elements
+  const BoundaryElement& a = geometry.elements[i];
+  const BoundaryElement& b = geometry.elements[j];
+  const Eigen::Vector2d a_lo = a.start.cwiseMin(a.end), a_hi = a.start.cwiseMax(a.end);
+  const Eigen::Vector2d b_lo = b.start.cwiseMin(b.end), b_hi = b.start.cwiseMax(b.end);
+  if ((b_lo.array() > a_hi.array() + 1e-12 * geometry.diameter).any() ||
+      (a_lo.array() > b_hi.array() + 1e-12 * geometry.diameter).any())
+    return;
+  const double tolerance = kOrientationTolerance * geometry.diameter * geometry.diameter;
+  if (segments_touch(a.start, a.end, b.start, b.end, tolerance))
+    fail("the polygon is self-overlapping: elements " + std::to_string(std::min(i, j)) + " and " +
+         std::to_string(std::max(i, j)) + " intersect near " + point_text(0.5 * (a.start + a.end)));
 }
 
 void check_solution(const BoundaryProblem& problem, const BoundarySolution& solution) {

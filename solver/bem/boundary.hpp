@@ -28,6 +28,10 @@ inline double log_scale(const BoundaryGeometry& geometry) { return 4.0 * geometr
 // elements (Somigliana's identities at many points re-check a problem that solve() has accepted).
 BoundaryGeometry check_problem(const BoundaryProblem& problem, bool self_overlap = true);
 
+// Throws std::invalid_argument unless elements i and j (neither equal nor adjacent) are apart: the O(n^2)
+// self-overlap test of check_problem() pair by pair, for callers that find the candidate pairs faster.
+void check_elements_apart(const BoundaryGeometry& geometry, std::size_t i, std::size_t j);
+
 // Throws std::invalid_argument unless `solution` has one displacement per node and one traction per element,
 // all finite.
 void check_solution(const BoundaryProblem& problem, const BoundarySolution& solution);

@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include <atomic>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -91,6 +92,41 @@ class ProgressPrinter final : public contact::Observer {
     std::printf("  %.2fs", r.elapsed_seconds);
     if (!r.note.empty()) std::printf("  [%s]", r.note.c_str());
     std::printf("\n");
+    std::fflush(stdout);
+  }
+
+  // One line per adaptive step: cells and unknowns per body (and the cells refined after the step), the global
+  // estimate, force and peak pressure with their relative changes over the step (what the stop test compares),
+  // the estimate's own time and the elapsed time.
+  void on_adaptive_step(const contact::AdaptiveStepReport& r) override {
+    if (ndjson_) {
+      nlohmann::json bodies = nlohmann::json::array();
+      for (const auto& b : r.bodies)
+        bodies.push_back({{"name", b.name}, {"cells", b.elements}, {"unknowns", b.dofs}, {"refined", b.elements_refined}});
+      const nlohmann::json line = {{"type", "adaptive_step"},       {"step", r.step},
+                                   {"bodies", bodies},              {"estimate", r.estimate},
+                                   {"force", r.force},              {"peak_pressure", r.peak_pressure},
+                                   {"estimate_change", r.estimate_change}, {"force_change", r.force_change},
+                                   {"peak_change", r.peak_change},  {"indicator_seconds", r.indicator_seconds},
+                                   {"elapsed_seconds", r.elapsed_seconds}};
+      std::printf("%s\n", line.dump().c_str());
+      std::fflush(stdout);
+      return;
+    }
+    if (quiet_) return;
+    std::printf("adaptive step %2d", r.step);
+    for (const auto& b : r.bodies) {
+      std::printf("  | %s: %d cells, %d unknowns", b.name.c_str(), b.elements, b.dofs);
+      if (b.elements_refined > 0) std::printf(" (refining %d)", b.elements_refined);
+    }
+    if (!std::isfinite(r.estimate))  // cancelled while estimating
+      std::printf("  | estimate cancelled  force %.6g  p_max %.6g", r.force, r.peak_pressure);
+    else if (r.step == 0)
+      std::printf("  | estimate %.3e  force %.6g  p_max %.6g", r.estimate, r.force, r.peak_pressure);
+    else
+      std::printf("  | estimate %.3e (change %.2g %%)  force %.6g (%.2g %%)  p_max %.6g (%.2g %%)", r.estimate,
+                  100 * r.estimate_change, r.force, 100 * r.force_change, r.peak_pressure, 100 * r.peak_change);
+    std::printf("  | estimating %.2fs  %.2fs\n", r.indicator_seconds, r.elapsed_seconds);
     std::fflush(stdout);
   }
 

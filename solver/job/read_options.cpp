@@ -141,7 +141,8 @@ void JobReader::resolve_method_defaults() {
 
 void JobReader::read_adaptivity(const json& value, const std::string& pointer) {
   Fields f(value, pointer, "adaptivity",
-           {"indicator", "normalization", "delta", "bodies", "max_level", "max_dofs", "strategy", "max_steps"},
+           {"indicator", "normalization", "delta", "bodies", "max_level", "max_dofs", "strategy", "max_steps",
+            "stop_tolerance"},
            errors_);
   if (!f.ok()) return;
   AdaptivitySettings& a = problem_.adaptivity;
@@ -169,6 +170,13 @@ void JobReader::read_adaptivity(const json& value, const std::string& pointer) {
       a.strategy = *x == "paper" ? AdaptStrategy::paper : AdaptStrategy::converge_then_refine;
   if (const json* n = f.find("max_steps"))
     if (auto x = bounded_int(*n, f.at("max_steps"), "max_steps", 1, errors_)) a.max_steps = *x;
+  if (const json* t = f.find("stop_tolerance"))
+    if (auto x = read::number(*t, f.at("stop_tolerance"), "stop_tolerance", errors_)) {
+      if (*x < 0.0 || *x >= 1.0)
+        errors_.add(f.at("stop_tolerance"), "stop_tolerance must lie in [0, 1) (a relative change; 0 turns the test off)");
+      else
+        a.stop_tolerance = *x;
+    }
   if (const json* b = f.find("bodies")) {
     const std::string bp = f.at("bodies");
     if (!b->is_array()) {
@@ -207,6 +215,7 @@ void JobReader::read_adaptivity(const json& value, const std::string& pointer) {
   set_default(out, "max_dofs", 400000);
   set_default(out, "strategy", "converge_then_refine");
   set_default(out, "max_steps", 20);
+  set_default(out, "stop_tolerance", 0.005);
 }
 
 void JobReader::read_robin(const json& value, const std::string& pointer) {

@@ -1,0 +1,31 @@
+// Restarted GMRES with right preconditioning (Saad, "Iterative Methods for Sparse Linear Systems", 2nd ed.,
+// algorithm 9.5): the residual it monitors is the true residual |b - A x|, not a preconditioned one.
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+
+namespace contact::bem {
+
+// y = A x (y pre-sized by the caller).
+using LinearOperator = std::function<void(const Eigen::VectorXd& x, Eigen::VectorXd& y)>;
+
+struct GmresOptions {
+  double relative_tolerance = 1e-10;  // stop at |b - A x| <= relative_tolerance |b|
+  int restart = 60;                   // Krylov dimension before a restart
+  int max_iterations = 2000;          // matrix products in all
+  std::function<bool()> cancelled;    // checked before every product; true stops at once
+};
+
+struct GmresResult {
+  int iterations = 0;
+  double relative_residual = 0.0;
+  bool converged = false;
+  bool cancelled = false;
+};
+
+// Solves A x = b from the initial guess in x, with the preconditioner M ~ A^-1 applied as x = M (M y).
+GmresResult gmres(const LinearOperator& A, const LinearOperator& M, const Eigen::VectorXd& b, Eigen::VectorXd& x,
+                  const GmresOptions& options);
+
+}  // namespace contact::bem

@@ -1,0 +1,227 @@
+// interior_stresses_hierarchical(): Somigliana's stress identity at many points through a second cluster tree,
+// on the points (docs/bem.md, "Hierarchical BEM"). As in hierarchical_solve.cpp, each element has eight element
+// columns, here for the stress (3 rows per point):
+//   k = 0..3: int D N_m (:, j) mu / diameter, times t_j at its end m divided by mu / diameter     (k = 2 m + j)
+//   k = 4..7: -int S N_m (:, j), times u_j at its node m
+// A far-field block (points of one cluster x elements of another, apart) is compressed by ACA and applied to the
+// element-column values at once (nothing is stored); a near-field block is summed exactly, as interior_stresses()
+// does. The inside test uses the boundary's tree: the ray crossings and the distance to the boundary visit only
+// the clusters whose boxes can matter.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+
+#include "aca.hpp"
+#include "bem.hpp"
+#include "boundary.hpp"
+#include "cluster_tree.hpp"
+#include "kelvin.hpp"
+#include "quadrature.hpp"
+
+namespace contact::bem {
+
+namespace {
+
+constexpr int kColumnsPerElement = 8;
+using StressColumns = Eigen::Matrix<double, 3, kColumnsPerElement>;
+
+class HierarchicalSomigliana {
+ public:
+  HierarchicalSomigliana(const BoundaryProblem& problem, const BoundarySolution& solution,
+                         const std::vector<Eigen::Vector2d>& points, const HierarchicalOptions& options)
+      : geometry_(check_problem(problem, /*self_overlap=*/false)),
+        points_(points),
+        options_(options),
+        kelvin_(effective_constants(problem.material), log_scale(geometry_)),
+        traction_scale_(effective_constants(problem.material).shear_modulus / geometry_.diameter),
+        sources_(problem.nodes, options.leaf_size),
+        targets_(points, options.leaf_size) {
+    check_solution(problem, solution);
+    element_values(solution);
+    std::vector<BoundingBox> boxes(geometry_.elements.size());
+    for (std::size_t e = 0; e < boxes.size(); ++e) {
+      boxes[e].extend(geometry_.elements[e].start);
+      boxes[e].extend(geometry_.elements[e].end);
+    }
+    source_boxes_ = sources_.cluster_boxes(boxes);
+  }
+
+  Eigen::MatrixX3d run(HierarchicalStats* stats) {
+    const auto t0 = std::chrono::steady_clock::now();
+    for (const Eigen::Vector2d& x : points_) check_inside(x);
+    std::vector<BoundingBox> point_boxes(points_.size());
+    for (std::size_t k = 0; k < points_.size(); ++k) point_boxes[k].extend(points_[k]);
+    const std::vector<BlockPair> pairs =
+        block_partition(targets_, targets_.cluster_boxes(point_boxes), sources_, source_boxes_, options_.eta);
+    stresses_ = Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(points_.size()), 3);
+    for (const BlockPair& pair : pairs) {
+      if (options_.cancelled && options_.cancelled()) throw Cancelled();
+      if (!pair.admissible || !add_far_block(pair)) add_near_block(pair);
+    }
+    if (stats) {
+      stats->near_blocks = near_blocks_;
+      stats->far_blocks = far_blocks_;
+      stats->largest_rank = largest_rank_;
+      stats->mean_rank = far_blocks_ > 0 ? static_cast<double>(rank_sum_) / far_blocks_ : 0.0;
+      stats->setup_seconds = 0.0;
+      stats->solve_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    }
+    return stresses_;
+  }
+
+ private:
+  // The element-column values y of the boundary state (see the file comment).
+  void element_values(const BoundarySolution& solution) {
+    const auto n = static_cast<Eigen::Index>(geometry_.elements.size());
+    values_.resize(kColumnsPerElement * n);
+    for (Eigen::Index e = 0; e < n; ++e)
+      for (int m = 0; m < 2; ++m)
+        for (int j = 0; j < 2; ++j) {
+          values_(kColumnsPerElement * e + 2 * m + j) = solution.traction[static_cast<std::size_t>(e)](j, m) / traction_scale_;
+          values_(kColumnsPerElement * e + 4 + 2 * m + j) = solution.displacement((e + m) % n, j);
+        }
+  }
+
+  // check_interior_point() through the tree: the even-odd count of crossings of the ray to +x, and the distance.
+  void check_inside(const Eigen::Vector2d& x) const {
+    const double tolerance = 1e-12 * geometry_.diameter;
+    bool inside = false, on_boundary = false;
+    const std::function<void(int)> visit = [&](int c) {
+      const BoundingBox& box = source_boxes_[static_cast<std::size_t>(c)];
+      const bool ray_hits = box.lo.y() <= x.y() && x.y() <= box.hi.y() && x.x() <= box.hi.x();
+      if (!ray_hits && box.distance(x) > tolerance) return;
+      const auto& cluster = sources_.clusters()[static_cast<std::size_t>(c)];
+      if (!cluster.leaf()) {
+        for (int child : cluster.children) visit(child);
+        return;
+      }
+      for (int p = cluster.begin; p < cluster.end; ++p) {
+        const BoundaryElement& el = geometry_.elements[static_cast<std::size_t>(sources_.order()[static_cast<std::size_t>(p)])];
+        if (distance_to_segment(x, el.start, el.end) <= tolerance) on_boundary = true;
+        if ((el.start.y() > x.y()) != (el.end.y() > x.y())) {
+          const double crossing = el.start.x() + (x.y() - el.start.y()) / (el.end.y() - el.start.y()) * (el.end.x() - el.start.x());
+          if (x.x() < crossing) inside = !inside;
+        }
+      }
+    };
+    if (!x.allFinite()) throw std::invalid_argument("bem: the interior point is not finite");
+    visit(0);
+    if (on_boundary || !inside) check_interior_point(geometry_, x);  // the exact test, for its message
+  }
+
+  StressColumns coefficients(int point, int element) const {
+    const BoundaryElement& el = geometry_.elements[static_cast<std::size_t>(element)];
+    const Eigen::Vector2d& xi = points_[static_cast<std::size_t>(point)];
+    StressColumns out = StressColumns::Zero();
+    integrate_adaptively(el.start, el.tangent, 0.0, el.length, xi, [&](double s, double w) {
+      const Eigen::Vector2d r = el.start + s * el.tangent - xi;
+      const Eigen::Matrix<double, 3, 2> d = kelvin_.stress_by_traction(r) * (w * traction_scale_);
+      const Eigen::Matrix<double, 3, 2> sk = kelvin_.stress_by_displacement(r, el.normal) * (-w);
+      const double n1 = s / el.length, n0 = 1.0 - n1;
+      out.block<3, 2>(0, 0) += n0 * d;
+      out.block<3, 2>(0, 2) += n1 * d;
+      out.block<3, 2>(0, 4) += n0 * sk;
+      out.block<3, 2>(0, 6) += n1 * sk;
+    });
+    return out;
+  }
+
+  int target_at(int position) const { return targets_.order()[static_cast<std::size_t>(position)]; }
+  int element_at(int position) const { return sources_.order()[static_cast<std::size_t>(position)]; }
+  Eigen::VectorXd cluster_values(const ClusterTree::Cluster& c) const {
+    Eigen::VectorXd y(kColumnsPerElement * c.size());
+    for (int p = c.begin; p < c.end; ++p)
+      y.segment<kColumnsPerElement>(kColumnsPerElement * (p - c.begin)) = values_.segment<kColumnsPerElement>(kColumnsPerElement * element_at(p));
+    return y;
+  }
+
+  void add_near_block(const BlockPair& pair) {
+    const auto& rows = targets_.clusters()[static_cast<std::size_t>(pair.row_cluster)];
+    const auto& columns = sources_.clusters()[static_cast<std::size_t>(pair.column_cluster)];
+    for (int t = rows.begin; t < rows.end; ++t)
+      for (int p = columns.begin; p < columns.end; ++p) {
+        const int e = element_at(p);
+        stresses_.row(target_at(t)) +=
+            (coefficients(target_at(t), e) * values_.segment<kColumnsPerElement>(kColumnsPerElement * e)).transpose();
+      }
+    ++near_blocks_;
+  }
+
+  // ACA of the block (3 rows per point); false if it is not worth it or does not compress (then it is summed
+  // exactly). ACA costs about (rank + samples) x (points + elements) coefficient evaluations (~20 x, rows and
+  // columns cached per point and per element), the exact sum points x elements: options.break_even.
+  bool add_far_block(const BlockPair& pair) {
+    const auto& rows = targets_.clusters()[static_cast<std::size_t>(pair.row_cluster)];
+    const auto& columns = sources_.clusters()[static_cast<std::size_t>(pair.column_cluster)];
+    if (static_cast<double>(rows.size()) * columns.size() <= options_.break_even * (rows.size() + columns.size()))
+      return false;
+    const int m = 3 * rows.size(), n = kColumnsPerElement * columns.size();
+    const int max_rank = std::min(m, n) / 2;
+    // The 3 x 8 coefficients of a point with every element of the block (a row strip), and of an element with
+    // every point (a column strip), computed once when first asked for.
+    std::vector<Eigen::MatrixXd> row_strips(static_cast<std::size_t>(rows.size()));
+    std::vector<Eigen::MatrixXd> column_strips(static_cast<std::size_t>(columns.size()));
+    LowRank block = adaptive_cross_approximation(
+        m, n,
+        [&](int i, Eigen::Ref<Eigen::VectorXd> out) {
+          Eigen::MatrixXd& strip = row_strips[static_cast<std::size_t>(i / 3)];
+          if (strip.size() == 0) {
+            strip.resize(3, n);
+            for (int p = columns.begin; p < columns.end; ++p)
+              strip.middleCols<kColumnsPerElement>(kColumnsPerElement * (p - columns.begin)) =
+                  coefficients(target_at(rows.begin + i / 3), element_at(p));
+          }
+          out = strip.row(i % 3).transpose();
+        },
+        [&](int j, Eigen::Ref<Eigen::VectorXd> out) {
+          Eigen::MatrixXd& strip = column_strips[static_cast<std::size_t>(j / kColumnsPerElement)];
+          if (strip.size() == 0) {
+            strip.resize(m, kColumnsPerElement);
+            const int e = element_at(columns.begin + j / kColumnsPerElement);
+            for (int t = 0; t < rows.size(); ++t) strip.middleRows<3>(3 * t) = coefficients(target_at(rows.begin + t), e);
+          }
+          out = strip.col(j % kColumnsPerElement);
+        },
+        options_.tolerance, max_rank);
+    if (block.rank() >= max_rank) return false;
+    const Eigen::VectorXd product = block.U * (block.V.transpose() * cluster_values(columns));
+    for (int t = 0; t < rows.size(); ++t) stresses_.row(target_at(rows.begin + t)) += product.segment<3>(3 * t).transpose();
+    ++far_blocks_;
+    rank_sum_ += block.rank();
+    largest_rank_ = std::max(largest_rank_, block.rank());
+    return true;
+  }
+
+  BoundaryGeometry geometry_;
+  const std::vector<Eigen::Vector2d>& points_;
+  const HierarchicalOptions& options_;
+  KelvinSolution kelvin_;
+  double traction_scale_;
+  ClusterTree sources_, targets_;
+  std::vector<BoundingBox> source_boxes_;
+  Eigen::VectorXd values_;
+  Eigen::MatrixX3d stresses_;
+  int near_blocks_ = 0, far_blocks_ = 0, largest_rank_ = 0;
+  long rank_sum_ = 0;
+};
+
+}  // namespace
+
+Eigen::MatrixX3d interior_stresses_hierarchical(const BoundaryProblem& problem, const BoundarySolution& solution,
+                                                const std::vector<Eigen::Vector2d>& points,
+                                                const HierarchicalOptions& options, HierarchicalStats* stats) {
+  if (points.empty()) return Eigen::MatrixX3d(0, 3);
+  return HierarchicalSomigliana(problem, solution, points, options).run(stats);
+}
+
+Eigen::MatrixX3d interior_stresses_auto(const BoundaryProblem& problem, const BoundarySolution& solution,
+                                        const std::vector<Eigen::Vector2d>& points,
+                                        const HierarchicalOptions& options) {
+  const double pairs = static_cast<double>(problem.nodes.size()) * static_cast<double>(points.size());
+  return problem.nodes.size() >= kHierarchicalFromNodes || pairs > kDenseInteriorPairs
+             ? interior_stresses_hierarchical(problem, solution, points, options)
+             : interior_stresses(problem, solution, points);
+}
+
+}  // namespace contact::bem
