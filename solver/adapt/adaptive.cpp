@@ -184,7 +184,7 @@ bool any_cancelled(const std::vector<IndicatorResult>& eta) {
 
 // One solve on the current meshes (run_enforced), its iterations appended to `total`.
 ddm::MethodOutcome solve_step(ddm::ContactSystem& system, const Problem& working, ddm::RunContext& context,
-                              ddm::MethodRunner& method, ddm::MethodOutcome& total, std::vector<int>& refined_last,
+                              ddm::ContactMethod& method, ddm::MethodOutcome& total, std::vector<int>& refined_last,
                               const ddm::Displacements& warm, int& updates) {
   ddm::OffsetObserver observer(context.observer, total.iterations, 0, refined_last);
   ddm::RunContext inner{observer, context.cancel, context.runner, context.start, warm.empty() ? nullptr : &warm};
