@@ -5,8 +5,8 @@
 // refine) with the FEM-BEM and the ZZ indicators; the DOFs uniform refinement needs for the same error
 // (log-log interpolation) and the ratio; and the time spent in the indicators (for FEM-BEM: the BEM) against
 // the solves.
-#include "job/job.hpp"
-#include "solve.hpp"
+#include "contact/job.hpp"
+#include "contact/solve.hpp"
 #include "bench_support.hpp"
 
 #include <chrono>

@@ -7,7 +7,7 @@
 // steps, the ratio of the wall time to "one factorisation + solve" (assemble and factorise both bodies, bodies in
 // parallel, and one back-substitution each) measured in the same run, and the total contact force.
 #include "ddm/contact_system.hpp"
-#include "solve.hpp"
+#include "contact/solve.hpp"
 #include "bench_support.hpp"
 
 #include <sys/resource.h>

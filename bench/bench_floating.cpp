@@ -5,7 +5,7 @@
 // Each mesh is the example's scaled by the factor in both directions. Columns: wall time (the best of the
 // repeats), active-set steps, the floating/restrained time ratio, and the two contact forces (equal for the
 // floating block: its equilibrium).
-#include "solve.hpp"
+#include "contact/solve.hpp"
 #include "bench_support.hpp"
 
 #include <algorithm>

@@ -6,8 +6,8 @@
 // of wall time to one elastic solve of the whole problem (assemble + factorise every body + one solve), and
 // the contact force (all methods solve the same discrete problem, so it must agree).
 #include "ddm/contact_system.hpp"
-#include "job/job.hpp"
-#include "solve.hpp"
+#include "contact/job.hpp"
+#include "contact/solve.hpp"
 #include "bench_support.hpp"
 
 #include <chrono>

@@ -2,7 +2,7 @@
 // the validation errors if the job is bad).
 #pragma once
 
-#include "job/job.hpp"
+#include "contact/job.hpp"
 
 #include <chrono>
 #include <cstdio>

@@ -1,6 +1,6 @@
 #include "connection_gate.hpp"
 
-#include "problem.hpp"
+#include "problem_document.hpp"
 #include "util.hpp"
 
 #include <arpa/inet.h>

@@ -1,6 +1,6 @@
 #include "events.hpp"
 
-#include "io/progress_json.hpp"
+#include "contact/progress_json.hpp"
 
 #include <utility>
 

@@ -4,7 +4,7 @@
 
 #include "job.hpp"
 
-#include "result.hpp"
+#include "contact/result.hpp"
 
 #include <nlohmann/json.hpp>
 

@@ -1,7 +1,7 @@
 // The job handlers: submit, validate, list, get, cancel, delete.
 #include "http_server.hpp"
 
-#include "problem.hpp"
+#include "problem_document.hpp"
 #include "util.hpp"
 
 #include <algorithm>

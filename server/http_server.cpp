@@ -1,6 +1,6 @@
 #include "http_server.hpp"
 
-#include "problem.hpp"
+#include "problem_document.hpp"
 #include "util.hpp"
 
 #include <algorithm>

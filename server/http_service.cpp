@@ -4,7 +4,7 @@
 
 #include "assets.hpp"
 
-#include "problem.hpp"
+#include "problem_document.hpp"
 #include "util.hpp"
 
 namespace contactd {

@@ -2,7 +2,7 @@
 #include "http_server.hpp"
 
 #include "events.hpp"
-#include "problem.hpp"
+#include "problem_document.hpp"
 #include "range.hpp"
 #include "util.hpp"
 

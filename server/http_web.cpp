@@ -5,9 +5,9 @@
 #include "http_server.hpp"
 
 #include "assets.hpp"
-#include "problem.hpp"
+#include "problem_document.hpp"
 
-#include "solve.hpp"
+#include "contact/solve.hpp"
 
 #include <cstdio>
 

@@ -4,7 +4,7 @@
 
 #include "event_log.hpp"
 
-#include <result.hpp>
+#include "contact/result.hpp"
 
 #include <nlohmann/json.hpp>
 

@@ -30,7 +30,7 @@
 #include "job_store.hpp"
 #include "metrics.hpp"
 
-#include "job/job.hpp"
+#include "contact/job.hpp"
 
 #include <chrono>
 #include <condition_variable>

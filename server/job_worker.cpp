@@ -5,8 +5,8 @@
 #include "events.hpp"
 #include "util.hpp"
 
-#include "io/result_file.hpp"
-#include "solve.hpp"
+#include "contact/result_file.hpp"
+#include "contact/solve.hpp"
 
 #include <sys/stat.h>
 #include <unistd.h>

@@ -9,7 +9,7 @@
 #include "metrics.hpp"
 #include "util.hpp"
 
-#include "solve.hpp"
+#include "contact/solve.hpp"
 
 #include <CLI/CLI.hpp>
 

@@ -2,7 +2,7 @@
 
 #include "job.hpp"
 
-#include "solve.hpp"
+#include "contact/solve.hpp"
 
 #include <cstdio>
 #include <sstream>

@@ -5,7 +5,7 @@
 // The child writes the result file and its sidecar itself (rank 0), under the names the store serves.
 #pragma once
 
-#include "result.hpp"
+#include "contact/result.hpp"
 
 #include <nlohmann/json.hpp>
 

@@ -1,6 +1,6 @@
 #include "request_guard.hpp"
 
-#include "problem.hpp"
+#include "problem_document.hpp"
 
 #include <algorithm>
 #include <cctype>

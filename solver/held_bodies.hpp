@@ -4,8 +4,8 @@
 // returns a zero displacement for a body whose rigid motion the solution leaves undetermined).
 #pragma once
 
-#include "problem.hpp"
-#include "result.hpp"
+#include "contact/problem.hpp"
+#include "contact/result.hpp"
 
 #include <string>
 

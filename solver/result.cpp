@@ -1,4 +1,4 @@
-#include "result.hpp"
+#include "contact/result.hpp"
 
 namespace contact {
 

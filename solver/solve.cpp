@@ -1,4 +1,4 @@
-#include "solve.hpp"
+#include "contact/solve.hpp"
 
 #include "adapt/adaptive.hpp"
 #include "ddm/driver.hpp"

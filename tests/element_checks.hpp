@@ -2,7 +2,7 @@
 #pragma once
 
 #include "fem/body_solver.hpp"
-#include "problem.hpp"
+#include "contact/problem.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>

@@ -3,8 +3,8 @@
 // A = (1+nu)(1-2nu) P a^2 / (E (b^2 - a^2)), B = (1+nu) P a^2 b^2 / (E (b^2 - a^2)).
 #pragma once
 
-#include "mesh/mesh.hpp"
-#include "problem.hpp"
+#include "contact/mesh.hpp"
+#include "contact/problem.hpp"
 
 namespace contact::testing {
 

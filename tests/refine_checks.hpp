@@ -2,7 +2,7 @@
 // mixed meshes): a local refinement towards a point, and the 1-irregularity check.
 #pragma once
 
-#include "mesh/mesh.hpp"
+#include "contact/mesh.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,8 +1,8 @@
 // Helpers shared by the tests that run whole jobs: the job examples and a quiet solve.
 #pragma once
 
-#include "job/job.hpp"
-#include "solve.hpp"
+#include "contact/job.hpp"
+#include "contact/solve.hpp"
 
 #include <gtest/gtest.h>
 

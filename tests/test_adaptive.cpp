@@ -1,7 +1,7 @@
 // The adaptive loop: the paper's run on seed_layers, both strategies and indicators, the limits, and the cycle
 // transcript (deal.II style: the per-step elements, DOFs and iterations are compared with a checked-in file).
-#include "job/job.hpp"
-#include "solve.hpp"
+#include "contact/job.hpp"
+#include "contact/solve.hpp"
 #include "support.hpp"
 
 #include <gtest/gtest.h>

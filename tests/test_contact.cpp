@@ -3,7 +3,7 @@
 #include "contact/dual_basis.hpp"
 #include "contact/pair.hpp"
 #include "contact/segments.hpp"
-#include "solve.hpp"
+#include "contact/solve.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // Bodies held by their contacts alone (floating bodies), force control, body forces and load steps. Every expected
 // number comes from mechanics: equilibrium of a free body, Hertz's formula, the linearity of the problem.
-#include "job/job.hpp"
-#include "solve.hpp"
+#include "contact/job.hpp"
+#include "contact/solve.hpp"
 #include "support.hpp"
 
 #include <gtest/gtest.h>

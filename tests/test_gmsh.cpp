@@ -1,7 +1,7 @@
 // Gmsh meshes: the MSH 4.1 reader, a physical surface as a body (edges, orientation, arcs), every kind of bad file
 // with its message, and the job's gmsh meshes (file, data, the server's refusal of files, references to curves).
 #include "fem/body_solver.hpp"
-#include "job/job.hpp"
+#include "contact/job.hpp"
 #include "mesh/gmsh.hpp"
 
 #include <gtest/gtest.h>

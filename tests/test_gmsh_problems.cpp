@@ -2,8 +2,8 @@
 // exact linear field, also with hanging nodes), the cylinder on a mixed mesh against Hertz and against the
 // quadrilateral version of the same problem, and the rounded punch (equilibrium, symmetry, refinement onto arcs).
 #include "fem/body_solver.hpp"
-#include "job/job.hpp"
-#include "solve.hpp"
+#include "contact/job.hpp"
+#include "contact/solve.hpp"
 #include "support.hpp"
 
 #include <gtest/gtest.h>

@@ -2,7 +2,7 @@
 // (projected MPRGP in SMALBE) give the discrete solution of the monolithic reference, an independent algebra, on
 // every example and on brick walls of many floating bodies; MPRGP alone solves bound-constrained QPs like the
 // active-set QP method; the iterative solver's iterations do not grow with the number of bodies (the FETI property).
-#include "io/result_file.hpp"
+#include "contact/result_file.hpp"
 #include "linalg/active_set.hpp"
 #include "linalg/mprgp.hpp"
 #include "support.hpp"

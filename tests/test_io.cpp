@@ -1,6 +1,6 @@
 // Result file I/O: what write_result writes, read_result reads back bit for bit; the VTKHDF partition sizes
 // agree; failures name the path and leave no file; the XDMF sidecar names every step and body.
-#include "io/result_file.hpp"
+#include "contact/result_file.hpp"
 #include "triangle_meshes.hpp"
 
 #include <gtest/gtest.h>

@@ -7,7 +7,7 @@
 #include <sstream>
 #include <string>
 
-#include "job/job.hpp"
+#include "contact/job.hpp"
 
 using contact::BoundaryCondition;
 using contact::job::Limits;

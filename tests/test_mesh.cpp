@@ -1,5 +1,5 @@
 // Mesh module: block generator geometry, curved edges on their curves, grading, edge sets, cell checks.
-#include "mesh/mesh.hpp"
+#include "contact/mesh.hpp"
 
 #include <gtest/gtest.h>
 

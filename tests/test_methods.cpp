@@ -1,8 +1,8 @@
 // The fast and exact methods (gamma auto, Anderson, Robin, interface Newton, augmented Lagrangian) against the
 // monolithic reference and against exact answers.
 #include "ddm/interface/interface_problem.hpp"
-#include "job/job.hpp"
-#include "solve.hpp"
+#include "contact/job.hpp"
+#include "contact/solve.hpp"
 #include "support.hpp"
 
 #include <gtest/gtest.h>

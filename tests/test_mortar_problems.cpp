@@ -2,8 +2,8 @@
 // slave choices against a fine matching mesh, Hertz with a curved (arc) edge against the formula, the paper's
 // adaptive problem with every default against a uniform fine mesh, and every example with its own settings and
 // with the defaults. Every expected number comes from mathematics or an independent solution.
-#include "job/job.hpp"
-#include "solve.hpp"
+#include "contact/job.hpp"
+#include "contact/solve.hpp"
 #include "support.hpp"
 
 #include <gtest/gtest.h>

@@ -1,7 +1,7 @@
 // The interfaces the server plugs into: one report per iteration, in order, with the documented fields; and
 // cancellation within one iteration.
-#include "job/job.hpp"
-#include "solve.hpp"
+#include "contact/job.hpp"
+#include "contact/solve.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // Refinement with hanging nodes: 1-irregularity, curved boundaries, constraints, patch test and convergence.
 #include "fem/body_solver.hpp"
 #include "lame_ring.hpp"
-#include "mesh/mesh.hpp"
+#include "contact/mesh.hpp"
 #include "refine_checks.hpp"
 
 #include <gtest/gtest.h>

@@ -5,7 +5,7 @@
 #include "fem/body_solver.hpp"
 #include "fem/element.hpp"
 #include "fem/triangle.hpp"
-#include "mesh/mesh.hpp"
+#include "contact/mesh.hpp"
 #include "element_checks.hpp"
 #include "lame_ring.hpp"
 #include "refine_checks.hpp"

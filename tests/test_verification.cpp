@@ -1,8 +1,8 @@
 // Verification on the job examples (api/examples): the DDM against the monolithic reference, equilibrium,
 // Hertz, symmetry, and the paper's run. Every expected number comes from mathematics, not from a past run.
 #include "contact/extent.hpp"
-#include "job/job.hpp"
-#include "solve.hpp"
+#include "contact/job.hpp"
+#include "contact/solve.hpp"
 #include "support.hpp"
 
 #include <gtest/gtest.h>

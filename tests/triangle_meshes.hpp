@@ -3,7 +3,7 @@
 // follow, so boundary conditions, contacts and refinement onto curves work as on the original mesh.
 #pragma once
 
-#include "mesh/mesh.hpp"
+#include "contact/mesh.hpp"
 
 #include <functional>
 

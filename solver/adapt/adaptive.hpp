@@ -8,7 +8,7 @@
 #pragma once
 
 #include "../ddm/driver.hpp"
-#include "../result.hpp"
+#include "contact/result.hpp"
 
 namespace contact::adapt {
 

@@ -14,7 +14,7 @@
 #pragma once
 
 #include "../fem/body_solver.hpp"
-#include "../problem.hpp"
+#include "contact/problem.hpp"
 
 #include <functional>
 #include <string>

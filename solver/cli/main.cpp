@@ -4,11 +4,11 @@
 //   mpirun -n N contact-solve JOB.json ...     the bodies spread over N MPI ranks (docs/parallel.md)
 // Exit codes: 0 converged; 1 solver or I/O error; 2 invalid job (errors printed with their JSON pointers);
 // 3 stopped without converging (max_iterations or cancelled; the result file is still written).
-#include "io/progress_json.hpp"
-#include "io/result_file.hpp"
-#include "job/job.hpp"
+#include "contact/progress_json.hpp"
+#include "contact/result_file.hpp"
+#include "contact/job.hpp"
 #include "session.hpp"
-#include "solve.hpp"
+#include "contact/solve.hpp"
 
 #include <CLI/CLI.hpp>
 

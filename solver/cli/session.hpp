@@ -4,8 +4,8 @@
 #pragma once
 
 #include "ddm/task_runner.hpp"
-#include "problem.hpp"
-#include "result.hpp"
+#include "contact/problem.hpp"
+#include "contact/result.hpp"
 
 #include <atomic>
 #include <memory>

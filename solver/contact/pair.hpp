@@ -17,7 +17,7 @@
 // z_r = max(0, -(g_r / area_r) / theta).
 #pragma once
 
-#include "../problem.hpp"
+#include "contact/problem.hpp"
 
 #include <Eigen/SparseCore>
 

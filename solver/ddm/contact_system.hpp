@@ -8,8 +8,8 @@
 
 #include "../contact/pair.hpp"
 #include "../fem/body_solver.hpp"
-#include "../problem.hpp"
-#include "../result.hpp"
+#include "contact/problem.hpp"
+#include "contact/result.hpp"
 #include "task_runner.hpp"
 
 #include <memory>

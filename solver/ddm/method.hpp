@@ -3,7 +3,7 @@
 // Lagrangian, load steps, adaptivity) and solve() know no method by name.
 #pragma once
 
-#include "../result.hpp"
+#include "contact/result.hpp"
 #include "contact_system.hpp"
 
 #include <chrono>

@@ -1,7 +1,7 @@
 // Which process owns which body when the bodies are spread over several processes (MPI ranks, solver/mpi/).
 #pragma once
 
-#include "../problem.hpp"
+#include "contact/problem.hpp"
 
 #include <vector>
 

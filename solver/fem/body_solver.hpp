@@ -5,7 +5,7 @@
 // Owns copies of nothing but its matrices: the Body and Model passed in must outlive the solver.
 #pragma once
 
-#include "../problem.hpp"
+#include "contact/problem.hpp"
 #include "cholesky.hpp"
 #include "constraints.hpp"
 #include "elasticity.hpp"

@@ -5,8 +5,8 @@
 // All element quantities include the out-of-plane thickness (1 in plane strain), so forces are totals.
 #pragma once
 
-#include "../mesh/mesh.hpp"
-#include "../problem.hpp"
+#include "contact/mesh.hpp"
+#include "contact/problem.hpp"
 
 #include <Eigen/Core>
 

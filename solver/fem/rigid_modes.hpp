@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "../mesh/mesh.hpp"
+#include "contact/mesh.hpp"
 
 #include <Eigen/Core>
 

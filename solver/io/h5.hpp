@@ -3,7 +3,7 @@
 // Every handle is owned by an h5::Handle that closes it with the matching H5*close, so nothing leaks when an
 // exception unwinds. Every failing HDF5 call throws h5::Error whose message names the step ("create dataset
 // '/steps/0/bodies/upper/points'") followed by the innermost messages of HDF5's error stack. Callers add the
-// file path. Not part of the public API: include io/result_file.hpp instead.
+// file path. Not part of the public API: include contact/result_file.hpp instead.
 #pragma once
 
 #include <hdf5.h>

@@ -1,4 +1,4 @@
-#include "progress_json.hpp"
+#include "contact/progress_json.hpp"
 
 namespace contact::io {
 

@@ -1,5 +1,5 @@
 // read_result: HDF5 result file -> ResultFile (the inverse of write_result, for tests and tools).
-#include "result_file.hpp"
+#include "contact/result_file.hpp"
 
 #include "h5.hpp"
 

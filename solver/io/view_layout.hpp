@@ -1,7 +1,7 @@
 // Internal to solver/io: how the viewers' formats (/VTKHDF and the XDMF sidecar) lay out cells and stresses.
 #pragma once
 
-#include "../mesh/mesh.hpp"
+#include "contact/mesh.hpp"
 
 #include <Eigen/Core>
 

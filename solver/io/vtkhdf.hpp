@@ -1,7 +1,7 @@
 // Internal to solver/io: the /VTKHDF group, the ParaView view of a result file's final step.
 #pragma once
 
-#include "../result.hpp"
+#include "contact/result.hpp"
 
 #include <hdf5.h>
 

@@ -1,8 +1,8 @@
 // write_result: Result -> HDF5 file in the layout of docs/results-format.md.
-#include "result_file.hpp"
+#include "contact/result_file.hpp"
 
 #include "../contact/extent.hpp"
-#include "../solve.hpp"
+#include "contact/solve.hpp"
 #include "view_layout.hpp"
 #include "file_util.hpp"
 #include "h5.hpp"

@@ -5,7 +5,7 @@
 // multi-component arrays are declared "Matrix" (rows x components), which both of ParaView 5.11's XDMF readers
 // (the default Xdmf3ReaderS and the XDMF 2 "XDMFReader") load with the right shape. HyperSlab items, which
 // could cut ux and uy out as scalars, are dropped by the Xdmf3 reader ("unrecognized array type").
-#include "result_file.hpp"
+#include "contact/result_file.hpp"
 
 #include "file_util.hpp"
 

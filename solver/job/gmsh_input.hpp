@@ -3,7 +3,7 @@
 #pragma once
 
 #include "../mesh/gmsh.hpp"
-#include "job.hpp"
+#include "contact/job.hpp"
 #include "read.hpp"
 
 #include <map>

@@ -1,7 +1,7 @@
 // The job format v1 (docs/job-format.md, api/job.schema.json): JSON -> Problem. The entry points of job.hpp, the
 // checks on the text before it is parsed, and the frame of the reader (job_reader.hpp, which says how validation
 // runs in phases): run, the header, the model, the limits on work and the normalized copy.
-#include "job.hpp"
+#include "contact/job.hpp"
 
 #include <algorithm>
 #include <cerrno>

@@ -23,7 +23,7 @@
 #include <vector>
 
 #include "gmsh_input.hpp"
-#include "job.hpp"
+#include "contact/job.hpp"
 #include "read.hpp"
 
 namespace contact::job::detail {

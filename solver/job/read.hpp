@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "job.hpp"
+#include "contact/job.hpp"
 
 namespace contact::job::read {
 

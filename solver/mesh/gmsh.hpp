@@ -12,7 +12,7 @@
 // Layering: like the rest of mesh/, nothing here knows of finite elements or of the job format.
 #pragma once
 
-#include "mesh.hpp"
+#include "contact/mesh.hpp"
 
 #include <cstddef>
 #include <limits>

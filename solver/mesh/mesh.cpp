@@ -1,4 +1,4 @@
-#include "mesh.hpp"
+#include "contact/mesh.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
 // Quadtree refinement with hanging nodes (deal.II / MFEM style): see mesh.hpp.
-#include "mesh.hpp"
+#include "contact/mesh.hpp"
 
 #include <algorithm>
 #include <set>

@@ -10,7 +10,7 @@
 #pragma once
 
 #include "ddm/task_runner.hpp"
-#include "result.hpp"
+#include "contact/result.hpp"
 
 #include <mpi.h>
 

@@ -194,7 +194,7 @@ rejected_at("a gmsh mesh without its surface",
 rejected_at("a gmsh mesh with a block beside it",
             lambda d: d["bodies"][0]["mesh"].update(gmsh=gmsh), ["bodies", 0, "mesh"])
 
-# The defaults the schema documents are the solver's (solver/problem.hpp): a spot check of the important ones.
+# The defaults the schema documents are the solver's (solver/include/contact/problem.hpp): a spot check of the important ones.
 solver_props = schema["$defs"]["solver"]["properties"]
 check("documented defaults are the fast and exact ones",
       solver_props["method"]["default"] == "interface_newton" and solver_props["gamma"]["default"] == "auto"

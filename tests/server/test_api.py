@@ -16,7 +16,7 @@ from harness import (CONTACT_SOLVE, SRC, Checks, Server, Stream, example, flat_p
 checks = Checks()
 check = checks.check
 
-# Every field of the solver's IterationReport, BodyReport and PairReport (solver/result.hpp).
+# Every field of the solver's IterationReport, BodyReport and PairReport (solver/include/contact/result.hpp).
 ITERATION_FIELDS = {"iteration", "measure", "paper_criterion", "fixed_point_residual", "complementarity",
                     "active_nodes", "active_set_changes", "elapsed_seconds", "gamma", "update", "note", "bodies", "pairs"}
 BODY_FIELDS = {"name", "elements", "dofs", "elements_refined"}

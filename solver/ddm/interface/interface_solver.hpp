@@ -13,8 +13,8 @@
 // make_interface_solver picks one from the settings and the size of the problem; a new solver is a new class here.
 #pragma once
 
-#include "../../problem.hpp"
-#include "../../result.hpp"
+#include "contact/problem.hpp"
+#include "contact/result.hpp"
 #include "interface_problem.hpp"
 
 #include <memory>

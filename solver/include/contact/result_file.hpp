@@ -7,8 +7,8 @@
 // libhdf5 is built thread-safe; HDF5 serialises the calls internally).
 #pragma once
 
-#include "../problem.hpp"
-#include "../result.hpp"
+#include "contact/problem.hpp"
+#include "contact/result.hpp"
 
 #include <Eigen/Core>
 

@@ -1,8 +1,8 @@
 // The solver's public entry point: the server and the CLI depend on this header (and those it includes) only.
 #pragma once
 
-#include "problem.hpp"
-#include "result.hpp"
+#include "contact/problem.hpp"
+#include "contact/result.hpp"
 
 namespace contact {
 

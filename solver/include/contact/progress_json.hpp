@@ -3,7 +3,7 @@
 // per line, which is how the server follows a job that runs under mpirun.
 #pragma once
 
-#include "../result.hpp"
+#include "contact/result.hpp"
 
 #include <nlohmann/json.hpp>
 

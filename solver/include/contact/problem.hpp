@@ -6,7 +6,7 @@
 //  * contact pressure is reported positive in compression (the paper's sigma_n = -pressure <= 0).
 #pragma once
 
-#include "mesh/mesh.hpp"
+#include "contact/mesh.hpp"
 
 #include <nlohmann/json.hpp>
 

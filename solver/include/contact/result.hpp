@@ -2,7 +2,7 @@
 // The server plugs into Observer and CancelToken; the HDF5 writer consumes Result.
 #pragma once
 
-#include "mesh/mesh.hpp"
+#include "contact/mesh.hpp"
 
 #include <Eigen/Core>
 

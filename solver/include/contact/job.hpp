@@ -2,7 +2,7 @@
 // with the RFC 6901 JSON pointer of the offending value and a sentence saying what is wrong.
 #pragma once
 
-#include "../problem.hpp"
+#include "contact/problem.hpp"
 
 #include <nlohmann/json.hpp>
 

@@ -1,4 +1,4 @@
-#include "problem.hpp"
+#include "problem_document.hpp"
 
 #include <iterator>
 
