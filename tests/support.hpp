@@ -46,6 +46,23 @@ inline Result run(const nlohmann::json& job) {
   return problem.bodies.empty() ? Result{} : solve_quietly(problem);
 }
 
+// A cap held sideways at one corner and pulled off a base held at its bottom: a valid job (its flat contact could
+// hold it), but the load pulls it away, so nothing holds it at the solution (a floating body that ends unheld).
+inline nlohmann::json cap_pulled_off_base() {
+  return nlohmann::json::parse(R"({
+    "name": "cap",
+    "bodies": [
+      {"name": "cap", "material": {"E": 1000, "nu": 0.3},
+       "mesh": {"block": {"corners": [[0, 1], [1, 1], [1, 2], [0, 2]], "nx": 4, "ny": 4}},
+       "boundary": [{"vertex": "bottom_left", "displacement": {"x": 0}}, {"edge": "top", "force": [0, 10]}]},
+      {"name": "base", "material": {"E": 1000, "nu": 0.3},
+       "mesh": {"block": {"corners": [[0, 0], [1, 0], [1, 1], [0, 1]], "nx": 4, "ny": 4}},
+       "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]}
+    ],
+    "contacts": [{"slave": "cap.bottom", "master": "base.top"}]
+  })");
+}
+
 // The body of a step by name (throws if it has none).
 inline const BodyField& body(const Step& s, const std::string& name) {
   for (const auto& b : s.bodies)

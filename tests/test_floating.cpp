@@ -185,18 +185,7 @@ TEST(FloatingErrors, ABodyThatSlidesFreelyOnAFlatContactIsNamedAtValidation) {
 TEST(FloatingErrors, TheMonolithicMethodRefusesAnUnheldBodyLikeTheDefaultMethod) {
   // A cap held sideways at one corner and pulled off a base held at its bottom: its flat contact could hold it
   // (the job is valid), but the load pulls it away, so nothing holds it at the solution.
-  const json cap = json::parse(R"({
-    "name": "cap",
-    "bodies": [
-      {"name": "cap", "material": {"E": 1000, "nu": 0.3},
-       "mesh": {"block": {"corners": [[0, 1], [1, 1], [1, 2], [0, 2]], "nx": 4, "ny": 4}},
-       "boundary": [{"vertex": "bottom_left", "displacement": {"x": 0}}, {"edge": "top", "force": [0, 10]}]},
-      {"name": "base", "material": {"E": 1000, "nu": 0.3},
-       "mesh": {"block": {"corners": [[0, 0], [1, 0], [1, 1], [0, 1]], "nx": 4, "ny": 4}},
-       "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]}
-    ],
-    "contacts": [{"slave": "cap.bottom", "master": "base.top"}]
-  })");
+  const json cap = contact::testing::cap_pulled_off_base();
   const std::vector<std::pair<json, std::string>> cases = {
       {cap, "body 'cap' floats (translation in y, rotation free) and no contact holds it: its contact "
             "'cap.bottom-base.top'"}};

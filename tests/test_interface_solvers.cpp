@@ -178,18 +178,7 @@ TEST(InterfaceSolvers, AnUnheldFloatingBodyIsNamedByTheIterativeSolverToo) {
   EXPECT_NE(r.message.find("body 'punch' floats (translation in y"), std::string::npos) << r.message;
   // A cap held sideways at a corner and pulled off a base: valid (its flat contact could hold it), unheld at the
   // solution.
-  job = with_solver(json::parse(R"({
-    "name": "cap",
-    "bodies": [
-      {"name": "cap", "material": {"E": 1000, "nu": 0.3},
-       "mesh": {"block": {"corners": [[0, 1], [1, 1], [1, 2], [0, 2]], "nx": 4, "ny": 4}},
-       "boundary": [{"vertex": "bottom_left", "displacement": {"x": 0}}, {"edge": "top", "force": [0, 10]}]},
-      {"name": "base", "material": {"E": 1000, "nu": 0.3},
-       "mesh": {"block": {"corners": [[0, 0], [1, 0], [1, 1], [0, 1]], "nx": 4, "ny": 4}},
-       "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]}
-    ],
-    "contacts": [{"slave": "cap.bottom", "master": "base.top"}]
-  })"), "iterative");
+  job = with_solver(contact::testing::cap_pulled_off_base(), "iterative");
   r = run(job);
   EXPECT_EQ(r.stop_reason, StopReason::error) << r.message;
   EXPECT_NE(r.message.find("body 'cap' floats (translation in y, rotation free) and no contact holds it"),

@@ -150,18 +150,24 @@ TEST(Stack3, SolutionDoesNotDependOnTheOrderOfBodiesInTheJob) {
   }
 }
 
+// Hertz's half-width for hertz.json (the half model, x >= 0, symmetry at x = 0: the full contact force is twice
+// the pair's force), its parabola's radius and the two materials.
+static double hertz_formula_half_width(const json& job, const Problem& p, double pair_force) {
+  const double P = 2.0 * pair_force;
+  const double R = 1.0 / (2.0 * job["bodies"][1]["mesh"]["block"]["edges"]["bottom"]["parabola"]["a"].get<double>());
+  double inv_E_star = 0;
+  for (const auto& b : p.bodies) inv_E_star += (1 - b.material.nu * b.material.nu) / b.material.E;
+  return std::sqrt(4 * P * R * inv_E_star / M_PI);
+}
+
 TEST(Hertz, HalfWidthAndPeakPressureWithinThreePercentOfTheFormula) {
   json job = load_example("hertz.json");
   const Problem p = parse_or_fail(job);
   const Result r = run(p);
   ASSERT_TRUE(r.converged) << r.message;
   const auto& pair = r.steps.back().pairs.at(0);
-  // The job is the half model (x >= 0, symmetry at x = 0): the full contact force is twice the pair's.
-  const double P = 2.0 * pair.force;
-  const double R = 1.0 / (2.0 * job["bodies"][1]["mesh"]["block"]["edges"]["bottom"]["parabola"]["a"].get<double>());
-  double inv_E_star = 0;
-  for (const auto& b : p.bodies) inv_E_star += (1 - b.material.nu * b.material.nu) / b.material.E;
-  const double a = std::sqrt(4 * P * R * inv_E_star / M_PI);
+  const double P = 2.0 * pair.force;  // the half model's full contact force
+  const double a = hertz_formula_half_width(job, p, pair.force);
   const double p0 = 2 * P / (M_PI * a);
   // Contact edge: midway between the last slave node in contact and the next one (error <= half an element,
   // about 2 % of a on this mesh).
@@ -295,11 +301,7 @@ TEST(Hertz, InterpolatedContactEdgeIsCloserToTheFormulaThanTheLastNodeInContact)
     const Result r = run(p);
     ASSERT_TRUE(r.converged) << r.message;
     const auto& pair = r.steps.back().pairs.at(0);
-    const double P = 2.0 * pair.force;
-    const double R = 1.0 / (2.0 * job["bodies"][1]["mesh"]["block"]["edges"]["bottom"]["parabola"]["a"].get<double>());
-    double inv_E_star = 0;
-    for (const auto& b : p.bodies) inv_E_star += (1 - b.material.nu * b.material.nu) / b.material.E;
-    const double a = std::sqrt(4 * P * R * inv_E_star / M_PI);
+    const double a = hertz_formula_half_width(job, p, pair.force);
     Eigen::Index last = -1;
     for (Eigen::Index j = 0; j < pair.pressure.size(); ++j)
       if (pair.pressure[j] > 0) last = j;

@@ -7,7 +7,11 @@ namespace contact::ddm {
 linalg::ActiveSetResult SparseDirectSolver::solve(const InterfaceQp& qp, const Eigen::VectorXd* z0,
                                                   InterfaceSolveContext& context) {
   const Eigen::Index m = qp.problem.size();
-  SparseMatrix H = qp.problem.assemble();
+  if (assembled_for_ != &qp.problem) {
+    F_ = qp.problem.assemble();
+    assembled_for_ = &qp.problem;
+  }
+  SparseMatrix H = F_;
   if (qp.penalty.size() == m && qp.penalty.cwiseAbs().maxCoeff() > 0) {
     SparseMatrix D(m, m);
     D.reserve(Eigen::VectorXi::Constant(m, 1));
