@@ -25,7 +25,7 @@ TEST_PACKAGES=(
   gmsh libgmsh-dev                          # scripts/make_gmsh_examples.sh; the MSH reader checked against libgmsh
 )
 RUNTIME_PACKAGES=(
-  libcholmod3 libopenblas0-pthread libhdf5-103-1 libcpp-httplib0.11 ca-certificates curl
+  libcholmod3 libumfpack5 libopenblas0-pthread libhdf5-103-1 libcpp-httplib0.11 ca-certificates curl
   libopenmpi3 openmpi-bin     # mpirun, for contactd --mpi-launcher
 )
 

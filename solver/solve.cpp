@@ -109,7 +109,7 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
     std::vector<Step> steps;
     ddm::MethodOutcome outcome;
     if (adaptive) {
-      system.set_load_factor(problem.loading.factors.back());
+      system.set_load_step(problem.loading.factors.size() - 1, problem.loading.factors.back());
       outcome = adapt::run_adaptive(working, system, context, *method, steps, updates);
     } else {
       outcome = ddm::run_load_steps(system, problem.solver, problem.loading.factors, context, *method, steps, updates);

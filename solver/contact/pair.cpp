@@ -67,6 +67,31 @@ void PairDiscretization::add_forces(const Eigen::VectorXd& z, Eigen::VectorXd& f
   fm.noalias() += Gm.transpose() * z;
 }
 
+void PairDiscretization::add_tangential_forces(const Eigen::VectorXd& q, Eigen::VectorXd& fs, Eigen::VectorXd& fm) const {
+  if (!has_friction() || q.size() != n_rows()) return;
+  fs.noalias() -= Ts.transpose() * q;
+  fm.noalias() += Tm.transpose() * q;
+}
+
+Eigen::Vector2d PairDiscretization::tangential_resultant(const Eigen::VectorXd& q) const {
+  Eigen::Vector2d out = Eigen::Vector2d::Zero();
+  if (!has_friction() || q.size() != Ts.rows()) return out;
+  for (int r = 0; r < Ts.outerSize(); ++r)
+    for (SparseRows::InnerIterator it(Ts, r); it; ++it) out[it.col() % 2] -= it.value() * q[r];
+  return out;
+}
+
+Eigen::VectorXi PairDiscretization::sticking(const Eigen::VectorXd& z, const Eigen::VectorXd& q) const {
+  Eigen::VectorXi out = Eigen::VectorXi::Zero(n_rows());
+  if (!has_friction() || q.size() != n_rows() || z.size() != n_rows()) return out;
+  for (Eigen::Index r = 0; r < n_rows(); ++r) {
+    const double bound = friction.law == FrictionSpec::Law::coulomb ? friction.coefficient * z[r] : friction.bound;
+    // A slipping node sits on the bound to rounding; a sticking one strictly inside.
+    out[r] = z[r] > 0 && std::abs(q[r]) < bound * (1 - 1e-8) ? 1 : 0;
+  }
+  return out;
+}
+
 Eigen::Vector2d PairDiscretization::resultant(const Eigen::VectorXd& z) const {
   Eigen::Vector2d out = Eigen::Vector2d::Zero();
   if (z.size() != Gs.rows()) return out;
@@ -164,6 +189,7 @@ class PairBuilder {
     d_.slave_body = pair_.slave_body;
     d_.master_body = pair_.master_body;
     d_.theta = theta;
+    d_.friction = pair_.friction;
   }
 
   PairDiscretization build() {
@@ -323,6 +349,7 @@ class PairBuilder {
             nu_[static_cast<size_t>(r)] += w * phi * nk;
             for (int l = 0; l < 2; ++l) {
               add(gs_, {r, d_.slave_nodes[k + static_cast<size_t>(l)]}, w * phi * Ns[l] * nk);
+              ss_[{r, d_.slave_nodes[k + static_cast<size_t>(l)]}] += w * phi * Ns[l];
               add(gm_, {r, l == 0 ? m0 : m1}, w * phi * Nm[l] * nk);
               mm_[{r, s->master + l}] += w * phi * Nm[l];
             }
@@ -336,6 +363,7 @@ class PairBuilder {
     for (size_t m = 0; m < n_runs_; ++m)
       if (basis_[m]) integrate_run(m);
     for (const auto& v : nu_) d_.normal.push_back(v.normalized());
+    for (const auto& n : d_.normal) d_.tangent.emplace_back(-n.y(), n.x());
   }
 
   // Sparse operators. Exact zeros (an axis-aligned normal touches one component only) are left out, which keeps
@@ -360,6 +388,17 @@ class PairBuilder {
       if (v != 0.0) tm.emplace_back(key.first, key.second, v);
     d_.M.resize(d_.D.size(), static_cast<Eigen::Index>(d_.master_nodes.size()));
     d_.M.setFromTriplets(tm.begin(), tm.end());
+    if (pair_.friction.active()) tangential_operators();
+  }
+
+  // Ts and Tm: the scalar mortar integrals of the slave and the master times the row's tangent.
+  void tangential_operators() {
+    VectorEntries ts, tm;
+    for (const auto& [key, v] : ss_) ts[key] = v * d_.tangent[static_cast<size_t>(key.first)];
+    for (const auto& [key, v] : mm_)
+      tm[{key.first, d_.master_nodes[static_cast<size_t>(key.second)]}] = v * d_.tangent[static_cast<size_t>(key.first)];
+    d_.Ts = sparse_rows(ts, 2 * slave_.mesh.num_nodes());
+    d_.Tm = sparse_rows(tm, 2 * master_.mesh.num_nodes());
   }
 
   const ContactPair& pair_;
@@ -376,6 +415,7 @@ class PairBuilder {
   std::vector<Eigen::Vector2d> nu_;
   VectorEntries gs_, gm_;
   std::map<std::pair<int, int>, double> mm_;  // (row, master edge position) -> scalar M
+  std::map<std::pair<int, int>, double> ss_;  // (row, slave node) -> integral Phi_r N_i
 };
 
 }  // namespace

@@ -15,6 +15,15 @@
 // sum_j M_rj = D_r segment by segment, so the forces balance exactly on any pair of meshes.
 // Contact conditions per row: z_r >= 0, g_r >= 0, z_r g_r = 0 (exact), or the paper's penalty in nodal form
 // z_r = max(0, -(g_r / area_r) / theta).
+//
+// Friction (docs/algorithm.md, "Friction"): one tangential multiplier q_r per contact node on the same dual basis,
+// acting along the row's tangent tau_r (its normal turned a quarter anticlockwise). The weighted tangential jump
+//   w_r = integral Phi_r (u' - u) . tau_r  =  Tm u_master - Ts u_slave,
+//   Ts(r, slave node i) = tau_r integral Phi_r N_i,   Tm(r, master node j) = tau_r M_rj,
+// has the structure of the weighted gap, and the forces are f_slave = -Ts^T q, f_master = Tm^T q (balanced
+// exactly, as the normal ones). So q is the tangential traction the slave exerts on the master, and the traction
+// on the slave along tau is t = -q. Friction acts on increments: the slip of a load step is w - w_origin, with
+// w_origin the jump at the end of the previous step.
 #pragma once
 
 #include "contact/problem.hpp"
@@ -61,6 +70,28 @@ struct PairDiscretization {
 
   // Augmented-Lagrangian multipliers per row (empty: none). The pressure is then max(0, lambda - g / theta).
   Eigen::VectorXd multiplier;
+
+  // Friction (empty operators when the pair is frictionless).
+  FrictionSpec friction;
+  std::vector<Eigen::Vector2d> tangent;  // per row: tau_r
+  SparseRows Ts, Tm;                     // rows x slave dofs, rows x master dofs
+  Eigen::VectorXd jump_origin;           // w at the end of the previous load step (empty: zero)
+  bool has_friction() const { return friction.active() && Ts.rows() == n_rows(); }
+  // w = Tm u_master - Ts u_slave (weighted; / area gives the master's tangential displacement relative to the
+  // slave's, a length).
+  Eigen::VectorXd weighted_jump(const Eigen::VectorXd& us, const Eigen::VectorXd& um) const { return Tm * um - Ts * us; }
+  // The slip of this step: w - w_origin.
+  Eigen::VectorXd weighted_slip(const Eigen::VectorXd& us, const Eigen::VectorXd& um) const {
+    Eigen::VectorXd w = weighted_jump(us, um);
+    if (jump_origin.size() == w.size()) w -= jump_origin;
+    return w;
+  }
+  // The resultant of the tangential forces on the slave, -Ts^T q summed by component.
+  Eigen::Vector2d tangential_resultant(const Eigen::VectorXd& q) const;
+  // Per row: 1 where the node is in contact (z > 0) and its tangential multiplier is below the friction bound.
+  Eigen::VectorXi sticking(const Eigen::VectorXd& z, const Eigen::VectorXd& q) const;
+  // Adds the tangential forces of multipliers q: fs -= Ts^T q, fm += Tm^T q.
+  void add_tangential_forces(const Eigen::VectorXd& q, Eigen::VectorXd& fs, Eigen::VectorXd& fm) const;
 
   int n_rows() const { return static_cast<int>(D.size()); }
   Eigen::VectorXd weighted_gap(const Eigen::VectorXd& us, const Eigen::VectorXd& um) const { return gap0 + Gm * um - Gs * us; }

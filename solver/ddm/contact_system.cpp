@@ -59,7 +59,7 @@ ContactSystem::ContactSystem(const Problem& problem, TaskRunner& runner, Factori
 std::unique_ptr<fem::BodySolver> ContactSystem::make_body(size_t a, bool local) const {
   auto b = std::make_unique<fem::BodySolver>(problem_.bodies[a], problem_.model, factorization_ != Factorization::none,
                                              interface_dofs(a), may_float(a), local);
-  b->set_load_factor(load_factor_);
+  b->set_load_step(load_step_, load_factor_);
   return b;
 }
 
@@ -105,6 +105,8 @@ std::vector<int> ContactSystem::interface_dofs(size_t a) const {
   for (const auto& pair : pairs_) {
     if (static_cast<size_t>(pair.slave_body) == a) collect(pair.Gs);
     if (static_cast<size_t>(pair.master_body) == a) collect(pair.Gm);
+    if (pair.has_friction() && static_cast<size_t>(pair.slave_body) == a) collect(pair.Ts);
+    if (pair.has_friction() && static_cast<size_t>(pair.master_body) == a) collect(pair.Tm);
   }
   std::sort(dofs.begin(), dofs.end());
   dofs.erase(std::unique(dofs.begin(), dofs.end()), dofs.end());
@@ -138,14 +140,31 @@ Pressures ContactSystem::penalty_pressures(const Displacements& u) const {
   return z;
 }
 
-Displacements ContactSystem::loads_from_pressures(const Pressures& z) const {
+Displacements ContactSystem::loads_from_pressures(const Pressures& z, const Pressures* q) const {
   Displacements f(bodies_.size());
   for (size_t a = 0; a < bodies_.size(); ++a) f[a] = Eigen::VectorXd::Zero(bodies_[a]->n_dofs());
   for (size_t k = 0; k < pairs_.size(); ++k) {
     const auto& p = pairs_[k];
     p.add_forces(z[k], f[static_cast<size_t>(p.slave_body)], f[static_cast<size_t>(p.master_body)]);
+    if (q && k < q->size())
+      p.add_tangential_forces((*q)[k], f[static_cast<size_t>(p.slave_body)], f[static_cast<size_t>(p.master_body)]);
   }
   return f;
+}
+
+bool ContactSystem::has_histories() const {
+  for (const auto& b : bodies_)
+    if (b->has_histories()) return true;
+  for (const auto& body : problem_.bodies)  // bodies of other processes are not assembled here
+    for (const auto& bc : body.boundary)
+      if (!bc.history.empty()) return true;
+  return false;
+}
+
+void ContactSystem::accept_step(const Displacements& u) {
+  for (auto& pair : pairs_)
+    if (pair.has_friction())
+      pair.jump_origin = pair.weighted_jump(u[static_cast<size_t>(pair.slave_body)], u[static_cast<size_t>(pair.master_body)]);
 }
 
 Displacements ContactSystem::contact_loads(const Displacements& u, Pressures* pressures) const {
@@ -252,11 +271,64 @@ IterationReport ContactSystem::report_gaps(int iteration, const Pressures& z, co
   return r;
 }
 
+namespace {
+
+// Stick flags of the rows at every slave node: a node inside a multiplier segment (no row of its own) sticks where
+// every row its value comes from sticks.
+Eigen::VectorXi stick_at_nodes(const mortar::PairDiscretization& pair, const Eigen::VectorXi& rows) {
+  Eigen::VectorXi out = Eigen::VectorXi::Zero(static_cast<Eigen::Index>(pair.slave_nodes.size()));
+  for (size_t j = 0; j < pair.slave_nodes.size(); ++j) {
+    const auto& from = pair.node_from_rows[j];
+    bool all = !from.empty();
+    for (const auto& [row, weight] : from) all = all && rows[row] != 0;
+    out[static_cast<Eigen::Index>(j)] = all ? 1 : 0;
+  }
+  return out;
+}
+
+}  // namespace
+
+void ContactSystem::report_friction(const Pressures& z, const Pressures& q, IterationReport& report) const {
+  for (size_t k = 0; k < pairs_.size() && k < report.pairs.size() && k < q.size(); ++k) {
+    const auto& pair = pairs_[k];
+    if (!pair.has_friction() || q[k].size() != pair.n_rows()) continue;
+    PairReport& pr = report.pairs[k];
+    const Eigen::VectorXd t = pair.to_nodes(-q[k], 0.0);
+    pr.tangential_tractions.assign(t.data(), t.data() + t.size());
+    const Eigen::VectorXi stick = stick_at_nodes(pair, pair.sticking(z[k], q[k]));
+    pr.stick.assign(stick.data(), stick.data() + stick.size());
+    pr.tangential_force = -pair.area.dot(q[k]);
+    pr.resultant += pair.tangential_resultant(q[k]);
+  }
+}
+
+namespace {
+
+// The friction results of a pair (PairField): tangents, the tangential traction t = -q on the slave, the
+// accumulated slip (the slave's tangential displacement relative to the master's, -w / area), stick flags.
+void friction_fields(const mortar::PairDiscretization& pair, const Eigen::VectorXd& us, const Eigen::VectorXd& um,
+                     const Eigen::VectorXd& z, const Eigen::VectorXd& q, PairField& f) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const Eigen::Index n = static_cast<Eigen::Index>(pair.slave_nodes.size());
+  f.friction = pair.friction.law == FrictionSpec::Law::coulomb ? "coulomb" : "tresca";
+  f.friction_coefficient = pair.friction.coefficient;
+  f.friction_bound = pair.friction.bound;
+  f.tangent.resize(n, 2);
+  for (Eigen::Index j = 0; j < n; ++j) f.tangent.row(j) << -f.normal(j, 1), f.normal(j, 0);
+  f.tangential_traction = pair.to_nodes(-q, 0.0);
+  f.slip = pair.to_nodes((-pair.weighted_jump(us, um)).cwiseQuotient(pair.area), nan);
+  f.stick = stick_at_nodes(pair, pair.sticking(z, q));
+  f.tangential_force = -pair.area.dot(q);
+  f.resultant += pair.tangential_resultant(q);
+}
+
+}  // namespace
+
 Step ContactSystem::fields(const Displacements& u, const Pressures& z, int iteration,
-                           const std::vector<Eigen::VectorXd>* rigid_amplitudes) const {
+                           const std::vector<Eigen::VectorXd>* rigid_amplitudes, const Pressures* q) const {
   Step step;
   step.iteration = iteration;
-  const Displacements loads = loads_from_pressures(z);
+  const Displacements loads = loads_from_pressures(z, q);
   // Stresses and support reactions on each body's owner (the reactions need its assembled loads).
   std::vector<fem::StressFields> stress(bodies_.size());
   std::vector<Eigen::VectorXd> reaction(bodies_.size());
@@ -366,6 +438,8 @@ Step ContactSystem::fields(const Displacements& u, const Pressures& z, int itera
     }
     f.force = pair.total_force(z[k]);
     f.resultant = pair.resultant(z[k]);
+    if (pair.has_friction() && q && k < q->size() && (*q)[k].size() == pair.n_rows())
+      friction_fields(pair, us, um, z[k], (*q)[k], f);
     step.pairs.push_back(std::move(f));
   }
   return step;

@@ -51,20 +51,30 @@ class ContactSystem {
   double setup_seconds() const { return setup_seconds_; }
   double factorization_seconds() const { return factorization_seconds_; }  // summed over bodies
 
-  // The load factor of every body (load steps): scales the bodies' loads and prescribed values.
-  void set_load_factor(double factor) {
+  // The load factor of every body (load steps): scales the bodies' loads and prescribed values; set_load_step also
+  // gives the conditions with their own history their factor of that step.
+  void set_load_factor(double factor) { set_load_step(0, factor); }
+  void set_load_step(size_t step, double factor) {
+    load_step_ = step;
     load_factor_ = factor;
-    for (auto& b : bodies_) b->set_load_factor(factor);
+    for (auto& b : bodies_) b->set_load_step(step, factor);
   }
   double load_factor() const { return load_factor_; }
+  // Some condition has its own load history: the loads of a step are then not a multiple of another step's.
+  bool has_histories() const;
+  bool has_friction() const { return problem_.has_friction(); }
+  // Friction acts on slip increments: the tangential jump at displacements u becomes each friction pair's origin
+  // (the end of a load step).
+  void accept_step(const Displacements& u);
 
   // Augmented-Lagrangian multipliers of pair k per row (an empty vector: none).
   void set_multipliers(size_t k, Eigen::VectorXd rows) { pairs_[k].multiplier = std::move(rows); }
 
   // The penalty pressures of displacements u (paper (16)'s last term, in nodal form).
   Pressures penalty_pressures(const Displacements& u) const;
-  // Contact forces on every body from pressures: f_slave = -Gs^T z, f_master = Gm^T z.
-  Displacements loads_from_pressures(const Pressures& z) const;
+  // Contact forces on every body from pressures: f_slave = -Gs^T z, f_master = Gm^T z; with tangential
+  // multipliers q (friction pairs; pair.hpp) also f_slave -= Ts^T q, f_master += Tm^T q.
+  Displacements loads_from_pressures(const Pressures& z, const Pressures* q = nullptr) const;
   // Contact forces from the penalty pressures of u (they go to *pressures if given).
   Displacements contact_loads(const Displacements& u, Pressures* pressures = nullptr) const;
 
@@ -91,6 +101,8 @@ class ContactSystem {
   IterationReport report(int iteration, const Displacements& u, std::vector<std::vector<char>>& previous_active) const {
     return report(iteration, u, penalty_pressures(u), previous_active);
   }
+  // Adds the friction pairs' tangential tractions, stick flags and tangential forces to a report.
+  void report_friction(const Pressures& z, const Pressures& q, IterationReport& report) const;
   // The nodal gaps (weighted gap / D) of displacements u.
   Pressures nodal_gaps(const Displacements& u) const;
 
@@ -98,7 +110,7 @@ class ContactSystem {
   // for displacements u with pressures z (the penalty form computes z from u), and the
   // floating bodies' rigid-mode amplitudes if known.
   Step fields(const Displacements& u, const Pressures& z, int iteration,
-              const std::vector<Eigen::VectorXd>* rigid_amplitudes = nullptr) const;
+              const std::vector<Eigen::VectorXd>* rigid_amplitudes = nullptr, const Pressures* q = nullptr) const;
   Step fields(const Displacements& u, int iteration) const { return fields(u, penalty_pressures(u), iteration); }
 
  private:
@@ -120,6 +132,7 @@ class ContactSystem {
   std::string error_;
   double setup_seconds_ = 0.0, factorization_seconds_ = 0.0;
   double load_factor_ = 1.0;
+  size_t load_step_ = 0;
 };
 
 // How one full vector per body (displacements, loads) moves from its owner to the other processes.

@@ -9,7 +9,7 @@ MethodOutcome run_load_steps(ContactSystem& system, const SolverSettings& settin
   Displacements warm;
   updates = 0;
   for (size_t k = 0; k < factors.size(); ++k) {
-    system.set_load_factor(factors[k]);
+    system.set_load_step(k, factors[k]);
     OffsetObserver observer(context.observer, total.iterations);
     RunContext inner{observer, context.cancel, context.runner, context.start, warm.empty() ? nullptr : &warm};
     int step_updates = 0;
@@ -32,15 +32,17 @@ MethodOutcome run_load_steps(ContactSystem& system, const SolverSettings& settin
       return total;
     }
     Step step = o.z.empty() ? system.fields(o.u, total.iterations)
-                            : system.fields(o.u, o.z, total.iterations, &o.rigid_amplitudes);
+                            : system.fields(o.u, o.z, total.iterations, &o.rigid_amplitudes, o.q.empty() ? nullptr : &o.q);
     step.index = static_cast<int>(k);
     step.load_factor = factors[k];
     steps.push_back(std::move(step));
     total.u = o.u;
     total.z = o.z;
     total.rigid_amplitudes = o.rigid_amplitudes;
+    total.q = o.q;
     total.message = prefix + o.message;
     if (!o.converged) return total;
+    system.accept_step(o.u);  // friction: the next step's slip is measured from here
     warm = std::move(o.u);
   }
   return total;

@@ -6,11 +6,16 @@
 //    K + B^T W_A B with CHOLMOD.
 //  * exact: the primal-dual active set on the whole system: on the active set A the saddle-point system
 //    [K  -B_A^T; B_A  0] [x; z_A] = [b; -g0_A] (equilibrium with the contact forces, and g_A = 0) is solved by a
-//    sparse LU factorisation (Eigen's SparseLU), and A is predicted as {z - c g / area > 0}. Slow for large
-//    problems (an unsymmetric factorisation per step): a reference, not a production method.
+//    sparse LU factorisation (Eigen's SparseLU), and A is predicted as {z - c g / area > 0}. With friction the
+//    rows of B include each friction pair's tangential rows (-Ts, +Tm; the slip of the step g0 - w_origin), and
+//    the same stick and slip sets as the interface solver's (linalg/friction_sets.hpp) give lambda = P y +
+//    lambda0: [K  -B^T P; R B  0] [x; y] = [b + B^T lambda0; -R g0]. Slow for large problems (an unsymmetric
+//    factorisation per step): a reference, not a production method.
 // Both are independent of the interface machinery (Schur complements, dense active-set solves) that
 // interface Newton uses, which is what makes them a check on it.
 #include "method.hpp"
+
+#include "../linalg/friction_sets.hpp"
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/SparseLU>
@@ -33,6 +38,9 @@ struct Stacked {
   SpMat B;                               // rows x n
   Eigen::VectorXd g0, D, c;              // per row: weighted gap at x = 0, D, and the active-set scaling
   std::vector<int> row_pair, row_index;  // per row: its pair and its row in the pair
+  // Friction: the tangential rows follow the normal ones (tangential_offset per pair, -1 if frictionless).
+  std::vector<Eigen::Index> tangential_offset;
+  std::vector<linalg::FrictionRow> friction;
 };
 
 Stacked stack(const ContactSystem& system, bool shift_by_multipliers) {
@@ -55,38 +63,64 @@ Stacked stack(const ContactSystem& system, bool shift_by_multipliers) {
   const auto& pairs = system.pairs();
   s.row_offset.assign(pairs.size() + 1, 0);
   for (size_t k = 0; k < pairs.size(); ++k) s.row_offset[k + 1] = s.row_offset[k] + pairs[k].n_rows();
-  const Eigen::Index m = s.row_offset.back();
+  Eigen::Index m = s.row_offset.back();
+  s.tangential_offset.assign(pairs.size(), -1);
+  for (size_t k = 0; k < pairs.size(); ++k)
+    if (pairs[k].has_friction()) {
+      s.tangential_offset[k] = m;
+      m += pairs[k].n_rows();
+    }
   s.g0.resize(m);
   s.D.resize(m);
   s.c.resize(m);
+  s.row_pair.resize(static_cast<size_t>(m));
+  s.row_index.resize(static_cast<size_t>(m));
   std::vector<Eigen::Triplet<double>> tb;
   const Problem& problem = system.problem();
   const double thickness = problem.model.plane == Plane::stress ? problem.model.thickness : 1.0;
-  for (size_t k = 0; k < pairs.size(); ++k) {
+  // Rows [first, first + rows) of B from a pair's slave and master operators (B = [-slave, +master]).
+  auto add_rows = [&](size_t k, Eigen::Index first, const mortar::SparseRows& Gs, const mortar::SparseRows& Gm) {
     const auto& pair = pairs[k];
     const size_t sb = static_cast<size_t>(pair.slave_body), mb = static_cast<size_t>(pair.master_body);
-    const auto& cs = system.body(sb).constraints();
-    const auto& cm = system.body(mb).constraints();
-    const SpMat Bs = SpMat(pair.Gs) * cs.T(), Bm = SpMat(pair.Gm) * cm.T();
+    const SpMat Bs = SpMat(Gs) * system.body(sb).constraints().T(), Bm = SpMat(Gm) * system.body(mb).constraints().T();
     for (int col = 0; col < Bs.outerSize(); ++col)
-      for (SpMat::InnerIterator it(Bs, col); it; ++it) tb.emplace_back(s.row_offset[k] + it.row(), s.offset[sb] + it.col(), -it.value());
+      for (SpMat::InnerIterator it(Bs, col); it; ++it) tb.emplace_back(first + it.row(), s.offset[sb] + it.col(), -it.value());
     for (int col = 0; col < Bm.outerSize(); ++col)
-      for (SpMat::InnerIterator it(Bm, col); it; ++it) tb.emplace_back(s.row_offset[k] + it.row(), s.offset[mb] + it.col(), it.value());
-    Eigen::VectorXd g0 = pair.gap0 + pair.Gm * system.body(mb).prescribed() - pair.Gs * system.body(sb).prescribed();
-    if (shift_by_multipliers && pair.multiplier.size() == pair.n_rows())
-      g0 -= pair.theta * pair.area.cwiseProduct(pair.multiplier);  // the augmented Lagrangian's shifted gap
-    s.g0.segment(s.row_offset[k], pair.n_rows()) = g0;
-    s.D.segment(s.row_offset[k], pair.n_rows()) = pair.area;
+      for (SpMat::InnerIterator it(Bm, col); it; ++it) tb.emplace_back(first + it.row(), s.offset[mb] + it.col(), it.value());
+    const Eigen::VectorXd g = Gm * system.body(mb).prescribed() - Gs * system.body(sb).prescribed();
+    s.g0.segment(first, pair.n_rows()) = g;
+    s.D.segment(first, pair.n_rows()) = pair.area;
     // c = E' / h: a contact node's own stiffness scale (h its support length), for the active-set prediction.
     const double E = system.penalties()[k].E_pair;
     for (Eigen::Index r = 0; r < pair.n_rows(); ++r) {
-      s.c[s.row_offset[k] + r] = E / (pair.area[r] / thickness);
-      s.row_pair.push_back(static_cast<int>(k));
-      s.row_index.push_back(static_cast<int>(r));
+      s.c[first + r] = E / (pair.area[r] / thickness);
+      s.row_pair[static_cast<size_t>(first + r)] = static_cast<int>(k);
+      s.row_index[static_cast<size_t>(first + r)] = static_cast<int>(r);
     }
+  };
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    const auto& pair = pairs[k];
+    add_rows(k, s.row_offset[k], pair.Gs, pair.Gm);
+    s.g0.segment(s.row_offset[k], pair.n_rows()) += pair.gap0;
+    if (shift_by_multipliers && pair.multiplier.size() == pair.n_rows())  // the augmented Lagrangian's shifted gap
+      s.g0.segment(s.row_offset[k], pair.n_rows()) -= pair.theta * pair.area.cwiseProduct(pair.multiplier);
+    if (s.tangential_offset[k] < 0) continue;
+    add_rows(k, s.tangential_offset[k], pair.Ts, pair.Tm);
+    if (pair.jump_origin.size() == pair.n_rows()) s.g0.segment(s.tangential_offset[k], pair.n_rows()) -= pair.jump_origin;
   }
   s.B.resize(m, n);
   s.B.setFromTriplets(tb.begin(), tb.end());
+  // Friction rows, but not where both sides' tangential motion is prescribed (a symmetry line): the row of B is
+  // zero there and the node cannot slip (q = 0; its traction goes into the supports).
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> rows_of_B = s.B;
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    if (s.tangential_offset[k] < 0) continue;
+    const auto& f = pairs[k].friction;
+    for (Eigen::Index r = 0; r < pairs[k].n_rows(); ++r)
+      if (rows_of_B.row(s.tangential_offset[k] + r).norm() > 0)
+        s.friction.push_back({s.row_offset[k] + r, s.tangential_offset[k] + r, f.law == FrictionSpec::Law::coulomb,
+                              f.coefficient, f.bound});
+  }
   return s;
 }
 
@@ -103,17 +137,68 @@ Pressures split_rows(const ContactSystem& system, const Stacked& s, const Eigen:
   return z;
 }
 
+Pressures split_tangential(const ContactSystem& system, const Stacked& s, const Eigen::VectorXd& rows) {
+  Pressures q(system.pairs().size());
+  for (size_t k = 0; k < q.size(); ++k)
+    if (s.tangential_offset[k] >= 0) q[k] = rows.segment(s.tangential_offset[k], s.row_offset[k + 1] - s.row_offset[k]);
+  return q;
+}
+
+// The saddle-point system of the sets, [K  -B^T P; R B  0] [x; y] = [b + B^T lambda0; -R g0], by sparse LU with
+// two steps of iterative refinement (the matrix mixes stiffnesses and lengths, and the unsymmetric LU loses a few
+// digits on it). Returns false (with the reason) when it is singular.
+bool solve_sets(const Stacked& s, const linalg::FrictionParametrization& p, Eigen::VectorXd& x, Eigen::VectorXd& lambda,
+                std::string& error) {
+  const Eigen::Index n = s.b.size(), na = static_cast<Eigen::Index>(p.rows.size());
+  const SpMat BtP = SpMat(s.B.transpose()) * p.P;
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> Brows = s.B;
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(static_cast<size_t>(s.K.nonZeros() + 2 * BtP.nonZeros()));
+  for (int col = 0; col < s.K.outerSize(); ++col)
+    for (SpMat::InnerIterator it(s.K, col); it; ++it) t.emplace_back(it.row(), it.col(), it.value());
+  for (int col = 0; col < BtP.outerSize(); ++col)
+    for (SpMat::InnerIterator it(BtP, col); it; ++it) t.emplace_back(it.row(), n + col, -it.value());
+  Eigen::VectorXd rhs(n + na);
+  rhs.head(n) = s.b + s.B.transpose() * p.lambda0;
+  for (Eigen::Index i = 0; i < na; ++i) {
+    const Eigen::Index row = p.rows[static_cast<size_t>(i)];
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Brows, static_cast<int>(row)); it; ++it)
+      t.emplace_back(n + i, it.col(), it.value());
+    rhs[n + i] = -s.g0[row];
+  }
+  SpMat kkt(n + na, n + na);
+  kkt.setFromTriplets(t.begin(), t.end());
+  kkt.makeCompressed();
+  Eigen::SparseLU<SpMat> lu;
+  lu.compute(kkt);
+  if (lu.info() != Eigen::Success) {
+    error = lu.lastErrorMessage();
+    return false;
+  }
+  Eigen::VectorXd solution = lu.solve(rhs);
+  for (int refine = 0; refine < 2; ++refine) solution += lu.solve(Eigen::VectorXd(rhs - kkt * solution));
+  x = solution.head(n);
+  lambda = p.P * solution.tail(na) + p.lambda0;
+  return true;
+}
+
 MethodOutcome run_exact(const ContactSystem& system, const SolverSettings& settings, RunContext& context) {
   MethodOutcome out;
   const Stacked s = stack(system, false);
   const Eigen::Index n = s.b.size(), m = s.g0.size();
-  const Eigen::SparseMatrix<double, Eigen::RowMajor> Brows = s.B;
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(n), z = Eigen::VectorXd::Zero(m);
+  const std::vector<char> mask = linalg::tangential_mask(m, s.friction);
+  const Eigen::VectorXd c = s.c.cwiseQuotient(s.D);  // prediction z - c g: g / D is the nodal gap
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(n), lambda = Eigen::VectorXd::Zero(m);
   // A floating body is held only by its contacts: start with every contact node active (the saddle-point system
-  // of an empty active set would be singular), and let the active set shrink to the nodes that press.
+  // of an empty active set would be singular), and let the active set shrink to the nodes that press. Nodes in
+  // contact start sticking.
   bool floating = false;
   for (size_t a = 0; a < system.n_bodies(); ++a) floating = floating || system.body(a).floating();
-  std::vector<char> active(static_cast<size_t>(m), floating ? 1 : 0);
+  linalg::FrictionSets sets;
+  sets.active.assign(static_cast<size_t>(m), 0);
+  for (Eigen::Index r = 0; r < m; ++r) sets.active[static_cast<size_t>(r)] = floating && !mask[static_cast<size_t>(r)];
+  sets.state.assign(s.friction.size(), floating ? linalg::Contact::stick : linalg::Contact::open);
+  sets.sign.assign(s.friction.size(), 0);
   bool first = true;
   std::vector<std::vector<char>> report_active;
   std::vector<Eigen::VectorXd> zone(system.n_bodies());
@@ -124,52 +209,16 @@ MethodOutcome run_exact(const ContactSystem& system, const SolverSettings& setti
       out.message = "cancelled";
       break;
     }
-    // The saddle-point system of the active set: [K  -B_A^T; B_A  0] [x; z_A] = [b; -g0_A].
-    std::vector<Eigen::Index> A;
-    for (Eigen::Index r = 0; r < m; ++r)
-      if (active[static_cast<size_t>(r)]) A.push_back(r);
-    const Eigen::Index na = static_cast<Eigen::Index>(A.size());
-    std::vector<Eigen::Triplet<double>> t;
-    t.reserve(static_cast<size_t>(s.K.nonZeros()) + 8 * static_cast<size_t>(na));
-    for (int col = 0; col < s.K.outerSize(); ++col)
-      for (SpMat::InnerIterator it(s.K, col); it; ++it) t.emplace_back(it.row(), it.col(), it.value());
-    Eigen::VectorXd rhs(n + na);
-    rhs.head(n) = s.b;
-    for (Eigen::Index i = 0; i < na; ++i) {
-      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Brows, static_cast<int>(A[i])); it; ++it) {
-        t.emplace_back(n + i, it.col(), it.value());
-        t.emplace_back(it.col(), n + i, -it.value());
-      }
-      rhs[n + i] = -s.g0[A[i]];
-    }
-    SpMat kkt(n + na, n + na);
-    kkt.setFromTriplets(t.begin(), t.end());
-    kkt.makeCompressed();
-    Eigen::SparseLU<SpMat> lu;
-    lu.compute(kkt);
-    if (lu.info() != Eigen::Success) {
+    const linalg::FrictionParametrization p = linalg::parametrize(sets, s.friction, mask);
+    std::string error;
+    if (!solve_sets(s, p, x, lambda, error)) {
       out.reason = StopReason::error;
       out.message = std::string("monolithic: the saddle-point system of the active set is singular (") +
-                    (floating ? "a floating body is not held by the contact nodes in contact: " : "") +
-                    lu.lastErrorMessage() + ")";
+                    (floating ? "a floating body is not held by the contact nodes in contact: " : "") + error + ")";
       return out;
     }
-    // Two steps of iterative refinement: the saddle-point matrix mixes stiffnesses and lengths, and the unsymmetric
-    // LU loses a few digits on it.
-    Eigen::VectorXd solution = lu.solve(rhs);
-    for (int refine = 0; refine < 2; ++refine) solution += lu.solve(Eigen::VectorXd(rhs - kkt * solution));
-    x = solution.head(n);
-    z.setZero();
-    for (Eigen::Index i = 0; i < na; ++i) z[A[i]] = solution[n + i];
-    const Eigen::VectorXd g = s.g0 + s.B * x;
-    std::vector<char> next(static_cast<size_t>(m), 0);
-    double c_norm = 0;
-    for (Eigen::Index r = 0; r < m; ++r) {
-      const double predicted = z[r] - s.c[r] * g[r] / s.D[r];
-      next[static_cast<size_t>(r)] = predicted > 0;
-      const double C = z[r] - std::max(0.0, predicted);
-      c_norm += C * C;
-    }
+    const Eigen::VectorXd h = s.g0 + s.B * x;
+    linalg::FrictionSets next = linalg::predict_friction_sets(lambda, h, c, s.friction, mask);
     const Displacements u = to_bodies(system, s, x);
     double paper = 0.0;
     for (size_t a = 0; a < system.n_bodies(); ++a) {
@@ -177,12 +226,13 @@ MethodOutcome run_exact(const ContactSystem& system, const SolverSettings& setti
       if (!first) paper = std::max(paper, relative_change(zn, zone[a]));
       zone[a] = zn;
     }
-    IterationReport r = system.report(k, u, split_rows(system, s, z), report_active);
+    const Pressures z = split_rows(system, s, lambda);
+    IterationReport r = system.report(k, u, z, report_active);
+    if (!s.friction.empty()) system.report_friction(z, split_tangential(system, s, lambda), r);
     r.paper_criterion = paper;
     r.measure = Measure::complementarity;
-    r.complementarity = std::sqrt(c_norm) / std::max(z.norm(), 1e-300);
-    r.active_set_changes = 0;
-    for (Eigen::Index i = 0; i < m; ++i) r.active_set_changes += next[static_cast<size_t>(i)] != active[static_cast<size_t>(i)];
+    r.complementarity = linalg::friction_complementarity(lambda, h, c, s.friction, mask);
+    r.active_set_changes = next.changes(sets);
     r.elapsed_seconds = context.elapsed();
     context.observer.on_iteration(r);
     const bool settled = !first && (r.active_set_changes == 0 || r.complementarity <= 1e-12);
@@ -192,25 +242,33 @@ MethodOutcome run_exact(const ContactSystem& system, const SolverSettings& setti
     if (settled) {
       out.converged = true;
       out.reason = StopReason::converged;
+      int na = 0;
+      for (Eigen::Index j = 0; j < m; ++j) na += sets.active[static_cast<size_t>(j)] && !mask[static_cast<size_t>(j)];
       std::ostringstream os;
-      os << "monolithic active set settled (" << na << " of " << m << " contact nodes in contact)";
+      os << "monolithic active set settled (" << na << " of " << s.row_offset.back() << " contact nodes in contact)";
       out.message = os.str();
       break;
     }
-    active = std::move(next);
+    sets = std::move(next);
     if (k == max_steps) {
       out.reason = StopReason::max_iterations;
       out.message = "monolithic: the active set did not settle within max_iterations";
     }
   }
   out.u = to_bodies(system, s, x);
-  out.z = split_rows(system, s, z);
+  out.z = split_rows(system, s, lambda);
+  if (!s.friction.empty()) out.q = split_tangential(system, s, lambda);
   return out;
 }
 
 MethodOutcome run_penalty(const ContactSystem& system, const SolverSettings& settings, RunContext& context) {
   MethodOutcome out;
   const Stacked s = stack(system, true);
+  if (!s.friction.empty()) {  // (the job reader refuses it first)
+    out.reason = StopReason::error;
+    out.message = "monolithic: friction needs exact contact (enforcement exact)";
+    return out;
+  }
   const Eigen::Index n = s.b.size();
   Eigen::VectorXd w_over_theta(s.D.size());  // 1 / (theta D_r): the penalty stiffness of row r
   for (Eigen::Index r = 0; r < s.D.size(); ++r)

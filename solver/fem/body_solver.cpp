@@ -32,6 +32,7 @@ BodySolver::BodySolver(const Body& body, const Model& model, bool factorize_now,
   setup_constraints();
   if (!ok() || !local) return;
   assemble_system();
+  setup_history_groups();
   assembly_seconds_ = seconds_since(t0);
   if (factorize_now) factorize();
 }
@@ -103,6 +104,82 @@ void BodySolver::setup_constraints() {
   if (!err.empty()) error_ = "body '" + body_.name + "': " + err;
 }
 
+void BodySolver::add_condition_load(const BoundaryCondition& bc, Eigen::VectorXd& f) const {
+  const auto& m = body_.mesh;
+  if (bc.kind == BoundaryCondition::Kind::force && !bc.vertex.empty()) {
+    for (int node : condition_nodes(m, bc)) f.segment<2>(2 * node) += bc.force;
+    return;
+  }
+  if (bc.kind != BoundaryCondition::Kind::traction && bc.kind != BoundaryCondition::Kind::force) return;
+  auto it = m.edge_sets.find(bc.edge);
+  if (it == m.edge_sets.end()) return;
+  double edge_length = 0;
+  for (const auto& e : it->second) {
+    const auto nn = m.edge_nodes(e);
+    edge_length += (m.nodes[static_cast<size_t>(nn[1])] - m.nodes[static_cast<size_t>(nn[0])]).norm();
+  }
+  for (const auto& e : it->second) {
+    const auto nn = m.edge_nodes(e);
+    const Eigen::Vector2d a = m.nodes[static_cast<size_t>(nn[0])], b = m.nodes[static_cast<size_t>(nn[1])];
+    const double length = (b - a).norm();
+    Eigen::Vector2d t = bc.traction;
+    if (bc.kind == BoundaryCondition::Kind::force) {
+      t = bc.force / (edge_length * elasticity_.thickness);
+    } else if (bc.normal_pressure) {
+      const Eigen::Vector2d outward((b - a).y() / length, -(b - a).x() / length);
+      t = -bc.pressure * outward;
+    }
+    for (int node : nn) f.segment<2>(2 * node) += 0.5 * length * elasticity_.thickness * t;
+  }
+}
+
+// Each condition with a history gets its own share of the loads: its traction or force, its prescribed values
+// (the dofs it prescribes, at the value the constraints hold), and T^T (f - K g) of those, element by element over
+// the cells its prescribed values touch.
+void BodySolver::setup_history_groups() {
+  const auto& m = body_.mesh;
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> T = constraints_.T();
+  for (const auto& bc : body_.boundary) {
+    if (bc.history.empty()) continue;
+    LoadGroup group;
+    group.condition = &bc;
+    group.f_ext = Eigen::VectorXd::Zero(n_dofs());
+    add_condition_load(bc, group.f_ext);
+    group.g = Eigen::VectorXd::Zero(n_dofs());
+    for (int node : condition_nodes(m, bc)) {
+      if (bc.ux) group.g[2 * node] = constraints_.g()[2 * node];
+      if (bc.uy) group.g[2 * node + 1] = constraints_.g()[2 * node + 1];
+    }
+    group.rhs = T.transpose() * group.f_ext;
+    if (group.g.cwiseAbs().maxCoeff() > 0)
+      for (int c = 0; c < m.num_cells(); ++c) {
+        const CellVector gc = cell_values(m, c, group.g);
+        if (gc.cwiseAbs().maxCoeff() == 0) continue;
+        const CellVector load = -(cell_stiffness(m, c, elasticity_) * gc);
+        const CellDofs dofs = cell_dofs(m.cells[static_cast<size_t>(c)]);
+        for (Eigen::Index i = 0; i < dofs.size(); ++i)
+          for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator ii(T, dofs[i]); ii; ++ii)
+            group.rhs[ii.col()] += ii.value() * load[i];
+      }
+    groups_.push_back(std::move(group));
+  }
+}
+
+void BodySolver::set_load_step(size_t step, double factor) {
+  load_factor_ = factor;
+  for (auto& group : groups_) {
+    const auto& h = group.condition->history;
+    group.factor = h.empty() ? factor : h[std::min(step, h.size() - 1)];
+  }
+}
+
+Eigen::VectorXd BodySolver::scaled(const Eigen::VectorXd& base, Eigen::VectorXd LoadGroup::*part) const {
+  Eigen::VectorXd out = load_factor_ * base;
+  for (const auto& group : groups_)
+    if (group.factor != load_factor_) out += (group.factor - load_factor_) * (group.*part);
+  return out;
+}
+
 void BodySolver::assemble_system() {
   // The reduced system T^T K T x = T^T (f - K g) is assembled directly, element by element: each element's
   // stiffness goes through the rows of T of its dofs (a free dof: itself; a prescribed one: nothing, its value
@@ -119,33 +196,7 @@ void BodySolver::assemble_system() {
   // Edge tractions: constant over each straight side, so the consistent load is half the side's force at
   // each end node (exact). A normal pressure p acts as t = -p n with n the outward normal. A total force on an
   // edge is the uniform traction force / (length x thickness); at a vertex it is a point load.
-  for (const auto& bc : body_.boundary) {
-    if (bc.kind == BoundaryCondition::Kind::force && !bc.vertex.empty()) {
-      for (int node : condition_nodes(m, bc)) f_ext_.segment<2>(2 * node) += bc.force;
-      continue;
-    }
-    if (bc.kind != BoundaryCondition::Kind::traction && bc.kind != BoundaryCondition::Kind::force) continue;
-    auto it = m.edge_sets.find(bc.edge);
-    if (it == m.edge_sets.end()) continue;
-    double edge_length = 0;
-    for (const auto& e : it->second) {
-      const auto nn = m.edge_nodes(e);
-      edge_length += (m.nodes[static_cast<size_t>(nn[1])] - m.nodes[static_cast<size_t>(nn[0])]).norm();
-    }
-    for (const auto& e : it->second) {
-      const auto nn = m.edge_nodes(e);
-      const Eigen::Vector2d a = m.nodes[static_cast<size_t>(nn[0])], b = m.nodes[static_cast<size_t>(nn[1])];
-      const double length = (b - a).norm();
-      Eigen::Vector2d t = bc.traction;
-      if (bc.kind == BoundaryCondition::Kind::force) {
-        t = bc.force / (edge_length * elasticity_.thickness);
-      } else if (bc.normal_pressure) {
-        const Eigen::Vector2d outward((b - a).y() / length, -(b - a).x() / length);
-        t = -bc.pressure * outward;
-      }
-      for (int node : nn) f_ext_.segment<2>(2 * node) += 0.5 * length * elasticity_.thickness * t;
-    }
-  }
+  for (const auto& bc : body_.boundary) add_condition_load(bc, f_ext_);
 
   // Pattern: the free unknowns each element couples, column by column.
   std::vector<std::vector<int>> columns(static_cast<size_t>(nf));
@@ -263,15 +314,13 @@ Eigen::MatrixXd BodySolver::solve_reduced(const Eigen::MatrixXd& reduced_rhs) co
   return factor_->solve(reduced_rhs);
 }
 
-Eigen::VectorXd BodySolver::reduced_rhs() const { return load_factor_ * rhs_base_; }
+Eigen::VectorXd BodySolver::reduced_rhs() const { return scaled(rhs_base_, &LoadGroup::rhs); }
 
-Eigen::VectorXd BodySolver::external_load() const { return load_factor_ * f_ext_; }
+Eigen::VectorXd BodySolver::external_load() const { return scaled(f_ext_, &LoadGroup::f_ext); }
 
-Eigen::VectorXd BodySolver::prescribed() const { return load_factor_ * constraints_.g(); }
+Eigen::VectorXd BodySolver::prescribed() const { return scaled(constraints_.g(), &LoadGroup::g); }
 
-Eigen::VectorXd BodySolver::expand(const Eigen::VectorXd& x) const {
-  return constraints_.T() * x + load_factor_ * constraints_.g();
-}
+Eigen::VectorXd BodySolver::expand(const Eigen::VectorXd& x) const { return constraints_.T() * x + prescribed(); }
 
 Eigen::VectorXd BodySolver::solve_homogeneous(const Eigen::VectorXd& load) const {
   if (n_free() == 0) return Eigen::VectorXd::Zero(n_dofs());
@@ -284,7 +333,7 @@ Eigen::VectorXd BodySolver::solve(const Eigen::VectorXd& extra_load) const {
   if (!factor_)
     throw std::logic_error(local_ ? "BodySolver::solve called on a solver built without factorisation"
                                   : "body '" + body_.name + "' is solved by another process");
-  Eigen::VectorXd rhs = load_factor_ * rhs_base_;
+  Eigen::VectorXd rhs = reduced_rhs();
   if (extra_load.size() > 0) rhs.noalias() += constraints_.T().transpose() * extra_load;
   return expand(factor_->solve(rhs));
 }
@@ -301,7 +350,7 @@ Eigen::VectorXd BodySolver::reactions(const Eigen::VectorXd& u, const Eigen::Vec
     const CellVector fe = cell_stiffness(m, c, elasticity_) * cell_values(m, c, u);
     for (Eigen::Index i = 0; i < dofs.size(); ++i) r[dofs[i]] += fe[i];
   }
-  r -= load_factor_ * f_ext_;
+  r -= external_load();
   if (extra_load.size() > 0) r -= extra_load;
   for (int d = 0; d < r.size(); ++d)
     if (!constraints_.is_dirichlet(d)) r[d] = 0.0;

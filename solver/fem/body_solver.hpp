@@ -75,8 +75,11 @@ class BodySolver {
   Eigen::SparseMatrix<double> stiffness() const;
   const Eigen::SparseMatrix<double>& reduced_stiffness() const { return K_red_; }
   // The body's own loads and prescribed values are scaled by the load factor (load steps; 1 by default): the
-  // factorisation does not change, only these.
-  void set_load_factor(double factor) { load_factor_ = factor; }
+  // factorisation does not change, only these. set_load_step also gives every condition with its own history
+  // (BoundaryCondition::history) its factor of step `step`, the others the loading's `factor`.
+  void set_load_factor(double factor) { set_load_step(0, factor); }
+  void set_load_step(size_t step, double factor);
+  bool has_histories() const { return !groups_.empty(); }
   double load_factor() const { return load_factor_; }
   Eigen::VectorXd external_load() const;   // all dofs: tractions, forces, body force
   Eigen::VectorXd reduced_rhs() const;     // T^T (f_ext - K g)
@@ -103,9 +106,21 @@ class BodySolver {
   double assembly_seconds() const { return assembly_seconds_; }
 
  private:
+  // One per condition with a history: its share of the loads (f_ext), of the prescribed values (g) and of the
+  // reduced right-hand side (T^T (f - K g)), at factor 1, and its current factor.
+  struct LoadGroup {
+    const BoundaryCondition* condition = nullptr;
+    Eigen::VectorXd f_ext, g, rhs;
+    double factor = 1.0;
+  };
   void setup_constraints();
   void assemble_system();
   void factorize();
+  void add_condition_load(const BoundaryCondition& bc, Eigen::VectorXd& f) const;
+  void setup_history_groups();
+  // The loading's factor times the base (every condition at factor 1) plus, per condition with a history, its
+  // own factor's difference times its part.
+  Eigen::VectorXd scaled(const Eigen::VectorXd& base, Eigen::VectorXd LoadGroup::*part) const;
   std::vector<int> interface_unknowns_of(const std::vector<int>& dofs) const;
 
   const Body& body_;
@@ -116,6 +131,7 @@ class BodySolver {
   std::vector<int> interface_dofs_;
   bool allow_floating_ = false, factorize_ = true, local_ = true;
   double load_factor_ = 1.0;
+  std::vector<LoadGroup> groups_;
   Eigen::MatrixXd rigid_modes_;
   std::vector<std::string> rigid_mode_names_;
   std::vector<int> fixing_dofs_;

@@ -19,9 +19,14 @@ nlohmann::json iteration_json(const IterationReport& report, bool with_profiles)
                            {"changed_nodes", p.changed_nodes},
                            {"theta", p.theta},
                            {"max_penetration", p.max_penetration}};
+    if (!p.stick.empty()) pair["tangential_force"] = p.tangential_force;  // friction pairs only
     if (with_profiles) {
       pair["positions"] = p.positions;
       pair["pressures"] = p.pressures;
+      if (!p.stick.empty()) {
+        pair["tangential_tractions"] = p.tangential_tractions;
+        pair["stick"] = p.stick;
+      }
     }
     pairs.push_back(std::move(pair));
   }

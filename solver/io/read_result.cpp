@@ -130,6 +130,8 @@ void read_history(hid_t file, ResultFile& r) {
     s.force = read_matrix<double>(g, "force", np);
     s.contact_begin = read_matrix<double>(g, "contact_begin", np);
     s.contact_end = read_matrix<double>(g, "contact_end", np);
+    if (h5::has_link(g, "tangential_force"))  // (older files: absent)
+      s.tangential_force = read_matrix<double>(g, "tangential_force", np);
   }
 }
 
@@ -200,6 +202,16 @@ PairField read_pair(hid_t contacts, const std::string& name) {
   p.penetration = read_column<double>(g, "penetration");
   p.active = read_column<int>(g, "active");
   p.status = read_column<int>(g, "status");
+  if (h5::has_attribute(g, "friction")) p.friction = h5::read_string_attribute(g, "friction");  // (older files: none)
+  if (p.friction != "none") {
+    p.friction_coefficient = h5::read_attribute<double>(g, "friction_coefficient");
+    p.friction_bound = h5::read_attribute<double>(g, "friction_bound");
+    p.tangential_force = h5::read_attribute<double>(g, "tangential_force");
+    p.tangent = read_matrix<double>(g, "tangent", 2);
+    p.tangential_traction = read_column<double>(g, "tangential_traction");
+    p.slip = read_column<double>(g, "slip");
+    p.stick = read_column<int>(g, "stick");
+  }
   return p;
 }
 

@@ -216,7 +216,7 @@ void write_step_history(hid_t history, const Result& result) {
   std::vector<std::int32_t> step, iteration;
   std::vector<double> load_factor;
   Eigen::MatrixXi elements(n, nb), dofs(n, nb);
-  Eigen::MatrixXd force(n, np), contact_begin(n, np), contact_end(n, np);
+  Eigen::MatrixXd force(n, np), contact_begin(n, np), contact_end(n, np), tangential_force(n, np);
   for (Eigen::Index k = 0; k < n; ++k) {
     const Step& s = result.steps[static_cast<size_t>(k)];
     if (body_names_of(s) != names)
@@ -234,6 +234,7 @@ void write_step_history(hid_t history, const Result& result) {
     for (Eigen::Index p = 0; p < np; ++p) {
       const PairField& pair = s.pairs[static_cast<size_t>(p)];
       force(k, p) = pair.force;
+      tangential_force(k, p) = pair.tangential_force;  // 0 for a frictionless pair
       // The contact zone along the slave edge, interpolated between nodes (contact/extent.hpp; 0, 0 if none).
       const mortar::ContactExtent extent = mortar::contact_extent(pair.arc_length, pair.pressure);
       contact_begin(k, p) = extent.begin;
@@ -250,6 +251,7 @@ void write_step_history(hid_t history, const Result& result) {
   write_matrix(g, "force", force);
   write_matrix(g, "contact_begin", contact_begin);
   write_matrix(g, "contact_end", contact_end);
+  write_matrix(g, "tangential_force", tangential_force);
 }
 
 // ---- steps --------------------------------------------------------------------------------------------
@@ -338,6 +340,13 @@ void write_pair(hid_t contacts, const PairField& p, const std::string& where) {
   same("penetration", p.penetration.rows());
   same("active", p.active.rows());
   same("status", p.status.rows());
+  const bool friction = p.friction != "none";
+  if (friction) {
+    same("tangent", p.tangent.rows());
+    same("tangential_traction", p.tangential_traction.rows());
+    same("slip", p.slip.rows());
+    same("stick", p.stick.rows());
+  }
 
   Handle g = h5::create_group(contacts, p.name);
   h5::write_attribute(g, "slave_body", p.slave_body);
@@ -359,6 +368,16 @@ void write_pair(hid_t contacts, const PairField& p, const std::string& where) {
   write_column(g, "penetration", p.penetration);
   write_column(g, "active", p.active.cast<std::int8_t>().eval());
   write_column(g, "status", p.status.cast<std::int8_t>().eval());
+  h5::write_attribute(g, "friction", p.friction);
+  if (friction) {
+    h5::write_attribute<double>(g, "friction_coefficient", p.friction_coefficient);
+    h5::write_attribute<double>(g, "friction_bound", p.friction_bound);
+    h5::write_attribute<double>(g, "tangential_force", p.tangential_force);
+    write_matrix(g, "tangent", p.tangent);
+    write_column(g, "tangential_traction", p.tangential_traction);
+    write_column(g, "slip", p.slip);
+    write_column(g, "stick", p.stick.cast<std::int8_t>().eval());
+  }
   // The slave polyline as line cells (rows of position), for the XDMF view of the contact surface.
   Eigen::Matrix<std::int64_t, Eigen::Dynamic, 2> segments(std::max<Eigen::Index>(n - 1, 0), 2);
   for (Eigen::Index j = 0; j + 1 < n; ++j) segments.row(j) << j, j + 1;

@@ -40,6 +40,7 @@ ParseResult JobReader::run() {
   read_loading(top);
   read_parallel(top);
   resolve_method_defaults();
+  check_friction_and_histories();
   check_floating_bodies();
   check_work_limits();
   return finish();

@@ -74,6 +74,7 @@ struct BodyInput {
   Body body;
   MeshInput mesh;
   std::vector<std::string> free_motions;  // rigid motions its displacement conditions leave free (a floating body)
+  std::vector<std::string> condition_pointers;  // per entry of body.boundary: its pointer (/bodies/i/boundary/j)
 };
 
 // Questions on what was read of a mesh (read_meshes.cpp).
@@ -141,6 +142,11 @@ class JobReader {
   void read_contacts(const Fields& top);
   void read_gap(const Fields& contact, GapSpec& gap, json& out);
 
+  // read_friction.cpp: a pair's friction, a condition's load history, and what they require of the rest
+  void read_friction(const Fields& contact, FrictionSpec& friction);
+  void read_history(const Fields& condition, BoundaryCondition& bc);
+  void check_friction_and_histories();
+
   const json& job_;
   const Limits& limits_;
   json normalized_;
@@ -148,7 +154,8 @@ class JobReader {
   Errors errors_;
   Problem problem_;
   bool method_given_ = false, enforcement_given_ = false;
-  std::string method_pointer_, enforcement_pointer_ = "/solver";
+  std::string method_pointer_, enforcement_pointer_ = "/solver", interface_solver_pointer_;
+  std::vector<std::string> friction_pointers_;  // per contact pair of problem_.contacts (empty: frictionless)
   std::vector<BodyInput> inputs_;
   GmshMeshes gmsh_;
 };

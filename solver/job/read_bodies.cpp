@@ -119,7 +119,7 @@ void JobReader::read_boundary(const json& value, const std::string& pointer, Bod
   std::map<std::string, std::string> first_pointer_of_place;
   for (size_t j = 0; j < value.size(); ++j) {
     const std::string bp = child(pointer, j);
-    Fields f(value[j], bp, "a boundary condition", {"edge", "vertex", "displacement", "traction", "force", "free"},
+    Fields f(value[j], bp, "a boundary condition", {"edge", "vertex", "displacement", "traction", "force", "free", "history"},
              errors_);
     if (!f.ok()) continue;
     const size_t before = errors_.size();
@@ -205,7 +205,11 @@ void JobReader::read_boundary(const json& value, const std::string& pointer, Bod
       if ((c == 0 ? bc.ux : bc.uy) && load[c] != 0.0)
         errors_.add(bp, std::string("the load's ") + (c == 0 ? "x" : "y") + " component acts where the " +
                             (c == 0 ? "x" : "y") + " displacement is prescribed: it would go straight into the support");
-    if (errors_.size() == before) in.body.boundary.push_back(bc);
+    read_history(f, bc);
+    if (errors_.size() == before) {
+      in.body.boundary.push_back(bc);
+      in.condition_pointers.push_back(bp);
+    }
   }
 }
 
@@ -256,7 +260,8 @@ void JobReader::check_loads_reach_the_body(const BodyInput& in) {
 namespace {
 
 // The directions in which body i is held whatever the loads, at best: its prescribed components, and the normal of
-// every node of its contact edges (a frictionless contact pushes only along it).
+// every node of its contact edges (a frictionless contact pushes only along it); a contact with friction may also
+// hold along the tangent, so at best in every direction.
 std::vector<fem::HeldDirection> best_held_directions(const Body& body, const std::vector<ContactPair>& contacts, size_t i) {
   std::vector<fem::HeldDirection> held;
   for (const auto& bc : body.boundary) {
@@ -291,6 +296,7 @@ std::vector<fem::HeldDirection> best_held_directions(const Body& body, const std
           if (std::abs(nu.x() * inner.y() - nu.y() * inner.x()) > 1e-9) continue;  // curved at the end
         }
         held.push_back({nodes[j], nu});
+        if (c.friction.active()) held.push_back({nodes[j], Eigen::Vector2d(-nu.y(), nu.x())});
       }
     }
   }

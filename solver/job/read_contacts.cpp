@@ -57,7 +57,7 @@ void JobReader::read_contacts(const Fields& top) {
   for (size_t k = 0; k < list->size(); ++k) {
     const std::string cp = child("/contacts", k);
     json& out = element(out_list, k);
-    Fields f((*list)[k], cp, "a contact", {"name", "slave", "master", "gap"}, errors_);
+    Fields f((*list)[k], cp, "a contact", {"name", "slave", "master", "gap", "friction"}, errors_);
     if (!f.ok()) continue;
     const size_t before = errors_.size();
     ContactPair pair;
@@ -101,7 +101,11 @@ void JobReader::read_contacts(const Fields& top) {
       set_default(out, "name", pair.name);
     }
     read_gap(f, pair.gap, sub_object(out, "gap"));
-    if (errors_.size() == before) problem_.contacts.push_back(pair);
+    read_friction(f, pair.friction);
+    if (errors_.size() == before) {
+      problem_.contacts.push_back(pair);
+      friction_pointers_.push_back(pair.friction.active() ? f.at("friction") : std::string());
+    }
   }
 }
 

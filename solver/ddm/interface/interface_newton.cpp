@@ -1,5 +1,7 @@
 #include "interface_newton.hpp"
 
+#include "friction_direct.hpp"
+
 
 #include <sstream>
 
@@ -48,8 +50,8 @@ InterfaceQp InterfaceNewton::make_qp(const SolverSettings& settings) const {
         if (pair.multiplier.size() == pair.n_rows()) qp.g[i] -= pair.theta * pair.area[r] * pair.multiplier[r];
       }
     }
-  qp.line.resize(static_cast<size_t>(m));
-  qp.position.resize(m);
+  qp.line.assign(static_cast<size_t>(m), -1);  // tangential rows lie on no line
+  qp.position = Eigen::VectorXd::Zero(m);
   for (size_t k = 0; k < pairs.size(); ++k)
     for (Eigen::Index r = 0; r < pairs[k].n_rows(); ++r) {
       qp.line[static_cast<size_t>(problem_.offset(k) + r)] = static_cast<int>(k);
@@ -60,6 +62,13 @@ InterfaceQp InterfaceNewton::make_qp(const SolverSettings& settings) const {
 
 MethodOutcome InterfaceNewton::solve(const SolverSettings& settings, RunContext& context) {
   MethodOutcome out;
+  if (system_.has_histories()) problem_.refresh_loads(context.runner);  // loads not proportional to the last ones
+  if (system_.has_friction())
+    if (std::string overload = friction_overload(system_); !overload.empty()) {
+      out.reason = StopReason::error;
+      out.message = overload;
+      return out;
+    }
   const InterfaceProblem& ip = problem_;
   const Eigen::Index m = ip.size();
   const InterfaceQp qp = make_qp(settings);
@@ -72,6 +81,7 @@ MethodOutcome InterfaceNewton::solve(const SolverSettings& settings, RunContext&
     // The reported gaps are the physical ones: h without the penalty's theta area z and the multipliers' shift.
     const Eigen::VectorXd gap = h - penalty_diagonal.cwiseProduct(z) - shift;
     IterationReport r = system_.report_gaps(step.step, ip.split(z), ip.split(gap.cwiseQuotient(ip.weights())), previous_active);
+    if (system_.has_friction()) system_.report_friction(ip.split(z), ip.split_tangential(z), r);
     r.measure = Measure::complementarity;
     r.complementarity = step.complementarity;
     r.active_set_changes = step.changes;
@@ -107,6 +117,7 @@ MethodOutcome InterfaceNewton::solve(const SolverSettings& settings, RunContext&
     out.message = "interface Newton: " + result.message;
   }
   out.z = ip.split(result.z);
+  if (system_.has_friction()) out.q = ip.split_tangential(result.z);
   out.u = ip.displacements(result.z, result.alpha, context.runner);
   out.rigid_amplitudes = rigid_amplitudes(result.alpha);
   out.solves_per_body = 1;

@@ -21,8 +21,8 @@ class InterfaceNewton {
   InterfaceNewton(const ContactSystem& system, const SolverSettings& settings, TaskRunner& runner)
       : system_(system),
         kind_(choose_interface_solver(settings.interface, system, runner)),
-        problem_(system, runner, interface_options(kind_, settings.interface)),
-        solver_(make_interface_solver(kind_, settings.interface)) {}
+        problem_(system, runner, interface_options(kind_, settings.interface, system.has_friction())),
+        solver_(make_interface_solver(kind_, settings.interface, system.has_friction())) {}
   // Solves with the settings' enforcement on the pairs' current multipliers; reports every active-set step.
   MethodOutcome solve(const SolverSettings& settings, RunContext& context);
   const InterfaceProblem& problem() const { return problem_; }

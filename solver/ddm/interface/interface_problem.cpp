@@ -12,21 +12,26 @@ struct BodyRows {
   std::vector<std::vector<std::pair<int, double>>> entries;
 };
 
-BodyRows body_rows(const ContactSystem& system, size_t a, const std::vector<Eigen::Index>& offset) {
+BodyRows body_rows(const ContactSystem& system, size_t a, const std::vector<Eigen::Index>& offset,
+                   const std::vector<Eigen::Index>& tangential_offset) {
   BodyRows out;
   const auto& pairs = system.pairs();
   for (size_t k = 0; k < pairs.size(); ++k) {
     const auto& pair = pairs[k];
-    auto add = [&](const mortar::SparseRows& G, double sign) {
+    auto add = [&](const mortar::SparseRows& G, double sign, Eigen::Index first) {
       for (int r = 0; r < G.outerSize(); ++r) {
         std::vector<std::pair<int, double>> e;
         for (mortar::SparseRows::InnerIterator it(G, r); it; ++it) e.emplace_back(static_cast<int>(it.col()), sign * it.value());
-        out.rows.push_back(offset[k] + r);
+        out.rows.push_back(first + r);
         out.entries.push_back(std::move(e));
       }
     };
-    if (static_cast<size_t>(pair.slave_body) == a) add(pair.Gs, -1.0);
-    if (static_cast<size_t>(pair.master_body) == a) add(pair.Gm, 1.0);
+    const bool slave = static_cast<size_t>(pair.slave_body) == a, master = static_cast<size_t>(pair.master_body) == a;
+    if (slave) add(pair.Gs, -1.0, offset[k]);
+    if (master) add(pair.Gm, 1.0, offset[k]);
+    if (tangential_offset[k] < 0) continue;
+    if (slave) add(pair.Ts, -1.0, tangential_offset[k]);
+    if (master) add(pair.Tm, 1.0, tangential_offset[k]);
   }
   return out;
 }
@@ -104,20 +109,28 @@ InterfaceProblem::InterfaceProblem(const ContactSystem& system, TaskRunner& runn
   const auto& pairs = system.pairs();
   offset_.assign(pairs.size() + 1, 0);
   for (size_t k = 0; k < pairs.size(); ++k) offset_[k + 1] = offset_[k] + pairs[k].n_rows();
-  const Eigen::Index m = offset_.back();
+  size_ = offset_.back();
+  tangential_offset_.assign(pairs.size(), -1);
+  for (size_t k = 0; k < pairs.size(); ++k)
+    if (options.friction && pairs[k].has_friction()) {
+      tangential_offset_[k] = size_;
+      size_ += pairs[k].n_rows();
+    }
+  const Eigen::Index m = size_;
   D_.resize(m);
-  gap0_.resize(m);
+  gap0_ = Eigen::VectorXd::Zero(m);  // tangential rows: the slip origin is subtracted in free_gap()
   factor_ = system.load_factor();
   for (size_t k = 0; k < pairs.size(); ++k) {
     D_.segment(offset_[k], pairs[k].n_rows()) = pairs[k].area;
     gap0_.segment(offset_[k], pairs[k].n_rows()) = pairs[k].gap0;
+    if (tangential_offset_[k] >= 0) D_.segment(tangential_offset_[k], pairs[k].n_rows()) = pairs[k].area;
   }
   // The preconditioner's scaling (feti.hpp): with B_a ~ D on both sides of a contact node, F ~ D (S_s^-1 +
   // S_m^-1) D, whose inverse for S_s ~ S_m is (D^-2 / 2) (B_s S_s B_s^T + B_m S_m B_m^T) (D^-2 / 2).
   inverse_weight_ = (2.0 * D_.cwiseAbs2()).cwiseInverse();
   const size_t n_bodies = system.n_bodies();
   std::vector<BodyParts> parts(n_bodies);
-  for (size_t a = 0; a < n_bodies; ++a) parts[a].rows = body_rows(system, a, offset_);
+  for (size_t a = 0; a < n_bodies; ++a) parts[a].rows = body_rows(system, a, offset_, tangential_offset_);
   // Each body's part on its owner; the blocks move to every process only when they are replicated.
   const bool replicate = options_.replicate_blocks;
   const BodyShare share{[&](size_t a, Packer& out) {
@@ -223,7 +236,40 @@ bool InterfaceProblem::apply_preconditioner(const Eigen::VectorXd& x, Eigen::Vec
 }
 
 Eigen::VectorXd InterfaceProblem::free_gap() const {
-  return gap0_ + (system_.load_factor() / factor_) * g_loads_;
+  Eigen::VectorXd g = gap0_ + (system_.load_factor() / factor_) * g_loads_;
+  const auto& pairs = system_.pairs();
+  for (size_t k = 0; k < pairs.size(); ++k)
+    if (tangential_offset_[k] >= 0 && pairs[k].jump_origin.size() == pairs[k].n_rows())
+      g.segment(tangential_offset_[k], pairs[k].n_rows()) -= pairs[k].jump_origin;
+  return g;
+}
+
+void InterfaceProblem::refresh_loads(TaskRunner& runner) {
+  const size_t n_bodies = system_.n_bodies();
+  std::vector<Eigen::VectorXd> g(n_bodies), e(n_bodies);
+  const BodyShare share{[&](size_t a, Packer& out) {
+                          out.put(g[a]);
+                          out.put(e[a]);
+                        },
+                        [&](size_t a, Unpacker& in) {
+                          g[a] = in.get_vector();
+                          e[a] = in.get_vector();
+                        }};
+  std::vector<BodyRows> rows(n_bodies);
+  for (size_t a = 0; a < n_bodies; ++a) rows[a] = body_rows(system_, a, offset_, tangential_offset_);
+  runner.run_bodies(n_bodies, [&](size_t a) {
+    const auto& body = system_.body(a);
+    const Eigen::VectorXd u_free = body.solve(Eigen::VectorXd());
+    g[a] = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(rows[a].rows.size()));
+    for (size_t i = 0; i < rows[a].rows.size(); ++i)
+      for (const auto& [dof, value] : rows[a].entries[i]) g[a][static_cast<Eigen::Index>(i)] += value * u_free[dof];
+    if (body.floating()) e[a] = -body.rigid_modes().transpose() * body.external_load();
+  }, share);
+  g_loads_.setZero();
+  for (size_t a = 0; a < n_bodies; ++a)
+    for (size_t i = 0; i < rows[a].rows.size(); ++i) g_loads_[rows[a].rows[i]] += g[a][static_cast<Eigen::Index>(i)];
+  for (const auto& f : floating_) equilibrium_.e.segment(f.offset, f.count) = e[f.body];
+  factor_ = system_.load_factor();
 }
 
 Equalities InterfaceProblem::equilibrium() const {
@@ -236,15 +282,23 @@ Pressures InterfaceProblem::split(const Eigen::VectorXd& stacked) const {
   return out;
 }
 
+Pressures InterfaceProblem::split_tangential(const Eigen::VectorXd& stacked) const {
+  Pressures out(offset_.size() - 1);
+  for (size_t k = 0; k + 1 < offset_.size(); ++k)
+    if (tangential_offset_[k] >= 0) out[k] = stacked.segment(tangential_offset_[k], offset_[k + 1] - offset_[k]);
+  return out;
+}
+
 Eigen::VectorXd InterfaceProblem::stack(const Pressures& per_pair) const {
-  Eigen::VectorXd out(offset_.back());
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(size_);
   for (size_t k = 0; k + 1 < offset_.size(); ++k) out.segment(offset_[k], offset_[k + 1] - offset_[k]) = per_pair[k];
   return out;
 }
 
 Displacements InterfaceProblem::displacements(const Eigen::VectorXd& z, const Eigen::VectorXd& alpha,
                                               TaskRunner& runner) const {
-  Displacements u = system_.solve_bodies(system_.loads_from_pressures(split(z)), runner);
+  const Pressures q = split_tangential(z);
+  Displacements u = system_.solve_bodies(system_.loads_from_pressures(split(z), &q), runner);
   if (alpha.size() == equilibrium_.G.rows())
     for (const auto& f : floating_) u[f.body] += system_.body(f.body).rigid_modes() * alpha.segment(f.offset, f.count);
   return u;

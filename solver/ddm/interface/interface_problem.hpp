@@ -41,6 +41,9 @@ class InterfaceProblem {
     // Every process holds every body's block (a direct solver assembles them all); false: each process keeps
     // only its own bodies' blocks (the iterative solver applies them where they live).
     bool replicate_blocks = true;
+    // Friction pairs add a tangential row per contact node (after all the normal rows): the weighted slip of this
+    // load step, conjugate to the tangential multiplier (contact/pair.hpp).
+    bool friction = false;
   };
 
   // Needs a system built with Factorization::interface. Free responses and Schur complements, bodies in
@@ -48,9 +51,16 @@ class InterfaceProblem {
   InterfaceProblem(const ContactSystem& system, TaskRunner& runner) : InterfaceProblem(system, runner, Options{}) {}
   InterfaceProblem(const ContactSystem& system, TaskRunner& runner, const Options& options);
 
-  Eigen::Index size() const { return static_cast<Eigen::Index>(offset_.back()); }
-  // Weighted gaps with no contact force, at the system's current load factor (the bodies' part scales with it).
+  Eigen::Index size() const { return size_; }
+  Eigen::Index normal_size() const { return static_cast<Eigen::Index>(offset_.back()); }
+  // The first tangential row of pair k (-1: frictionless, or friction not asked for).
+  Eigen::Index tangential_offset(size_t pair) const { return tangential_offset_[pair]; }
+  // Weighted gaps (and slips) with no contact force, at the system's current load factor (the bodies' part scales
+  // with it) and friction pairs' current slip origins.
   Eigen::VectorXd free_gap() const;
+  // Recomputes the bodies' free responses for the current loads: needed when a step's loads are not a multiple of
+  // the previous ones (conditions with their own history). One solve per body.
+  void refresh_loads(TaskRunner& runner);
   const Eigen::VectorXd& weights() const { return D_; }       // area of every row, stacked
   Eigen::Index offset(size_t pair) const { return offset_[pair]; }
   const ContactSystem& system() const { return system_; }
@@ -74,8 +84,10 @@ class InterfaceProblem {
   // The diagonal of F (every process holds all of it).
   const Eigen::VectorXd& diagonal() const { return diagonal_; }
 
-  // Splits a stacked vector into one vector per pair, and the reverse.
+  // Splits a stacked vector into one vector per pair (its normal rows), and the reverse; split_tangential gives
+  // the tangential rows (empty for frictionless pairs).
   Pressures split(const Eigen::VectorXd& stacked) const;
+  Pressures split_tangential(const Eigen::VectorXd& stacked) const;
   Eigen::VectorXd stack(const Pressures& per_pair) const;
 
   // Floating bodies: each one's rigid-mode amplitudes alpha_a are rows [offset, offset + count) of alpha.
@@ -99,7 +111,8 @@ class InterfaceProblem {
 
   const ContactSystem& system_;
   Options options_;
-  std::vector<Eigen::Index> offset_;
+  std::vector<Eigen::Index> offset_, tangential_offset_;
+  Eigen::Index size_ = 0;
   std::vector<Block> blocks_;
   Eigen::VectorXd gap0_, g_loads_, D_, diagonal_, inverse_weight_;  // g_loads_: at load factor factor_
   double factor_ = 1.0;

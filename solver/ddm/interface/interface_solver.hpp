@@ -8,6 +8,8 @@
 //   direct    (sparse_direct.hpp): the primal-dual active set on F assembled as a sparse matrix, CHOLMOD at every
 //             step; first active set from nested coarse solves. Exact in finitely many steps; one process holds
 //             every block.
+//   friction  (friction_direct.hpp): the direct solver's setting with friction pairs: semismooth Newton on the
+//             stick and slip sets of the normal and tangential multipliers (the only solver that takes friction).
 //   iterative (feti.hpp): FETI-style projected MPRGP inside SMALBE, applying F block by block where the blocks
 //             live (MPI ranks: each its own bodies), with the coarse space of the floating bodies.
 // make_interface_solver picks one from the settings and the size of the problem; a new solver is a new class here.
@@ -53,8 +55,12 @@ class InterfaceSolver {
 // large, the direct one otherwise (by size alone: the same on any number of processes).
 InterfaceSolverKind choose_interface_solver(const InterfaceSolverSettings& settings, const ContactSystem& system,
                                             const TaskRunner& runner);
-// How the interface problem must be built for that solver (blocks replicated or not, preconditioner).
-InterfaceProblem::Options interface_options(InterfaceSolverKind kind, const InterfaceSolverSettings& settings);
-std::unique_ptr<InterfaceSolver> make_interface_solver(InterfaceSolverKind kind, const InterfaceSolverSettings& settings);
+// How the interface problem must be built for that solver (blocks replicated or not, preconditioner, tangential
+// rows for friction).
+InterfaceProblem::Options interface_options(InterfaceSolverKind kind, const InterfaceSolverSettings& settings,
+                                            bool friction = false);
+// With friction: the direct solver with stick and slip sets (friction_direct.hpp); automatic picks it.
+std::unique_ptr<InterfaceSolver> make_interface_solver(InterfaceSolverKind kind, const InterfaceSolverSettings& settings,
+                                                       bool friction = false);
 
 }  // namespace contact::ddm

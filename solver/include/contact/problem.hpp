@@ -47,6 +47,9 @@ struct BoundaryCondition {
   // force: the total force on the edge, spread as a uniform traction, or a point load at the vertex (per unit
   // thickness in plane strain, the total in plane stress, like every force)
   Eigen::Vector2d force = Eigen::Vector2d::Zero();
+  // This condition's own load factor for each load step (its value is scaled by history[k] in step k instead of
+  // the loading's factor): a normal load held while a tangential one grows. Empty: it follows the loading.
+  std::vector<double> history;
 };
 
 inline bool prescribes_displacement(const BoundaryCondition& bc) { return bc.ux.has_value() || bc.uy.has_value(); }
@@ -77,6 +80,16 @@ struct GapSpec {
   double parabola_x0 = 0.0;
 };
 
+// Friction of a contact pair (docs/algorithm.md, "Friction"): none (frictionless), Coulomb (|t| <= mu p at every
+// contact node) or Tresca (|t| <= bound, a given traction: force per unit length and thickness, like p).
+struct FrictionSpec {
+  enum class Law { none, coulomb, tresca };
+  Law law = Law::none;
+  double coefficient = 0.0;  // Coulomb's mu
+  double bound = 0.0;        // Tresca's g
+  bool active() const { return law != Law::none; }
+};
+
 struct ContactPair {
   std::string name;      // "slave_body.edge-master_body.edge" unless the job names it
   int slave_body = -1;   // index into Problem::bodies
@@ -84,6 +97,7 @@ struct ContactPair {
   int master_body = -1;
   std::string master_edge;
   GapSpec gap;
+  FrictionSpec friction;
 };
 
 // theta = c * length / E_pair unless theta is given. E_pair is the harmonic mean 2 E1 E2 / (E1 + E2) of the
@@ -200,6 +214,12 @@ struct Problem {
   int ranks = 1;              // parallel.ranks: MPI ranks a server launches (contact-solve takes mpirun's)
   nlohmann::json submitted;   // the job JSON as submitted
   nlohmann::json normalized;  // the same with every default filled in
+
+  bool has_friction() const {
+    for (const auto& c : contacts)
+      if (c.friction.active()) return true;
+    return false;
+  }
 };
 
 }  // namespace contact

@@ -37,6 +37,11 @@ struct PairReport {
   double max_penetration = 0.0;   // largest overlap max(0, -g) of the nodal gaps
   std::vector<double> positions;  // arc length along the slave edge of each slave node
   std::vector<double> pressures;  // contact pressure at each slave node
+  // Friction pairs only (empty otherwise): the tangential traction on the slave along its tangent at each slave
+  // node, 1 where the node sticks, and the tangential force (sum of weight x tangential traction).
+  std::vector<double> tangential_tractions;
+  std::vector<int> stick;
+  double tangential_force = 0.0;
 };
 
 // Which number decides convergence in a report: the fixed-point residual (Neumann, Robin, the paper's adaptive
@@ -109,9 +114,21 @@ struct PairField {
   double force = 0.0;            // sum of weight x pressure: the total normal force (a scalar sum of normal
                                  // pressures: on a curved slave more than the load it carries)
   // The resultant contact force vector on the slave body (the master exerts it; the master receives its
-  // opposite): the sum over the slave's nodes of its discrete contact forces -Gs^T z. Equal and opposite to the
-  // slave's other loads and reactions in equilibrium.
+  // opposite): the sum over the slave's nodes of its discrete contact forces -Gs^T z (with friction also the
+  // tangential ones, -Ts^T q). Equal and opposite to the slave's other loads and reactions in equilibrium.
   Eigen::Vector2d resultant = Eigen::Vector2d::Zero();
+  // Friction ("none", "coulomb" or "tresca"; the fields below are empty for "none"). The tangent is the normal
+  // turned a quarter anticlockwise; the tangential traction is the master's traction on the slave along it; the
+  // slip is the slave's tangential displacement relative to the master's (mortar-projected), accumulated over the
+  // load steps; stick is 1 where a node in contact does not slip in this step (|t| below the bound), 0 where it
+  // slips or is open.
+  std::string friction = "none";
+  double friction_coefficient = 0.0, friction_bound = 0.0;
+  Eigen::MatrixX2d tangent;
+  Eigen::VectorXd tangential_traction;
+  Eigen::VectorXd slip;
+  Eigen::VectorXi stick;
+  double tangential_force = 0.0;  // sum of weight x tangential traction
 };
 
 // One mesh state of the adaptive loop, or one load step; without either there is a single step.

@@ -75,6 +75,7 @@ struct StepHistory {
   std::vector<double> load_factor;
   Eigen::MatrixXi elements, dofs;
   Eigen::MatrixXd force, contact_begin, contact_end;  // S x P
+  Eigen::MatrixXd tangential_force;                   // S x P (0 for frictionless pairs; empty in older files)
 };
 
 // How a string attribute is stored (VTKHDF's Type must be fixed-length with size == its text length).

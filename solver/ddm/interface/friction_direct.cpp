@@ -1,0 +1,301 @@
+#include "friction_direct.hpp"
+
+#include <Eigen/UmfPackSupport>
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace contact::ddm {
+
+namespace {
+
+using linalg::Contact;
+using linalg::FrictionRow;
+using linalg::FrictionSets;
+using Rows = std::vector<Eigen::Index>;
+
+// Rows `rows` of a column-major sparse matrix A (in that order).
+SparseMatrix select_rows(const SparseMatrix& A, const Rows& rows) {
+  std::vector<Eigen::Index> position(static_cast<size_t>(A.rows()), -1);
+  for (size_t i = 0; i < rows.size(); ++i) position[static_cast<size_t>(rows[i])] = static_cast<Eigen::Index>(i);
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int col = 0; col < A.outerSize(); ++col)
+    for (SparseMatrix::InnerIterator it(A, col); it; ++it)
+      if (const Eigen::Index i = position[static_cast<size_t>(it.row())]; i >= 0) entries.emplace_back(i, col, it.value());
+  SparseMatrix out(static_cast<Eigen::Index>(rows.size()), A.cols());
+  out.setFromTriplets(entries.begin(), entries.end());
+  return out;
+}
+
+// The Newton step on the sets: lambda, alpha and whether the system could be solved.
+struct SetSolve {
+  Eigen::VectorXd lambda, alpha;
+  bool ok = false;
+};
+
+SetSolve solve_on_sets(const SparseMatrix& F, const InterfaceQp& qp, const linalg::FrictionParametrization& p) {
+  const Eigen::Index na = static_cast<Eigen::Index>(p.rows.size()), r = qp.equilibrium.G.rows();
+  const SparseMatrix RFP = select_rows(SparseMatrix(F * p.P), p.rows);
+  const SparseMatrix RGt = select_rows(SparseMatrix(qp.equilibrium.G.transpose()), p.rows);
+  const SparseMatrix GP = r > 0 ? SparseMatrix(qp.equilibrium.G * p.P) : SparseMatrix(0, na);
+  std::vector<Eigen::Triplet<double>> entries;
+  auto put = [&](const SparseMatrix& A, Eigen::Index row0, Eigen::Index col0) {
+    for (int col = 0; col < A.outerSize(); ++col)
+      for (SparseMatrix::InnerIterator it(A, col); it; ++it) entries.emplace_back(row0 + it.row(), col0 + col, it.value());
+  };
+  put(RFP, 0, 0);
+  put(RGt, 0, na);
+  put(GP, na, 0);
+  SparseMatrix M(na + r, na + r);
+  M.setFromTriplets(entries.begin(), entries.end());
+  M.makeCompressed();
+  Eigen::VectorXd rhs(na + r);
+  const Eigen::VectorXd h0 = qp.g + F * p.lambda0;
+  for (Eigen::Index i = 0; i < na; ++i) rhs[i] = -h0[p.rows[static_cast<size_t>(i)]];
+  if (r > 0) rhs.tail(r) = qp.equilibrium.e - qp.equilibrium.G * p.lambda0;
+  SetSolve out;
+  if (na + r == 0) {
+    out.lambda = p.lambda0;
+    out.alpha = Eigen::VectorXd::Zero(r);
+    out.ok = true;
+    return out;
+  }
+  Eigen::UmfPackLU<SparseMatrix> lu(M);
+  if (lu.info() != Eigen::Success) return out;
+  Eigen::VectorXd y = lu.solve(rhs);
+  y += lu.solve(Eigen::VectorXd(rhs - M * y));  // one step of refinement: the system mixes F's scales and G's
+  if (!y.allFinite()) return out;
+  out.lambda = p.P * y.head(na) + p.lambda0;
+  out.alpha = y.tail(r);
+  out.ok = true;
+  return out;
+}
+
+// The floating bodies' equilibrium as far as normal pressures alone can give it: the columns of the normal rows,
+// without the rows they cannot meet (a motion that only friction holds: sliding along a flat contact, a roller's
+// spin).
+linalg::Equalities normal_equalities(const linalg::Equalities& all, Eigen::Index m) {
+  if (all.empty()) return all;
+  const SparseMatrix Gn = all.G.leftCols(m);
+  std::vector<Eigen::Index> keep;
+  const Eigen::VectorXd normal_part = (Gn.cwiseAbs2() * Eigen::VectorXd::Ones(m)).cwiseSqrt();
+  const Eigen::VectorXd whole = (all.G.cwiseAbs2() * Eigen::VectorXd::Ones(all.G.cols())).cwiseSqrt();
+  for (Eigen::Index i = 0; i < Gn.rows(); ++i)
+    if (normal_part[i] > 1e-8 * whole[i]) keep.push_back(i);
+  linalg::Equalities out;
+  out.G = select_rows(Gn, keep);
+  out.e.resize(static_cast<Eigen::Index>(keep.size()));
+  for (size_t i = 0; i < keep.size(); ++i) out.e[static_cast<Eigen::Index>(i)] = all.e[keep[i]];
+  return out;
+}
+
+// The first sets: from a warm start, or from the frictionless normal problem (with the equilibrium normal
+// pressures can meet), or where that fails every normal row active (floating bodies) or those that overlap;
+// every node in contact sticking.
+FrictionSets first_sets(const SparseMatrix& F, const InterfaceQp& qp, const Eigen::VectorXd* z0,
+                        const Eigen::VectorXd& alpha0, const Eigen::VectorXd& c, const std::vector<FrictionRow>& rows,
+                        const std::vector<char>& mask, std::string& note) {
+  const Eigen::Index n = qp.g.size(), m = qp.problem.normal_size();
+  if (z0 && z0->size() == n && z0->cwiseAbs().maxCoeff() > 0) {
+    // The normal sets predicted from the previous answer (with its rigid amplitudes); every node in contact
+    // sticking: the tied problem under the new loads is well posed (friction holds the floating bodies), and the
+    // slip zones grow from it. Predicting slip from the previous step's tractions can start far off.
+    Eigen::VectorXd h = qp.g + F * *z0;
+    if (alpha0.size() == qp.equilibrium.G.rows() && alpha0.size() > 0) h += qp.equilibrium.G.transpose() * alpha0;
+    FrictionSets s = linalg::predict_friction_sets(*z0, h, c, rows, mask);
+    for (size_t t = 0; t < rows.size(); ++t)
+      s.state[t] = s.active[static_cast<size_t>(rows[t].normal)] || !rows[t].coulomb ? Contact::stick : Contact::open;
+    return s;
+  }
+  Eigen::VectorXd lambda = Eigen::VectorXd::Zero(n);
+  const SparseMatrix Fnn = F.topLeftCorner(m, m);
+  const Eigen::VectorXd gn = qp.g.head(m);
+  const linalg::Equalities held = normal_equalities(qp.equilibrium, m);
+  const std::vector<int> line(qp.line.begin(), qp.line.begin() + m);
+  const Eigen::VectorXd guess = linalg::nested_initial_guess(Fnn, gn, line, qp.position.head(m), held);
+  const linalg::StepCallback quiet = [](const Eigen::VectorXd&, const Eigen::VectorXd&, const linalg::ActiveSetStep&) { return true; };
+  const linalg::ActiveSetResult normal = linalg::solve_active_set(Fnn, gn, 100, quiet, &guess, held);
+  if (normal.converged) {
+    lambda.head(m) = normal.z;
+    note = "first sets from the frictionless solution (" + std::to_string(normal.steps) + " active-set steps)";
+  }
+  // Its pressing nodes are the first normal set (its own gaps, with its rigid amplitudes, confirm them).
+  FrictionSets s;
+  const bool solved = lambda.cwiseAbs().maxCoeff() > 0;
+  s.active.assign(static_cast<size_t>(n), 0);
+  for (Eigen::Index j = 0; j < m; ++j)
+    s.active[static_cast<size_t>(j)] = solved ? lambda[j] > 0 : !qp.equilibrium.empty() || qp.g[j] < 0;
+  s.state.assign(rows.size(), Contact::open);
+  s.sign.assign(rows.size(), 0);
+  for (size_t t = 0; t < rows.size(); ++t)
+    if (s.active[static_cast<size_t>(rows[t].normal)] || !rows[t].coulomb) s.state[t] = Contact::stick;
+  return s;
+}
+
+// Why the sets' system is singular, for the message: some floating body's load along a free translation exceeds
+// what its friction contacts carried at the last iterate (lambda), or, if none does, that nothing holds it.
+std::string friction_shortfall(const InterfaceQp& qp, const Eigen::VectorXd& lambda) {
+  const ContactSystem& system = qp.problem.system();
+  const auto& pairs = system.pairs();
+  for (const auto& f : qp.problem.floating()) {
+    const auto& body = system.body(f.body);
+    const auto& names = body.rigid_mode_names();
+    const Eigen::VectorXd load = body.external_load();
+    for (size_t mode = 0; mode < names.size(); ++mode) {
+      if (names[mode].rfind("translation in ", 0) != 0) continue;
+      const int c = names[mode].back() == 'x' ? 0 : 1;
+      double required = 0, capacity = 0;
+      for (Eigen::Index d = c; d < load.size(); d += 2) required += load[d];
+      std::string names_of_pairs;
+      for (size_t k = 0; k < pairs.size(); ++k) {
+        const auto& pair = pairs[k];
+        if (static_cast<size_t>(pair.slave_body) != f.body && static_cast<size_t>(pair.master_body) != f.body) continue;
+        if (!pair.has_friction()) continue;
+        names_of_pairs += (names_of_pairs.empty() ? "'" : ", '") + pair.name + "'";
+        for (Eigen::Index r = 0; r < pair.n_rows(); ++r) {
+          const double z = lambda.size() > qp.problem.offset(k) + r ? std::max(0.0, lambda[qp.problem.offset(k) + r]) : 0.0;
+          const double bound = pair.friction.law == FrictionSpec::Law::coulomb ? pair.friction.coefficient * z : pair.friction.bound;
+          capacity += bound * pair.area[r] * std::abs(pair.tangent[static_cast<size_t>(r)][c]);
+        }
+      }
+      if (names_of_pairs.empty() || !(std::abs(required) > capacity)) continue;
+      std::ostringstream os;
+      os.precision(4);
+      os << "friction cannot hold body '" << system.problem().bodies[f.body].name << "' against its load along "
+         << (c == 0 ? "x" : "y") << ": its contact" << (names_of_pairs.find(',') != std::string::npos ? "s " : " ")
+         << names_of_pairs << (names_of_pairs.find(',') != std::string::npos ? " carry" : " carries") << " at most " << capacity << " by friction at the last iterate, the load is "
+         << std::abs(required) << " (" << std::abs(required) / std::max(capacity, 1e-300)
+         << " times); under force control it would slide without end: lower the load, raise the friction, or "
+            "prescribe the body's displacement";
+      return os.str();
+    }
+  }
+  return "the system of the stick and slip sets is singular: a floating body is held neither by normal contact nor "
+         "by friction";
+}
+
+}  // namespace
+
+std::vector<FrictionRow> friction_rows(const InterfaceProblem& problem) {
+  std::vector<FrictionRow> rows;
+  const auto& pairs = problem.system().pairs();
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    const Eigen::Index t0 = problem.tangential_offset(k);
+    if (t0 < 0) continue;
+    const auto& f = pairs[k].friction;
+    for (Eigen::Index r = 0; r < pairs[k].n_rows(); ++r)
+      rows.push_back({problem.offset(k) + r, t0 + r, f.law == FrictionSpec::Law::coulomb, f.coefficient, f.bound});
+  }
+  return rows;
+}
+
+linalg::ActiveSetResult FrictionDirectSolver::solve(const InterfaceQp& qp, const Eigen::VectorXd* z0,
+                                                    InterfaceSolveContext& context) {
+  linalg::ActiveSetResult result;
+  const Eigen::Index n = qp.problem.size();
+  if (assembled_for_ != &qp.problem) {
+    F_ = qp.problem.assemble();
+    assembled_for_ = &qp.problem;
+  }
+  // A node whose tangential motion both sides prescribe (on a symmetry line) cannot slip: its row of F is zero and
+  // its tangential traction goes into the supports; it is left out (q = 0 there).
+  std::vector<FrictionRow> rows;
+  const double tmax = F_.diagonal().cwiseAbs().maxCoeff();
+  for (const auto& r : friction_rows(qp.problem))
+    if (F_.coeff(r.tangential, r.tangential) > 1e-12 * tmax) rows.push_back(r);
+  const std::vector<char> mask = linalg::tangential_mask(n, rows);
+  // c_j: the inverse of the unknown's own compliance (the pressure or traction that would close its gap or slip
+  // alone); a row no body can move gets the largest scale.
+  Eigen::VectorXd c(n);
+  const double dmax = F_.diagonal().cwiseAbs().maxCoeff();
+  for (Eigen::Index j = 0; j < n; ++j) c[j] = 1.0 / std::max(F_.coeff(j, j), 1e-12 * dmax + 1e-300);
+  if (last_alpha_.size() != qp.equilibrium.G.rows()) last_alpha_.resize(0);
+  FrictionSets sets = first_sets(F_, qp, z0, last_alpha_, c, rows, mask, context.note);
+  result.z = Eigen::VectorXd::Zero(n);
+  bool restarted = false;
+  for (int step = 1; step <= context.max_steps; ++step) {
+    const linalg::FrictionParametrization p = linalg::parametrize(sets, rows, mask);
+    const SetSolve s = solve_on_sets(F_, qp, p);
+    if (!s.ok && !restarted && step > 1) {
+      // A floating body held by nothing on these sets, which may be a bad guess: once, every node in contact sticks.
+      restarted = true;
+      for (size_t t = 0; t < rows.size(); ++t)
+        if (sets.active[static_cast<size_t>(rows[t].normal)] || !rows[t].coulomb) sets.state[t] = Contact::stick;
+      continue;
+    }
+    if (!s.ok) {
+      result.message = friction_shortfall(qp, result.z);
+      result.steps = step;
+      return result;
+    }
+    result.z = s.lambda;
+    result.alpha = s.alpha;
+    last_alpha_ = s.alpha;
+    result.h = qp.g + F_ * s.lambda;
+    if (s.alpha.size() > 0) result.h += qp.equilibrium.G.transpose() * s.alpha;
+    const FrictionSets next = linalg::predict_friction_sets(result.z, result.h, c, rows, mask);
+    linalg::ActiveSetStep info;
+    info.step = step;
+    info.changes = next.changes(sets);
+    for (char a : next.active) info.active += a;
+    info.complementarity = linalg::friction_complementarity(result.z, result.h, c, rows, mask);
+    result.steps = step;
+    if (!context.on_step(result.z, result.h, info)) {
+      result.cancelled = true;
+      return result;
+    }
+    if (next == sets || info.complementarity <= 1e-13) {
+      int stick = 0, slip = 0;
+      for (auto st : sets.state) {
+        stick += st == Contact::stick;
+        slip += st == Contact::slip;
+      }
+      std::ostringstream os;
+      os << "stick and slip sets settled in " << step << " steps (" << info.active << " nodes in contact: " << stick
+         << " sticking, " << slip << " slipping)";
+      result.converged = true;
+      result.message = os.str();
+      return result;
+    }
+    sets = next;
+  }
+  result.message = "the stick and slip sets did not settle within " + std::to_string(context.max_steps) + " steps";
+  return result;
+}
+
+std::string friction_overload(const ContactSystem& system) {
+  const Problem& problem = system.problem();
+  const auto& pairs = system.pairs();
+  for (size_t a = 0; a < system.n_bodies(); ++a) {
+    if (system.body(a).rigid_modes().cols() < 3) continue;  // held in some direction by its own supports
+    std::vector<size_t> touching;
+    for (size_t k = 0; k < pairs.size(); ++k)
+      if (static_cast<size_t>(pairs[k].slave_body) == a || static_cast<size_t>(pairs[k].master_body) == a) touching.push_back(k);
+    if (touching.size() != 1 || !pairs[touching[0]].has_friction()) continue;
+    const auto& pair = pairs[touching[0]];
+    Eigen::Vector2d n = Eigen::Vector2d::Zero();
+    for (Eigen::Index r = 0; r < pair.n_rows(); ++r) n += pair.area[r] * pair.normal[static_cast<size_t>(r)];
+    if (!(n.norm() > 0)) continue;
+    n.normalize();
+    const Eigen::VectorXd f = system.body(a).external_load();
+    Eigen::Vector2d load = Eigen::Vector2d::Zero();
+    for (Eigen::Index d = 0; d < f.size(); ++d) load[d % 2] += f[d];
+    const double normal = std::abs(load.dot(n)), tangential = std::abs(load.x() * n.y() - load.y() * n.x());
+    const bool coulomb = pair.friction.law == FrictionSpec::Law::coulomb;
+    const double capacity = coulomb ? pair.friction.coefficient * normal : pair.friction.bound * pair.area.sum();
+    if (!(tangential > capacity * (1 + 1e-6))) continue;
+    std::ostringstream os;
+    os.precision(4);
+    os << "contact '" << pair.name << "': friction cannot hold body '" << problem.bodies[a].name
+       << "': its loads push it along the contact with " << tangential << ", "
+       << (capacity > 0 ? tangential / capacity : std::numeric_limits<double>::infinity()) << " times what friction can carry ("
+       << (coulomb ? "mu x normal load = " : "bound x contact length = ") << capacity
+       << "); under force control it would slide without end: lower the tangential load, raise the friction, or "
+          "prescribe the body's displacement";
+    return os.str();
+  }
+  return {};
+}
+
+}  // namespace contact::ddm

@@ -1,0 +1,96 @@
+// Friction of a contact pair ("friction": {"coefficient": mu} or {"bound": g}), a boundary condition's own load
+// history ("history": [f_1, ..., f_n]), and what they require of the rest of the job: the number of load steps,
+// a method and enforcement that solve friction (docs/job-format.md, "Friction").
+#include "job_reader.hpp"
+
+namespace contact::job::detail {
+
+void JobReader::read_friction(const Fields& contact, FrictionSpec& friction) {
+  const json* v = contact.find("friction");
+  if (!v) return;
+  Fields f(*v, contact.at("friction"), "friction", {"coefficient", "bound"}, errors_);
+  if (!f.ok()) return;
+  if (f.has("coefficient") == f.has("bound")) {
+    errors_.add(contact.at("friction"), "give exactly one of coefficient (Coulomb's mu: |t| <= mu p) and bound "
+                                        "(Tresca's g: |t| <= g, a traction like the pressure)");
+    return;
+  }
+  const std::string key = f.has("coefficient") ? "coefficient" : "bound";
+  const auto x = read::number(*f.find(key), f.at(key), key, errors_);
+  if (!x) return;
+  if (*x < 0) {
+    errors_.add(f.at(key), key + " = " + format_number(*x) + " is negative: " +
+                               (key == "coefficient" ? "a friction coefficient is >= 0 (0: frictionless)"
+                                                     : "a friction bound is a traction magnitude, >= 0"));
+    return;
+  }
+  friction.law = key == "coefficient" ? FrictionSpec::Law::coulomb : FrictionSpec::Law::tresca;
+  (key == "coefficient" ? friction.coefficient : friction.bound) = *x;
+}
+
+void JobReader::read_history(const Fields& condition, BoundaryCondition& bc) {
+  const json* v = condition.find("history");
+  if (!v) return;
+  const std::string pointer = condition.at("history");
+  if (!v->is_array() || v->empty()) {
+    errors_.add(pointer, "history must be a non-empty array of load factors, one per load step, got " +
+                             read::type_name(*v));
+    return;
+  }
+  if (static_cast<long>(v->size()) > limits_.max_load_steps) {
+    errors_.add(pointer, "history has " + std::to_string(v->size()) + " entries: at most " +
+                             std::to_string(limits_.max_load_steps) + " load steps");
+    return;
+  }
+  for (size_t k = 0; k < v->size(); ++k)
+    if (auto x = read::number((*v)[k], child(pointer, k), "load factor", errors_)) bc.history.push_back(*x);
+}
+
+// After the bodies, contacts, solver and loading are read: a history has one factor per load step; friction
+// needs the exact interface problem (interface_newton with its direct solver, or the monolithic reference).
+void JobReader::check_friction_and_histories() {
+  const size_t steps = problem_.loading.factors.size();
+  for (const auto& in : inputs_)
+    for (size_t j = 0; j < in.body.boundary.size() && j < in.condition_pointers.size(); ++j) {
+      const auto& h = in.body.boundary[j].history;
+      if (!h.empty() && problem_.adaptivity.enabled)
+        errors_.add(child(in.condition_pointers[j], "history"),
+                    "a load history needs load steps, which adaptivity does not take (it refines for one load)");
+      else if (!h.empty() && h.size() != steps)
+        errors_.add(child(in.condition_pointers[j], "history"),
+                    "history has " + std::to_string(h.size()) + " load factors but the job has " +
+                        std::to_string(steps) + " load step" + (steps == 1 ? "" : "s") +
+                        " (loading): give one factor per step");
+    }
+  const SolverSettings& s = problem_.solver;
+  for (size_t k = 0; k < problem_.contacts.size() && k < friction_pointers_.size(); ++k) {
+    if (!problem_.contacts[k].friction.active()) continue;
+    const std::string& at = friction_pointers_[k];
+    if (s.method == Method::neumann || s.method == Method::robin) {
+      errors_.add(at, std::string("friction is solved on the interface problem (semismooth Newton on stick and slip): "
+                                  "method \"") + (s.method == Method::neumann ? "neumann" : "robin") +
+                          "\" cannot take it; use method \"interface_newton\" (the default) or \"monolithic\"" +
+                          (method_pointer_.empty() ? "" : " at " + method_pointer_));
+      return;
+    }
+    if (s.enforcement != Enforcement::exact) {
+      errors_.add(at, "friction needs exact contact (enforcement \"exact\", the default of interface_newton), not \"" +
+                          std::string(s.enforcement == Enforcement::penalty ? "penalty" : "augmented_lagrangian") +
+                          "\" at " + enforcement_pointer_);
+      return;
+    }
+    if (problem_.adaptivity.enabled) {
+      errors_.add(at, "friction with adaptivity is not supported: the error indicators take the normal contact "
+                      "tractions only; solve the frictional job on a fixed (e.g. previously refined) mesh");
+      return;
+    }
+    if (s.interface.solver == InterfaceSolverKind::iterative) {
+      errors_.add(at, "friction is solved by the direct interface solver; the iterative one (at " +
+                          interface_solver_pointer_ + ") takes frictionless contact only: choose \"direct\" or "
+                          "\"auto\" (which picks direct for friction)");
+      return;
+    }
+  }
+}
+
+}  // namespace contact::job::detail

@@ -1,0 +1,348 @@
+// Coulomb and Tresca friction (docs/algorithm.md, "Friction"). Every expected number comes from mechanics or an
+// independent computation: Cattaneo-Mindlin's partial slip, the Tresca bound times the contact length, equilibrium,
+// the frictionless solution at mu = 0, one merged body for a bond that cannot slip, and the monolithic reference
+// solving the same discrete problem in one system.
+#include "contact/job.hpp"
+#include "contact/solve.hpp"
+#include "support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+using namespace contact;
+using nlohmann::json;
+using contact::testing::body;
+using contact::testing::parse_or_fail;
+using contact::testing::run;
+using contact::testing::solve_quietly;
+
+namespace {
+
+const PairField& pair_of(const Step& s, const std::string& name) {
+  for (const auto& p : s.pairs)
+    if (p.name == name) return p;
+  throw std::runtime_error("no pair " + name);
+}
+
+double relative(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  const double scale = std::max(a.norm(), b.norm());
+  return scale > 0 ? (a - b).norm() / scale : 0.0;
+}
+
+// A cylinder (radius R = 60, arc from x = -30 to 30) on a block of the same material, both 60 wide and 30 deep,
+// mirror images as nearly as a cylinder and a block can be, so that pressing them together makes no tangential
+// traction (a half-space pair of one material does not slip under normal load; bodies of different shapes
+// would). The cylinder's top is held at y = -0.05 (its rotation too); the tangential load is two point loads at
+// its top corners, scaled per step by their history. The block's slave nodes (spacing 0.046) are as coarse as
+// the cylinder's (0.041), so that every slave node carries a multiplier.
+json cattaneo_job(const std::vector<double>& tangential) {
+  const double y0 = 60 - std::sqrt(3600.0 - 900.0);
+  json job = json::parse(R"({
+    "name": "cattaneo",
+    "bodies": [
+      {"name": "block", "material": {"E": 2.1e5, "nu": 0.3},
+       "mesh": {"block": {"corners": [[-30, -30], [30, -30], [30, 0], [-30, 0]], "nx": 1300, "ny": 40,
+                          "grading": {"top": 60}}},
+       "boundary": [{"edge": "bottom", "displacement": {"y": 0}}, {"vertex": "bottom_left", "displacement": {"x": 0}}]},
+      {"name": "cylinder", "material": {"E": 2.1e5, "nu": 0.3},
+       "mesh": {"block": {"nx": 1500, "ny": 40, "edges": {"bottom": {"arc": {"center": [0, 60], "radius": 60}}},
+                          "grading": {"bottom": 60}}},
+       "boundary": [{"edge": "top", "displacement": {"y": -0.05}},
+                    {"vertex": "top_left", "force": [0.5, 0]}, {"vertex": "top_right", "force": [0.5, 0]}]}
+    ],
+    "contacts": [{"slave": "block.top", "master": "cylinder.bottom", "friction": {"coefficient": 0.3}}]
+  })");
+  job["bodies"][1]["mesh"]["block"]["corners"] = {{-30, y0}, {30, y0}, {30, 30}, {-30, 30}};
+  job["loading"] = {{"factors", std::vector<double>(tangential.size(), 1.0)}};
+  job["bodies"][1]["boundary"][1]["history"] = tangential;
+  job["bodies"][1]["boundary"][2]["history"] = tangential;
+  return job;
+}
+
+// Half the length of the stick zone: from the middle of the last sticking and the first slipping node on each side.
+double stick_half_width(const PairField& p) {
+  std::vector<std::pair<double, int>> nodes;
+  for (Eigen::Index j = 0; j < p.position.rows(); ++j) nodes.emplace_back(p.position(j, 0), p.stick[j]);
+  std::sort(nodes.begin(), nodes.end());
+  size_t lo = nodes.size(), hi = 0;
+  for (size_t j = 0; j < nodes.size(); ++j)
+    if (nodes[j].second) lo = std::min(lo, j), hi = std::max(hi, j);
+  if (lo > hi || lo == 0 || hi + 1 >= nodes.size()) return 0.0;
+  return 0.25 * (nodes[hi].first + nodes[hi + 1].first - nodes[lo].first - nodes[lo - 1].first);
+}
+
+}  // namespace
+
+TEST(Friction, CattaneoMindlinStickZoneAndTractionFollowTheTheory) {
+  const double mu = 0.3, R = 60, E = 2.1e5, nu = 0.3;
+  const double E_star = E / (2 * (1 - nu * nu));  // plane strain, both bodies alike
+  // The normal force the held top gives (no tangential load yet), to choose the tangential loads.
+  const Result first = run(cattaneo_job({0.0}));
+  ASSERT_TRUE(first.converged) << first.message;
+  const double P = pair_of(first.steps.back(), "block.top-cylinder.bottom").force;
+  ASSERT_GT(P, 0);
+  const std::vector<double> ratios = {0.25, 0.5, 0.75};
+  std::vector<double> Q = {0.0};
+  for (double r : ratios) Q.push_back(r * mu * P);
+  const Result result = run(cattaneo_job(Q));
+  ASSERT_TRUE(result.converged) << result.message;
+  ASSERT_EQ(result.steps.size(), 4u);
+  for (size_t k = 1; k < 4; ++k) {
+    const PairField& p = pair_of(result.steps[k], "block.top-cylinder.bottom");
+    // Equilibrium of the cylinder along x: the flat slave's tangential tractions carry Q (the traction on the
+    // block points along +x, its tangent along -x).
+    const double carried = -p.weight.dot(p.tangential_traction);
+    EXPECT_NEAR(carried, Q[k], 1e-8 * Q[k]) << "step " << k;
+    EXPECT_NEAR(p.tangential_force, -Q[k], 1e-8 * Q[k]);
+    // Cattaneo-Mindlin with this step's normal force (the held top lets it change by a per cent).
+    const double Pk = p.force, ratio = Q[k] / (mu * Pk);
+    const double a = std::sqrt(4 * Pk * R / (M_PI * E_star)), p0 = 2 * Pk / (M_PI * a);
+    const double c = a * std::sqrt(1 - ratio);
+    EXPECT_NEAR(stick_half_width(p) / a, c / a, 0.03) << "Q / (mu P) = " << ratio;
+    // Mindlin's traction: mu p(x) less the stick zone's mu p0 (c / a) sqrt(1 - x^2 / c^2).
+    double error = 0, norm = 0;
+    for (Eigen::Index j = 0; j < p.position.rows(); ++j) {
+      const double x = p.position(j, 0);
+      double q = mu * p0 * std::sqrt(std::max(0.0, 1 - x * x / (a * a)));
+      if (std::abs(x) < c) q -= mu * p0 * (c / a) * std::sqrt(1 - x * x / (c * c));
+      error += std::pow(-p.tangential_traction[j] - q, 2);
+      norm += q * q;
+    }
+    EXPECT_LT(std::sqrt(error / norm), 0.05) << "Q / (mu P) = " << ratio;
+    // Where a node slips its traction is on the bound.
+    for (Eigen::Index j = 0; j < p.position.rows(); ++j)
+      if (p.pressure[j] > 0) EXPECT_LE(std::abs(p.tangential_traction[j]), mu * p.pressure[j] * (1 + 1e-9));
+  }
+}
+
+namespace {
+
+// A block (1 x 0.5) on a foundation (2 x 0.5), non-matching meshes, Tresca friction g = 5 along the contact; the
+// block's top is moved sideways by up to 0.05 (a shear stress of about G 0.05 / 0.5 = 38 if it stuck) and pressed.
+json tresca_job() {
+  return json::parse(R"({
+    "name": "tresca",
+    "bodies": [
+      {"name": "ground", "material": {"E": 1000, "nu": 0.3},
+       "mesh": {"block": {"corners": [[-1, -0.5], [1, -0.5], [1, 0], [-1, 0]], "nx": 20, "ny": 5}},
+       "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]},
+      {"name": "block", "material": {"E": 1000, "nu": 0.3},
+       "mesh": {"block": {"corners": [[-0.5, 0], [0.5, 0], [0.5, 0.5], [-0.5, 0.5]], "nx": 7, "ny": 4}},
+       "boundary": [{"edge": "top", "displacement": {"x": 0.05, "y": -0.005}}]}
+    ],
+    "contacts": [{"name": "c", "slave": "block.bottom", "master": "ground.top", "friction": {"bound": 5}}],
+    "loading": {"factors": [0.02, 0.05, 0.5, 1]}
+  })");
+}
+
+}  // namespace
+
+TEST(Friction, TrescaBlockSticksBelowTheBoundAndSlidesAtBoundTimesLength) {
+  const Result r = run(tresca_job());
+  ASSERT_TRUE(r.converged) << r.message;
+  const double capacity = 5 * 1.0;  // g x contact length (x thickness 1)
+  bool some_stick_early = false;
+  for (size_t k = 0; k < r.steps.size(); ++k) {
+    const PairField& p = pair_of(r.steps[k], "c");
+    const double F = std::abs(p.tangential_force);
+    EXPECT_LE(F, capacity * (1 + 1e-10)) << "step " << k;
+    if (k < 2) some_stick_early = some_stick_early || p.stick.sum() > 0;
+    if (k >= 2) {  // pushed far enough: every node slides, the force is the bound times the length
+      EXPECT_EQ(p.stick.sum(), 0) << "step " << k;
+      EXPECT_NEAR(F, capacity, 1e-9 * capacity) << "step " << k;
+      EXPECT_GT(p.slip.maxCoeff(), 0.0);
+    }
+  }
+  EXPECT_TRUE(some_stick_early);
+  // Sliding accumulates: the last step's slip exceeds the third's.
+  EXPECT_GT(pair_of(r.steps[3], "c").slip.maxCoeff(), pair_of(r.steps[2], "c").slip.maxCoeff());
+}
+
+TEST(Friction, AForceFrictionCannotHoldStopsAtOnceNamingThePairAndTheRatio) {
+  // The block pressed by 100 and pushed sideways by 40 with mu = 0.3: 40 / (0.3 x 100) = 1.333.
+  json job = tresca_job();
+  job["contacts"][0]["friction"] = {{"coefficient", 0.3}};
+  job["bodies"][1]["boundary"] = json::parse(R"([{"edge": "top", "force": [40, -100]}])");
+  job.erase("loading");
+  const Result r = run(job);
+  EXPECT_EQ(r.stop_reason, StopReason::error);
+  EXPECT_TRUE(r.steps.empty());
+  EXPECT_NE(r.message.find("contact 'c'"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("1.333 times"), std::string::npos) << r.message;
+  EXPECT_LE(r.iterations, 1);
+  // Below the bound (20 < 30) it holds, and the contact carries exactly the push.
+  job["bodies"][1]["boundary"] = json::parse(R"([{"edge": "top", "force": [20, -100]}])");
+  const Result held = run(job);
+  ASSERT_TRUE(held.converged) << held.message;
+  const PairField& p = pair_of(held.steps.back(), "c");
+  EXPECT_NEAR(p.resultant.x(), -20, 1e-8 * 20);
+  EXPECT_NEAR(p.resultant.y(), 100, 1e-8 * 100);
+}
+
+TEST(Friction, ZeroCoefficientIsTheFrictionlessSolution) {
+  json job = contact::testing::example("hertz_force.json");
+  const Result frictionless = run(job);
+  job["contacts"][0]["friction"] = {{"coefficient", 0.0}};
+  const Result zero = run(job);
+  ASSERT_TRUE(frictionless.converged && zero.converged) << zero.message;
+  for (size_t b = 0; b < 2; ++b)
+    EXPECT_LT(relative(zero.steps.back().bodies[b].displacement, frictionless.steps.back().bodies[b].displacement), 1e-10);
+  const PairField& p = zero.steps.back().pairs[0];
+  EXPECT_LT(relative(p.pressure, frictionless.steps.back().pairs[0].pressure), 1e-10);
+  EXPECT_LT(p.tangential_traction.cwiseAbs().maxCoeff(), 1e-10 * p.pressure.maxCoeff());
+}
+
+TEST(Friction, ALargeCoefficientBondsLikeOneMergedBody) {
+  // Two blocks on matching meshes, the upper one's top pushed sideways and down: with mu = 1e6 nothing slips, and
+  // the displacements are those of one block meshed as the two together.
+  const json two = json::parse(R"({
+    "name": "bonded",
+    "bodies": [
+      {"name": "lower", "material": {"E": 1000, "nu": 0.3},
+       "mesh": {"block": {"corners": [[0, 0], [1, 0], [1, 1], [0, 1]], "nx": 6, "ny": 6}},
+       "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]},
+      {"name": "upper", "material": {"E": 1000, "nu": 0.3},
+       "mesh": {"block": {"corners": [[0, 1], [1, 1], [1, 2], [0, 2]], "nx": 6, "ny": 6}},
+       "boundary": [{"edge": "top", "displacement": {"x": 0.01, "y": -0.02}}]}
+    ],
+    "contacts": [{"slave": "upper.bottom", "master": "lower.top", "friction": {"coefficient": 1e6}}]
+  })");
+  const json one = json::parse(R"({
+    "name": "merged",
+    "bodies": [
+      {"name": "both", "material": {"E": 1000, "nu": 0.3},
+       "mesh": {"block": {"corners": [[0, 0], [1, 0], [1, 2], [0, 2]], "nx": 6, "ny": 12}},
+       "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}},
+                    {"edge": "top", "displacement": {"x": 0.01, "y": -0.02}}]}
+    ]
+  })");
+  const Result bonded = run(two), merged = run(one);
+  ASSERT_TRUE(bonded.converged && merged.converged) << bonded.message;
+  const BodyField& m = merged.steps.back().bodies[0];
+  double worst = 0;
+  for (const auto& part : bonded.steps.back().bodies)
+    for (int i = 0; i < part.mesh.num_nodes(); ++i)
+      for (int j = 0; j < m.mesh.num_nodes(); ++j)
+        if ((part.mesh.nodes[static_cast<size_t>(i)] - m.mesh.nodes[static_cast<size_t>(j)]).norm() < 1e-12)
+          worst = std::max(worst, (part.displacement.row(i) - m.displacement.row(j)).norm());
+  EXPECT_LT(worst, 1e-8 * m.displacement.cwiseAbs().maxCoeff());
+  EXPECT_EQ(bonded.steps.back().pairs[0].stick.sum(), 7);  // every contact node
+}
+
+namespace {
+
+// A half-cylinder (R = 2) pressed on a block and pushed sideways in three steps, non-matching meshes: partial
+// slip, for comparing two solvers of the same discrete problem.
+json pushed_cylinder(bool cylinder_is_slave) {
+  json job = json::parse(R"({
+    "name": "pushed",
+    "bodies": [
+      {"name": "block", "material": {"E": 1000, "nu": 0.3},
+       "mesh": {"block": {"corners": [[-2, -2], [2, -2], [2, 0], [-2, 0]], "nx": 37, "ny": 9}},
+       "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]},
+      {"name": "cylinder", "material": {"E": 600, "nu": 0.25},
+       "mesh": {"block": {"corners": [[-1.2, 0.4], [1.2, 0.4], [1.2, 2], [-1.2, 2]], "nx": 29, "ny": 8,
+                          "edges": {"bottom": {"arc": {"center": [0, 2], "radius": 2}}}}},
+       "boundary": [{"edge": "top", "displacement": {"y": -0.03}},
+                    {"vertex": "top_left", "force": [1, 0], "history": [0, 0.5, 1]}]}
+    ],
+    "contacts": [{"name": "c", "slave": "cylinder.bottom", "master": "block.top", "friction": {"coefficient": 0.2}}],
+    "loading": {"factors": [1, 1, 1]}
+  })");
+  if (!cylinder_is_slave) {
+    job["contacts"][0]["slave"] = "block.top";
+    job["contacts"][0]["master"] = "cylinder.bottom";
+  }
+  return job;
+}
+
+}  // namespace
+
+TEST(Friction, InterfaceSolverEqualsTheMonolithicReferenceOnNonMatchingMeshesEitherWayRound) {
+  for (bool cylinder_is_slave : {true, false}) {
+    json job = pushed_cylinder(cylinder_is_slave);
+    const Result interface = run(job);
+    job["solver"] = {{"method", "monolithic"}};
+    const Result monolithic = run(job);
+    ASSERT_TRUE(interface.converged) << interface.message;
+    ASSERT_TRUE(monolithic.converged) << monolithic.message;
+    ASSERT_EQ(interface.steps.size(), 3u);
+    bool partial_slip = false;
+    for (size_t k = 0; k < 3; ++k) {
+      const Step& a = interface.steps[k];
+      const Step& b = monolithic.steps[k];
+      for (size_t i = 0; i < a.bodies.size(); ++i)
+        EXPECT_LT(relative(a.bodies[i].displacement, b.bodies[i].displacement), 1e-8) << "step " << k;
+      const PairField& p = a.pairs[0];
+      EXPECT_LT(relative(p.pressure, b.pairs[0].pressure), 1e-8);
+      EXPECT_LT(relative(p.tangential_traction, b.pairs[0].tangential_traction), 1e-8) << "step " << k;
+      EXPECT_EQ(p.stick, b.pairs[0].stick);
+      if (k == 2) partial_slip = p.stick.sum() > 0 && (p.active - p.stick).sum() > 0;
+    }
+    EXPECT_TRUE(partial_slip) << "the last step should have both stick and slip";
+  }
+}
+
+TEST(Friction, RollerBetweenPlatesLoadedByAForceAloneIsHeldByFriction) {
+  // The naive roller of the frictionless diagnosis (test_job.cpp): with friction the job is accepted and solved.
+  const json job = json::parse(R"({
+    "name": "roller",
+    "bodies": [
+      {"name": "base", "material": {"E": 2.1e5, "nu": 0.3},
+       "mesh": {"block": {"corners": [[-2, -1], [2, -1], [2, 0], [-2, 0]], "nx": 32, "ny": 8}},
+       "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]},
+      {"name": "roller", "material": {"E": 2.1e5, "nu": 0.3},
+       "mesh": {"block": {"corners": [[-0.5, 0.1339745962155614], [0.5, 0.1339745962155614],
+                                      [0.5, 1.8660254037844386], [-0.5, 1.8660254037844386]], "nx": 24, "ny": 24,
+                          "edges": {"bottom": {"arc": {"center": [0, 1], "radius": 1}},
+                                    "top": {"arc": {"center": [0, 1], "radius": 1}}}}}},
+      {"name": "plate", "material": {"E": 2.1e5, "nu": 0.3},
+       "mesh": {"block": {"corners": [[-2, 2], [2, 2], [2, 3], [-2, 3]], "nx": 32, "ny": 8}},
+       "boundary": [{"edge": "top", "force": [0, -10000]}]}
+    ],
+    "contacts": [{"slave": "roller.bottom", "master": "base.top", "friction": {"coefficient": 0.2}},
+                 {"slave": "roller.top", "master": "plate.bottom", "friction": {"coefficient": 0.2}}]
+  })");
+  const Result r = run(job);
+  ASSERT_TRUE(r.converged) << r.message;
+  const Step& s = r.steps.back();
+  const PairField& bottom = pair_of(s, "roller.bottom-base.top");
+  const PairField& top = pair_of(s, "roller.top-plate.bottom");
+  // Both contacts carry the whole load: the roller's bottom is pushed up by 10000, its top down.
+  EXPECT_NEAR(bottom.resultant.y(), 10000, 1e-8 * 10000);
+  EXPECT_NEAR(top.resultant.y(), -10000, 1e-8 * 10000);
+  EXPECT_NEAR(bottom.resultant.x(), 0, 1e-8 * 10000);
+  EXPECT_GT(bottom.active.sum(), 2);
+  EXPECT_GT(top.active.sum(), 2);
+  EXPECT_NEAR(body(s, "base").reaction_total.y(), 10000, 1e-8 * 10000);
+}
+
+TEST(LoadHistory, EachConditionFollowsItsOwnFactors) {
+  // One block, bottom fixed: a downward force held while a sideways one grows from 0 and is then removed.
+  const json job = json::parse(R"({
+    "name": "history",
+    "bodies": [
+      {"name": "b", "material": {"E": 1000, "nu": 0.3},
+       "mesh": {"block": {"corners": [[0, 0], [1, 0], [1, 1], [0, 1]], "nx": 4, "ny": 4}},
+       "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}},
+                    {"edge": "top", "force": [0, -10], "history": [1, 1, 1]},
+                    {"edge": "right", "force": [-4, 0], "history": [0, 1, 0]}]}
+    ],
+    "loading": {"factors": [0.5, 1, 2]}
+  })");
+  const Result r = run(job);
+  ASSERT_TRUE(r.converged) << r.message;
+  ASSERT_EQ(r.steps.size(), 3u);
+  const double expected_x[] = {0, 4, 0};
+  for (size_t k = 0; k < 3; ++k) {
+    const Eigen::Vector2d total = r.steps[k].bodies[0].reaction_total;
+    EXPECT_NEAR(total.x(), expected_x[k], 1e-9) << "step " << k;
+    EXPECT_NEAR(total.y(), 10, 1e-9) << "step " << k;  // held by its history, whatever the loading's factor
+  }
+  // Linearity: step 2 (the same loads as step 0) repeats step 0's field.
+  EXPECT_LT(relative(r.steps[2].bodies[0].displacement, r.steps[0].bodies[0].displacement), 1e-12);
+}
