@@ -29,11 +29,15 @@ void set_default(json& object, const std::string& key, json value) {
 
 ParseResult JobReader::run() {
   Fields top(job_, "", "the job",
-             {"name", "version", "model", "bodies", "contacts", "solver", "adaptivity", "loading", "parallel"}, errors_);
+             {"name", "version", "model", "meshes", "bodies", "contacts", "solver", "adaptivity", "loading", "parallel"},
+             errors_);
   if (!top.ok()) return finish();
   read_header(top);
   read_model(top);
+  if (const json* m = top.find("meshes"))
+    gmsh_.read_table(*m, top.at("meshes"), errors_, sub_object(normalized_, "meshes"));
   read_bodies(top);
+  gmsh_.check_table_used(errors_);
   read_contacts(top);
   read_solver(top);
   if (const json* a = top.find("adaptivity")) read_adaptivity(*a, top.at("adaptivity"));

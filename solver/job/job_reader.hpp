@@ -120,7 +120,7 @@ class JobReader {
   // read_meshes.cpp: blocks and their curves, explicit arrays, Gmsh surfaces; building and checking the meshes
   void read_mesh(const json& value, const std::string& pointer, MeshInput& m, json& out);
   void read_block(const json& value, const std::string& pointer, MeshInput& m);
-  void read_gmsh(const json& value, const std::string& pointer, MeshInput& m);
+  void read_gmsh(const json& value, const std::string& pointer, MeshInput& m, json& out);
   std::optional<long long> read_count(const json& value, const std::string& pointer, const std::string& what);
   void read_curve(const json& value, const std::string& pointer, const std::string& edge, MeshInput& m);
   void read_arrays(const json& value, const std::string& pointer, MeshInput& m, json& out);

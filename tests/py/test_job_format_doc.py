@@ -240,10 +240,16 @@ def main():
         body["mesh"]["gmsh"]["file"] = os.path.join(EXAMPLES, body["mesh"]["gmsh"]["file"])
     gmsh_objects = [("/bodies/0/mesh/gmsh", "Gmsh mesh", "Gmsh mesh", "#/$defs/gmsh_mesh/properties/gmsh")]
     gmsh_mesh_objects = [("/bodies/0/mesh", None, "Gmsh mesh", "#/$defs/gmsh_mesh")]
+    # The same file once in the job's "meshes" table, the bodies naming the entry.
+    table_job = copy.deepcopy(gmsh_job)
+    table_job["meshes"] = {"m": {"file": gmsh_job["bodies"][0]["mesh"]["gmsh"]["file"]}}
+    for body in table_job["bodies"]:
+        body["mesh"]["gmsh"] = {"mesh": "m", "surface": body["mesh"]["gmsh"]["surface"]}
+    table_objects = [("/meshes/m", None, "Gmsh mesh", "#/properties/meshes/additionalProperties")]
 
     with tempfile.TemporaryDirectory() as tmp:
         for job, objects in ((block_job, block_objects), (explicit_job, explicit_objects), (gmsh_job, gmsh_objects),
-                             (gmsh_job, gmsh_mesh_objects)):
+                             (gmsh_job, gmsh_mesh_objects), (table_job, table_objects)):
             check("the probe job is valid", run_cli(job, tmp, "--validate").returncode == 0,
                   run_cli(job, tmp, "--validate").stderr[-600:])
             parser = parser_fields(job, [o[0] for o in objects], tmp)
