@@ -645,6 +645,11 @@ TEST(GmshJob, TableErrorsAreReportedAtTheirPointersOnceEach) {
   r = job::parse(job);
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.errors[0].pointer, "/meshes") << job::format_errors(r.errors);
+  // Without bodies to use them the entries are not called unused: the missing bodies are the error.
+  job = flat_patch_table({{"data", text}});
+  job.erase("bodies");
+  job.erase("contacts");
+  expect_only_error(job::parse(job), "/bodies", "bodies");
   // A surface the file does not have is the body's error, naming the mesh by its table name.
   job = flat_patch_table({{"data", text}});
   job["bodies"][1]["mesh"]["gmsh"]["surface"] = "punch";

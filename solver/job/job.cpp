@@ -37,7 +37,7 @@ ParseResult JobReader::run() {
   if (const json* m = top.find("meshes"))
     gmsh_.read_table(*m, top.at("meshes"), errors_, sub_object(normalized_, "meshes"));
   read_bodies(top);
-  gmsh_.check_table_used(errors_);
+  if (!inputs_.empty()) gmsh_.check_table_used(errors_);  // not when the bodies could not be read at all
   read_contacts(top);
   read_solver(top);
   if (const json* a = top.find("adaptivity")) read_adaptivity(*a, top.at("adaptivity"));
