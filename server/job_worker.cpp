@@ -248,7 +248,7 @@ void JobQueue::run(const std::shared_ptr<Job>& job) {
       outcome.message = "cannot write the result file: " + write_error_summary(e.what(), store_.data_dir());
     }
   }
-  for (const auto& step : result.steps) job->events.append("step", step_event(step));
+  for (const auto& step : result.step_history) job->events.append("step", step_event(step));
   finish(job, std::move(outcome));
 }
 

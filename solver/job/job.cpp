@@ -29,7 +29,8 @@ void set_default(json& object, const std::string& key, json value) {
 
 ParseResult JobReader::run() {
   Fields top(job_, "", "the job",
-             {"name", "version", "model", "meshes", "bodies", "contacts", "solver", "adaptivity", "loading", "parallel"},
+             {"name", "version", "model", "meshes", "bodies", "contacts", "solver", "adaptivity", "loading", "parallel",
+              "output"},
              errors_);
   if (!top.ok()) return finish();
   read_header(top);
@@ -42,6 +43,7 @@ ParseResult JobReader::run() {
   read_solver(top);
   if (const json* a = top.find("adaptivity")) read_adaptivity(*a, top.at("adaptivity"));
   read_loading(top);
+  read_output(top);
   read_parallel(top);
   resolve_method_defaults();
   check_floating_bodies();

@@ -97,7 +97,7 @@ class JobReader {
   json& element(json& array, size_t index);
   json& discard();
 
-  // read_options.cpp: solver, adaptivity, loading, parallel
+  // read_options.cpp: solver, adaptivity, loading, parallel, output
   void read_solver(const Fields& top);
   void resolve_method_defaults();
   void read_adaptivity(const json& value, const std::string& pointer);
@@ -107,6 +107,7 @@ class JobReader {
   void read_penalty(const json& value, const std::string& pointer, json& out);
   void read_parallel(const Fields& top);
   void read_loading(const Fields& top);
+  void read_output(const Fields& top);
 
   // read_bodies.cpp: bodies, materials, boundary conditions; the checks on the built bodies
   void read_bodies(const Fields& top);

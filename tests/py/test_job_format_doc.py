@@ -206,6 +206,7 @@ def main():
                                                          "top": {"arc": {"center": [2, -10], "radius": 125 ** 0.5}}}
     block_job["solver"].update(robin={"psi": "active_set"}, augmented_lagrangian={"tolerance": 1e-6})
     block_job["adaptivity"] = {}
+    block_job["output"] = {}
     block_objects = [
         ("", "Top level", "Top level", "#"),
         ("/model", "`model`", "`model`", "#/properties/model"),
@@ -227,6 +228,7 @@ def main():
         ("/solver/robin", None, "Solver", "#/$defs/solver/properties/robin"),
         ("/solver/augmented_lagrangian", None, "Solver", "#/$defs/solver/properties/augmented_lagrangian"),
         ("/adaptivity", "Adaptivity", "Adaptivity", "#/$defs/adaptivity"),
+        ("/output", "Output", "Output", "#/properties/output"),
     ]
     explicit_job = copy.deepcopy(small)
     explicit_job["bodies"][0]["mesh"] = {"nodes": [[0, -1], [2, -1], [2, 0], [0, 0]], "quads": [[0, 1, 2, 3]],
