@@ -94,6 +94,7 @@ const GmshMeshes::Parsed& GmshMeshes::parse_data(const std::string& text) {
 }
 
 void GmshMeshes::read_table(const json& value, const std::string& pointer, read::Errors& errors, json& out) {
+  table_given_ = true;
   if (!value.is_object()) {
     errors.add(pointer, "meshes must be an object {\"name\": {\"file\": ...} or {\"data\": ...}, ...}, got " +
                             read::type_name(value));
@@ -168,10 +169,12 @@ const GmshMeshes::Parsed* GmshMeshes::from_table(const std::string& name, const 
   if (it == table_.end()) {
     std::vector<std::string> names;
     for (const auto& [known, entry] : table_) names.push_back("'" + read::shown(known) + "'");
-    errors.add(pointer, "the job has no mesh '" + read::shown(name) + "' in its \"meshes\" table; " +
-                            (names.empty() ? std::string("it has no \"meshes\" table (give {\"meshes\": {\"") +
-                                                 read::shown(name) + "\": {\"data\": ...}}} at the top level)"
-                                           : "its meshes are " + read::join_names(names)));
+    std::string known = "its meshes are " + read::join_names(names);
+    if (names.empty())
+      known = table_given_ ? "the table has no entry that could be read (see /meshes)"
+                           : "it has no \"meshes\" table (give {\"meshes\": {\"" + read::shown(name) +
+                                 "\": {\"data\": ...}}} at the top level)";
+    errors.add(pointer, "the job has no mesh '" + read::shown(name) + "' in its \"meshes\" table; " + known);
     return nullptr;
   }
   TableEntry& entry = it->second;

@@ -83,6 +83,7 @@ class GmshMeshes {
   std::map<std::string, std::unique_ptr<Parsed>> files_;             // by resolved path
   std::multimap<std::size_t, std::unique_ptr<Parsed>> data_;         // by the hash of the text
   std::map<std::string, TableEntry> table_;                          // the job's "meshes", by name
+  bool table_given_ = false;                                         // the job has "meshes" (maybe malformed)
 };
 
 }  // namespace contact::job
