@@ -12,7 +12,7 @@ nlohmann::json state_event(JobState state, const std::string& message, int attem
 
 nlohmann::json iteration_event(const contact::IterationReport& report) { return contact::io::iteration_json(report, true); }
 
-nlohmann::json step_event(const contact::Step& step) { return contact::io::step_json(step); }
+nlohmann::json step_event(const contact::StepSummary& step) { return contact::io::step_json(step); }
 
 nlohmann::json end_event(const JobRecord& r) {
   return {{"state", to_string(r.state)},

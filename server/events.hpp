@@ -19,7 +19,7 @@ nlohmann::json state_event(JobState state, const std::string& message, int attem
 nlohmann::json iteration_event(const contact::IterationReport& report);
 
 // "step": one mesh state of the result: {"step", "iteration", "bodies": [{"name", "elements", "nodes"}]}.
-nlohmann::json step_event(const contact::Step& step);
+nlohmann::json step_event(const contact::StepSummary& step);
 
 // "end": {"state", "stop_reason", "message", "converged", "iterations", "solve_seconds", "result_available"}.
 nlohmann::json end_event(const JobRecord& record);

@@ -69,9 +69,7 @@ bool HttpServer::read_json_body(const Request& req, Response& res, const Content
   });
   if (too_large || res.status == 413) {
     if (too_large) res.set_header("Connection", "close");  // the rest of the chunked body is still unread
-    send_problem(res, 413, "",
-                 "the body is larger than the limit of " + std::to_string(settings_.max_request_bytes) + " bytes",
-                 req.path);
+    send_too_large(res, req.path, !too_large && announced > 0 ? std::optional<std::uint64_t>(announced) : std::nullopt);
     return false;
   }
   if (!read) {

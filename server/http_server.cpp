@@ -4,6 +4,8 @@
 #include "util.hpp"
 
 #include <algorithm>
+#include <iomanip>
+#include <sstream>
 #include <thread>
 
 namespace contactd {
@@ -11,6 +13,13 @@ namespace contactd {
 namespace {
 
 using Handled = httplib::Server::HandlerResponse;
+
+// "8 MiB", "12.5 MiB": a byte count for people.
+std::string format_mib(std::uint64_t bytes) {
+  std::ostringstream os;
+  os << std::setprecision(4) << static_cast<double>(bytes) / 1048576.0 << " MiB";
+  return os.str();
+}
 
 std::chrono::milliseconds millis(double seconds) {
   return std::chrono::milliseconds(static_cast<std::int64_t>(seconds * 1000.0));
@@ -186,9 +195,7 @@ Handled HttpServer::pre_route(const Request& req, Response& res) {
     // Up to a few times the limit the body is read and dropped by httplib (set_payload_max_length), which keeps
     // the connection usable and lets every client read the 413; far beyond, it is refused unread.
     if (length > 4 * static_cast<std::uint64_t>(settings_.max_request_bytes) + (1u << 20))
-      return refuse(413, "",
-                    "the body has " + std::to_string(length) + " bytes; the limit is " +
-                        std::to_string(settings_.max_request_bytes));
+      return (send_too_large(res, req.path, length), res.set_header("Connection", "close"), Handled::Handled);
   }
   if (api && !ready_) return (res.set_header("Retry-After", "1"), refuse(503, "not-ready", "the server is starting"));
   // Unknown paths (404) and methods (405) are answered here, before httplib reads a body for them.
@@ -231,13 +238,23 @@ int HttpServer::expect_continue(const Request& req, Response& res) {
   std::uint64_t length = 0;
   if (req.has_header("Content-Length") && parse_count(req.get_header_value("Content-Length"), UINT64_MAX / 2, length) &&
       length > settings_.max_request_bytes) {
-    send_problem(res, 413, "",
-                 "the body has " + std::to_string(length) + " bytes; the limit is " +
-                     std::to_string(settings_.max_request_bytes),
-                 req.path);
+    send_too_large(res, req.path, length);
     return 413;
   }
   return 100;
+}
+
+void HttpServer::send_too_large(Response& res, const std::string& path, std::optional<std::uint64_t> bytes) const {
+  const std::uint64_t limit = settings_.max_request_bytes;
+  const std::string size = bytes ? "has " + std::to_string(*bytes) + " bytes, more than" : "is larger than";
+  nlohmann::json extra = {{"limit_bytes", limit}, {"setting", "--max-request-bytes"}};
+  if (bytes) extra["request_bytes"] = *bytes;
+  send_problem(res, 413, "",
+               "the request body " + size + " the limit of " + std::to_string(limit) + " bytes (" +
+                   format_mib(limit) + ") that contactd's --max-request-bytes (CONTACTD_MAX_REQUEST_BYTES) sets; a job "
+                   "whose bodies come from one Gmsh file can give its text once, in the job's \"meshes\" table, "
+                   "instead of once per body (docs/job-format.md)",
+               path, std::move(extra));
 }
 
 void HttpServer::method_not_allowed_or_not_found(const Request& req, Response& res) {
@@ -262,11 +279,12 @@ Handled HttpServer::on_error(const Request& req, Response& res) {
     case 404:
       method_not_allowed_or_not_found(req, res);
       break;
-    case 413:
-      send_problem(res, 413, "",
-                   "the body is larger than the limit of " + std::to_string(settings_.max_request_bytes) + " bytes",
-                   req.path);
+    case 413: {
+      std::uint64_t length = 0;
+      const bool known = parse_count(trim(req.get_header_value("Content-Length")), UINT64_MAX / 2, length);
+      send_too_large(res, req.path, known ? std::optional<std::uint64_t>(length) : std::nullopt);
       break;
+    }
     case 400:
       send_problem(res, 400, "", "the request could not be read (malformed HTTP, body or encoding)", req.path);
       break;

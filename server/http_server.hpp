@@ -24,6 +24,7 @@
 #include <chrono>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <regex>
 #include <string>
 #include <vector>
@@ -91,6 +92,8 @@ class HttpServer {
 
   httplib::Server::HandlerResponse pre_route(const Request& req, Response& res);
   int expect_continue(const Request& req, Response& res);
+  // 413: the request's size (when known), the limit and the setting that raises it.
+  void send_too_large(Response& res, const std::string& path, std::optional<std::uint64_t> bytes) const;
   httplib::Server::HandlerResponse on_error(const Request& req, Response& res);
   void on_exception(const Request& req, Response& res, std::exception_ptr error);
   void on_response(const Request& req, const Response& res);

@@ -35,29 +35,47 @@ const assets::File* find(const std::vector<assets::File>& files, std::string_vie
   return nullptr;
 }
 
-// The examples as served: a Gmsh mesh that an example names by "file" is put in as "data", the file's text (a job
-// sent to the server carries its meshes: the server reads no files for a job). Built once; owns the texts.
+// An example as served: the Gmsh meshes its bodies name by "file" go into the job's "meshes" table with their
+// text as "data", each file once under its name without ".msh" (a job sent to the server carries its meshes: the
+// server reads no files for a job), and the bodies refer to them by that name.
+std::string with_meshes(const std::string& text) {
+  auto job = nlohmann::ordered_json::parse(text);  // keeps the fields in the file's order
+  nlohmann::ordered_json meshes = job.value("meshes", nlohmann::ordered_json::object());
+  for (auto& body : job.at("bodies")) {
+    if (!body.contains("mesh") || !body["mesh"].contains("gmsh")) continue;
+    auto& gmsh = body["mesh"]["gmsh"];
+    if (!gmsh.is_object() || !gmsh.contains("file")) continue;
+    const std::string file = gmsh["file"].get<std::string>();
+    const auto* mesh = find(assets::example_meshes(), file);
+    if (!mesh) continue;  // left as it is: the server's validation names the file
+    const bool msh = file.size() > 4 && file.compare(file.size() - 4, 4, ".msh") == 0;
+    const std::string name = msh ? file.substr(0, file.size() - 4) : file;
+    meshes[name] = {{"data", std::string(mesh->data)}};
+    nlohmann::ordered_json by_name;
+    for (auto& [key, value] : gmsh.items()) {
+      if (key == "file")
+        by_name["mesh"] = name;
+      else
+        by_name[key] = value;
+    }
+    gmsh = std::move(by_name);
+  }
+  nlohmann::ordered_json out;  // "meshes" just before "bodies"
+  for (auto& [key, value] : job.items()) {
+    if (key == "meshes") continue;
+    if (key == "bodies" && !meshes.empty()) out["meshes"] = meshes;
+    out[key] = value;
+  }
+  return out.dump(2) + "\n";
+}
+
+// The examples as served (with_meshes). Built once; owns the texts.
 const std::vector<assets::File>& served_examples() {
   static const std::vector<std::string> texts = [] {
     std::vector<std::string> out;
     for (const auto& e : assets::examples()) {
       std::string text(e.data);
-      if (text.find("\"gmsh\"") != std::string::npos) {
-        auto job = nlohmann::ordered_json::parse(text);  // keeps the fields in the file's order
-        for (auto& body : job.at("bodies")) {
-          if (!body.contains("mesh") || !body["mesh"].contains("gmsh")) continue;
-          auto& gmsh = body["mesh"]["gmsh"];
-          if (!gmsh.is_object() || !gmsh.contains("file")) continue;
-          const auto* mesh = find(assets::example_meshes(), gmsh["file"].get<std::string>());
-          if (!mesh) continue;  // left as it is: the server's validation names the file
-          nlohmann::ordered_json inlined;
-          for (auto& [key, value] : gmsh.items()) inlined[key == "file" ? "data" : key] = value;
-          inlined["data"] = std::string(mesh->data);
-          gmsh = std::move(inlined);
-        }
-        text = job.dump(2) + "\n";
-      }
-      out.push_back(std::move(text));
+      out.push_back(text.find("\"gmsh\"") != std::string::npos ? with_meshes(text) : std::move(text));
     }
     return out;
   }();

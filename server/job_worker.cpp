@@ -55,6 +55,8 @@ class EventObserver final : public contact::Observer {
         if (pair.is_object()) {
           pair.erase("positions");
           pair.erase("pressures");
+          pair.erase("tangential_tractions");
+          pair.erase("stick");
         }
     {
       std::lock_guard<std::mutex> lock(records_mutex_);
@@ -248,7 +250,7 @@ void JobQueue::run(const std::shared_ptr<Job>& job) {
       outcome.message = "cannot write the result file: " + write_error_summary(e.what(), store_.data_dir());
     }
   }
-  for (const auto& step : result.steps) job->events.append("step", step_event(step));
+  for (const auto& step : result.step_history) job->events.append("step", step_event(step));
   finish(job, std::move(outcome));
 }
 

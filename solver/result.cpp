@@ -1,5 +1,7 @@
 #include "contact/result.hpp"
 
+#include "contact/extent.hpp"  // solver/contact/: the contact zone between nodes
+
 namespace contact {
 
 const char* to_string(StopReason r) {
@@ -28,6 +30,27 @@ const char* to_string(Measure m) {
       return "gradient";
   }
   return "fixed_point";
+}
+
+StepSummary summarize(const Step& step) {
+  StepSummary s;
+  s.index = step.index;
+  s.iteration = step.iteration;
+  s.load_factor = step.load_factor;
+  for (const auto& b : step.bodies) {
+    s.body_names.push_back(b.name);
+    s.elements.push_back(b.mesh.num_cells());
+    s.nodes.push_back(b.mesh.num_nodes());
+  }
+  for (const auto& p : step.pairs) {
+    s.pair_names.push_back(p.name);
+    s.force.push_back(p.force);
+    s.tangential_force.push_back(p.tangential_force);
+    const mortar::ContactExtent extent = mortar::contact_extent(p.arc_length, p.pressure);
+    s.contact_begin.push_back(extent.begin);
+    s.contact_end.push_back(extent.end);
+  }
+  return s;
 }
 
 }  // namespace contact

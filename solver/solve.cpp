@@ -54,6 +54,7 @@ void refuse_unheld_bodies(const Problem& problem, Result& result) {
     result.converged = false;
     result.message = "monolithic: " + unheld;
     result.steps.clear();
+    result.step_history.clear();
     return;
   }
 }
@@ -106,7 +107,7 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
     ddm::RunContext context{observer, cancel, runner, start};
     const std::unique_ptr<ddm::ContactMethod> method = ddm::make_method(system, active.solver);
     int updates = 0;
-    std::vector<Step> steps;
+    ddm::StepLog steps(problem.output.steps);  // every step's scalars; the fields the job keeps
     ddm::MethodOutcome outcome;
     if (adaptive) {
       system.set_load_step(problem.loading.factors.size() - 1, problem.loading.factors.back());
@@ -126,7 +127,8 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
     result.indicator_seconds = outcome.indicator_seconds;
     result.history = std::move(outcome.history);
     result.factorization_seconds = system.total_factorization_seconds();
-    result.steps = std::move(steps);
+    result.steps = steps.take_steps();
+    result.step_history = steps.take_summaries();
     if (problem.solver.method == Method::monolithic) refuse_unheld_bodies(active, result);
     if (updates > 0 && !result.steps.empty()) {
       std::ostringstream os;

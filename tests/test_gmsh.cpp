@@ -385,7 +385,7 @@ TEST(GmshJob, FieldAndFileErrorsAreReportedAtTheirPointers) {
                         ") cannot be opened: No such file or directory");
   job = flat_patch_gmsh();
   job["bodies"][0]["mesh"]["gmsh"]["data"] = "x";
-  expect_only_error(job::parse(job, in_examples()), "/bodies/0/mesh/gmsh", "give exactly one of file");
+  expect_only_error(job::parse(job, in_examples()), "/bodies/0/mesh/gmsh", "give exactly one of mesh");
   job["bodies"][0]["mesh"]["gmsh"].erase("file");
   job["bodies"][0]["mesh"]["gmsh"]["data"] = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n";
   expect_only_error(job::parse(job, in_examples()), "/bodies/0/mesh/gmsh/data",
@@ -564,4 +564,97 @@ TEST(GmshJob, NodeCoordinatesAreBoundedLikeJsonNumbers) {
                       "the mesh data (MSH text): line " + line + ": node 2: x = " + shown.str() +
                           " is too large in magnitude (at most 1e+30)");
   }
+}
+
+// ---- the job's "meshes" table (issue 23, item 1) ---------------------------------------------------------
+
+namespace {
+
+// flat_patch_gmsh.json with its one file given once, in the table, as `entry` ({"data": text} or {"file": ...}).
+json flat_patch_table(const json& entry) {
+  json job = flat_patch_gmsh();
+  job["meshes"] = {{"patch", entry}};
+  for (auto& body : job["bodies"]) body["mesh"]["gmsh"] = {{"mesh", "patch"}, {"surface", body["name"]}};
+  return job;
+}
+
+}  // namespace
+
+TEST(GmshJob, ATableEntryGivesTheBodiesOfItsFileOnceAndTheNormalizedJobLeavesItsTextOut) {
+  const std::string text = read_text(kExamples + "flat_patch_gmsh.msh");
+  const auto by_file = job::parse(flat_patch_gmsh(), in_examples());
+  const auto by_data = job::parse(flat_patch_table({{"data", text}}));  // the server's limits: no directory
+  const auto by_table_file = job::parse(flat_patch_table({{"file", "flat_patch_gmsh.msh"}}), in_examples());
+  ASSERT_TRUE(by_file.ok() && by_data.ok() && by_table_file.ok())
+      << job::format_errors(by_data.errors) << job::format_errors(by_table_file.errors);
+  for (const auto* r : {&by_data, &by_table_file})
+    for (size_t b = 0; b < 2; ++b) {
+      EXPECT_EQ(r->problem->bodies[b].mesh.nodes, by_file.problem->bodies[b].mesh.nodes);
+      EXPECT_EQ(r->problem->bodies[b].mesh.cells, by_file.problem->bodies[b].mesh.cells);
+    }
+  // The submitted job holds the text once; the normalized copy gives its size only (also for a body's own data).
+  const json& normalized = by_data.problem->normalized;
+  EXPECT_EQ(normalized["meshes"]["patch"], json({{"data_bytes", text.size()}}));
+  EXPECT_EQ(normalized.dump().find("$MeshFormat"), std::string::npos);
+  json per_body = flat_patch_gmsh();
+  for (auto& body : per_body["bodies"]) body["mesh"]["gmsh"] = {{"data", text}, {"surface", body["name"]}};
+  const auto old_form = job::parse(per_body);
+  ASSERT_TRUE(old_form.ok()) << job::format_errors(old_form.errors);
+  EXPECT_EQ(old_form.problem->normalized["bodies"][1]["mesh"]["gmsh"],
+            json({{"data_bytes", text.size()}, {"surface", "upper"}}));
+}
+
+TEST(GmshJob, TableErrorsAreReportedAtTheirPointersOnceEach) {
+  const std::string text = read_text(kExamples + "flat_patch_gmsh.msh");
+  json job = flat_patch_table({{"data", text}});
+  job["bodies"][1]["mesh"]["gmsh"]["mesh"] = "pach";
+  job["meshes"]["other"] = {{"data", text}};
+  auto r = job::parse(job);
+  ASSERT_EQ(r.errors.size(), 2u) << job::format_errors(r.errors);
+  EXPECT_EQ(r.errors[0].pointer, "/bodies/1/mesh/gmsh/mesh");
+  EXPECT_NE(r.errors[0].message.find("the job has no mesh 'pach' in its \"meshes\" table; its meshes are 'other' and "
+                                     "'patch'"),
+            std::string::npos)
+      << r.errors[0].message;
+  EXPECT_EQ(r.errors[1].pointer, "/meshes/other");
+  EXPECT_NE(r.errors[1].message.find("mesh 'other' is used by no body"), std::string::npos) << r.errors[1].message;
+
+  job = flat_patch_table({{"data", text}});
+  job.erase("meshes");
+  r = job::parse(job);
+  ASSERT_EQ(r.errors.size(), 2u) << job::format_errors(r.errors);
+  for (size_t b = 0; b < 2; ++b) {
+    EXPECT_EQ(r.errors[b].pointer, "/bodies/" + std::to_string(b) + "/mesh/gmsh/mesh");
+    EXPECT_NE(r.errors[b].message.find("it has no \"meshes\" table"), std::string::npos) << r.errors[b].message;
+  }
+  // A bad text is the entry's error, reported once at its field however many bodies use it.
+  expect_only_error(job::parse(flat_patch_table({{"data", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"}})),
+                    "/meshes/patch/data", "the mesh data (MSH text): line 2: MSH format version 2.2 is not supported");
+  expect_only_error(job::parse(flat_patch_table({{"file", "flat_patch_gmsh.msh"}})), "/meshes/patch/file",
+                    "the server reads no files for a job; send the .msh file's text as \"data\"");
+  expect_only_error(job::parse(flat_patch_table({{"file", "x.msh"}, {"data", text}})), "/meshes/patch",
+                    "give exactly one of file");
+  expect_only_error(job::parse(flat_patch_table({{"dat", text}})), "/meshes/patch/dat", "dat");
+  job = flat_patch_table({{"data", text}});
+  job["bodies"][0]["mesh"]["gmsh"]["data"] = text;
+  expect_only_error(job::parse(job), "/bodies/0/mesh/gmsh", "give exactly one of mesh");
+  job = flat_patch_table({{"data", text}});
+  job["meshes"]["bad name"] = {{"data", text}};
+  expect_only_error(job::parse(job), "/meshes/bad name", "mesh name 'bad name' must consist of letters, digits");
+  job["meshes"] = json::array();
+  r = job::parse(job);
+  ASSERT_EQ(r.errors.size(), 3u) << job::format_errors(r.errors);
+  EXPECT_EQ(r.errors[0].pointer, "/meshes");
+  EXPECT_NE(r.errors[1].message.find("the table has no entry that could be read (see /meshes)"), std::string::npos)
+      << r.errors[1].message;
+  // Without bodies to use them the entries are not called unused: the missing bodies are the error.
+  job = flat_patch_table({{"data", text}});
+  job.erase("bodies");
+  job.erase("contacts");
+  expect_only_error(job::parse(job), "/bodies", "bodies");
+  // A surface the file does not have is the body's error, naming the mesh by its table name.
+  job = flat_patch_table({{"data", text}});
+  job["bodies"][1]["mesh"]["gmsh"]["surface"] = "punch";
+  expect_only_error(job::parse(job), "/bodies/1/mesh/gmsh/surface",
+                    "the mesh 'patch': the file has no physical surface 'punch'");
 }

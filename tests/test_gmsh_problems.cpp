@@ -129,7 +129,8 @@ TEST(GmshProblems, RoundedPunchIsInEquilibriumSymmetricAndRefinesOntoItsArcs) {
   job["adaptivity"] = {{"indicator", "zz"}, {"max_steps", 3}};
   const Result adaptive = run(job);
   ASSERT_TRUE(adaptive.converged) << adaptive.message;
-  ASSERT_GE(adaptive.steps.size(), 3u);
+  ASSERT_GE(adaptive.step_history.size(), 3u);
+  ASSERT_EQ(adaptive.steps.size(), 1u);  // an adaptive job keeps the last step's fields by default
   const auto& punch = adaptive.steps.back().bodies.at(1);
   ASSERT_EQ(punch.name, "punch");
   const PairField& last = adaptive.steps.back().pairs.at(0);

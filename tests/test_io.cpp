@@ -1,6 +1,10 @@
 // Result file I/O: what write_result writes, read_result reads back bit for bit; the VTKHDF partition sizes
 // agree; failures name the path and leave no file; the XDMF sidecar names every step and body.
+#include "contact/job.hpp"
 #include "contact/result_file.hpp"
+#include "contact/solve.hpp"
+#include "ddm/step_log.hpp"
+#include "io/h5.hpp"
 #include "triangle_meshes.hpp"
 
 #include <gtest/gtest.h>
@@ -720,5 +724,68 @@ TEST(Xdmf, LoadStepsAreTimedByTheirLoadFactor) {
     value.precision(17);
     value << f.result.steps[k].load_factor;
     EXPECT_NE(text.find("<Time Value=\"" + value.str() + "\"/>"), std::string::npos) << value.str();
+  }
+}
+
+// output.steps "last" (issue 23, item 3): of the paper's problem in 10 load steps the file keeps the last step's
+// fields only, as /steps/0 with its row in the history, and /history/steps has every step; the numbers are those
+// of the run that keeps every step.
+TEST(ResultFile, OutputStepsLastKeepsTheLastStepsFieldsAndEveryStepsHistory) {
+  std::ifstream in(std::string(CONTACT_SOURCE_DIR) + "/api/examples/seed_layers_steps.json");
+  nlohmann::json job = nlohmann::json::parse(in);
+  std::map<std::string, io::ResultFile> files;
+  std::map<std::string, std::vector<std::string>> groups;
+  for (const std::string keep : {"all", "last"}) {
+    job["output"] = {{"steps", keep}};
+    const auto parsed = job::parse(job);
+    ASSERT_TRUE(parsed.ok()) << job::format_errors(parsed.errors);
+    Observer quiet;
+    CancelToken never;
+    const Result r = solve(*parsed.problem, quiet, never);
+    ASSERT_TRUE(r.converged) << r.message;
+    const std::string path = (output_dir() / ("steps_" + keep + ".hdf")).string();
+    io::write_result(path, *parsed.problem, r, {});
+    files[keep] = io::read_result(path);
+    io::h5::Handle file = io::h5::open_file(path);
+    groups[keep] = io::h5::link_names(io::h5::open_group(file, "steps"));
+  }
+  const io::ResultFile& all = files["all"];
+  const io::ResultFile& last = files["last"];
+  ASSERT_EQ(all.steps.size(), 10u);
+  EXPECT_EQ(groups["last"], std::vector<std::string>{"0"});
+  ASSERT_EQ(last.steps.size(), 1u);
+  EXPECT_EQ(last.steps[0].index, 9);  // its row in /history/steps
+  EXPECT_EQ(last.steps[0].load_factor, 1.0);
+  ASSERT_EQ(last.step_history.load_factor.size(), 10u);
+  for (size_t k = 0; k < 10; ++k) EXPECT_NEAR(last.step_history.load_factor[k], (k + 1) / 10.0, 1e-15) << k;
+  EXPECT_TRUE(last.step_history.force.isApprox(all.step_history.force, 1e-12));
+  EXPECT_TRUE(last.step_history.contact_end.isApprox(all.step_history.contact_end, 1e-12));
+  EXPECT_EQ(last.step_history.dofs, all.step_history.dofs);
+  const PairField& kept = last.steps[0].pairs.at(0);
+  EXPECT_TRUE(kept.pressure.isApprox(all.steps[9].pairs.at(0).pressure, 1e-12));
+  EXPECT_NEAR(kept.force, last.step_history.force(9, 0), 1e-12 * kept.force);
+  EXPECT_LT(last.step_history.force(0, 0), last.step_history.force(9, 0));
+}
+
+// The solver keeps in memory only what the file will hold: with StepOutput::last one step's fields at a time,
+// and every step's scalars.
+TEST(StepLog, LastKeepsOneStepsFieldsAndEveryStepsSummary) {
+  ddm::StepLog log(StepOutput::last);
+  for (int k = 0; k < 3; ++k) {
+    Step s;
+    s.index = k;
+    s.load_factor = (k + 1) / 3.0;
+    s.bodies.push_back(body_field("b", block(0, 0, 1, 1, k + 1, 1), false));
+    log.push_back(std::move(s));
+    EXPECT_EQ(log.back().index, k);
+  }
+  const auto steps = log.take_steps();
+  const auto rows = log.take_summaries();
+  ASSERT_EQ(steps.size(), 1u);
+  EXPECT_EQ(steps[0].index, 2);
+  ASSERT_EQ(rows.size(), 3u);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(rows[static_cast<size_t>(k)].elements, std::vector<int>{k + 1});
+    EXPECT_EQ(rows[static_cast<size_t>(k)].nodes, std::vector<int>{2 * (k + 2)});
   }
 }

@@ -1038,3 +1038,34 @@ TEST(JobErrors, ControlCharactersInNamesAreRefusedAtTheirPointer) {
   job["bodies"][0]["boundary"][1]["edge"] = "top\x1b";
   expect_only_error(parse(job), "/bodies/0/boundary/1/edge", "the body has no edge 'top\\u001B'");
 }
+
+// "output": which steps' fields the result keeps (issue 23, item 3). The default follows the job: the last step
+// of an adaptive run, every load step otherwise; the normalized copy says which.
+TEST(JobOutput, StepsDefaultToLastForAdaptiveJobsAndAllOtherwiseAndBadValuesAreNamed) {
+  json job = small_job();
+  ParseResult r = parse(job);
+  ASSERT_TRUE(r.ok()) << listing(r);
+  EXPECT_EQ(r.problem->output.steps, contact::StepOutput::all);
+  EXPECT_EQ(r.problem->normalized["output"], json({{"steps", "all"}}));
+  job["adaptivity"] = json::object();
+  r = parse(job);
+  ASSERT_TRUE(r.ok()) << listing(r);
+  EXPECT_EQ(r.problem->output.steps, contact::StepOutput::last);
+  EXPECT_EQ(r.problem->normalized["output"], json({{"steps", "last"}}));
+  job["output"] = {{"steps", "all"}};
+  r = parse(job);
+  ASSERT_TRUE(r.ok()) << listing(r);
+  EXPECT_EQ(r.problem->output.steps, contact::StepOutput::all);
+  json steps = small_job();
+  steps["loading"] = {{"steps", 3}};
+  steps["output"] = {{"steps", "last"}};
+  r = parse(steps);
+  ASSERT_TRUE(r.ok()) << listing(r);
+  EXPECT_EQ(r.problem->output.steps, contact::StepOutput::last);
+  steps["output"] = {{"steps", "first"}};
+  expect_only_error(parse(steps), "/output/steps", "steps \"first\" is not one of \"last\" and \"all\"");
+  steps["output"] = {{"fields", "all"}};
+  expect_only_error(parse(steps), "/output/fields", "fields");
+  steps["output"] = "last";
+  expect_only_error(parse(steps), "/output", "object");
+}

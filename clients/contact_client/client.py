@@ -4,6 +4,7 @@ file of the announced length. Anything else is a ClientError with one line sayin
 import http.client
 import json
 import os
+import re
 import socket
 import sys
 import time
@@ -189,25 +190,56 @@ class Client:
 
     @staticmethod
     def _with_meshes(doc, directory):
-        """The job serialised with every {"gmsh": {"file": f}} of its bodies as {"gmsh": {"data": <f's text>}}
-        (f relative to `directory`); None when it names no mesh file."""
-        bodies = doc.get("bodies") if isinstance(doc, dict) else None
-        if not isinstance(bodies, list):  # {"bodies": 3}: sent as it is, for the server to name /bodies
+        """The job serialised with its Gmsh mesh files put in as text, each file once (the server reads no files,
+        and a file sent once per body can overflow its request limit): an entry of the job's "meshes" table given
+        by "file" gets the file's text as "data", and a body's {"gmsh": {"file": f, ...}} becomes
+        {"gmsh": {"mesh": name, ...}} with f's text in the table under name (one entry per distinct file). Files
+        are read relative to `directory`, as contact-solve reads them. None when the job names no mesh file."""
+        if not isinstance(doc, dict) or not isinstance(doc.get("meshes", {}), dict):
+            return None  # {"meshes": 3}: sent as it is, for the server to name /meshes
+        table = doc.get("meshes", {})
+        bodies = doc.get("bodies") if isinstance(doc.get("bodies"), list) else []
+        by_file = [b["mesh"]["gmsh"] for b in bodies if isinstance(b, dict) and isinstance(b.get("mesh"), dict)
+                   and isinstance(b["mesh"].get("gmsh"), dict) and isinstance(b["mesh"]["gmsh"].get("file"), str)
+                   and not {"data", "mesh"} & set(b["mesh"]["gmsh"])]  # several: left for the server to refuse
+        entries = {name: e for name, e in table.items()
+                   if isinstance(e, dict) and isinstance(e.get("file"), str) and "data" not in e}
+        if not by_file and not entries:
             return None
-        meshes = [b["mesh"]["gmsh"] for b in bodies if isinstance(b, dict) and isinstance(b.get("mesh"), dict)
-                  and isinstance(b["mesh"].get("gmsh"), dict) and isinstance(b["mesh"]["gmsh"].get("file"), str)
-                  and "data" not in b["mesh"]["gmsh"]]  # both: left for the server to refuse
-        for gmsh in meshes:
-            path = os.path.join(directory, gmsh["file"])
+        names = {}  # the file's path -> its entry's name
+
+        def put(name, entry):
+            path = os.path.normpath(os.path.join(directory, entry.pop("file")))
             try:
                 with open(path, encoding="utf-8") as f:
-                    text = f.read()
+                    entry["data"] = f.read()
             except (OSError, UnicodeDecodeError) as exc:
                 raise BadInput(f"cannot read the Gmsh mesh {path}: {getattr(exc, 'strerror', None) or exc}") from None
+            names.setdefault(path, name)
+
+        for name, entry in entries.items():
+            put(name, entry)
+        for gmsh in by_file:
+            path = os.path.normpath(os.path.join(directory, gmsh["file"]))
+            if path not in names:
+                name = Client._mesh_name(gmsh["file"], table)
+                table[name] = {"file": gmsh["file"]}
+                put(name, table[name])
             rest = {k: v for k, v in gmsh.items() if k != "file"}
             gmsh.clear()
-            gmsh.update({"data": text, **rest})
-        return json.dumps(doc).encode() if meshes else None
+            gmsh.update({"mesh": names[path], **rest})
+        doc["meshes"] = table
+        return json.dumps(doc).encode()
+
+    @staticmethod
+    def _mesh_name(file, table):
+        """A name for the file in the job's "meshes" table: its base name without extension made a valid name
+        (letters, digits, '_', '-'), numbered if the table has it already."""
+        base = re.sub(r"[^A-Za-z0-9_-]", "_", os.path.splitext(os.path.basename(file))[0])[:56] or "mesh"
+        name, k = base, 2
+        while name in table:
+            name, k = f"{base}_{k}", k + 1
+        return name
 
     @staticmethod
     def _check_id(job_id):

@@ -211,7 +211,7 @@ ddm::MethodOutcome solve_step(ddm::ContactSystem& system, const Problem& working
 
 // Solve, estimate, report the step, and stop (stop test, max_steps, nothing refinable, cancellation) or refine.
 ddm::MethodOutcome converge_then_refine(Problem& working, ddm::ContactSystem& system, ddm::RunContext& context,
-                                        ddm::ContactMethod& method, std::vector<Step>& steps, int& updates) {
+                                        ddm::ContactMethod& method, ddm::StepLog& steps, int& updates) {
   const auto& s = working.adaptivity;
   ddm::MethodOutcome total;
   std::vector<int> refined_last;
@@ -276,7 +276,7 @@ ddm::MethodOutcome converge_then_refine(Problem& working, ddm::ContactSystem& sy
 
 // The paper's interleaving: one Neumann update, then estimate and refine, every iteration.
 ddm::MethodOutcome paper_interleaving(Problem& working, ddm::ContactSystem& system, ddm::RunContext& context,
-                                      std::vector<Step>& steps) {
+                                      ddm::StepLog& steps) {
   const SolverSettings& settings = working.solver;
   ddm::MethodOutcome out;
   const size_t n = working.bodies.size();
@@ -371,7 +371,7 @@ ddm::MethodOutcome paper_interleaving(Problem& working, ddm::ContactSystem& syst
 }  // namespace
 
 ddm::MethodOutcome run_adaptive(Problem& working, ddm::ContactSystem& system, ddm::RunContext& context,
-                                ddm::ContactMethod& method, std::vector<Step>& steps, int& updates) {
+                                ddm::ContactMethod& method, ddm::StepLog& steps, int& updates) {
   updates = 0;
   if (working.adaptivity.strategy == AdaptStrategy::paper) return paper_interleaving(working, system, context, steps);
   return converge_then_refine(working, system, context, method, steps, updates);

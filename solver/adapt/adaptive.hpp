@@ -8,12 +8,13 @@
 #pragma once
 
 #include "../ddm/driver.hpp"
+#include "../ddm/step_log.hpp"
 #include "contact/result.hpp"
 
 namespace contact::adapt {
 
 // `working` is the problem the system was built from; its meshes are refined in place.
 ddm::MethodOutcome run_adaptive(Problem& working, ddm::ContactSystem& system, ddm::RunContext& context,
-                                ddm::ContactMethod& method, std::vector<Step>& steps, int& updates);
+                                ddm::ContactMethod& method, ddm::StepLog& steps, int& updates);
 
 }  // namespace contact::adapt

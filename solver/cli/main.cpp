@@ -241,7 +241,7 @@ int solve_and_write(contact::cli::Session& session, contact::Problem& problem, c
       std::printf("wrote %s and %s (in ParaView, open %s with the Xdmf3 Reader)\n", output.c_str(),
                   xmf.string().c_str(), xmf.string().c_str());
     summary["result_written"] = true;
-    for (const auto& step : result.steps) summary["steps"].push_back(contact::io::step_json(step));
+    for (const auto& step : result.step_history) summary["steps"].push_back(contact::io::step_json(step));
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
     summary["message"] = std::string("cannot write the result file: ") + e.what();

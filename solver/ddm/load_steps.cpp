@@ -4,7 +4,7 @@
 namespace contact::ddm {
 
 MethodOutcome run_load_steps(ContactSystem& system, const SolverSettings& settings, const std::vector<double>& factors,
-                             RunContext& context, ContactMethod& method, std::vector<Step>& steps, int& updates) {
+                             RunContext& context, ContactMethod& method, StepLog& steps, int& updates) {
   MethodOutcome total;
   Displacements warm;
   updates = 0;

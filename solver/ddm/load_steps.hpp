@@ -2,14 +2,16 @@
 // displacement, traction, force and body force is scaled by the step's factor (BodySolver::set_load_factor: the
 // factorisations stay), each step is solved with the chosen method starting from the previous step's answer
 // (interface Newton: its active set; the fixed-point schemes: its displacements), and each step's fields become
-// one result Step with its factor. The iteration reports run on across the steps.
+// one result Step with its factor, recorded in `steps` (which keeps all or the last, StepLog). The iteration
+// reports run on across the steps.
 #pragma once
 
 #include "driver.hpp"
+#include "step_log.hpp"
 
 namespace contact::ddm {
 
 MethodOutcome run_load_steps(ContactSystem& system, const SolverSettings& settings, const std::vector<double>& factors,
-                             RunContext& context, ContactMethod& method, std::vector<Step>& steps, int& updates);
+                             RunContext& context, ContactMethod& method, StepLog& steps, int& updates);
 
 }  // namespace contact::ddm

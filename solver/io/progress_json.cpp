@@ -46,10 +46,10 @@ nlohmann::json iteration_json(const IterationReport& report, bool with_profiles)
   return j;
 }
 
-nlohmann::json step_json(const Step& step) {
+nlohmann::json step_json(const StepSummary& step) {
   nlohmann::json bodies = nlohmann::json::array();
-  for (const auto& b : step.bodies)
-    bodies.push_back({{"name", b.name}, {"elements", b.mesh.num_cells()}, {"nodes", b.mesh.num_nodes()}});
+  for (size_t b = 0; b < step.body_names.size(); ++b)
+    bodies.push_back({{"name", step.body_names[b]}, {"elements", step.elements[b]}, {"nodes", step.nodes[b]}});
   return {{"step", step.index}, {"iteration", step.iteration}, {"bodies", bodies}};
 }
 

@@ -221,7 +221,7 @@ void read_steps(hid_t file, ResultFile& r) {
   for (int k = 0; k < count; ++k) {
     Handle g = h5::open_group(steps, std::to_string(k));
     Step s;
-    s.index = k;
+    s.index = h5::has_attribute(g, "step") ? h5::read_attribute<std::int32_t>(g, "step") : k;  // its history row
     s.iteration = h5::read_attribute<std::int32_t>(g, "iteration");
     s.load_factor = h5::read_attribute<double>(g, "load_factor");
     Handle bodies = h5::open_group(g, "bodies");

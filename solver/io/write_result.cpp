@@ -1,7 +1,6 @@
 // write_result: Result -> HDF5 file in the layout of docs/results-format.md.
 #include "contact/result_file.hpp"
 
-#include "../contact/extent.hpp"
 #include "contact/solve.hpp"
 #include "view_layout.hpp"
 #include "file_util.hpp"
@@ -204,13 +203,19 @@ std::vector<std::string> pair_names_of(const Step& s) {
   return names;
 }
 
-void write_step_history(hid_t history, const Result& result) {
+// Every step's scalars: Result::step_history, or (a Result built without it) the steps' own.
+std::vector<StepSummary> step_rows(const Result& result) {
+  if (!result.step_history.empty()) return result.step_history;
+  std::vector<StepSummary> rows;
+  for (const Step& s : result.steps) rows.push_back(summarize(s));
+  return rows;
+}
+
+void write_step_history(hid_t history, const std::vector<StepSummary>& rows) {
   Handle g = h5::create_group(history, "steps");
-  const auto n = static_cast<Eigen::Index>(result.steps.size());
-  const std::vector<std::string> names =
-      result.steps.empty() ? std::vector<std::string>{} : body_names_of(result.steps.front());
-  const std::vector<std::string> pairs =
-      result.steps.empty() ? std::vector<std::string>{} : pair_names_of(result.steps.front());
+  const auto n = static_cast<Eigen::Index>(rows.size());
+  const std::vector<std::string> names = rows.empty() ? std::vector<std::string>{} : rows.front().body_names;
+  const std::vector<std::string> pairs = rows.empty() ? std::vector<std::string>{} : rows.front().pair_names;
   const auto nb = static_cast<Eigen::Index>(names.size());
   const auto np = static_cast<Eigen::Index>(pairs.size());
   std::vector<std::int32_t> step, iteration;
@@ -218,27 +223,23 @@ void write_step_history(hid_t history, const Result& result) {
   Eigen::MatrixXi elements(n, nb), dofs(n, nb);
   Eigen::MatrixXd force(n, np), contact_begin(n, np), contact_end(n, np), tangential_force(n, np);
   for (Eigen::Index k = 0; k < n; ++k) {
-    const Step& s = result.steps[static_cast<size_t>(k)];
-    if (body_names_of(s) != names)
+    const StepSummary& s = rows[static_cast<size_t>(k)];
+    if (s.body_names != names)
       throw std::runtime_error("step " + rows_text(k) + " does not have the bodies of step 0 in the same order");
-    if (pair_names_of(s) != pairs)
+    if (s.pair_names != pairs)
       throw std::runtime_error("step " + rows_text(k) + " does not have the pairs of step 0 in the same order");
     step.push_back(static_cast<std::int32_t>(k));
     iteration.push_back(s.iteration);
     load_factor.push_back(s.load_factor);
     for (Eigen::Index b = 0; b < nb; ++b) {
-      const mesh::Mesh& m = s.bodies[static_cast<size_t>(b)].mesh;
-      elements(k, b) = m.num_cells();
-      dofs(k, b) = 2 * m.num_nodes();
+      elements(k, b) = s.elements[static_cast<size_t>(b)];
+      dofs(k, b) = 2 * s.nodes[static_cast<size_t>(b)];
     }
     for (Eigen::Index p = 0; p < np; ++p) {
-      const PairField& pair = s.pairs[static_cast<size_t>(p)];
-      force(k, p) = pair.force;
-      tangential_force(k, p) = pair.tangential_force;  // 0 for a frictionless pair
-      // The contact zone along the slave edge, interpolated between nodes (contact/extent.hpp; 0, 0 if none).
-      const mortar::ContactExtent extent = mortar::contact_extent(pair.arc_length, pair.pressure);
-      contact_begin(k, p) = extent.begin;
-      contact_end(k, p) = extent.end;
+      force(k, p) = s.force[static_cast<size_t>(p)];
+      tangential_force(k, p) = s.tangential_force[static_cast<size_t>(p)];  // 0 for a frictionless pair
+      contact_begin(k, p) = s.contact_begin[static_cast<size_t>(p)];
+      contact_end(k, p) = s.contact_end[static_cast<size_t>(p)];
     }
   }
   h5::write_attribute(g, "body_names", names);
@@ -384,13 +385,19 @@ void write_pair(hid_t contacts, const PairField& p, const std::string& where) {
   write_matrix(g, "segments", segments);
 }
 
-void write_steps(hid_t file, const Result& result) {
+// The steps whose fields were kept: every step, or the last ones (output.steps "last": one). Each group's `step`
+// is its row in /history/steps.
+void write_steps(hid_t file, const Result& result, std::size_t history_rows) {
   Handle steps = h5::create_group(file, "steps");
   h5::write_attribute<std::int32_t>(steps, "count", static_cast<std::int32_t>(result.steps.size()));
+  if (result.steps.size() > history_rows)
+    throw std::runtime_error(std::to_string(result.steps.size()) + " steps kept, more than the " +
+                             std::to_string(history_rows) + " rows of the step history");
   for (size_t k = 0; k < result.steps.size(); ++k) {
     const Step& s = result.steps[k];
     const std::string where = "step " + std::to_string(k);
     Handle g = h5::create_group(steps, std::to_string(k));
+    h5::write_attribute<std::int32_t>(g, "step", static_cast<std::int32_t>(history_rows - result.steps.size() + k));
     h5::write_attribute<std::int32_t>(g, "iteration", s.iteration);
     h5::write_attribute<double>(g, "load_factor", s.load_factor);
     h5::write_attribute(g, "body_names", body_names_of(s));
@@ -406,12 +413,13 @@ void write_contents(hid_t file, const Problem& problem, const Result& result, co
   write_root_attributes(file, problem, result, info);
   write_input(file, problem);
   write_provenance(file, result, info);
+  const std::vector<StepSummary> rows = step_rows(result);
   {
     Handle history = h5::create_group(file, "history");
     write_iteration_history(history, problem, result);
-    write_step_history(history, result);
+    write_step_history(history, rows);
   }
-  write_steps(file, result);
+  write_steps(file, result, rows.size());
   if (!result.steps.empty()) write_vtkhdf(file, result.steps.back());
 }
 

@@ -43,6 +43,14 @@ std::string read_bytes(const fs::path& path, std::size_t max_bytes, std::string&
   return text;
 }
 
+// The normalized copy of an object holding a mesh text as "data": the text is in the submitted job already, so
+// the copy (stored with it in the result file, answered by validation) gives only its size.
+void leave_out_data(json& out, const std::string& text) {
+  if (!out.is_object() || !out.contains("data")) return;
+  out.erase("data");
+  out["data_bytes"] = text.size();
+}
+
 }  // namespace
 
 std::unique_ptr<GmshMeshes::Parsed> GmshMeshes::parse(const std::string& text) const {
@@ -85,70 +93,143 @@ const GmshMeshes::Parsed& GmshMeshes::parse_data(const std::string& text) {
   return *data_.emplace(hash, std::move(parsed))->second;
 }
 
-std::optional<GmshBody> GmshMeshes::read(const json& value, const std::string& pointer, read::Errors& errors) {
+void GmshMeshes::read_table(const json& value, const std::string& pointer, read::Errors& errors, json& out) {
+  table_given_ = true;
+  if (!value.is_object()) {
+    errors.add(pointer, "meshes must be an object {\"name\": {\"file\": ...} or {\"data\": ...}, ...}, got " +
+                            read::type_name(value));
+    return;
+  }
+  for (const auto& item : value.items()) {
+    const std::string p = read::child(pointer, item.key());
+    if (auto problem = read::name_problem(item.key(), "mesh name", limits_.max_name_length, false)) {
+      errors.add(p, *problem);  // not an entry: a body that names it is told the names there are
+      continue;
+    }
+    TableEntry& entry = table_[item.key()];
+    entry.pointer = p;
+    const size_t before = errors.size();
+    read::Fields f(item.value(), p, "a mesh", {"file", "data"}, errors);
+    if (!f.ok() || errors.size() != before) continue;
+    if (f.has("file") == f.has("data")) {
+      errors.add(p, "give exactly one of file (the .msh file's path, relative to the job file) or data (the .msh "
+                    "file's text)");
+      continue;
+    }
+    const std::string key = f.has("file") ? "file" : "data";
+    if (!read::string(*f.find(key), f.at(key), key, errors)) continue;
+    entry.source = Source{key == "file", &f.find(key)->get_ref<const std::string&>()};
+    if (out.is_object() && out.contains(item.key())) leave_out_data(out[item.key()], *entry.source->text);
+  }
+}
+
+void GmshMeshes::check_table_used(read::Errors& errors) const {
+  for (const auto& [name, entry] : table_)
+    if (!entry.used)
+      errors.add(entry.pointer, "mesh '" + read::shown(name) + "' is used by no body (a body uses it as {\"gmsh\": "
+                                "{\"mesh\": \"" + read::shown(name) + "\", \"surface\": ...}}); remove it or use it");
+}
+
+const GmshMeshes::Parsed* GmshMeshes::resolve(const Source& source, const std::string& pointer, read::Errors& errors,
+                                              std::string& label) {
+  const std::string& text = *source.text;
+  if (!source.file) {
+    const Parsed* parsed = &parse_data(text);
+    if (!parsed->error.empty()) {
+      errors.add(pointer, "the mesh data (MSH text): " + parsed->error);
+      return nullptr;
+    }
+    label = "data";
+    return parsed;
+  }
+  if (!limits_.mesh_directory) {
+    errors.add(pointer, "a gmsh mesh cannot be read from a file here: the server reads no files for a job; send the "
+                        ".msh file's text as \"data\" instead of \"file\"");
+    return nullptr;
+  }
+  if (text.empty()) {
+    errors.add(pointer, "file must name a .msh file, got an empty string");
+    return nullptr;
+  }
+  const fs::path given(text);
+  const fs::path path = (given.is_absolute() ? given : fs::path(*limits_.mesh_directory) / given).lexically_normal();
+  const Parsed* parsed = &parse_file(path.string());
+  label = "'" + read::shown(text) + "'";
+  if (!parsed->error.empty()) {
+    const std::string resolved = path.string() != text ? " (" + read::shown(path.string()) + ")" : "";
+    errors.add(pointer, "the mesh file " + label + resolved + (parsed->unreadable ? " " : ": ") + parsed->error);
+    return nullptr;
+  }
+  return parsed;
+}
+
+const GmshMeshes::Parsed* GmshMeshes::from_table(const std::string& name, const std::string& pointer,
+                                                 read::Errors& errors, std::string& label) {
+  auto it = table_.find(name);
+  if (it == table_.end()) {
+    std::vector<std::string> names;
+    for (const auto& [known, entry] : table_) names.push_back("'" + read::shown(known) + "'");
+    std::string known = "its meshes are " + read::join_names(names);
+    if (names.empty())
+      known = table_given_ ? "the table has no entry that could be read (see /meshes)"
+                           : "it has no \"meshes\" table (give {\"meshes\": {\"" + read::shown(name) +
+                                 "\": {\"data\": ...}}} at the top level)";
+    errors.add(pointer, "the job has no mesh '" + read::shown(name) + "' in its \"meshes\" table; " + known);
+    return nullptr;
+  }
+  TableEntry& entry = it->second;
+  entry.used = true;
+  if (!entry.source) return nullptr;  // its fields are bad: reported at /meshes/<name>
+  if (!entry.resolved) {
+    // Its problems are the entry's: reported once, at its field, however many bodies use it.
+    entry.parsed = resolve(*entry.source, read::child(entry.pointer, entry.source->file ? "file" : "data"), errors,
+                           entry.label);
+    entry.resolved = true;
+    if (!entry.source->file) entry.label = "'" + read::shown(name) + "'";
+  }
+  label = entry.label;
+  return entry.parsed;
+}
+
+std::optional<GmshBody> GmshMeshes::read(const json& value, const std::string& pointer, read::Errors& errors,
+                                         json& out) {
   const size_t before = errors.size();
-  read::Fields f(value, pointer, "gmsh", {"file", "data", "surface"}, errors);
+  read::Fields f(value, pointer, "gmsh", {"file", "data", "mesh", "surface"}, errors);
   if (!f.ok()) return std::nullopt;
   std::optional<std::string> surface;
   if (const json* s = f.require("surface", "the name of the physical surface that is this body"))
     surface = read::string(*s, f.at("surface"), "surface", errors);
   if (surface)
     if (auto problem = read::control_character_problem(*surface, "surface")) errors.add(f.at("surface"), *problem);
-  if (f.has("file") == f.has("data")) {
-    errors.add(pointer, "give exactly one of file (the .msh file's path, relative to the job file) or data (the "
-                        ".msh file's text)");
+  if (f.has("file") + f.has("data") + f.has("mesh") != 1) {
+    errors.add(pointer, "give exactly one of mesh (the name of an entry of the job's \"meshes\" table), file (the "
+                        ".msh file's path, relative to the job file) or data (the .msh file's text)");
     return std::nullopt;
   }
-  const std::string source_pointer = f.at(f.has("file") ? "file" : "data");
-  const auto text = read::string(*f.find(f.has("file") ? "file" : "data"), source_pointer,
-                                 f.has("file") ? "file" : "data", errors);
+  const std::string key = f.has("mesh") ? "mesh" : f.has("file") ? "file" : "data";
+  const auto text = read::string(*f.find(key), f.at(key), key, errors);
   if (!text || !surface || errors.size() != before) return std::nullopt;
 
-  const Parsed* parsed = nullptr;
-  std::string source;  // names the mesh in messages
-  if (f.has("file")) {
-    if (!limits_.mesh_directory) {
-      errors.add(source_pointer,
-                 "a gmsh mesh cannot be read from a file here: the server reads no files for a job; send the .msh "
-                 "file's text as \"data\" instead of \"file\"");
-      return std::nullopt;
-    }
-    if (text->empty()) {
-      errors.add(source_pointer, "file must name a .msh file, got an empty string");
-      return std::nullopt;
-    }
-    const fs::path given(*text);
-    const fs::path path = (given.is_absolute() ? given : fs::path(*limits_.mesh_directory) / given).lexically_normal();
-    parsed = &parse_file(path.string());
-    source = "'" + read::shown(*text) + "'";
-    if (!parsed->error.empty()) {
-      errors.add(source_pointer, "the mesh file " + source +
-                                     (path.string() != *text ? " (" + read::shown(path.string()) + ")" : "") +
-                                     (parsed->unreadable ? " " : ": ") + parsed->error);
-      return std::nullopt;
-    }
-  } else {
-    // The job's own string (text is a copy): the cache refers to it, and the job outlives the parse.
-    parsed = &parse_data(f.find("data")->get_ref<const std::string&>());
-    source = "data";
-    if (!parsed->error.empty()) {
-      errors.add(source_pointer, "the mesh data (MSH text): " + parsed->error);
-      return std::nullopt;
-    }
-  }
+  // The job's own string (text is a copy): the cache refers to it, and the job outlives the parse.
+  const std::string& given = f.find(key)->get_ref<const std::string&>();
+  std::string label;  // names the mesh in messages
+  const Parsed* parsed = key == "mesh" ? from_table(given, f.at(key), errors, label)
+                                       : resolve(Source{key == "file", &given}, f.at(key), errors, label);
+  if (key == "data") leave_out_data(out, given);
+  if (!parsed) return std::nullopt;
   mesh::gmsh::Surface s = mesh::gmsh::surface(parsed->file, *surface);
   if (!s.errors.empty()) {
-    for (const auto& e : s.errors) errors.add(s.found ? pointer : f.at("surface"), "the mesh " + source + ": " + e);
+    for (const auto& e : s.errors) errors.add(s.found ? pointer : f.at("surface"), "the mesh " + label + ": " + e);
     return std::nullopt;
   }
-  GmshBody out;
-  out.mesh = std::move(s.mesh);
-  out.edges = std::move(s.edges);
-  out.elsewhere = std::move(s.elsewhere);
-  out.vertices = std::move(s.vertices);
-  out.points_elsewhere = std::move(s.points_elsewhere);
-  out.surface = *surface;
-  return out;
+  GmshBody body;
+  body.mesh = std::move(s.mesh);
+  body.edges = std::move(s.edges);
+  body.elsewhere = std::move(s.elsewhere);
+  body.vertices = std::move(s.vertices);
+  body.points_elsewhere = std::move(s.points_elsewhere);
+  body.surface = *surface;
+  return body;
 }
 
 }  // namespace contact::job

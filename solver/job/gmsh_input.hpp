@@ -1,5 +1,7 @@
-// A body's Gmsh mesh in a job: {"gmsh": {"file": "model.msh" | "data": "<the file's text>", "surface": "name"}}.
-// Private to the job module (read_meshes.cpp calls it; the rest of the body is read by read_bodies.cpp).
+// A body's Gmsh mesh in a job: {"gmsh": {"file": "model.msh" | "data": "<the file's text>" | "mesh": "name",
+// "surface": "name"}}, where "mesh" names an entry of the job's table {"meshes": {"name": {"file": ...} |
+// {"data": ...}}} (each file's text given once however many bodies it has). Private to the job module
+// (read_meshes.cpp calls it; the rest of the body is read by read_bodies.cpp).
 #pragma once
 
 #include "../mesh/gmsh.hpp"
@@ -33,7 +35,17 @@ class GmshMeshes {
   // Reads the "gmsh" object at `pointer` (a body's /mesh/gmsh) and builds the surface's mesh; nullopt after
   // reporting every problem at its pointer: the fields, a file that cannot be read or is not allowed (no
   // Limits::mesh_directory: the server), the MSH text (with its line), the surface and its curves.
-  std::optional<GmshBody> read(const nlohmann::json& value, const std::string& pointer, read::Errors& errors);
+  // `out` is the object's normalized copy: a "data" text is left out of it (it is in the submitted job), its size
+  // given as "data_bytes".
+  std::optional<GmshBody> read(const nlohmann::json& value, const std::string& pointer, read::Errors& errors,
+                               nlohmann::json& out);
+
+  // Reads the job's "meshes" table at `pointer` (before the bodies): each entry's name and its one field, file
+  // or data; the text is parsed when a body first uses the entry. `out` is the table's normalized copy.
+  void read_table(const nlohmann::json& value, const std::string& pointer, read::Errors& errors,
+                  nlohmann::json& out);
+  // After the bodies: an entry that no body used is an error at its pointer.
+  void check_table_used(read::Errors& errors) const;
 
  private:
   struct Parsed {
@@ -46,9 +58,32 @@ class GmshMeshes {
   const Parsed& parse_data(const std::string& text);  // text: a string of the job, kept by reference
   std::unique_ptr<Parsed> parse(const std::string& text) const;
 
+  // The MSH text a body's mesh comes from, parsed; nullptr after reporting why not (at `pointer`, the file or
+  // data field). `label` names the mesh in later messages.
+  struct Source {
+    bool file = false;
+    const std::string* text = nullptr;  // the path or the data, a string of the job
+  };
+  const Parsed* resolve(const Source& source, const std::string& pointer, read::Errors& errors, std::string& label);
+  // The table entry `name` at `pointer` (the body's /mesh/gmsh/mesh); nullptr after reporting an unknown name, or
+  // when the entry's own problem is reported at /meshes/<name>.
+  const Parsed* from_table(const std::string& name, const std::string& pointer, read::Errors& errors,
+                           std::string& label);
+
+  struct TableEntry {
+    std::string pointer;       // /meshes/<name>
+    std::optional<Source> source;  // unset when the entry's fields are bad (reported at its pointer)
+    bool used = false;
+    bool resolved = false;
+    const Parsed* parsed = nullptr;  // once resolved: nullptr if its problem was reported
+    std::string label;
+  };
+
   const Limits& limits_;
   std::map<std::string, std::unique_ptr<Parsed>> files_;             // by resolved path
   std::multimap<std::size_t, std::unique_ptr<Parsed>> data_;         // by the hash of the text
+  std::map<std::string, TableEntry> table_;                          // the job's "meshes", by name
+  bool table_given_ = false;                                         // the job has "meshes" (maybe malformed)
 };
 
 }  // namespace contact::job

@@ -29,15 +29,21 @@ void set_default(json& object, const std::string& key, json value) {
 
 ParseResult JobReader::run() {
   Fields top(job_, "", "the job",
-             {"name", "version", "model", "bodies", "contacts", "solver", "adaptivity", "loading", "parallel"}, errors_);
+             {"name", "version", "model", "meshes", "bodies", "contacts", "solver", "adaptivity", "loading", "parallel",
+              "output"},
+             errors_);
   if (!top.ok()) return finish();
   read_header(top);
   read_model(top);
+  if (const json* m = top.find("meshes"))
+    gmsh_.read_table(*m, top.at("meshes"), errors_, sub_object(normalized_, "meshes"));
   read_bodies(top);
+  if (!inputs_.empty()) gmsh_.check_table_used(errors_);  // not when the bodies could not be read at all
   read_contacts(top);
   read_solver(top);
   if (const json* a = top.find("adaptivity")) read_adaptivity(*a, top.at("adaptivity"));
   read_loading(top);
+  read_output(top);
   read_parallel(top);
   resolve_method_defaults();
   check_friction_and_histories();

@@ -98,7 +98,7 @@ class JobReader {
   json& element(json& array, size_t index);
   json& discard();
 
-  // read_options.cpp: solver, adaptivity, loading, parallel
+  // read_options.cpp: solver, adaptivity, loading, parallel, output
   void read_solver(const Fields& top);
   void resolve_method_defaults();
   void read_adaptivity(const json& value, const std::string& pointer);
@@ -108,6 +108,7 @@ class JobReader {
   void read_penalty(const json& value, const std::string& pointer, json& out);
   void read_parallel(const Fields& top);
   void read_loading(const Fields& top);
+  void read_output(const Fields& top);
 
   // read_bodies.cpp: bodies, materials, boundary conditions; the checks on the built bodies
   void read_bodies(const Fields& top);
@@ -121,7 +122,7 @@ class JobReader {
   // read_meshes.cpp: blocks and their curves, explicit arrays, Gmsh surfaces; building and checking the meshes
   void read_mesh(const json& value, const std::string& pointer, MeshInput& m, json& out);
   void read_block(const json& value, const std::string& pointer, MeshInput& m);
-  void read_gmsh(const json& value, const std::string& pointer, MeshInput& m);
+  void read_gmsh(const json& value, const std::string& pointer, MeshInput& m, json& out);
   std::optional<long long> read_count(const json& value, const std::string& pointer, const std::string& what);
   void read_curve(const json& value, const std::string& pointer, const std::string& edge, MeshInput& m);
   void read_arrays(const json& value, const std::string& pointer, MeshInput& m, json& out);

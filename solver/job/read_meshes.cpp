@@ -45,7 +45,7 @@ void JobReader::read_mesh(const json& value, const std::string& pointer, MeshInp
       errors_.add(pointer, "give either a gmsh mesh, a block or explicit nodes and quads, not several");
       return;
     }
-    read_gmsh(value.at("gmsh"), child(pointer, "gmsh"), m);
+    read_gmsh(value.at("gmsh"), child(pointer, "gmsh"), m, sub_object(out, "gmsh"));
     return;
   }
   const bool block = value.contains("block");
@@ -165,10 +165,10 @@ void JobReader::read_block(const json& value, const std::string& pointer, MeshIn
 
 // {"gmsh": {...}}: the file (or data) is read and the surface's mesh built here, so that its edge names are
 // known to the boundary conditions and contacts; its size counts in the limit like any other mesh's.
-void JobReader::read_gmsh(const json& value, const std::string& pointer, MeshInput& m) {
+void JobReader::read_gmsh(const json& value, const std::string& pointer, MeshInput& m, json& out) {
   m.kind = MeshInput::Kind::gmsh;
   const size_t before = errors_.size();
-  m.gmsh = gmsh_.read(value, pointer, errors_);
+  m.gmsh = gmsh_.read(value, pointer, errors_, out);
   if (!m.gmsh) return;
   for (const auto& name : m.gmsh->edges)
     if (auto problem = name_problem(name, "physical curve name", limits_.max_name_length, false))

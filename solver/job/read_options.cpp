@@ -1,5 +1,5 @@
 // The job's settings: "solver" (with the method and enforcement defaults, which depend on the adaptive strategy),
-// "adaptivity", "loading" and "parallel".
+// "adaptivity", "loading", "parallel" and "output" (its default depends on adaptivity).
 #include "job_reader.hpp"
 
 #include <algorithm>
@@ -356,6 +356,21 @@ void JobReader::read_loading(const Fields& top) {
     errors_.add(pointer, "load steps and adaptivity together are not supported: refine for one load, or step a "
                          "fixed mesh");
   problem_.loading.factors = std::move(factors);
+}
+
+// {"steps": "last" | "all"}: which steps' fields the result keeps. The default depends on the job (after
+// adaptivity was read): an adaptive run's steps are ever finer meshes on the way to the answer, each about as large
+// as the last, so only the last is kept; load steps are answers to different loads, kept all.
+void JobReader::read_output(const Fields& top) {
+  json& out = sub_object(normalized_, "output");
+  problem_.output.steps = problem_.adaptivity.enabled ? StepOutput::last : StepOutput::all;
+  if (const json* v = top.find("output")) {
+    Fields f(*v, top.at("output"), "output", {"steps"}, errors_);
+    if (const json* s = f.find("steps"))
+      if (auto c = choice(*s, f.at("steps"), "steps", {"last", "all"}, errors_))
+        problem_.output.steps = *c == "last" ? StepOutput::last : StepOutput::all;
+  }
+  set_default(out, "steps", problem_.output.steps == StepOutput::last ? "last" : "all");
 }
 
 }  // namespace contact::job::detail

@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """An adaptive run's result file: every adaptive step's meshes with refinement level and indicator per cell,
-the step history, the XDMF sidecar stepping through them, and the VTKHDF view of the final step.
+the step history, the XDMF sidecar stepping through them, and the VTKHDF view of the final step; and with the
+default output of an adaptive job ("steps": "last"), the last step's fields alone with the whole step history.
 Standard library plus Debian's python3-h5py and python3-numpy; exits non-zero on any failure."""
+import json
 import os
 import subprocess
 import sys
@@ -63,6 +65,29 @@ with tempfile.TemporaryDirectory() as tmp:
         check("the sidecar has one time per step", len(times) >= len(steps), f"{len(times)} times, {len(steps)} steps")
         check("the sidecar references every step's meshes",
               all(f"/steps/{k}/bodies/lower/quads" in text for k in steps))
+
+    # The same job with its output left to the default of an adaptive job: the last step's fields only, the
+    # same numbers, and the history of every step.
+    with open(os.path.join(SRC, "api", "examples", "seed_layers_adaptive.json")) as f:
+        job = json.load(f)
+    del job["output"]
+    path, last_out = os.path.join(tmp, "last.json"), os.path.join(tmp, "last.hdf")
+    with open(path, "w") as f:
+        json.dump(job, f)
+    r = subprocess.run([os.path.join(BIN, "contact-solve"), path, "-o", last_out, "-q"], capture_output=True, text=True,
+                       timeout=300)
+    check("the adaptive example with the default output converges", r.returncode == 0, r.stdout[-500:] + r.stderr)
+    with h5py.File(out, "r") as every, h5py.File(last_out, "r") as last:
+        check("the default keeps one step's fields", list(last["steps"].keys()) == ["0"]
+              and last["steps"].attrs["count"] == 1, list(last["steps"].keys()))
+        check("it is the last step, by its history row", int(last["steps/0"].attrs["step"]) == len(steps) - 1,
+              last["steps/0"].attrs.get("step"))
+        for name in ("step", "elements", "dofs", "force", "contact_end"):
+            check(f"/history/steps/{name} covers every step, as with every step kept",
+                  np.array_equal(last["history/steps"][name][()], every["history/steps"][name][()]), name)
+        for path_in in ("bodies/lower/points", "bodies/lower/displacement", "contacts/upper.bottom-lower.top/pressure"):
+            check(f"its {path_in} is the last step's", np.array_equal(last["steps/0/" + path_in][()],
+                                                                      every[f"steps/{steps[-1]}/" + path_in][()]))
 
 print(f"{passed} passed, {failed} failed")
 sys.exit(1 if failed else 0)

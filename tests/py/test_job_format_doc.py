@@ -206,6 +206,7 @@ def main():
                                                          "top": {"arc": {"center": [2, -10], "radius": 125 ** 0.5}}}
     block_job["solver"].update(robin={"psi": "active_set"}, augmented_lagrangian={"tolerance": 1e-6})
     block_job["adaptivity"] = {}
+    block_job["output"] = {}
     block_objects = [
         ("", "Top level", "Top level", "#"),
         ("/model", "`model`", "`model`", "#/properties/model"),
@@ -227,6 +228,7 @@ def main():
         ("/solver/robin", None, "Solver", "#/$defs/solver/properties/robin"),
         ("/solver/augmented_lagrangian", None, "Solver", "#/$defs/solver/properties/augmented_lagrangian"),
         ("/adaptivity", "Adaptivity", "Adaptivity", "#/$defs/adaptivity"),
+        ("/output", "Output", "Output", "#/properties/output"),
     ]
     explicit_job = copy.deepcopy(small)
     explicit_job["bodies"][0]["mesh"] = {"nodes": [[0, -1], [2, -1], [2, 0], [0, 0]], "quads": [[0, 1, 2, 3]],
@@ -240,10 +242,16 @@ def main():
         body["mesh"]["gmsh"]["file"] = os.path.join(EXAMPLES, body["mesh"]["gmsh"]["file"])
     gmsh_objects = [("/bodies/0/mesh/gmsh", "Gmsh mesh", "Gmsh mesh", "#/$defs/gmsh_mesh/properties/gmsh")]
     gmsh_mesh_objects = [("/bodies/0/mesh", None, "Gmsh mesh", "#/$defs/gmsh_mesh")]
+    # The same file once in the job's "meshes" table, the bodies naming the entry.
+    table_job = copy.deepcopy(gmsh_job)
+    table_job["meshes"] = {"m": {"file": gmsh_job["bodies"][0]["mesh"]["gmsh"]["file"]}}
+    for body in table_job["bodies"]:
+        body["mesh"]["gmsh"] = {"mesh": "m", "surface": body["mesh"]["gmsh"]["surface"]}
+    table_objects = [("/meshes/m", None, "Gmsh mesh", "#/properties/meshes/additionalProperties")]
 
     with tempfile.TemporaryDirectory() as tmp:
         for job, objects in ((block_job, block_objects), (explicit_job, explicit_objects), (gmsh_job, gmsh_objects),
-                             (gmsh_job, gmsh_mesh_objects)):
+                             (gmsh_job, gmsh_mesh_objects), (table_job, table_objects)):
             check("the probe job is valid", run_cli(job, tmp, "--validate").returncode == 0,
                   run_cli(job, tmp, "--validate").stderr[-600:])
             parser = parser_fields(job, [o[0] for o in objects], tmp)

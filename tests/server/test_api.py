@@ -116,14 +116,17 @@ with Server() as server, tempfile.TemporaryDirectory() as tmp:
         seed_bytes = f.read()
     check("an example is served as its file", server.get("/v1/examples/seed_layers").body == seed_bytes
           and server.get("/v1/examples/seed_layers.json").body == seed_bytes)
-    # A Gmsh example is served with its meshes in it ("data"): the server reads no files for a job.
+    # A Gmsh example is served with its mesh in it, once, in the job's "meshes" table ("data"): the server reads no
+    # files for a job, and the bodies name the entry.
     with open(os.path.join(SRC, "api", "examples", "flat_patch_gmsh.msh")) as f:
         msh = f.read()
     served = server.get("/v1/examples/flat_patch_gmsh").json()
-    check("a Gmsh example is served with its .msh text as data, not a file name",
-          served is not None and all(b["mesh"]["gmsh"] == {"data": msh, "surface": b["name"]}
-                                     for b in served["bodies"])
-          and list(served) == list(example("flat_patch_gmsh.json")), served and served["bodies"][0]["mesh"])
+    fields = list(example("flat_patch_gmsh.json"))
+    check("a Gmsh example is served with its .msh text once, in the meshes table, the bodies naming it",
+          served is not None and served.get("meshes") == {"flat_patch_gmsh": {"data": msh}}
+          and all(b["mesh"]["gmsh"] == {"mesh": "flat_patch_gmsh", "surface": b["name"]} for b in served["bodies"])
+          and list(served) == fields[:fields.index("bodies")] + ["meshes"] + fields[fields.index("bodies"):],
+          served and (list(served), served["bodies"][0]["mesh"]))
     r = server.request("POST", "/v1/validate", json_body=served)
     check("the served Gmsh example is valid on the server", r.status == 200 and r.json()["valid"] is True, r)
     r = server.request("POST", "/v1/validate", json_body=example("flat_patch_gmsh.json"))

@@ -203,6 +203,14 @@ struct LoadingSpec {
   std::vector<double> factors = {1.0};
 };
 
+// Which steps the result keeps whole (the job's "output"): every step's fields, or the last step's only. The
+// scalars of every step (Result::step_history, /history/steps) are kept either way. The job reader's default is
+// `last` for adaptive jobs and `all` otherwise (docs/job-format.md, "Output"); a Problem built in code keeps all.
+enum class StepOutput { all, last };
+struct OutputSettings {
+  StepOutput steps = StepOutput::all;
+};
+
 struct Problem {
   std::string name;
   Model model;
@@ -211,6 +219,7 @@ struct Problem {
   SolverSettings solver;
   AdaptivitySettings adaptivity;
   LoadingSpec loading;
+  OutputSettings output;
   int ranks = 1;              // parallel.ranks: MPI ranks a server launches (contact-solve takes mpirun's)
   nlohmann::json submitted;   // the job JSON as submitted
   nlohmann::json normalized;  // the same with every default filled in

@@ -12,7 +12,8 @@ namespace contact::io {
 // Every field of the report; the pressure profile of every pair (positions, pressures) only with `profiles`.
 nlohmann::json iteration_json(const IterationReport& report, bool profiles = true);
 
-// One mesh state of the result: {"step", "iteration", "bodies": [{"name", "elements", "nodes"}]}.
-nlohmann::json step_json(const Step& step);
+// One step of the result (Result::step_history: every step, whether its fields are kept or not):
+// {"step", "iteration", "bodies": [{"name", "elements", "nodes"}]}.
+nlohmann::json step_json(const StepSummary& step);
 
 }  // namespace contact::io

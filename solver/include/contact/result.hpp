@@ -140,6 +140,22 @@ struct Step {
   std::vector<PairField> pairs;
 };
 
+// The scalars of one step (a row of /history/steps), kept for every step whatever Problem::output keeps of the
+// steps' fields.
+struct StepSummary {
+  int index = 0;
+  int iteration = 0;
+  double load_factor = 1.0;
+  std::vector<std::string> body_names;
+  std::vector<int> elements, nodes;  // per body
+  std::vector<std::string> pair_names;
+  std::vector<double> force, contact_begin, contact_end;  // per pair: the total normal force, the contact zone
+  std::vector<double> tangential_force;                   // per pair: friction's (0 for a frictionless pair)
+};
+
+// The step's scalars; the contact zone interpolated between nodes (solver/contact/extent.hpp; 0, 0 if none).
+StepSummary summarize(const Step& step);
+
 struct Result {
   bool converged = false;
   StopReason stop_reason = StopReason::error;
@@ -153,7 +169,8 @@ struct Result {
   std::string interface_solver;   // interface_newton: "direct" or "iterative" (solver.interface.solver)
   long interface_iterations = 0;  // the iterative interface solver's MPRGP iterations, all solves together
   std::vector<IterationReport> history;
-  std::vector<Step> steps;  // the last one is the final solution
+  std::vector<Step> steps;  // the last one is the final solution; with StepOutput::last the only one
+  std::vector<StepSummary> step_history;  // every step's scalars, in order (solve() fills it; empty: from steps)
   double wall_seconds = 0.0;
   double setup_seconds = 0.0;       // assembly + factorisations
   double factorization_seconds = 0.0;

@@ -114,7 +114,8 @@ struct ResultFile {
   Provenance provenance;
   IterationHistory history;
   StepHistory step_history;
-  // /steps/<k>; Step::index = k. Meshes carry nodes, cells and level only (no edge sets).
+  // /steps/<k>; Step::index = its row in /history/steps (k when every step is kept). Meshes carry nodes, cells
+  // and level only (no edge sets).
   std::vector<Step> steps;
   VtkHdf vtkhdf;
 };
