@@ -1069,3 +1069,81 @@ TEST(JobOutput, StepsDefaultToLastForAdaptiveJobsAndAllOtherwiseAndBadValuesAreN
   steps["output"] = "last";
   expect_only_error(parse(steps), "/output", "object");
 }
+
+// ---- friction and load histories (docs/job-format.md, "Friction") ----------------------------------------
+
+TEST(JobFriction, CoulombAndTrescaAreReadAndTheirErrorsNamed) {
+  json job = small_job();
+  job["contacts"][0]["friction"] = {{"coefficient", 0.3}};
+  ParseResult r = parse(job);
+  ASSERT_TRUE(r.ok()) << listing(r);
+  EXPECT_EQ(r.problem->contacts[0].friction.law, contact::FrictionSpec::Law::coulomb);
+  EXPECT_EQ(r.problem->contacts[0].friction.coefficient, 0.3);
+  job["contacts"][0]["friction"] = {{"bound", 2.5}};
+  r = parse(job);
+  ASSERT_TRUE(r.ok()) << listing(r);
+  EXPECT_EQ(r.problem->contacts[0].friction.law, contact::FrictionSpec::Law::tresca);
+  EXPECT_EQ(r.problem->contacts[0].friction.bound, 2.5);
+  // Without it: frictionless.
+  EXPECT_FALSE(parse(small_job()).problem->contacts[0].friction.active());
+
+  job["contacts"][0]["friction"] = {{"coefficient", 0.3}, {"bound", 1}};
+  expect_only_error(parse(job), "/contacts/0/friction", "exactly one of coefficient");
+  job["contacts"][0]["friction"] = json::object();
+  expect_only_error(parse(job), "/contacts/0/friction", "exactly one of coefficient");
+  job["contacts"][0]["friction"] = {{"coefficient", -0.1}};
+  expect_only_error(parse(job), "/contacts/0/friction/coefficient", "is negative");
+  job["contacts"][0]["friction"] = {{"bound", "high"}};
+  expect_only_error(parse(job), "/contacts/0/friction/bound", "must be a number");
+  job["contacts"][0]["friction"] = {{"mu", 0.3}};
+  expect_only_error(parse(job), "/contacts/0/friction/mu", "unknown field 'mu'");
+}
+
+TEST(JobFriction, MethodsEnforcementsSolversAndAdaptivityThatCannotTakeItAreRefused) {
+  json job = small_job();
+  job["contacts"][0]["friction"] = {{"coefficient", 0.3}};
+  job["solver"] = {{"method", "neumann"}};
+  expect_only_error(parse(job), "/contacts/0/friction", "method \"neumann\" cannot take it");
+  job["solver"] = {{"method", "robin"}};
+  expect_only_error(parse(job), "/contacts/0/friction", "method \"robin\" cannot take it");
+  job["solver"] = {{"method", "interface_newton"}, {"enforcement", "penalty"}};
+  expect_only_error(parse(job), "/contacts/0/friction", "needs exact contact");
+  job["solver"] = {{"interface", {{"solver", "iterative"}}}};
+  expect_only_error(parse(job), "/contacts/0/friction", "at /solver/interface/solver");
+  job["solver"] = {{"method", "monolithic"}};
+  EXPECT_TRUE(parse(job).ok());
+  job["solver"] = {{"interface", {{"solver", "direct"}}}};
+  EXPECT_TRUE(parse(job).ok());
+  job.erase("solver");
+  job["adaptivity"] = {{"indicator", "zz"}};
+  expect_only_error(parse(job), "/contacts/0/friction", "friction with adaptivity is not supported");
+}
+
+TEST(JobFriction, AFlatContactWithFrictionMayHoldASlidingBody) {
+  // The upper block held only in y at its top: frictionless, nothing stops it sliding in x (refused at
+  // validation); with friction the contact may hold it.
+  json job = small_job();
+  job["bodies"][0]["boundary"] = json::parse(R"([{"edge": "top", "displacement": {"y": -0.001}}])");
+  expect_only_error(parse(job), "/bodies/0/boundary", "it slides along them");
+  job["contacts"][0]["friction"] = {{"coefficient", 0.5}};
+  EXPECT_TRUE(parse(job).ok()) << listing(parse(job));
+}
+
+TEST(JobHistory, AConditionsHistoryHasOneFactorPerLoadStep) {
+  json job = small_job();
+  job["bodies"][0]["boundary"][1]["history"] = {1, 0, 2};
+  job["loading"] = {{"steps", 3}};
+  ParseResult r = parse(job);
+  ASSERT_TRUE(r.ok()) << listing(r);
+  EXPECT_EQ(r.problem->bodies[0].boundary[1].history, (std::vector<double>{1, 0, 2}));
+  job["loading"] = {{"steps", 2}};
+  expect_only_error(parse(job), "/bodies/0/boundary/1/history", "history has 3 load factors but the job has 2 load steps");
+  job["bodies"][0]["boundary"][1]["history"] = json::array();
+  expect_only_error(parse(job), "/bodies/0/boundary/1/history", "non-empty array");
+  job["bodies"][0]["boundary"][1]["history"] = {1, "two"};
+  expect_only_error(parse(job), "/bodies/0/boundary/1/history/1", "must be a number");
+  job["bodies"][0]["boundary"][1]["history"] = {1};
+  job.erase("loading");
+  job["adaptivity"] = {{"indicator", "zz"}};
+  expect_only_error(parse(job), "/bodies/0/boundary/1/history", "adaptivity does not take");
+}

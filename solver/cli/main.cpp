@@ -220,6 +220,13 @@ int solve_and_write(contact::cli::Session& session, contact::Problem& problem, c
       std::printf("pair %s: %s, theta %.4g, force %.8g, resultant (%.8g, %.8g), max pressure %.8g, max penetration %.4g\n",
                   p.name.c_str(), p.enforcement.c_str(), p.theta, p.force, p.resultant.x(), p.resultant.y(), p_max,
                   penetration);
+    if (p.friction != "none") {
+      const long stick = p.stick.size() ? p.stick.cast<long>().sum() : 0, in_contact = p.active.cast<long>().sum();
+      std::printf("pair %s: %s friction (%s %.4g), tangential force %.8g, %ld of %ld nodes in contact sticking\n",
+                  p.name.c_str(), p.friction.c_str(), p.friction == "coulomb" ? "mu" : "bound",
+                  p.friction == "coulomb" ? p.friction_coefficient : p.friction_bound, p.tangential_force, stick,
+                  in_contact);
+    }
   }
   // Support reactions: per displacement condition (the components it prescribes) and the body's total.
   for (const auto& b : result.steps.back().bodies) {

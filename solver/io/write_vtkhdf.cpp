@@ -5,7 +5,8 @@
 // partitions' arrays one after the other, with Connectivity holding partition-local point ids and each
 // partition's Offsets starting at 0. VTKHDF 1.0 needs every array on every partition, so:
 //  * a contact partition's points carry the slave body's displacement, stress and reaction at those nodes;
-//  * body points carry pressure and gap NaN and active -1 (not a contact point);
+//  * body points carry pressure and gap NaN and active -1 (not a contact point); with friction pairs also
+//    tangential_traction and slip (NaN off the friction pairs' points);
 //  * contact cells carry NaN for the cell stresses, body_id -1 and their pair's index in pair_id (-1 on body
 //    cells), so that a Threshold on pair_id >= 0 shows the contact surfaces alone.
 #include "vtkhdf.hpp"
@@ -64,6 +65,9 @@ void write_vtkhdf(hid_t file, const Step& last) {
   StressTensor stress_node(total_points, 6), stress_cell(total_cells, 6);  // ParaView names these components
   Eigen::VectorXd von_mises(total_cells), indicator(total_cells);
   Eigen::VectorXd pressure = Eigen::VectorXd::Constant(total_points, nan), gap = pressure;
+  // Friction (written when some pair has it): NaN off the friction pairs' points.
+  Eigen::VectorXd tangential_traction = pressure, slip = pressure;
+  bool any_friction = false;
   Eigen::Matrix<std::int8_t, Eigen::Dynamic, 1> active = Eigen::Matrix<std::int8_t, Eigen::Dynamic, 1>::Constant(total_points, -1);
   Eigen::Index p0 = 0, c0 = 0;
   for (size_t id = 0; id < last.bodies.size(); ++id) {
@@ -132,6 +136,11 @@ void write_vtkhdf(hid_t file, const Step& last) {
       pressure[p0 + j] = p.pressure[j];
       gap[p0 + j] = p.normal_gap[j];
       active[p0 + j] = static_cast<std::int8_t>(p.active[j]);
+      if (p.friction != "none" && p.tangential_traction.size() == n) {
+        any_friction = true;
+        tangential_traction[p0 + j] = p.tangential_traction[j];
+        slip[p0 + j] = p.slip[j];
+      }
     }
     stress_cell.middleRows(c0, c).setConstant(nan);
     von_mises.segment(c0, c).setConstant(nan);
@@ -154,6 +163,10 @@ void write_vtkhdf(hid_t file, const Step& last) {
   write_column(pd, "pressure", pressure);
   write_column(pd, "gap", gap);
   write_column(pd, "active", active);
+  if (any_friction) {
+    write_column(pd, "tangential_traction", tangential_traction);
+    write_column(pd, "slip", slip);
+  }
   Handle cd = h5::create_group(v, "CellData");
   if (all_stress_cell) write_matrix(cd, "stress", stress_cell);
   if (all_von_mises) write_column(cd, "von_mises", von_mises);

@@ -89,7 +89,8 @@ struct Writer {
     out << "      </Grid>\n";
   }
 
-  // The contact surface of one pair: its slave polyline with the nodal pressure, gap and active flag.
+  // The contact surface of one pair: its slave polyline with the nodal pressure, gap and active flag (and with
+  // friction its tangential traction, slip, stick flag and tangent).
   void pair(const std::string& step_path, const PairField& p) {
     const Eigen::Index n = p.position.rows();
     if (n < 2) return;
@@ -105,6 +106,12 @@ struct Writer {
     attribute(in, "pressure", "Node", base + "/pressure", n, 0);
     attribute(in, "gap", "Node", base + "/normal_gap", n, 0);
     attribute(in, "active", "Node", base + "/active", n, 0, "Int", 1);
+    if (p.friction != "none") {  // friction: the tangential traction, the accumulated slip, stick and the tangent
+      attribute(in, "tangential_traction", "Node", base + "/tangential_traction", n, 0);
+      attribute(in, "slip", "Node", base + "/slip", n, 0);
+      attribute(in, "stick", "Node", base + "/stick", n, 0, "Int", 1);
+      attribute(in, "tangent", "Node", base + "/tangent", n, 2);
+    }
     out << "      </Grid>\n";
   }
 };

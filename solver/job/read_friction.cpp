@@ -8,8 +8,9 @@ namespace contact::job::detail {
 void JobReader::read_friction(const Fields& contact, FrictionSpec& friction) {
   const json* v = contact.find("friction");
   if (!v) return;
+  const size_t before = errors_.size();
   Fields f(*v, contact.at("friction"), "friction", {"coefficient", "bound"}, errors_);
-  if (!f.ok()) return;
+  if (!f.ok() || errors_.size() > before) return;  // (an unknown field is the error to read first)
   if (f.has("coefficient") == f.has("bound")) {
     errors_.add(contact.at("friction"), "give exactly one of coefficient (Coulomb's mu: |t| <= mu p) and bound "
                                         "(Tresca's g: |t| <= g, a traction like the pressure)");
