@@ -789,3 +789,44 @@ TEST(StepLog, LastKeepsOneStepsFieldsAndEveryStepsSummary) {
     EXPECT_EQ(rows[static_cast<size_t>(k)].nodes, std::vector<int>{2 * (k + 2)});
   }
 }
+
+TEST(ResultFile, FrictionFieldsRoundTripAndShowInTheSidecarAndVtkhdf) {
+  // The roller example: two Coulomb pairs in three load steps.
+  std::ifstream in(std::string(CONTACT_SOURCE_DIR) + "/api/examples/roller_friction.json");
+  const auto parsed = job::parse(nlohmann::json::parse(in));
+  ASSERT_TRUE(parsed.ok()) << job::format_errors(parsed.errors);
+  Observer quiet;
+  CancelToken cancel;
+  const Result result = solve(*parsed.problem, quiet, cancel);
+  ASSERT_TRUE(result.converged) << result.message;
+  const fs::path hdf = output_dir() / "friction.hdf";
+  io::write_result(hdf.string(), *parsed.problem, result);
+  const std::string xmf = io::xdmf_path_for(hdf.string());
+  io::write_xdmf(xmf, hdf.filename().string(), result);
+  const auto back = io::read_result(hdf.string());
+  ASSERT_EQ(back.steps.size(), result.steps.size());
+  for (size_t k = 0; k < result.steps.size(); ++k)
+    for (size_t p = 0; p < result.steps[k].pairs.size(); ++p) {
+      const PairField& a = result.steps[k].pairs[p];
+      const PairField& b = back.steps[k].pairs[p];
+      EXPECT_EQ(b.friction, "coulomb");
+      EXPECT_EQ(b.friction_coefficient, 0.2);
+      EXPECT_EQ(b.tangential_force, a.tangential_force);
+      EXPECT_EQ(b.tangent, a.tangent);
+      EXPECT_EQ(b.tangential_traction, a.tangential_traction);
+      EXPECT_EQ(b.stick, a.stick);
+      EXPECT_TRUE(b.slip.isApprox(a.slip) || (b.slip.array().isNaN() == a.slip.array().isNaN()).all());
+      EXPECT_EQ(back.step_history.tangential_force(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(p)),
+                a.tangential_force);
+    }
+  // The last step sticks and slips somewhere: both flags occur.
+  const PairField& last = back.steps.back().pairs[0];
+  EXPECT_GT(last.stick.sum(), 0);
+  EXPECT_LT(last.stick.sum(), last.active.sum());
+  const std::string text = read_text(xmf);
+  for (const char* name : {"tangential_traction", "slip", "stick", "tangent"})
+    EXPECT_NE(text.find("<Attribute Name=\"" + std::string(name) + "\""), std::string::npos) << name;
+  // ParaView's VTKHDF grid carries them too.
+  io::h5::Handle file = io::h5::open_file(hdf.string());
+  EXPECT_TRUE(io::h5::has_link(io::h5::open_group(file, "VTKHDF/PointData"), "tangential_traction"));
+}
