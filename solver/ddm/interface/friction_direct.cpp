@@ -90,24 +90,16 @@ linalg::Equalities normal_equalities(const linalg::Equalities& all, Eigen::Index
   return out;
 }
 
-// The first sets: from a warm start, or from the frictionless normal problem (with the equilibrium normal
-// pressures can meet), or where that fails every normal row active (floating bodies) or those that overlap;
-// every node in contact sticking.
+// The first sets: the frictionless normal problem's (with the equilibrium normal pressures can meet; from nested
+// coarse solves, which keeps the number of steps independent of the mesh, also at a new load step, where the
+// previous step's sets would move the zone's edge by a few nodes per step); where that fails, the warm start's
+// prediction, or every normal row active (floating bodies) or those that overlap. Every node in contact sticks:
+// the tied problem under the loads is well posed (friction holds the floating bodies), and the slip zones grow
+// from it (predicting slip from the previous step's tractions can start far off).
 FrictionSets first_sets(const SparseMatrix& F, const InterfaceQp& qp, const Eigen::VectorXd* z0,
                         const Eigen::VectorXd& alpha0, const Eigen::VectorXd& c, const std::vector<FrictionRow>& rows,
                         const std::vector<char>& mask, std::string& note) {
   const Eigen::Index n = qp.g.size(), m = qp.problem.normal_size();
-  if (z0 && z0->size() == n && z0->cwiseAbs().maxCoeff() > 0) {
-    // The normal sets predicted from the previous answer (with its rigid amplitudes); every node in contact
-    // sticking: the tied problem under the new loads is well posed (friction holds the floating bodies), and the
-    // slip zones grow from it. Predicting slip from the previous step's tractions can start far off.
-    Eigen::VectorXd h = qp.g + F * *z0;
-    if (alpha0.size() == qp.equilibrium.G.rows() && alpha0.size() > 0) h += qp.equilibrium.G.transpose() * alpha0;
-    FrictionSets s = linalg::predict_friction_sets(*z0, h, c, rows, mask);
-    for (size_t t = 0; t < rows.size(); ++t)
-      s.state[t] = s.active[static_cast<size_t>(rows[t].normal)] || !rows[t].coulomb ? Contact::stick : Contact::open;
-    return s;
-  }
   Eigen::VectorXd lambda = Eigen::VectorXd::Zero(n);
   const SparseMatrix Fnn = F.topLeftCorner(m, m);
   const Eigen::VectorXd gn = qp.g.head(m);
@@ -120,9 +112,19 @@ FrictionSets first_sets(const SparseMatrix& F, const InterfaceQp& qp, const Eige
     lambda.head(m) = normal.z;
     note = "first sets from the frictionless solution (" + std::to_string(normal.steps) + " active-set steps)";
   }
+  const bool solved = lambda.cwiseAbs().maxCoeff() > 0;
+  if (!solved && z0 && z0->size() == n && z0->cwiseAbs().maxCoeff() > 0) {
+    // The normal sets predicted from the previous answer (with its rigid amplitudes); every node in contact
+    // sticking.
+    Eigen::VectorXd h = qp.g + F * *z0;
+    if (alpha0.size() == qp.equilibrium.G.rows() && alpha0.size() > 0) h += qp.equilibrium.G.transpose() * alpha0;
+    FrictionSets s = linalg::predict_friction_sets(*z0, h, c, rows, mask);
+    for (size_t t = 0; t < rows.size(); ++t)
+      s.state[t] = s.active[static_cast<size_t>(rows[t].normal)] || !rows[t].coulomb ? Contact::stick : Contact::open;
+    return s;
+  }
   // Its pressing nodes are the first normal set (its own gaps, with its rigid amplitudes, confirm them).
   FrictionSets s;
-  const bool solved = lambda.cwiseAbs().maxCoeff() > 0;
   s.active.assign(static_cast<size_t>(n), 0);
   for (Eigen::Index j = 0; j < m; ++j)
     s.active[static_cast<size_t>(j)] = solved ? lambda[j] > 0 : !qp.equilibrium.empty() || qp.g[j] < 0;
@@ -164,9 +166,10 @@ std::string friction_shortfall(const InterfaceQp& qp, const Eigen::VectorXd& lam
       os.precision(4);
       os << "friction cannot hold body '" << system.problem().bodies[f.body].name << "' against its load along "
          << (c == 0 ? "x" : "y") << ": its contact" << (names_of_pairs.find(',') != std::string::npos ? "s " : " ")
-         << names_of_pairs << (names_of_pairs.find(',') != std::string::npos ? " carry" : " carries") << " at most " << capacity << " by friction at the last iterate, the load is "
-         << std::abs(required) << " (" << std::abs(required) / std::max(capacity, 1e-300)
-         << " times); under force control it would slide without end: lower the load, raise the friction, or "
+         << names_of_pairs << (names_of_pairs.find(',') != std::string::npos ? " carry" : " carries") << " at most "
+         << capacity << " by friction at the last iterate, the load is " << std::abs(required);
+      if (capacity > 0) os << " (" << std::abs(required) / capacity << " times)";
+      os << "; under force control it would slide without end: lower the load, raise the friction, or "
             "prescribe the body's displacement";
       return os.str();
     }
