@@ -16,6 +16,8 @@ def _fields(path):
                 out[f"{k}/{name}/displacement"] = body["displacement"][()]
             for name, pair in step["contacts"].items():
                 out[f"{k}/{name}/pressure"] = pair["pressure"][()]
+                if "tangential_traction" in pair:
+                    out[f"{k}/{name}/tangential_traction"] = pair["tangential_traction"][()]
     return out
 
 

@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""contact-solve under mpirun: the same job on 1, 2 and 3 ranks gives the same displacements and pressures
+"""contact-solve under mpirun: the same job on 1, 2 and 3 ranks gives the same displacements and pressures (and
+tangential tractions with friction)
 (to 1e-12 relative) after the same number of iterations; the brick wall carries its load through every course;
 a failure on one rank ends every rank with its message and exit code 1.
 
@@ -65,6 +66,7 @@ with tempfile.TemporaryDirectory() as tmp:
         "stack3_floating": os.path.join(EXAMPLES, "stack3_floating.json"),  # interface Newton, a floating body
         "brick_wall": os.path.join(EXAMPLES, "brick_wall.json"),       # 69 bodies, 120 pairs, 68 floating
         "adaptive": adaptive_path,                                      # meshes refined between solves
+        "roller_friction": os.path.join(EXAMPLES, "roller_friction.json"),  # friction, load histories, floating
     }
     for name, job in jobs.items():
         files = {}
