@@ -260,8 +260,9 @@ def build_parser():
     s.set_defaults(func=_cmd_validate)
 
     s = sub.add_parser("plot", parents=[common],
-                       help="plot a result: pressure along each pair, deformed mesh by von Mises stress, "
-                            "the force-load curve of a load-stepped job")
+                       help="plot a result: pressure along each pair (with friction also the tangential "
+                            "traction and the stick zone), deformed mesh by von Mises stress, the force-load curve "
+                            "of a load-stepped job")
     s.add_argument("file", metavar="FILE.hdf")
     s.add_argument("-o", "--output", required=True, metavar="PNG")
     s.add_argument("--events", metavar="FILE",
