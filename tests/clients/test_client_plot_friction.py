@@ -28,7 +28,7 @@ import h5py  # noqa: E402
 import numpy as np  # noqa: E402
 
 import contact_client as cc  # noqa: E402
-from harness import HOST, Checks, Server, example  # noqa: E402
+from harness import HOST, Checks, Server, example, roller_job  # noqa: E402
 
 CLIENT = os.path.join(SRC, "clients", "contact_client.py")
 t = Checks()
@@ -66,25 +66,6 @@ def tresca_job():
     return {"name": "tresca", "bodies": [ground, block],
             "contacts": [{"name": "c", "slave": "block.bottom", "master": "ground.top", "friction": {"bound": 5}}],
             "loading": {"factors": [0.02, 0.05, 0.5, 1]}}
-
-
-def roller_job():
-    """The roller between two plates, loaded by a force alone, held by friction (issue 21): one step."""
-    arcs = {"bottom": {"arc": {"center": [0, 1], "radius": 1}}, "top": {"arc": {"center": [0, 1], "radius": 1}}}
-    steel = {"E": 2.1e5, "nu": 0.3}
-    return {"name": "roller", "bodies": [
-        {"name": "base", "material": steel,
-         "mesh": {"block": {"corners": [[-2, -1], [2, -1], [2, 0], [-2, 0]], "nx": 32, "ny": 8}},
-         "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]},
-        {"name": "roller", "material": steel,
-         "mesh": {"block": {"corners": [[-0.5, 0.1339745962155614], [0.5, 0.1339745962155614],
-                                        [0.5, 1.8660254037844386], [-0.5, 1.8660254037844386]],
-                            "nx": 24, "ny": 24, "edges": arcs}}},
-        {"name": "plate", "material": steel,
-         "mesh": {"block": {"corners": [[-2, 2], [2, 2], [2, 3], [-2, 3]], "nx": 32, "ny": 8}},
-         "boundary": [{"edge": "top", "force": [0, -10000]}]}],
-        "contacts": [{"slave": "roller.bottom", "master": "base.top", "friction": {"coefficient": 0.2}},
-                     {"slave": "roller.top", "master": "plate.bottom", "friction": {"coefficient": 0.2}}]}
 
 
 def solve(client, job, tmp):
