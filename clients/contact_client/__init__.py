@@ -12,7 +12,8 @@ As a command (clients/contact_client.py, or python3 -m contact_client with clien
     contact_client.py download ID -o seed.hdf [--xmf]
     contact_client.py validate my_job.json
     contact_client.py plot seed.hdf -o seed.png [--events events.ndjson] [--xlim LO HI | --xlim full]
-                                              [--along arc|x]
+                                              [--along arc|x]   # friction pairs: also the tangential
+                                              # traction, the stick zone shaded
 
     --url (CONTACT_URL, default http://127.0.0.1:8080), --token (CONTACT_TOKEN), --timeout (seconds).
     Exit codes: 0 ok; 1 server, connection or job error (an answer that is not the API's included);

@@ -174,7 +174,17 @@ def _cmd_plot(c, a):
         zone = drawn["contact_zone"].get(pair)
         print(f"  {pair}: pressure drawn from {coordinate} {lo:g} to {hi:g}, "
               + (f"contact from {zone[0]:g} to {zone[1]:g}" if zone else "no contact"))
+        if pair in drawn["friction"]:
+            print(f"  {pair}: {drawn['friction'][pair]}, tangential force {drawn['tangential_force'][pair]:.6g}, "
+                  + _stick_text(drawn["stick_zones"][pair]))
     return EXIT_OK
+
+
+def _stick_text(zones):
+    """ "stick from 0.37 to 0.68" (several zones joined by "and"), or "no node sticks"."""
+    if not zones:
+        return "no node sticks"
+    return "stick " + " and ".join(f"from {lo:g} to {hi:g}" for lo, hi in zones)
 
 
 class _Parser(argparse.ArgumentParser):
@@ -250,8 +260,9 @@ def build_parser():
     s.set_defaults(func=_cmd_validate)
 
     s = sub.add_parser("plot", parents=[common],
-                       help="plot a result: pressure along each pair, deformed mesh by von Mises stress, "
-                            "the force-load curve of a load-stepped job")
+                       help="plot a result: pressure along each pair (with friction also the tangential "
+                            "traction and the stick zone), deformed mesh by von Mises stress, the force-load curve "
+                            "of a load-stepped job")
     s.add_argument("file", metavar="FILE.hdf")
     s.add_argument("-o", "--output", required=True, metavar="PNG")
     s.add_argument("--events", metavar="FILE",

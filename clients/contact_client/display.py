@@ -145,16 +145,22 @@ def _label(e):
     return "step" if word(e.get("measure")) == "complementarity" else "iter"
 
 
+def _tangential(p):
+    """ " t_force -0.9847" for a friction pair's event (it carries `tangential_force`), "" otherwise."""
+    return f" t_force {num(p['tangential_force'], '.5g')}" if "tangential_force" in p else ""
+
+
 def format_iteration(e):
     """ "iter 12  paper 1.23e-03  residual 2.22e-02  dofs upper 528 lower 528  | pair: force 140.9 p_max 166.4"
-    (active-set methods: "step 3  active 245 (2 changed)  compl 1.20e-03 ...") """
+    (active-set methods: "step 3  active 245 (2 changed)  compl 1.20e-03 ..."; a friction pair adds its
+    tangential force: "| pair: force 6.18 p_max 20.3 t_force -0.985") """
     parts = [f"{_label(e)} {num(e.get('iteration', 0), '5d'):>5}"] + _measure_parts(e)
     bodies = dicts(e.get("bodies"))
     if bodies:
         parts.append("dofs " + " ".join(f"{word(b.get('name'))} {num(b.get('dofs'), 'd')}" for b in bodies))
     for p in dicts(e.get("pairs")):
         parts.append(f"| {word(p.get('name'))}: force {num(p.get('force', 0), '.5g')} "
-                     f"p_max {num(p.get('max_pressure', 0), '.5g')}")
+                     f"p_max {num(p.get('max_pressure', 0), '.5g')}{_tangential(p)}")
     if e.get("elapsed_seconds") is not None:
         parts.append(f"{num(e['elapsed_seconds'], '.2f')}s")
     note = word(e.get("note"), 200).strip().rstrip(";").strip()
@@ -167,13 +173,16 @@ def compact_iterations(e, elapsed=True):
     """The terminal's live line, in forms from the fullest to the shortest (the first that fits is drawn):
     "iter 12  paper 1.23e-03  res 2.22e-02  active 15  force 140.9  p_max 166.4  dofs 528/528  0.05s", or for
     the active-set methods "step 2  active 245 (3 changed)  compl 1.20e-03  force ..." (several pairs or bodies:
-    values joined by '/', in the order of the job). elapsed=False leaves out the solver's elapsed time."""
+    values joined by '/', in the order of the job; with friction pairs "t_force", '-' for a frictionless pair).
+    elapsed=False leaves out the solver's elapsed time."""
     pairs, bodies = dicts(e.get("pairs")), dicts(e.get("bodies"))
     head = [f"{_label(e)} {num(e.get('iteration', 0), 'd')}"] + _measure_parts(e, wide=False)
     extra = []  # left out from the end first when the line is too long
     if pairs:
         extra.append("force " + "/".join(num(p.get("force", 0), ".5g") for p in pairs))
         extra.append("p_max " + "/".join(num(p.get("max_pressure", 0), ".5g") for p in pairs))
+        if any("tangential_force" in p for p in pairs):
+            extra.append("t_force " + "/".join(num(p.get("tangential_force"), ".5g", "-") for p in pairs))
     if bodies:
         extra.append("dofs " + "/".join(num(b.get("dofs"), "d") for b in bodies))
     seconds = [f"{num(e['elapsed_seconds'], '.1f')}s"] if elapsed and e.get("elapsed_seconds") is not None else []

@@ -1,9 +1,10 @@
-"""The figure of a result: contact pressure along each pair, zoomed on the contact zone; the final mesh coloured
-by von Mises stress, whole and around the contact."""
+"""The figure of a result: contact pressure along each pair, zoomed on the contact zone (for a friction pair with
+the tangential traction below it, the stick zone shaded); the final mesh coloured by von Mises stress, whole and
+around the contact."""
 import os
 
 from .errors import BadInput
-from .results import read_events, read_result
+from .results import pair_friction, read_events, read_result
 
 # The pressure panels' horizontal coordinate: "arc", the arc length along the slave edge from its first node (the
 # coordinate of the events' profiles, of the web page, of contact_begin/contact_end; it also serves edges that are
@@ -14,6 +15,8 @@ AXIS_LABELS = {"arc": "arc length along the slave edge", "x": "x of the slave ed
 # ZOOM_NODES slave nodes beyond each end (so that the opening of the contact shows on a coarse mesh).
 ZOOM_MARGIN = 0.15
 ZOOM_NODES = 3
+STICK_COLOUR = "tab:green"  # the stick zone's shading
+BOUND_COLOUR = "grey"  # the friction bound (slip where the traction reaches it)
 
 
 def _spread(n, k):
@@ -41,15 +44,57 @@ def auto_warp(step, fraction=0.04):
     return float(max(m for m in (1.0, 2.0, 5.0) if m * power <= raw * (1 + 1e-12)) * power)
 
 
-def contact_pressure(c):
-    """A pair's pressure per slave node, NaN where the node takes no part in the contact (status 1 to 3: not
+def _node_values(c, key):
+    """A pair's dataset `key` per slave node, NaN where the node takes no part in the contact (status 1 to 3: not
     opposite the master, a crosspoint, barely covered; docs/results-format.md), so curves break there."""
     import numpy as np
-    p = np.asarray(c["pressure"], dtype=float).copy()
+    v = np.asarray(c[key], dtype=float).copy()
     status = c.get("status")
-    if status is not None and len(status) == len(p):
-        p[np.isin(np.asarray(status), (1, 2, 3))] = np.nan
-    return p
+    if status is not None and len(status) == len(v):
+        v[np.isin(np.asarray(status), (1, 2, 3))] = np.nan
+    return v
+
+
+def contact_pressure(c):
+    """A pair's pressure per slave node, NaN where the node takes no part in the contact (_node_values)."""
+    return _node_values(c, "pressure")
+
+
+def tangential_traction(c):
+    """A friction pair's tangential traction per slave node (along its tangent), NaN where the node takes no
+    part in the contact; None for a frictionless pair or a file without it."""
+    return _node_values(c, "tangential_traction") if "tangential_traction" in c else None
+
+
+def friction_text(friction):
+    """ "Coulomb, mu = 0.2" or "Tresca, g = 5" for pair_friction()'s dict."""
+    if friction["law"] == "tresca":
+        return f"Tresca, g = {friction['bound']:g}"
+    if friction["law"] == "coulomb":
+        return f"Coulomb, mu = {friction['coefficient']:g}"
+    return friction["law"]
+
+
+def stick_zones(s, stick):
+    """Where the nodes stick along the coordinate s: [(lo, hi), ...], one per run of neighbouring nodes with
+    stick true, each reaching halfway to the next node that does not stick (to the node itself at an end of the
+    edge), in increasing order; [] when no node sticks."""
+    import numpy as np
+    order = np.argsort(s)
+    s, on = np.asarray(s, dtype=float)[order], np.asarray(stick, dtype=bool)[order]
+    zones, n, i = [], len(s), 0
+    while i < n:
+        if not on[i]:
+            i += 1
+            continue
+        j = i
+        while j + 1 < n and on[j + 1]:
+            j += 1
+        lo = (s[i - 1] + s[i]) / 2 if i > 0 else s[i]
+        hi = (s[j] + s[j + 1]) / 2 if j + 1 < n else s[j]
+        zones.append((float(lo), float(hi)))
+        i = j + 1
+    return zones
 
 
 def load_curve(result):
@@ -146,60 +191,74 @@ def pressure_range(curves, xlim=None):
 
 
 def _iteration_profiles(events):
-    """{pair: [(iteration, arc length, pressure), ...]} from the iteration events."""
+    """{pair: [(iteration, arc length, pressure, tangential traction or None), ...]} from the iteration events
+    (a friction pair's events carry `tangential_tractions`, as many as `positions`)."""
     import numpy as np
     profiles = {}
     for e in events or []:
         if e.get("type") == "iteration":
             for p in e.get("pairs", []):
                 if p.get("positions") and p.get("pressures"):
+                    t = p.get("tangential_tractions")
+                    t = np.asarray(t, float) if t and len(t) == len(p["positions"]) else None
                     profiles.setdefault(p["name"], []).append(
-                        (e["iteration"], np.asarray(p["positions"], float), np.asarray(p["pressures"], float)))
+                        (e["iteration"], np.asarray(p["positions"], float), np.asarray(p["pressures"], float), t))
     return profiles
 
 
-def _step_curves(steps, pair, along, max_curves, loaded):
-    """One curve per plotted step: [(step, coordinate, pressure, label suffix), ...]."""
+def _step_curves(steps, pair, along, max_curves, loaded, values=contact_pressure):
+    """One curve per plotted step: [(step, coordinate, values(pair), label suffix), ...] (values: contact_pressure
+    or tangential_traction; a step whose pair has none is left out)."""
     curves = []
     for k in _spread(len(steps), max_curves):
         c = steps[k]["contacts"].get(pair)
-        if c is not None and "x" in c:
+        v = values(c) if c is not None and "x" in c else None
+        if v is not None:
             load = f"load {steps[k]['load_factor']:g}, " if loaded else ""
-            curves.append((k, edge_coordinate(c, along), contact_pressure(c),
+            curves.append((k, edge_coordinate(c, along), v,
                            f" ({load}iter {steps[k]['iteration']}, {len(c['x'])} nodes)"))
     return curves
 
 
-def _iteration_curves(profiles, c_final, along, max_curves):
-    """One curve per plotted iteration of the events: [(iteration, coordinate, pressure, ""), ...]. The events
-    give arc lengths: with along="x" they are mapped to x through the final step's slave nodes."""
+def _iteration_curves(profiles, c_final, along, max_curves, tangential=False):
+    """One curve per plotted iteration of the events: [(iteration, coordinate, pressure, ""), ...], or with
+    tangential=True the tangential traction (iterations without it left out). The events give arc lengths: with
+    along="x" they are mapped to x through the final step's slave nodes."""
     import numpy as np
     arc, xs = c_final.get("arc_length"), c_final.get("x")
     to_x = along == "x" and arc is not None and xs is not None and len(arc) >= 2
     curves = []
     for i in _spread(len(profiles), max_curves):
-        it, s, p = profiles[i]
-        curves.append((it, np.interp(s, arc, xs) if to_x else s, p, ""))
+        it, s, p, t = profiles[i]
+        v = t if tangential else p
+        if v is not None:
+            curves.append((it, np.interp(s, arc, xs) if to_x else s, v, ""))
     return curves
 
 
-def _draw_pressure(fig, ax, pair, curves, c_final, final_iteration, what, total, along, xlim):
-    """One pair's panel: the curves coloured by their place in the run, the final profile from the file; the
-    horizontal range from pressure_range() of the step curves and the final profile. Returns the contact zone
-    and the range set ((lo, hi) or None each)."""
-    import matplotlib.cm
+def _curve_colours(curves):
+    """(colour map, norm) that colour the curves [(number, ...), ...] from the first number to the last."""
     import matplotlib.colors
     import matplotlib.pyplot as plt
-    cmap = plt.get_cmap("viridis")
     numbers = [n for n, *_ in curves] or [0]
-    norm = matplotlib.colors.Normalize(vmin=numbers[0], vmax=max(numbers[-1], numbers[0] + 1))
+    return plt.get_cmap("viridis"), matplotlib.colors.Normalize(vmin=numbers[0],
+                                                                vmax=max(numbers[-1], numbers[0] + 1))
+
+
+def _draw_pressure(fig, ax, pair, curves, c_final, final_iteration, what, total, along, xlim, bar_axes=None):
+    """One pair's panel: the curves coloured by their place in the run, the final profile from the file; the
+    horizontal range from pressure_range() of the step curves and the final profile. The colour bar (more than 6
+    curves) takes its room from bar_axes (default: ax). Returns the contact zone and the range set ((lo, hi) or
+    None each)."""
+    import matplotlib.cm
+    cmap, norm = _curve_colours(curves)
     labelled = len(curves) <= 6
     for number, s, p, extra in curves:
         ax.plot(s, p, color=cmap(norm(number)), lw=1.0, marker="." if len(s) < 80 else None, ms=2.5,
                 label=f"{what} {number}{extra}" if labelled else None)
     if len(curves) > 1 and not labelled:
         sm = matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap)
-        fig.colorbar(sm, ax=ax, fraction=0.05, pad=0.02).set_label(what, fontsize=8)
+        fig.colorbar(sm, ax=bar_axes or ax, fraction=0.05, pad=0.02).set_label(what, fontsize=8)
     # The zone is that of the solutions drawn: the steps' profiles and the final one, not the iterations on the
     # way (an early iterate may press far beyond the final contact).
     solutions = [(s, p) for _, s, p, _ in curves] if what == "step" else []
@@ -220,6 +279,76 @@ def _draw_pressure(fig, ax, pair, curves, c_final, final_iteration, what, total,
         ax.legend(fontsize=7, loc="best", framealpha=0.8)
     found = contact_zone(solutions) if solutions else None
     return (found[0] if found else None), limits
+
+
+def _pair_axes(fig, spec, friction):
+    """A pair's panels in the gridspec cell `spec`: the pressure panel; for a friction pair it takes the upper
+    half and the tangential traction the lower, sharing the horizontal axis. (pressure axes, tangential axes or
+    None)."""
+    if not friction:
+        return fig.add_subplot(spec), None
+    halves = spec.subgridspec(2, 1, hspace=0.08)
+    ax = fig.add_subplot(halves[0, 0])
+    return ax, fig.add_subplot(halves[1, 0], sharex=ax)
+
+
+def _draw_stick(ax, zones, label):
+    """The stick zones [(lo, hi), ...] shaded across ax's height, behind the curves (the first one labelled when
+    `label`)."""
+    for i, (lo, hi) in enumerate(zones):
+        ax.axvspan(lo, hi, color=STICK_COLOUR, alpha=0.2, lw=0, zorder=0, gid="stick_zone",
+                   label="stick zone (final)" if label and i == 0 else None)
+
+
+def _friction_bound(c, friction):
+    """The largest tangential traction each slave node can carry, the bound where it slips: mu p (Coulomb) or g
+    (Tresca, on the whole edge)."""
+    import numpy as np
+    if friction["law"] == "coulomb":
+        return friction["coefficient"] * contact_pressure(c)
+    return np.full(len(c["pressure"]), friction["bound"])
+
+
+def _draw_tangential(ax, curves, c_final, friction, along, zones):
+    """A friction pair's tangential-traction panel (below its pressure panel, sharing the horizontal axis): the
+    curves [(number, coordinate, traction, _), ...] coloured as the pressure's, the final traction from the file
+    (black; its legend names the friction law and the total tangential force), the final state's friction bound
+    +-mu p or +-g (dotted: where the traction reaches it the node slips) and the final stick zones shaded."""
+    cmap, norm = _curve_colours(curves)
+    for number, s, t, _ in curves:
+        ax.plot(s, t, color=cmap(norm(number)), lw=1.0, marker="." if len(s) < 80 else None, ms=2.5)
+    s, t = edge_coordinate(c_final, along), tangential_traction(c_final)
+    bound = _friction_bound(c_final, friction)
+    name = "mu p" if friction["law"] == "coulomb" else "g"
+    ax.plot(s, bound, color=BOUND_COLOUR, lw=1.0, ls=":", label=f"slip bound ±{name}", gid="friction_bound")
+    ax.plot(s, -bound, color=BOUND_COLOUR, lw=1.0, ls=":", gid="friction_bound")
+    if t is not None:
+        ax.plot(s, t, color="black", lw=1.5, ls=(0, (5, 3)) if curves else "-", zorder=5, gid="tangential_traction",
+                label=f"final ({friction_text(friction)}): force {friction['tangential_force']:.4g}")
+    _draw_stick(ax, zones, label=True)
+    ax.axhline(0.0, color="black", lw=0.5)
+    ax.set_xlabel(AXIS_LABELS[along])
+    ax.set_ylabel("tangential traction")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, loc="best", framealpha=0.8)
+
+
+def _draw_friction(ax, tax, steps, pair, friction, profiles, along, max_curves, loaded):
+    """The friction pair's tangential traction in tax (the step curves, or with a single step the events'
+    iterations) and its final stick zones shaded in both panels; ax's tick labels left to tax, below it.
+    Returns the stick zones [(lo, hi), ...]."""
+    c_final = steps[-1]["contacts"][pair]
+    if len(steps) > 1:
+        curves = _step_curves(steps, pair, along, max_curves, loaded, values=tangential_traction)
+    else:
+        curves = _iteration_curves(profiles, c_final, along, max_curves, tangential=True)
+    stick = friction["stick"]
+    zones = stick_zones(edge_coordinate(c_final, along), stick) if stick is not None else []
+    _draw_stick(ax, zones, label=False)
+    _draw_tangential(tax, curves, c_final, friction, along, zones)
+    ax.set_xlabel("")
+    ax.tick_params(labelbottom=False)
+    return zones
 
 
 def _displaced(body, warp, nodes=None):
@@ -421,6 +550,10 @@ def plot_result(result, png, events=None, warp=None, title=None, max_curves=12, 
          pair) plus ZOOM_MARGIN (15 %) of its width on each side and at least ZOOM_NODES (3) nodes beyond each
          end, within the slave edge (the whole edge without contact); xlim=(lo, hi) for every pair's panel;
          xlim="full": the whole slave edge;
+         a friction pair's panel is split: the pressure above, the tangential traction below on the same
+         horizontal axis (its curves as the pressure's, the final one from the file in black, the final friction
+         bound +-mu p or +-g dotted, the legend naming the law, its coefficient or bound and the tangential
+         force), the final stick zones (stick_zones()) shaded green in both;
     bottom: each body's final mesh, deformed, cells coloured by von Mises stress, cell edges drawn where the cells
          are large enough on screen to show them (_edge_opacity), the slave edge of each pair
          in red; next to it, when the pressure panels are zoomed, the mesh around the part of the slave edges
@@ -430,7 +563,9 @@ def plot_result(result, png, events=None, warp=None, title=None, max_curves=12, 
 
     result is a path or the dict of read_result(). Returns {"warp": the mesh's scale, "pressure_xlim": {pair:
     (lo, hi) of its panel's horizontal axis, as drawn}, "contact_zone": {pair: (lo, hi) of its nodes in contact,
-    or None}, "mesh_zoom": (x0, x1, y0, y1) of the zoom panel or None}."""
+    or None}, "mesh_zoom": (x0, x1, y0, y1) of the zoom panel or None, "friction": {friction pair: its law, as
+    "Coulomb, mu = 0.2"}, "tangential_force": {friction pair: its final total tangential force}, "stick_zones":
+    {friction pair: [(lo, hi), ...] shaded}, "figure": the matplotlib Figure drawn (closed)}."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -454,8 +589,11 @@ def plot_result(result, png, events=None, warp=None, title=None, max_curves=12, 
     fig = plt.figure(figsize=(10, 8), dpi=100)
     curve = load_curve(result)
     npairs = max(1, len(pair_names))
-    gs = fig.add_gridspec(2, npairs + (curve is not None), height_ratios=[1.0, 1.25], left=0.08, right=0.92,
-                          top=0.92, bottom=0.07, hspace=0.4, wspace=0.4)
+    frictions = {pair: pair_friction(final["contacts"][pair]) for pair in pair_names}
+    frictions = {pair: f for pair, f in frictions.items() if f is not None}  # the friction pairs
+    # A friction pair's pressure and tangential traction share the top row's height: the row gets more of it.
+    gs = fig.add_gridspec(2, npairs + (curve is not None), height_ratios=[1.6, 1.0] if frictions else [1.0, 1.25],
+                          left=0.08, right=0.92, top=0.92, bottom=0.07, hspace=0.4, wspace=0.4)
     name = attrs.get("name") or os.path.basename(result.get("path", ""))
     stop = attrs.get("stop_reason", "")
     iterations = attrs.get("iterations", "?")
@@ -463,9 +601,9 @@ def plot_result(result, png, events=None, warp=None, title=None, max_curves=12, 
                  f"{len(steps)} step{'s' if len(steps) != 1 else ''}", fontsize=12)
 
     profiles = _iteration_profiles(events) if len(steps) == 1 else {}
-    xlims, zones, zoomed = {}, {}, {}
+    xlims, zones, zoomed, sticks = {}, {}, {}, {}
     for j, pair in enumerate(pair_names or [None]):
-        ax = fig.add_subplot(gs[0, j])
+        ax, tax = _pair_axes(fig, gs[0, j], pair in frictions)
         if pair is None:
             ax.text(0.5, 0.5, "no contact pair", ha="center", va="center", transform=ax.transAxes)
             continue
@@ -477,7 +615,10 @@ def plot_result(result, png, events=None, warp=None, title=None, max_curves=12, 
             curves = _iteration_curves(profiles.get(pair, []), c_final, along, max_curves)
             what, total = "iteration", len(profiles.get(pair, []))
         zones[pair], limits = _draw_pressure(fig, ax, pair, curves, c_final, final["iteration"], what, total,
-                                             along, xlim)
+                                             along, xlim, bar_axes=[ax, tax] if tax else None)
+        if tax is not None:
+            sticks[pair] = _draw_friction(ax, tax, steps, pair, frictions[pair], profiles.get(pair, []), along,
+                                          max_curves, loaded=curve is not None)
         if limits is not None:
             zoomed[pair] = limits
         xlims[pair] = tuple(float(v) for v in ax.get_xlim())
@@ -488,4 +629,7 @@ def plot_result(result, png, events=None, warp=None, title=None, max_curves=12, 
     os.makedirs(os.path.dirname(os.path.abspath(png)), exist_ok=True)
     fig.savefig(png, dpi=100)
     plt.close(fig)
-    return {"warp": warp, "pressure_xlim": xlims, "contact_zone": zones, "mesh_zoom": zoom}
+    return {"warp": warp, "pressure_xlim": xlims, "contact_zone": zones, "mesh_zoom": zoom,
+            "friction": {pair: friction_text(f) for pair, f in frictions.items()},
+            "tangential_force": {pair: f["tangential_force"] for pair, f in frictions.items()},
+            "stick_zones": sticks, "figure": fig}

@@ -17,7 +17,10 @@ def read_result(path):
                 "bodies": {name: {"points", "cells" (-1 ends a triangle), "cell_types", "quads" (all-quadrilateral
                                   meshes only), "level", "von_mises", "displacement", "stress_cell", ...}},
                 "contacts": {pair: {"position", "x", "arc_length", "pressure", "gap", "normal_gap", "active",
-                                    "attrs": {...}}}}, ...],                   # in step order; the last is final
+                                    "attrs": {...},                    # friction pairs also "tangent",
+                                    ...}}}, ...],                      # "tangential_traction", "slip", "stick"
+                                                                       # (pair_friction()); in step order, the
+                                                                       # last is final
      "history": {"iterations": {"iteration", "fixed_point_residual", "max_pressure" (I, P), ...,
                                 "body_names", "pair_names"},
                  "steps": {...}}}
@@ -92,6 +95,30 @@ def read_result(path):
             except ValueError:
                 pass
     return result
+
+
+def pair_friction(c):
+    """A pair's friction (c: a pair of read_result()'s steps): None for a frictionless pair and for a file
+    written before friction (no `friction` attribute, no tangential datasets); else {"law": "coulomb" or
+    "tresca", "coefficient": mu, "bound": g, "tangential_force": the total tangential force, "tangential_traction"
+    (k,), "stick" (k,) bool}, the per-node arrays None when the file lacks them."""
+    import numpy as np
+    attrs = c.get("attrs", {})
+    law = attrs.get("friction", "none")
+    if law in ("none", "", None):
+        return None
+    k = len(c.get("pressure", []))
+
+    def per_node(key, dtype):
+        v = c.get(key)
+        return np.asarray(v, dtype=dtype) if v is not None and len(v) == k else None
+
+    stick = per_node("stick", int)
+    return {"law": str(law), "coefficient": float(attrs.get("friction_coefficient", 0.0)),
+            "bound": float(attrs.get("friction_bound", 0.0)),
+            "tangential_force": float(attrs.get("tangential_force", float("nan"))),
+            "tangential_traction": per_node("tangential_traction", float),
+            "stick": stick == 1 if stick is not None else None}
 
 
 def read_events(path):

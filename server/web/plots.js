@@ -3,11 +3,15 @@
 //     says what that is: fixed_point -> the fixed-point residual and the paper's criterion; complementarity ->
 //     the complementarity residual and, on a linear axis at the right, the active-set changes; gradient -> the
 //     relative energy gradient (carried in fixed_point_residual).
-//   PressurePlot: one pair's contact pressure along its slave edge (arc length), the latest iteration's profile.
+//   PressurePlot: one pair's contact pressure along its slave edge (arc length), the latest iteration's profile;
+//     for a friction pair (its events carry `tangential_tractions` and `stick`) the tangential traction below it,
+//     on the same arc length, with the stick zone shaded green.
 // Each keeps its data and redraws at most a few times a second; the container's data-points / data-iteration
-// attributes say what has been drawn (what the browser test reads).
+// (and data-tangential-points / data-stick-zones) attributes say what has been drawn (what the browser test
+// reads).
 
 const COLOURS = ["#1f6fb2", "#d9480f", "#2b8a3e", "#862e9c"];
+const STICK_FILL = "rgba(44, 160, 44, 0.2)";  // the client plot's stick zone (tab:green, alpha 0.2)
 
 const SERIES = {
   fixed_point: [
@@ -149,6 +153,85 @@ export class ConvergencePlot {
   }
 }
 
+// Where the nodes stick along the sorted arc lengths x (stick[i] 1: node i sticks): [[lo, hi], ...], one per run
+// of neighbouring sticking nodes, each reaching halfway to the next node that does not stick (to the node itself
+// at an end of the edge): the client plot's stick_zones().
+export function stickZones(x, stick) {
+  const zones = [];
+  for (let i = 0; i < x.length; ++i) {
+    if (stick[i] !== 1) continue;
+    let j = i;
+    while (j + 1 < x.length && stick[j + 1] === 1) ++j;
+    zones.push([i > 0 ? (x[i - 1] + x[i]) / 2 : x[i], j + 1 < x.length ? (x[j] + x[j + 1]) / 2 : x[j]]);
+    i = j;
+  }
+  return zones;
+}
+
+// A uPlot draw hook that shades the zones [[lo, hi], ...] (x values) across the plotting area, under the series.
+function shadeZones(getZones) {
+  return (u) => {
+    const {top, height} = u.bbox;
+    u.ctx.save();
+    u.ctx.fillStyle = STICK_FILL;
+    for (const [lo, hi] of getZones()) {
+      const a = u.valToPos(lo, "x", true);
+      const b = u.valToPos(hi, "x", true);
+      u.ctx.fillRect(Math.min(a, b), top, Math.max(1, Math.abs(b - a)), height);
+    }
+    u.ctx.restore();
+  };
+}
+
+// A friction pair's tangential traction along the slave edge, the stick zone shaded: the chart under its
+// pressure (PressurePlot makes it when the events carry tangential tractions).
+class TangentialChart {
+  constructor(el) {
+    this.caption = document.createElement("div");
+    this.caption.className = "muted";
+    this.chart = document.createElement("div");
+    this.chart.className = "chart tangential";
+    el.append(this.chart, this.caption);
+    this.el = el;
+    this.plot = null;
+    this.zones = [];
+  }
+
+  // d: the latest profile (PressurePlot.add), zones: its stick zones.
+  draw(d, zones) {
+    this.zones = zones;
+    const data = [d.x, d.t];
+    if (!this.plot) {
+      this.plot = new uPlot({
+        width: width(this.chart),
+        height: 220,
+        scales: {x: {time: false}},
+        axes: [{label: "arc length along the slave edge"}, {label: "tangential traction", size: 70}],
+        series: [{label: "s"},
+                 {label: "tangential traction", stroke: COLOURS[0], width: 1.5,
+                  points: {show: (u) => u.data[0].length < 80}}],
+        hooks: {drawClear: [shadeZones(() => this.zones)]},
+      }, data, this.chart);
+    } else {
+      this.plot.setData(data);
+    }
+    const num = (v, digits) => (typeof v === "number" && isFinite(v) ? v.toPrecision(digits) : "?");
+    const where = this.zones.map(([lo, hi]) => `${num(lo, 4)} to ${num(hi, 4)}`).join(", ");
+    this.caption.textContent = `tangential force ${num(d.pair.tangential_force, 6)}; ` +
+        (where ? `stick zone (shaded): ${where}` : "no node sticks");
+    this.el.dataset.tangentialPoints = String(d.x.length);
+    this.el.dataset.stickZones = JSON.stringify(this.zones);
+  }
+
+  resize() {
+    if (this.plot) this.plot.setSize({width: width(this.chart), height: 220});
+  }
+
+  destroy() {
+    if (this.plot) this.plot.destroy();
+  }
+}
+
 export class PressurePlot {
   constructor(el, name) {
     this.el = el;
@@ -161,6 +244,7 @@ export class PressurePlot {
     title.textContent = name;
     el.append(title, this.caption, this.chart);
     this.plot = null;
+    this.tangential = null;  // a TangentialChart once the events carry tangential tractions
     this.latest = null;
     this.throttle = new Throttled(() => this.draw());
     el.dataset.iteration = "0";
@@ -169,12 +253,18 @@ export class PressurePlot {
   add(iteration, pair) {
     if (!Array.isArray(pair.positions) || !Array.isArray(pair.pressures)) return;
     const n = Math.min(pair.positions.length, pair.pressures.length);
+    // A friction pair: its tangential tractions and stick flags, node by node with the positions.
+    const friction = Array.isArray(pair.tangential_tractions) && Array.isArray(pair.stick) &&
+        pair.tangential_tractions.length === n && pair.stick.length === n;
     // uPlot wants x increasing: arc lengths are, but sort anyway.
     const rows = [];
     for (let i = 0; i < n; ++i)
-      if (finite(pair.positions[i]) !== null) rows.push([pair.positions[i], finite(pair.pressures[i])]);
+      if (finite(pair.positions[i]) !== null)
+        rows.push([pair.positions[i], finite(pair.pressures[i]),
+                   friction ? finite(pair.tangential_tractions[i]) : null, friction ? pair.stick[i] : 0]);
     rows.sort((a, b) => a[0] - b[0]);
-    this.latest = {iteration, x: rows.map((r) => r[0]), p: rows.map((r) => r[1]), pair};
+    this.latest = {iteration, x: rows.map((r) => r[0]), p: rows.map((r) => r[1]), pair,
+                   t: friction ? rows.map((r) => r[2]) : null, stick: rows.map((r) => r[3])};
     this.throttle.request();
   }
 
@@ -182,6 +272,7 @@ export class PressurePlot {
     const d = this.latest;
     if (!d) return;
     const data = [d.x, d.p];
+    this.zones = d.t ? stickZones(d.x, d.stick) : [];
     if (!this.plot) {
       this.plot = new uPlot({
         width: width(this.chart),
@@ -190,6 +281,7 @@ export class PressurePlot {
         axes: [{label: "arc length along the slave edge"}, {label: "pressure", size: 70}],
         series: [{label: "s"},
                  {label: "pressure", stroke: COLOURS[1], width: 1.5, points: {show: (u) => u.data[0].length < 80}}],
+        hooks: d.t ? {drawClear: [shadeZones(() => this.zones)]} : {},  // a friction pair: its stick zone too
       }, data, this.chart);
     } else {
       this.plot.setData(data);
@@ -197,15 +289,21 @@ export class PressurePlot {
     const num = (v, digits) => (typeof v === "number" && isFinite(v) ? v.toPrecision(digits) : "?");
     this.caption.textContent = `iteration ${d.iteration}: force ${num(d.pair.force, 6)}, ` +
         `max pressure ${num(d.pair.max_pressure, 6)}, ${d.pair.active_nodes ?? "?"} nodes in contact`;
+    if (d.t) {
+      if (!this.tangential) this.tangential = new TangentialChart(this.el);
+      this.tangential.draw(d, this.zones);
+    }
     this.el.dataset.iteration = String(d.iteration);
   }
 
   resize() {
     if (this.plot) this.plot.setSize({width: width(this.chart), height: 220});
+    if (this.tangential) this.tangential.resize();
   }
 
   destroy() {
     this.throttle.cancel();
     if (this.plot) this.plot.destroy();
+    if (this.tangential) this.tangential.destroy();
   }
 }

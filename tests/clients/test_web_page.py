@@ -5,7 +5,9 @@ chromium-driver, against the real contactd.
 Without a token: the page lists jobs; a job pasted into the form and submitted through the page runs, and while
 it runs (the API still says RUNNING) the convergence plot gains points, the pressure plot and the mesh table
 follow the iterations; the page's Cancel stops it; an example picked from the list fills the form with the
-file's text and solves, and the page's download link serves the HDF5 result; an invalid job shows every error
+file's text and solves, and the page's download link serves the HDF5 result (a frictionless job: no tangential
+plot); a friction job (the roller between two plates) shows under each pair's pressure its tangential traction,
+the final event's, with the stick zone shaded where the event's stick flags say; an invalid job shows every error
 with its pointer; the page's Delete removes a job. With a token: the page says it needs one, works once it is
 entered (the list, submit, the live plot through the stream read with the Authorization header, the download
 saved by the browser), and keeps it across a reload. Throughout: no script error and no Content-Security-Policy
@@ -25,7 +27,7 @@ SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(HERE, "..", ".."))
 sys.path.insert(0, os.path.join(SRC, "tests", "server"))
 sys.path.insert(0, os.path.join(SRC, "clients"))
 from contact_client.plot import AXIS_LABELS  # noqa: E402
-from harness import EXAMPLES, Checks, Server, example, long_job  # noqa: E402
+from harness import EXAMPLES, Checks, Server, example, long_job, read_all_events, roller_job  # noqa: E402
 
 checks = Checks()
 check = checks.check
@@ -213,6 +215,8 @@ def test_without_token(server, b, downloads):
     check("example: the plot of the new job starts afresh", points(b) < long_points, (points(b), long_points))
     check("example: the active-set method's measure",
           "complementarity" in b.text("convergence-title"), b.text("convergence-title"))
+    check("example: frictionless, no tangential-traction plot",
+          not b.driver.find_elements(By.CSS_SELECTOR, "#pressure .tangential"))
     link = b.wait(lambda: b.el("result-link").is_displayed() and b.attr("result-link", "href"), 10)
     check("example: a download link to the result", bool(link) and link.endswith(f"/v1/jobs/{patch_id}/result"),
           link)
@@ -220,6 +224,8 @@ def test_without_token(server, b, downloads):
     if link:
         with urllib.request.urlopen(link, timeout=10) as r:
             check("example: the link serves the HDF5 file", r.read(8) == b"\x89HDF\r\n\x1a\n")
+
+    test_friction(server, b)
 
     # 4. An invalid job: every error with its pointer, no job created.
     bad = example("flat_patch.json")
@@ -247,6 +253,64 @@ def test_without_token(server, b, downloads):
           b.wait(lambda: not b.driver.find_elements(By.CSS_SELECTOR, f'#jobs tr[data-id="{job_id}"]'), 10))
     errors = errors_in(b.logs())
     check("no script error or CSP violation in the console", not errors, errors)
+
+
+def stick_zones(x, stick):
+    """The stick zones the page should shade: per run of sticking nodes (stick 1) along x (increasing), from
+    halfway to the node before it to halfway to the node after it (the node itself at an end of the edge)."""
+    zones, i = [], 0
+    while i < len(x):
+        if stick[i] != 1:
+            i += 1
+            continue
+        j = i
+        while j + 1 < len(x) and stick[j + 1] == 1:
+            j += 1
+        zones.append([(x[i - 1] + x[i]) / 2 if i > 0 else x[i], (x[j] + x[j + 1]) / 2 if j + 1 < len(x) else x[j]])
+        i = j + 1
+    return zones
+
+
+def test_friction(server, b):
+    """3b. A friction job: each pair's tangential traction under its pressure, the stick zone shaded."""
+    b.driver.execute_script("window.pressureCanvasTexts.length = 0;")
+    b.set_job_text(json.dumps(roller_job()))
+    before = b.text("job-id")
+    b.el("submit").click()
+    job_id = b.wait(lambda: b.text("job-id") if b.text("job-id") != before else None, 10)
+    check("friction: solved", b.wait(lambda: b.text("job-state") == "SUCCEEDED", 30), b.text("job-state"))
+    events = read_all_events(server, job_id, ndjson=True) if job_id else []
+    last = [e for e in events if e.get("type") == "iteration"][-1:]
+    if not check("friction: the events carry tangential tractions and stick flags",
+                 last and all("tangential_tractions" in p and "stick" in p for p in last[0]["pairs"]), last):
+        return
+    b.wait(lambda: b.attr("pressure", "data-iteration") == str(last[0]["iteration"]), 10)
+    for pair in last[0]["pairs"]:
+        shown = b.wait(lambda: [el for el in b.driver.find_elements(By.CSS_SELECTOR, "#pressure .pair")
+                                if el.text.startswith(pair["name"])
+                                and el.find_elements(By.CSS_SELECTOR, ".chart.tangential canvas")], 10)
+        if not check(f"friction {pair['name']}: a tangential-traction plot under its pressure",
+                     shown and len(shown[0].find_elements(By.CSS_SELECTOR, ".chart canvas")) == 2, b.text("pressure")):
+            continue
+        el = shown[0]
+        order = sorted(range(len(pair["positions"])), key=lambda i: pair["positions"][i])
+        x = [pair["positions"][i] for i in order]
+        want = stick_zones(x, [pair["stick"][i] for i in order])
+        got = json.loads(el.get_attribute("data-stick-zones") or "null")
+        check(f"friction {pair['name']}: every node of the last iteration plotted",
+              el.get_attribute("data-tangential-points") == str(len(x)), el.get_attribute("data-tangential-points"))
+        check(f"friction {pair['name']}: the stick zone shaded where the event's stick flags say",
+              got is not None and want and len(got) == len(want)
+              and all(abs(a - w) < 1e-12 for g, z in zip(got, want) for a, w in zip(g, z)), (got, want))
+        check(f"friction {pair['name']}: the caption gives the tangential force and the stick zone",
+              "tangential force" in el.text and "stick zone (shaded)" in el.text, el.text)
+    drawn = b.driver.execute_script(
+        "return Array.from(document.querySelectorAll('#pressure .chart.tangential'))"
+        "  .map(c => c.querySelector('.uplot') !== null);")
+    check("friction: a uPlot chart per pair", drawn == [True] * len(last[0]["pairs"]), drawn)
+    labels = b.driver.execute_script("return window.pressureCanvasTexts || null;")
+    check("friction: the tangential axis is labelled", labels is not None and "tangential traction" in labels,
+          labels and sorted(set(labels))[:20])
 
 
 def test_with_token(b, downloads):

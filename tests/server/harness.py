@@ -64,6 +64,26 @@ def long_job(max_iterations=100000, name="long"):
     return job
 
 
+def roller_job():
+    """The roller between two plates, loaded by a force alone, held by friction (issue 21; Coulomb mu = 0.2 on both
+    contacts, roller.bottom-base.top and roller.top-plate.bottom): one step, partial stick on both."""
+    arcs = {"bottom": {"arc": {"center": [0, 1], "radius": 1}}, "top": {"arc": {"center": [0, 1], "radius": 1}}}
+    steel = {"E": 2.1e5, "nu": 0.3}
+    return {"name": "roller", "bodies": [
+        {"name": "base", "material": steel,
+         "mesh": {"block": {"corners": [[-2, -1], [2, -1], [2, 0], [-2, 0]], "nx": 32, "ny": 8}},
+         "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]},
+        {"name": "roller", "material": steel,
+         "mesh": {"block": {"corners": [[-0.5, 0.1339745962155614], [0.5, 0.1339745962155614],
+                                        [0.5, 1.8660254037844386], [-0.5, 1.8660254037844386]],
+                            "nx": 24, "ny": 24, "edges": arcs}}},
+        {"name": "plate", "material": steel,
+         "mesh": {"block": {"corners": [[-2, 2], [2, 2], [2, 3], [-2, 3]], "nx": 32, "ny": 8}},
+         "boundary": [{"edge": "top", "force": [0, -10000]}]}],
+        "contacts": [{"slave": "roller.bottom", "master": "base.top", "friction": {"coefficient": 0.2}},
+                     {"slave": "roller.top", "master": "plate.bottom", "friction": {"coefficient": 0.2}}]}
+
+
 class Checks:
     """Counts named checks; prints each failure with its detail."""
 
