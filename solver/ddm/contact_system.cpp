@@ -298,6 +298,9 @@ void ContactSystem::report_friction(const Pressures& z, const Pressures& q, Iter
     const Eigen::VectorXi stick = stick_at_nodes(pair, pair.sticking(z[k], q[k]));
     pr.stick.assign(stick.data(), stick.data() + stick.size());
     pr.tangential_force = -pair.area.dot(q[k]);
+    pr.friction = pair.friction.law == FrictionSpec::Law::coulomb ? "coulomb" : "tresca";
+    pr.friction_coefficient = pair.friction.coefficient;
+    pr.friction_bound = pair.friction.bound;
     pr.resultant += pair.tangential_resultant(q[k]);
   }
 }

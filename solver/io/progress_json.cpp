@@ -19,7 +19,12 @@ nlohmann::json iteration_json(const IterationReport& report, bool with_profiles)
                            {"changed_nodes", p.changed_nodes},
                            {"theta", p.theta},
                            {"max_penetration", p.max_penetration}};
-    if (!p.stick.empty()) pair["tangential_force"] = p.tangential_force;  // friction pairs only
+    if (!p.stick.empty()) {  // friction pairs only
+      pair["friction"] = p.friction;
+      pair["friction_coefficient"] = p.friction_coefficient;
+      pair["friction_bound"] = p.friction_bound;
+      pair["tangential_force"] = p.tangential_force;
+    }
     if (with_profiles) {
       pair["positions"] = p.positions;
       pair["pressures"] = p.pressures;

@@ -42,6 +42,8 @@ struct PairReport {
   std::vector<double> tangential_tractions;
   std::vector<int> stick;
   double tangential_force = 0.0;
+  std::string friction;  // "coulomb" or "tresca" for friction pairs, empty otherwise
+  double friction_coefficient = 0.0, friction_bound = 0.0;
 };
 
 // Which number decides convergence in a report: the fixed-point residual (Neumann, Robin, the paper's adaptive
