@@ -10,7 +10,7 @@
 #include "../fem/body_solver.hpp"
 #include "contact/problem.hpp"
 #include "contact/result.hpp"
-#include "task_runner.hpp"
+#include "../parallel/task_runner.hpp"
 
 #include <memory>
 #include <string>

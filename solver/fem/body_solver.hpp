@@ -34,7 +34,7 @@ class BodySolver {
   // allow_floating: a body that its own displacement conditions do not restrain is accepted (it is held by its
   // contacts): its rigid modes R are fixed at a few well-chosen dofs for the factorisation, so every solve gives
   // a particular solution K^+ f (zero at those dofs; meaningful when R^T f = 0), and the caller adds R alpha.
-  // local = false: the body belongs to another process (MPI ranks, ddm/task_runner.hpp): only its constraints and
+  // local = false: the body belongs to another process (MPI ranks, parallel/task_runner.hpp): only its constraints and
   // rigid modes are set up (the same as on its owner), nothing is assembled or factorised, and the owner's outcome
   // arrives through adopt_outcome(). Its solves throw; its stresses and reactions need no factorisation and work.
   BodySolver(const Body& body, const Model& model, bool factorize = true, const std::vector<int>& interface_dofs = {},

@@ -1,4 +1,4 @@
-// The per-body work of the DDM on MPI ranks (OpenMPI): each rank owns some bodies (ddm/ownership.hpp), assembles
+// The per-body work of the DDM on MPI ranks (OpenMPI): each rank owns some bodies (parallel/ownership.hpp), assembles
 // and factorises only those, and runs their tasks with its own threads; after every batch of per-body tasks the
 // outputs (BodyShare) go to every rank with one MPI_Allgatherv. Everything else - the contact discretisation,
 // the small interface problem, the active set, the stopping tests - runs on every rank on the same data, so all
@@ -9,7 +9,7 @@
 // sets the agreed token on every rank at the same point.
 #pragma once
 
-#include "ddm/task_runner.hpp"
+#include "parallel/task_runner.hpp"
 #include "contact/result.hpp"
 
 #include <mpi.h>

@@ -1,6 +1,8 @@
-#include "session.hpp"
+#include "contact/session.hpp"
 
-#include "ddm/ownership.hpp"
+#include "contact/solve.hpp"
+#include "parallel/ownership.hpp"
+#include "parallel/task_runner.hpp"
 
 #include <cstdlib>
 #include <sstream>
@@ -9,7 +11,7 @@
 #include "mpi/mpi_runner.hpp"
 #endif
 
-namespace contact::cli {
+namespace contact {
 
 namespace {
 
@@ -37,6 +39,7 @@ Session::Session(int* argc, char*** argv) {
 }
 
 Session::~Session() {
+  runner_.reset();  // (an MPI runner before MPI_Finalize)
 #ifdef CONTACT_WITH_MPI
   if (mpi_) MPI_Finalize();
 #endif
@@ -66,22 +69,31 @@ int Session::broadcast(int value) const {
   return value;
 }
 
-std::unique_ptr<ddm::TaskRunner> Session::runner(const Problem& problem, const std::atomic<bool>* request,
-                                                 CancelToken* agreed) const {
+namespace {
+
+std::unique_ptr<ddm::TaskRunner> make_runner(const Problem& problem, bool mpi, int rank, int size,
+                                             const std::atomic<bool>* request, CancelToken* agreed) {
 #ifdef CONTACT_WITH_MPI
-  if (mpi_ && size_ > 1) {
-    const std::vector<int> owner = ddm::assign_bodies(problem, size_);
+  if (mpi && size > 1) {
+    const std::vector<int> owner = ddm::assign_bodies(problem, size);
     size_t mine = 0;
-    for (int r : owner) mine += r == rank_ ? 1 : 0;
+    for (int r : owner) mine += r == rank ? 1 : 0;
     auto runner = std::make_unique<mpi::MpiTaskRunner>(MPI_COMM_WORLD, owner,
                                                        ddm::choose_threads(problem.solver.threads, std::max<size_t>(mine, 1)));
     runner->watch_cancel(request, agreed);
     return runner;
   }
 #endif
-  (void)request;
-  (void)agreed;
+  (void)mpi, (void)rank, (void)size, (void)request, (void)agreed;
   return std::make_unique<ddm::ThreadTaskRunner>(ddm::choose_threads(problem.solver.threads, problem.bodies.size()));
+}
+
+}  // namespace
+
+Result Session::solve(const Problem& problem, Observer& observer, const std::atomic<bool>* request,
+                      CancelToken* agreed) {
+  runner_ = make_runner(problem, mpi_, rank_, size_, request, agreed);
+  return contact::solve(problem, observer, *agreed, *runner_);
 }
 
 std::string Session::placement(const Problem& problem) const {
@@ -102,9 +114,9 @@ std::string Session::placement(const Problem& problem) const {
   return os.str();
 }
 
-std::string Session::traffic(const ddm::TaskRunner& runner) const {
+std::string Session::traffic() const {
 #ifdef CONTACT_WITH_MPI
-  const auto* r = dynamic_cast<const mpi::MpiTaskRunner*>(&runner);
+  const auto* r = dynamic_cast<const mpi::MpiTaskRunner*>(runner_.get());
   if (!r) return "";
   // Every rank's message goes to the size - 1 others.
   long long sent = r->bytes_sent(), total = 0;
@@ -113,9 +125,8 @@ std::string Session::traffic(const ddm::TaskRunner& runner) const {
   os << r->exchanges() << " exchanges, " << total * (size_ - 1) << " bytes moved between the ranks";
   return os.str();
 #else
-  (void)runner;
   return "";
 #endif
 }
 
-}  // namespace contact::cli
+}  // namespace contact

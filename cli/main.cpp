@@ -7,7 +7,7 @@
 #include "contact/progress_json.hpp"
 #include "contact/result_file.hpp"
 #include "contact/job.hpp"
-#include "session.hpp"
+#include "contact/session.hpp"
 #include "contact/solve.hpp"
 
 #include <CLI/CLI.hpp>
@@ -24,7 +24,7 @@
 namespace {
 
 // A stop request (SIGINT, SIGTERM, or SIGUSR1 which mpirun forwards to every rank): the solver sees it at its
-// next iteration, on every rank at the same point (cli/session.hpp).
+// next iteration, on every rank at the same point (contact/session.hpp).
 // One process: the request is the cancel token itself.
 std::atomic<bool> g_stop_request{false};
 std::atomic<contact::CancelToken*> g_direct_cancel{nullptr};
@@ -151,7 +151,7 @@ std::string read_file(const std::string& path) {
 
 // Everything after the job is parsed: solve on this process's share, report and write on rank 0. Returns the
 // exit code (rank 0's decides for all).
-int solve_and_write(contact::cli::Session& session, contact::Problem& problem, const std::string& output,
+int solve_and_write(contact::Session& session, contact::Problem& problem, const std::string& output,
                     const std::string& job_id, bool quiet, bool ndjson) {
   const bool root = session.root();
   contact::CancelToken cancel;
@@ -174,11 +174,10 @@ int solve_and_write(contact::cli::Session& session, contact::Problem& problem, c
   }
   ProgressPrinter printer(quiet, ndjson);
   Silent silent;
-  std::unique_ptr<contact::ddm::TaskRunner> runner = session.runner(problem, &g_stop_request, &cancel);
   const contact::Result result =
-      contact::solve(problem, root ? static_cast<contact::Observer&>(printer) : silent, cancel, *runner);
+      session.solve(problem, root ? static_cast<contact::Observer&>(printer) : silent, &g_stop_request, &cancel);
   g_direct_cancel = nullptr;
-  const std::string traffic = session.traffic(*runner);
+  const std::string traffic = session.traffic();
   if (!root) return 0;
 
   if (!ndjson) {
@@ -259,7 +258,7 @@ int solve_and_write(contact::cli::Session& session, contact::Problem& problem, c
 }
 
 // Rank 0 reads the job file; every rank gets its text ("" and false when it cannot be read: the error is printed).
-bool read_job(const contact::cli::Session& session, const std::string& path, std::string& text) {
+bool read_job(const contact::Session& session, const std::string& path, std::string& text) {
   int ok = 1;
   if (session.root()) {
     try {
@@ -278,7 +277,7 @@ bool read_job(const contact::cli::Session& session, const std::string& path, std
 
 int main(int argc, char** argv) {
   catch_stop_signals();
-  contact::cli::Session session(&argc, &argv);
+  contact::Session session(&argc, &argv);
   CLI::App app{
       "contact-solve: frictionless contact of elastic bodies by domain decomposition (each body solved on its own).\n"
       "Methods (job field solver.method): interface_newton (default: exact dual-mortar contact, primal-dual active\n"
