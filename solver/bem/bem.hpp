@@ -117,6 +117,7 @@ struct HierarchicalOptions {
 struct HierarchicalStats {
   int unknowns = 0;
   int near_blocks = 0, far_blocks = 0;
+  int interpolated_blocks = 0;  // interior evaluation: far blocks through Chebyshev interpolation (in far_blocks)
   int largest_rank = 0;
   double mean_rank = 0.0;
   std::size_t matrix_bytes = 0;          // the compressed matrix (near + far blocks)
