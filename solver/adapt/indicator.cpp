@@ -292,11 +292,16 @@ IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fe
   return r;
 }
 
-Marking mark(const mesh::Mesh& mesh, const Eigen::VectorXd& eta, double delta, int max_level, long max_dofs) {
+Marking mark(const mesh::Mesh& mesh, const Eigen::VectorXd& eta, double delta, int max_level, long max_dofs,
+             const std::vector<char>& graded) {
   Marking out;
   std::vector<int> candidates;
   for (int c = 0; c < mesh.num_cells(); ++c) {
     if (!(eta[c] > delta)) continue;
+    if (!graded.empty() && graded[static_cast<size_t>(c)]) {
+      ++out.graded_out;
+      continue;
+    }
     if (mesh.level[static_cast<size_t>(c)] >= max_level) {
       out.level_limit_hit = true;
       continue;
