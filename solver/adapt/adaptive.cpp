@@ -266,6 +266,12 @@ ddm::MethodOutcome converge_then_refine(Problem& working, ddm::ContactSystem& sy
          << " refinement steps (" << (r.note.empty() ? "" : r.note + "; ") << "last solve: " << o.message << ")";
       return finish(os.str());
     }
+    if (context.cancel.cancelled()) {  // during the marking and refinement: the refined meshes are not solved
+      total.reason = StopReason::cancelled;
+      total.converged = false;
+      return finish("cancelled during adaptive step " + std::to_string(step) +
+                    " (the result holds that step's solution)");
+    }
     for (size_t a = 0; a < report.bodies.size() && a < r.refined.size(); ++a)
       report.bodies[a].elements_refined = r.refined[a];
     context.observer.on_adaptive_step(report);
