@@ -168,17 +168,24 @@ class HierarchicalSomigliana {
   // Whether a far block is interpolated: enough points to repay the p x p nodes, and a points' box small against
   // its distance to the elements (the interpolation's condition, stricter than the partition's min(diam)).
   bool interpolates(const BlockPair& pair) const {
-    const auto& rows = targets_.clusters()[static_cast<std::size_t>(pair.row_cluster)];
     const BoundingBox& box = target_boxes_[static_cast<std::size_t>(pair.row_cluster)];
-    return rows.size() > interpolation_.nodes() &&
+    return repays_interpolation(pair) &&
            box.diameter() <= options_.eta * box.distance(source_boxes_[static_cast<std::size_t>(pair.column_cluster)]);
   }
 
-  // A far block whose points' box is too large to interpolate over but holds more points than the nodes: its
-  // point cluster's children are tried instead (each pair stays admissible: a child's box is inside the parent's).
+  // A far block whose points' box is too large to interpolate over but would repay it: its point cluster's
+  // children are tried instead (each pair stays admissible: a child's box is inside the parent's).
   bool splits_for_interpolation(const BlockPair& pair) const {
-    const auto& rows = targets_.clusters()[static_cast<std::size_t>(pair.row_cluster)];
-    return !rows.leaf() && rows.size() > interpolation_.nodes();
+    return !targets_.clusters()[static_cast<std::size_t>(pair.row_cluster)].leaf() && repays_interpolation(pair);
+  }
+
+  // Interpolation costs ~p^2 E coefficient evaluations for E elements, ACA ~20 (P + E) for P points (rank and
+  // samples; see add_far_block): worth it, and worth splitting for, only where the points outnumber the nodes
+  // and p^2 E < 20 P (many points per element: the indicator's cell centres, not a few points per node).
+  bool repays_interpolation(const BlockPair& pair) const {
+    const int points = targets_.clusters()[static_cast<std::size_t>(pair.row_cluster)].size();
+    const int elements = sources_.clusters()[static_cast<std::size_t>(pair.column_cluster)].size();
+    return points > interpolation_.nodes() && static_cast<double>(interpolation_.nodes()) * elements < 20.0 * points;
   }
 
   // The far field of an admissible pair: interpolated where it can be, else by point-cluster children, else by
