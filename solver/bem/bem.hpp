@@ -140,9 +140,10 @@ Eigen::MatrixX3d interior_stresses_hierarchical(const BoundaryProblem& problem, 
 
 // The automatic choice: the dense path below this many boundary nodes (exact to round-off and faster there),
 // the hierarchical one from there on (docs/bem.md, "Which path"). The dense interior evaluation costs
-// ~0.2 us per (node, point) pair, so above kDenseInteriorPairs pairs (~1 s) the points go through the tree too.
+// ~0.2 us per (node, point) pair, so above kDenseInteriorPairs pairs (~0.04 s) the points go through the tree too
+// (with many points per node its interpolated far field costs a few us per point: docs/bem.md).
 constexpr std::size_t kHierarchicalFromNodes = 1000;
-constexpr double kDenseInteriorPairs = 4e6;
+constexpr double kDenseInteriorPairs = 2e5;
 BoundarySolution solve_auto(const BoundaryProblem& problem, const HierarchicalOptions& options = {});
 Eigen::MatrixX3d interior_stresses_auto(const BoundaryProblem& problem, const BoundarySolution& solution,
                                         const std::vector<Eigen::Vector2d>& points,
