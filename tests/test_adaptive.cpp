@@ -6,7 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -224,4 +226,48 @@ TEST(AdaptiveStop, ACancelBetweenStepsStopsWithTheStepsSoFar) {
   // Steps 0 and 1 complete, and the solve on step 2's mesh as far as it got.
   ASSERT_EQ(r.steps.size(), 3u) << r.message;
   EXPECT_GT(body(r.steps[2], "lower").mesh.num_cells(), body(r.steps[1], "lower").mesh.num_cells());
+}
+
+TEST(TwoCylindersGmshAdaptive, FemBemStopsByItselfWithinThreeTimesZzAndMatchesHertz) {
+  // api/examples/two_cylinders_gmsh.json (issue 20): a steel half-cylinder R1 = 10 on an aluminium one R2 = 25,
+  // Gmsh triangles from a coarse start (~1.4k unknowns), the job's defaults with fem_bem, then the same with zz.
+  // Plane-strain Hertz for two cylinders: 1/R* = 1/R1 + 1/R2, 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2,
+  // a = sqrt(4 P R* / (pi E*)), p0 = 2 P / (pi a), with P the computed contact force.
+  const json job = example("two_cylinders_gmsh.json");
+  ASSERT_EQ(job["adaptivity"]["indicator"], "fem_bem");
+  // Wall times, each the shorter of two runs, alternating (the machine may be shared: a run slowed by another
+  // process's burst says nothing about the indicators).
+  json zz_job = job;
+  zz_job["adaptivity"]["indicator"] = "zz";
+  Result fem_bem, zz;
+  double fem_bem_seconds = HUGE_VAL, zz_seconds = HUGE_VAL;
+  for (int repeat = 0; repeat < 2; ++repeat)
+    for (const bool bem : {true, false}) {
+      const auto t0 = std::chrono::steady_clock::now();
+      Result r = run(bem ? job : zz_job);
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      (bem ? fem_bem_seconds : zz_seconds) = std::min(bem ? fem_bem_seconds : zz_seconds, seconds);
+      (bem ? fem_bem : zz) = std::move(r);
+    }
+  long coarse = 0;
+  for (const auto& b : fem_bem.history.front().bodies) coarse += b.dofs;
+  std::printf("  coarse %ld unknowns; fem_bem %zu steps %.2f s (indicator %.2f s), zz %zu steps %.2f s: ratio %.2f\n",
+              coarse, fem_bem.steps.size(), fem_bem_seconds, fem_bem.indicator_seconds, zz.steps.size(), zz_seconds,
+              fem_bem_seconds / zz_seconds);
+  EXPECT_GT(coarse, 1200);
+  EXPECT_LT(coarse, 1600);
+  for (const Result* r : {&fem_bem, &zz}) {
+    ASSERT_TRUE(r->converged) << r->message;
+    EXPECT_NE(r->message.find("all below stop_tolerance"), std::string::npos) << r->message;  // stopped by itself
+  }
+  EXPECT_LE(fem_bem_seconds, 3.0 * zz_seconds);
+  const PairField& pair = fem_bem.steps.back().pairs.at(0);
+  const double R = 1.0 / (1.0 / 10 + 1.0 / 25);
+  const double inv_E = (1 - 0.3 * 0.3) / 2.1e5 + (1 - 0.33 * 0.33) / 7.0e4;
+  const double a = std::sqrt(4 * pair.force * R * inv_E / M_PI), p0 = 2 * pair.force / (M_PI * a);
+  const double peak = pair.pressure.maxCoeff();
+  std::printf("  P = %.3f, Hertz a = %.4f p0 = %.2f; computed peak %.2f (%.3f %%), half-width %.4f\n", pair.force, a,
+              p0, peak, 100 * (peak - p0) / p0, contact::testing::hertz_half_width(pair));
+  EXPECT_NEAR(peak, p0, 0.003 * p0);
+  EXPECT_NEAR(contact::testing::hertz_half_width(pair), a, 0.01 * a);
 }

@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -19,6 +20,7 @@
 #include "bem/bem.hpp"
 #include "bem/cluster_tree.hpp"
 #include "bem/gmres.hpp"
+#include "bem/interpolation.hpp"
 #include "bem_problems.hpp"
 
 using namespace contact::bem;
@@ -227,6 +229,67 @@ TEST(HBemAgreesWithDense, QuadraticFieldOnATriangle) {
   const BoundaryProblem problem = polygon_problem(triangle, sides, 1.0 / 40, field, kSteel);
   expect_agreement(compare_with_dense(problem, grid_inside(triangle, {0, 0}, {2, 1.5}, 16, 0.01)),
                    "triangle, h = 1/40 (" + std::to_string(problem.nodes.size()) + " nodes)");
+}
+
+TEST(HBemInterpolation, ChebyshevGridIsExactForItsDegreeAndReachesTheToleranceAtOneDiameter) {
+  const ChebyshevGrid grid = ChebyshevGrid::for_tolerance(1e-8);
+  const int p = grid.per_direction();
+  EXPECT_EQ(p, 12);  // rho = 3 + sqrt(8): rho^-11 < 1e-8
+  BoundingBox box;
+  box.extend(Vector2d(1.0, 2.0));
+  box.extend(Vector2d(1.6, 2.4));
+  const auto values_at = [&](const std::function<double(const Vector2d&)>& f) {
+    Eigen::MatrixX3d v = Eigen::MatrixX3d::Zero(grid.nodes(), 3);
+    const std::vector<Vector2d> nodes = grid.nodes_in(box);
+    for (int k = 0; k < grid.nodes(); ++k) v(k, 0) = f(nodes[static_cast<std::size_t>(k)]);
+    return v;
+  };
+  // Degree p - 1 in each coordinate: exact to round-off.
+  const auto polynomial = [&](const Vector2d& x) { return std::pow(x.x(), p - 1) * std::pow(x.y(), p - 1) + x.x() - 3 * x.y(); };
+  // A stress-kernel-like 1/r^2 (times an angle factor) from a source one box diameter from the box.
+  const Vector2d source = box.hi + box.diameter() * Vector2d(1, 1).normalized();
+  const auto kernel = [&](const Vector2d& x) { return (x - source).x() * (x - source).y() / std::pow((x - source).squaredNorm(), 2); };
+  const Eigen::MatrixX3d poly_values = values_at(polynomial), kernel_values = values_at(kernel);
+  double poly_error = 0.0, kernel_error = 0.0, kernel_max = 0.0;
+  for (int i = 0; i <= 20; ++i)
+    for (int j = 0; j <= 20; ++j) {
+      const Vector2d x = box.lo + Vector2d(i / 20.0 * 0.6, j / 20.0 * 0.4);
+      poly_error = std::max(poly_error, std::abs(grid.at(box, poly_values, x)(0) - polynomial(x)) / std::abs(polynomial(x)));
+      kernel_error = std::max(kernel_error, std::abs(grid.at(box, kernel_values, x)(0) - kernel(x)));
+      kernel_max = std::max(kernel_max, std::abs(kernel(x)));
+    }
+  std::printf("  p = %d: polynomial %.1e, 1/r^2 kernel at one diameter %.1e (relative)\n", p, poly_error, kernel_error / kernel_max);
+  EXPECT_LE(poly_error, 1e-12);
+  EXPECT_LE(kernel_error, 1e-8 * kernel_max);
+  // Points on a line (a zero-width box): the nodes stay distinct and a linear function is reproduced.
+  BoundingBox line;
+  line.extend(Vector2d(0, 0));
+  line.extend(Vector2d(1, 0));
+  Eigen::MatrixX3d linear = Eigen::MatrixX3d::Zero(grid.nodes(), 3);
+  const std::vector<Vector2d> nodes = grid.nodes_in(line);
+  for (int k = 0; k < grid.nodes(); ++k) linear(k, 0) = 2 * nodes[static_cast<std::size_t>(k)].x() + nodes[static_cast<std::size_t>(k)].y();
+  EXPECT_NEAR(grid.at(line, linear, Vector2d(0.3, 0))(0), 0.6, 1e-12);
+}
+
+TEST(HBemInterpolation, ManyPointsThroughInterpolatedBoxesAgreeWithTheDenseEvaluation) {
+  // The indicator's case: far more points than boundary nodes (a cell centre per cell), down to 1/500 of the
+  // square from its boundary; the default leaf size, so the far field is mostly interpolated.
+  const Field field = quadratic_field(kSteel);
+  const std::vector<SideCondition> sides{kDisplacement, kTraction, kRollerY, kDisplacement};
+  const BoundaryProblem problem = polygon_problem(kSquare, sides, 1.0 / 64, field, kSteel);
+  const BoundarySolution solution = solve(problem);
+  const std::vector<Vector2d> points = grid_inside(kSquare, {0, 0}, {1, 1}, 110, 0.002);
+  for (const double tolerance : {1e-8, 1e-6}) {
+    HierarchicalOptions options;
+    options.tolerance = tolerance;
+    HierarchicalStats stats;
+    const double difference = relative(interior_stresses_hierarchical(problem, solution, points, options, &stats),
+                                       interior_stresses(problem, solution, points));
+    std::printf("  %zu points, tolerance %.0e: %d interpolated of %d far blocks, difference %.1e\n", points.size(),
+                tolerance, stats.interpolated_blocks, stats.far_blocks, difference);
+    EXPECT_GT(stats.interpolated_blocks, 0);
+    EXPECT_LE(difference, 10 * tolerance);
+  }
 }
 
 TEST(HBemAgreesWithDense, LShapeGradedTowardsTheReentrantCorner) {

@@ -429,6 +429,25 @@ TEST(JobErrors, AdaptivityStopToleranceMustBeARelativeChangeBelowOne) {
   EXPECT_EQ(r.problem->normalized["adaptivity"]["stop_tolerance"], 0.0);
 }
 
+TEST(JobErrors, AdaptivityMarkingIsContactOrPlainAndGradingNonNegative) {
+  json job = small_job();
+  job["adaptivity"] = {{"marking", "dorfler"}};
+  expect_only_error(parse(job), "/adaptivity/marking", "\"contact\"");
+  job["adaptivity"] = {{"grading", -0.5}};
+  expect_only_error(parse(job), "/adaptivity/grading", "must be >= 0");
+  job["adaptivity"] = json::object();
+  ParseResult r = parse(job);
+  ASSERT_TRUE(r.ok()) << listing(r);
+  EXPECT_EQ(r.problem->adaptivity.marking, contact::MarkingRule::contact);
+  EXPECT_EQ(r.problem->adaptivity.grading, 0.0);
+  EXPECT_EQ(r.problem->normalized["adaptivity"]["marking"], "contact");
+  job["adaptivity"] = {{"marking", "plain"}, {"grading", 0.25}};
+  r = parse(job);
+  ASSERT_TRUE(r.ok()) << listing(r);
+  EXPECT_EQ(r.problem->adaptivity.marking, contact::MarkingRule::plain);
+  EXPECT_EQ(r.problem->adaptivity.grading, 0.25);
+}
+
 TEST(JobDefaults, AdaptivityDefaultsToAllBodiesAndTheFemBemIndicator) {
   json job = small_job();
   job["adaptivity"] = json::object();

@@ -1,6 +1,7 @@
 #include "adaptive.hpp"
 
 #include "../ddm/fixed_point.hpp"
+#include "contact_zones.hpp"
 #include "indicator.hpp"
 
 #include <algorithm>
@@ -67,8 +68,10 @@ void add_note(std::string& notes, const std::string& note) {
   notes += note;
 }
 
-RefineOutcome mark_and_refine(Problem& problem, const std::vector<IndicatorResult>& eta) {
+// Marks and refines the adaptive bodies; `step` is the current mesh state (its contact zones for the grading).
+RefineOutcome mark_and_refine(Problem& problem, const std::vector<IndicatorResult>& eta, const Step& step) {
   const auto& s = problem.adaptivity;
+  const std::vector<ContactZone> zones = s.marking == MarkingRule::contact ? contact_zones(step) : std::vector<ContactZone>{};
   RefineOutcome out;
   const size_t n = problem.bodies.size();
   out.changed.assign(n, 0);
@@ -77,10 +80,16 @@ RefineOutcome mark_and_refine(Problem& problem, const std::vector<IndicatorResul
   for (size_t a = 0; a < n; ++a) {
     if (!adapts(s, a) || eta[a].eta.size() == 0) continue;
     auto& mesh = problem.bodies[a].mesh;
-    const Marking m = mark(mesh, eta[a].eta, s.delta, s.max_level, s.max_dofs);
+    const ContactMarking rules = contact_marking(mesh, zones, s.grading);
+    Eigen::VectorXd weighted = eta[a].eta;
+    for (Eigen::Index c = 0; c < weighted.size(); ++c) weighted[c] *= rules.factor[static_cast<size_t>(c)];
+    const Marking m = mark(mesh, weighted, s.delta, s.max_level, s.max_dofs, rules.graded);
     if (m.dof_limit_hit) add_note(out.note, "body '" + problem.bodies[a].name + "': max_dofs reached, refinement cut back");
     if (m.level_limit_hit) add_note(out.note, "body '" + problem.bodies[a].name + "': cells at max_level not refined");
-    out.blocked = out.blocked || m.dof_limit_hit || m.level_limit_hit;
+    if (m.graded_out > 0)
+      add_note(out.note, "body '" + problem.bodies[a].name + "': " + std::to_string(m.graded_out) +
+                             " cells over delta already fine enough for the contact (grading)");
+    out.blocked = out.blocked || m.dof_limit_hit || m.level_limit_hit || m.graded_out > 0;
     add_note(out.note, eta[a].note);
     if (m.cells.empty()) continue;
     out.refinements[a] = mesh::refine(mesh, m.cells, s.max_level);
@@ -250,12 +259,18 @@ ddm::MethodOutcome converge_then_refine(Problem& working, ddm::ContactSystem& sy
     if (const std::string stop = stalled(report, s.stop_tolerance); !stop.empty()) return finish(stop);
     if (step >= s.max_steps)
       return finish("adaptive: max_steps = " + std::to_string(s.max_steps) + " refinement steps done; " + o.message);
-    RefineOutcome r = mark_and_refine(working, eta);
+    RefineOutcome r = mark_and_refine(working, eta, steps.back());
     if (!r.any) {
       std::ostringstream os;
       os << "adaptive: " << (r.blocked ? "nothing marked can be refined" : "no cell marked") << " after " << step
          << " refinement steps (" << (r.note.empty() ? "" : r.note + "; ") << "last solve: " << o.message << ")";
       return finish(os.str());
+    }
+    if (context.cancel.cancelled()) {  // during the marking and refinement: the refined meshes are not solved
+      total.reason = StopReason::cancelled;
+      total.converged = false;
+      return finish("cancelled during adaptive step " + std::to_string(step) +
+                    " (the result holds that step's solution)");
     }
     for (size_t a = 0; a < report.bodies.size() && a < r.refined.size(); ++a)
       report.bodies[a].elements_refined = r.refined[a];
@@ -321,7 +336,7 @@ ddm::MethodOutcome paper_interleaving(Problem& working, ddm::ContactSystem& syst
     rep.gamma = gamma;
     // Record the mesh state (before it is refined), then refine.
     Step st = make_step(system, u_new, {}, k, step, eta);
-    RefineOutcome r = mark_and_refine(working, eta);
+    RefineOutcome r = mark_and_refine(working, eta, st);
     for (size_t a = 0; a < n; ++a) rep.bodies[a].elements_refined = r.refined[a];
     rep.note = r.note;
     rep.elapsed_seconds = context.elapsed();

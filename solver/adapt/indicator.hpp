@@ -46,14 +46,17 @@ IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fe
                                   const std::function<bool()>& cancelled = {});
 
 struct Marking {
-  std::vector<int> cells;  // to refine (cells over delta that max_level and max_dofs leave refinable)
+  std::vector<int> cells;  // to refine (cells over delta that max_level, max_dofs and the grading leave refinable)
   bool dof_limit_hit = false;
   bool level_limit_hit = false;
+  int graded_out = 0;  // cells over delta left alone because `graded` says they are fine enough for the contact
 };
 
-// Cells with eta > delta below max_level; if refining them all would take the body above max_dofs (counted as
-// 2 x nodes, an upper bound on its unknowns), only the largest-eta cells that fit are kept.
-Marking mark(const mesh::Mesh& mesh, const Eigen::VectorXd& eta, double delta, int max_level, long max_dofs);
+// Cells with eta > delta below max_level and not `graded` (per cell; empty: none); if refining them all would
+// take the body above max_dofs (counted as 2 x nodes, an upper bound on its unknowns), only the largest-eta cells
+// that fit are kept.
+Marking mark(const mesh::Mesh& mesh, const Eigen::VectorXd& eta, double delta, int max_level, long max_dofs,
+             const std::vector<char>& graded = {});
 
 // The boundary of a mesh as one closed counter-clockwise loop of nodes (hanging nodes are interior). Empty if
 // the boundary is not a single loop.

@@ -117,6 +117,7 @@ struct HierarchicalOptions {
 struct HierarchicalStats {
   int unknowns = 0;
   int near_blocks = 0, far_blocks = 0;
+  int interpolated_blocks = 0;  // interior evaluation: far blocks through Chebyshev interpolation (in far_blocks)
   int largest_rank = 0;
   double mean_rank = 0.0;
   std::size_t matrix_bytes = 0;          // the compressed matrix (near + far blocks)
@@ -139,9 +140,10 @@ Eigen::MatrixX3d interior_stresses_hierarchical(const BoundaryProblem& problem, 
 
 // The automatic choice: the dense path below this many boundary nodes (exact to round-off and faster there),
 // the hierarchical one from there on (docs/bem.md, "Which path"). The dense interior evaluation costs
-// ~0.2 us per (node, point) pair, so above kDenseInteriorPairs pairs (~1 s) the points go through the tree too.
+// ~0.2 us per (node, point) pair, so above kDenseInteriorPairs pairs (~0.04 s) the points go through the tree too
+// (with many points per node its interpolated far field costs a few us per point: docs/bem.md).
 constexpr std::size_t kHierarchicalFromNodes = 1000;
-constexpr double kDenseInteriorPairs = 4e6;
+constexpr double kDenseInteriorPairs = 2e5;
 BoundarySolution solve_auto(const BoundaryProblem& problem, const HierarchicalOptions& options = {});
 Eigen::MatrixX3d interior_stresses_auto(const BoundaryProblem& problem, const BoundarySolution& solution,
                                         const std::vector<Eigen::Vector2d>& points,

@@ -3,19 +3,24 @@
 // columns, here for the stress (3 rows per point):
 //   k = 0..3: int D N_m (:, j) mu / diameter, times t_j at its end m divided by mu / diameter     (k = 2 m + j)
 //   k = 4..7: -int S N_m (:, j), times u_j at its node m
-// A far-field block (points of one cluster x elements of another, apart) is compressed by ACA and applied to the
-// element-column values at once (nothing is stored); a near-field block is summed exactly, as interior_stresses()
-// does. The inside test uses the boundary's tree: the ray crossings and the distance to the boundary visit only
+// A far-field block whose points' box is small against its distance to the elements (diam <= eta dist) and holds
+// many points is interpolated: the block's stresses at the p x p Chebyshev nodes of the points' box, summed
+// exactly, then the tensor-product polynomial through them at every point of the box (the field of elements
+// that far is analytic over the box; see interpolation.hpp). Other far blocks are compressed by ACA and applied
+// to the element-column values at once (nothing is stored); a near-field block is summed exactly, as
+// interior_stresses() does. The inside test uses the boundary's tree: the ray crossings and the distance to the boundary visit only
 // the clusters whose boxes can matter.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <map>
 
 #include "aca.hpp"
 #include "bem.hpp"
 #include "boundary.hpp"
 #include "cluster_tree.hpp"
+#include "interpolation.hpp"
 #include "kelvin.hpp"
 #include "quadrature.hpp"
 
@@ -36,7 +41,8 @@ class HierarchicalSomigliana {
         kelvin_(effective_constants(problem.material), log_scale(geometry_)),
         traction_scale_(effective_constants(problem.material).shear_modulus / geometry_.diameter),
         sources_(problem.nodes, options.leaf_size),
-        targets_(points, options.leaf_size) {
+        targets_(points, options.leaf_size),
+        interpolation_(ChebyshevGrid::for_tolerance(options.tolerance)) {
     check_solution(problem, solution);
     element_values(solution);
     std::vector<BoundingBox> boxes(geometry_.elements.size());
@@ -52,16 +58,24 @@ class HierarchicalSomigliana {
     for (const Eigen::Vector2d& x : points_) check_inside(x);
     std::vector<BoundingBox> point_boxes(points_.size());
     for (std::size_t k = 0; k < points_.size(); ++k) point_boxes[k].extend(points_[k]);
-    const std::vector<BlockPair> pairs =
-        block_partition(targets_, targets_.cluster_boxes(point_boxes), sources_, source_boxes_, options_.eta);
+    target_boxes_ = targets_.cluster_boxes(point_boxes);
+    const std::vector<BlockPair> pairs = block_partition(targets_, target_boxes_, sources_, source_boxes_, options_.eta);
     stresses_ = Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(points_.size()), 3);
     for (const BlockPair& pair : pairs) {
       if (options_.cancelled && options_.cancelled()) throw Cancelled();
-      if (!pair.admissible || !add_far_block(pair)) add_near_block(pair);
+      if (!pair.admissible) {
+        add_near_block(pair);
+      } else if (interpolates(pair) || splits_for_interpolation(pair)) {
+        add_far_field(pair);
+      } else if (!add_far_block(pair)) {
+        add_near_block(pair);
+      }
     }
+    apply_interpolation();
     if (stats) {
       stats->near_blocks = near_blocks_;
-      stats->far_blocks = far_blocks_;
+      stats->far_blocks = far_blocks_ + interpolated_blocks_;
+      stats->interpolated_blocks = interpolated_blocks_;
       stats->largest_rank = largest_rank_;
       stats->mean_rank = far_blocks_ > 0 ? static_cast<double>(rank_sum_) / far_blocks_ : 0.0;
       stats->setup_seconds = 0.0;
@@ -111,8 +125,11 @@ class HierarchicalSomigliana {
   }
 
   StressColumns coefficients(int point, int element) const {
+    return coefficients_at(points_[static_cast<std::size_t>(point)], element);
+  }
+
+  StressColumns coefficients_at(const Eigen::Vector2d& xi, int element) const {
     const BoundaryElement& el = geometry_.elements[static_cast<std::size_t>(element)];
-    const Eigen::Vector2d& xi = points_[static_cast<std::size_t>(point)];
     StressColumns out = StressColumns::Zero();
     integrate_adaptively(el.start, el.tangent, 0.0, el.length, xi, [&](double s, double w) {
       const Eigen::Vector2d r = el.start + s * el.tangent - xi;
@@ -146,6 +163,108 @@ class HierarchicalSomigliana {
             (coefficients(target_at(t), e) * values_.segment<kColumnsPerElement>(kColumnsPerElement * e)).transpose();
       }
     ++near_blocks_;
+  }
+
+  // Whether a far block is interpolated: enough points to repay the p x p nodes, and a points' box small against
+  // its distance to the elements (the interpolation's condition, stricter than the partition's min(diam)).
+  bool interpolates(const BlockPair& pair) const {
+    const BoundingBox& box = target_boxes_[static_cast<std::size_t>(pair.row_cluster)];
+    return repays_interpolation(pair) &&
+           box.diameter() <= options_.eta * box.distance(source_boxes_[static_cast<std::size_t>(pair.column_cluster)]);
+  }
+
+  // A far block whose points' box is too large to interpolate over but would repay it: its point cluster's
+  // children are tried instead (each pair stays admissible: a child's box is inside the parent's).
+  bool splits_for_interpolation(const BlockPair& pair) const {
+    return !targets_.clusters()[static_cast<std::size_t>(pair.row_cluster)].leaf() && repays_interpolation(pair);
+  }
+
+  // Interpolation costs ~p^2 E coefficient evaluations for E elements, ACA ~20 (P + E) for P points (rank and
+  // samples; see add_far_block): worth it, and worth splitting for, only where the points outnumber the nodes
+  // and p^2 E < 20 P (many points per element: the indicator's cell centres, not a few points per node).
+  bool repays_interpolation(const BlockPair& pair) const {
+    const int points = targets_.clusters()[static_cast<std::size_t>(pair.row_cluster)].size();
+    const int elements = sources_.clusters()[static_cast<std::size_t>(pair.column_cluster)].size();
+    return points > interpolation_.nodes() && static_cast<double>(interpolation_.nodes()) * elements < 20.0 * points;
+  }
+
+  // The far field of an admissible pair: interpolated where it can be, else by point-cluster children, else by
+  // ACA or the exact sum.
+  void add_far_field(const BlockPair& pair) {
+    if (options_.cancelled && options_.cancelled()) throw Cancelled();
+    if (interpolates(pair)) {
+      for (const BlockPair& part : interpolation_blocks(pair)) add_interpolated_block(part);
+    } else if (splits_for_interpolation(pair)) {
+      for (int child : targets_.clusters()[static_cast<std::size_t>(pair.row_cluster)].children)
+        add_far_field({child, pair.column_cluster, true});
+    } else if (!add_far_block(pair)) {
+      add_near_block(pair);
+    }
+  }
+
+  // An interpolated block with more elements than its points' box has nodes is split into the column cluster's
+  // descendants of at most that many elements (so one pass over a part's elements per node stays cheap to poll).
+  std::vector<BlockPair> interpolation_blocks(const BlockPair& pair) const {
+    std::vector<BlockPair> parts;
+    const std::function<void(int)> visit = [&](int c) {
+      const auto& cluster = sources_.clusters()[static_cast<std::size_t>(c)];
+      if (cluster.leaf() || cluster.size() <= interpolation_.nodes()) {
+        parts.push_back({pair.row_cluster, c, true});
+        return;
+      }
+      for (int child : cluster.children) visit(child);
+    };
+    visit(pair.column_cluster);
+    return parts;
+  }
+
+  // The block's stresses at the Chebyshev nodes of the points' box, added to that box's node values.
+  void add_interpolated_block(const BlockPair& pair) {
+    const auto& columns = sources_.clusters()[static_cast<std::size_t>(pair.column_cluster)];
+    auto [it, fresh] = node_stresses_.try_emplace(pair.row_cluster);
+    const std::vector<Eigen::Vector2d> nodes =
+        interpolation_.nodes_in(target_boxes_[static_cast<std::size_t>(pair.row_cluster)]);
+    if (fresh) it->second = Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(nodes.size()), 3);
+    for (std::size_t k = 0; k < nodes.size(); ++k)
+      for (int p = columns.begin; p < columns.end; ++p) {
+        const int e = element_at(p);
+        it->second.row(static_cast<Eigen::Index>(k)) +=
+            (coefficients_at(nodes[k], e) * values_.segment<kColumnsPerElement>(kColumnsPerElement * e)).transpose();
+      }
+    ++interpolated_blocks_;
+  }
+
+  // Every interpolating box's polynomial at its points, top down: a box passes its polynomial on to the nodes
+  // of each child box that holds more points than nodes (the child's box lies inside, so the polynomial is valid
+  // there; std::map visits the children, which have larger indices, after their parent), and is evaluated at the
+  // points of the other children (or of its own, for a leaf). So every point costs one evaluation.
+  void apply_interpolation() {
+    const auto at_points = [&](int cluster, int from, const Eigen::MatrixX3d& values) {
+      const auto& rows = targets_.clusters()[static_cast<std::size_t>(cluster)];
+      const BoundingBox& box = target_boxes_[static_cast<std::size_t>(from)];
+      for (int t = rows.begin; t < rows.end; ++t)
+        stresses_.row(target_at(t)) += interpolation_.at(box, values, points_[static_cast<std::size_t>(target_at(t))]);
+    };
+    for (auto it = node_stresses_.begin(); it != node_stresses_.end(); ++it) {
+      if (options_.cancelled && options_.cancelled()) throw Cancelled();
+      const auto& cluster = targets_.clusters()[static_cast<std::size_t>(it->first)];
+      if (cluster.leaf()) {
+        at_points(it->first, it->first, it->second);
+        continue;
+      }
+      for (int child : cluster.children) {
+        if (targets_.clusters()[static_cast<std::size_t>(child)].size() <= interpolation_.nodes()) {
+          at_points(child, it->first, it->second);
+          continue;
+        }
+        const std::vector<Eigen::Vector2d> nodes = interpolation_.nodes_in(target_boxes_[static_cast<std::size_t>(child)]);
+        auto [child_it, fresh] = node_stresses_.try_emplace(child);
+        if (fresh) child_it->second = Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(nodes.size()), 3);
+        for (std::size_t k = 0; k < nodes.size(); ++k)
+          child_it->second.row(static_cast<Eigen::Index>(k)) +=
+              interpolation_.at(target_boxes_[static_cast<std::size_t>(it->first)], it->second, nodes[k]);
+      }
+    }
   }
 
   // ACA of the block (3 rows per point); false if it is not worth it or does not compress (then it is summed
@@ -199,10 +318,12 @@ class HierarchicalSomigliana {
   KelvinSolution kelvin_;
   double traction_scale_;
   ClusterTree sources_, targets_;
-  std::vector<BoundingBox> source_boxes_;
+  std::vector<BoundingBox> source_boxes_, target_boxes_;
+  ChebyshevGrid interpolation_;
+  std::map<int, Eigen::MatrixX3d> node_stresses_;  // per interpolating target cluster: stresses at its nodes
   Eigen::VectorXd values_;
   Eigen::MatrixX3d stresses_;
-  int near_blocks_ = 0, far_blocks_ = 0, largest_rank_ = 0;
+  int near_blocks_ = 0, far_blocks_ = 0, interpolated_blocks_ = 0, largest_rank_ = 0;
   long rank_sum_ = 0;
 };
 

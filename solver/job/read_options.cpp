@@ -141,8 +141,8 @@ void JobReader::resolve_method_defaults() {
 
 void JobReader::read_adaptivity(const json& value, const std::string& pointer) {
   Fields f(value, pointer, "adaptivity",
-           {"indicator", "normalization", "delta", "bodies", "max_level", "max_dofs", "strategy", "max_steps",
-            "stop_tolerance"},
+           {"indicator", "normalization", "delta", "marking", "grading", "bodies", "max_level", "max_dofs", "strategy",
+            "max_steps", "stop_tolerance"},
            errors_);
   if (!f.ok()) return;
   AdaptivitySettings& a = problem_.adaptivity;
@@ -156,6 +156,16 @@ void JobReader::read_adaptivity(const json& value, const std::string& pointer) {
       a.normalization = *x == "area" ? Normalization::area : Normalization::rms;
   if (const json* d = f.find("delta"))
     if (auto x = positive(*d, f.at("delta"), "delta", errors_)) a.delta = *x;
+  if (const json* mk = f.find("marking"))
+    if (auto x = choice(*mk, f.at("marking"), "marking", {"contact", "plain"}, errors_))
+      a.marking = *x == "plain" ? MarkingRule::plain : MarkingRule::contact;
+  if (const json* g = f.find("grading"))
+    if (auto x = read::number(*g, f.at("grading"), "grading", errors_)) {
+      if (*x < 0.0)
+        errors_.add(f.at("grading"), "grading must be >= 0 (a cell size over a distance; 0 turns the limit off)");
+      else
+        a.grading = *x;
+    }
   if (const json* l = f.find("max_level"))
     if (auto x = bounded_int(*l, f.at("max_level"), "max_level", 0, errors_)) {
       if (*x > 30)
@@ -205,6 +215,8 @@ void JobReader::read_adaptivity(const json& value, const std::string& pointer) {
   set_default(out, "indicator", "fem_bem");
   set_default(out, "normalization", "rms");
   set_default(out, "delta", 0.1);
+  set_default(out, "marking", "contact");
+  set_default(out, "grading", 0.0);
   if (!out.contains("bodies")) {
     json all = json::array();
     for (const auto& in : inputs_)

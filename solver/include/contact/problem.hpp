@@ -181,12 +181,18 @@ enum class AdaptStrategy { paper, converge_then_refine };
 // printed in the paper, (||.||_e / |e|) / (||.||_Omega / |Omega|), which grows like 1/sqrt|e| under refinement
 // and so never stops refining where the relative error is only O(h).
 enum class Normalization { rms, area };
+// Which cells over delta are refined (docs/algorithm.md, "Marking that serves the contact"): plain = all of them
+// (the paper); contact = the cells along the contact zones held to a tighter delta, and with grading > 0 none
+// already smaller than grading x their distance to the nearest zone.
+enum class MarkingRule { contact, plain };
 
 struct AdaptivitySettings {
   bool enabled = false;
   Indicator indicator = Indicator::fem_bem;
   Normalization normalization = Normalization::rms;
   double delta = 0.1;
+  MarkingRule marking = MarkingRule::contact;
+  double grading = 0.0;     // marking contact: cells below grading x distance to the contact zone are not refined (0: off)
   std::vector<int> bodies;  // indices of the adaptive bodies; empty = all
   int max_level = 8;        // refinement levels above the initial mesh
   long max_dofs = 400000;   // per body; refinement that would exceed it is cut back (and reported)

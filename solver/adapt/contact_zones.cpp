@@ -1,0 +1,49 @@
+#include "contact_zones.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace contact::adapt {
+
+std::vector<ContactZone> contact_zones(const Step& step) {
+  std::vector<ContactZone> zones;
+  for (const PairField& pair : step.pairs) {
+    ContactZone zone{Eigen::Vector2d::Constant(HUGE_VAL), Eigen::Vector2d::Constant(-HUGE_VAL)};
+    bool any = false;
+    for (Eigen::Index j = 0; j < pair.pressure.size(); ++j) {
+      if (!(pair.pressure[j] > 0.0)) continue;  // also skips NaN (nodes outside the mortar zone)
+      const Eigen::Vector2d x = pair.position.row(j).transpose();
+      zone.lo = zone.lo.cwiseMin(x);
+      zone.hi = zone.hi.cwiseMax(x);
+      any = true;
+    }
+    if (any) zones.push_back(zone);
+  }
+  return zones;
+}
+
+ContactMarking contact_marking(const mesh::Mesh& mesh, const std::vector<ContactZone>& zones, double grading) {
+  const auto n = static_cast<size_t>(mesh.num_cells());
+  ContactMarking out{std::vector<double>(n, 1.0), std::vector<char>(n, 0)};
+  if (zones.empty()) return out;
+  for (size_t c = 0; c < n; ++c) {
+    const auto& cell = mesh.cells[c];
+    Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+    double size = 0.0;  // the longest side
+    for (int k = 0; k < cell.size(); ++k) {
+      const Eigen::Vector2d& a = mesh.nodes[static_cast<size_t>(cell[static_cast<size_t>(k)])];
+      const Eigen::Vector2d& b = mesh.nodes[static_cast<size_t>(cell[static_cast<size_t>((k + 1) % cell.size())])];
+      centre += a / cell.size();
+      size = std::max(size, (b - a).norm());
+    }
+    const ContactZone* nearest = &zones.front();
+    for (const ContactZone& z : zones)
+      if (z.distance(centre) < nearest->distance(centre)) nearest = &z;
+    const double distance = nearest->distance(centre);
+    if (distance < size) out.factor[c] = std::sqrt(std::max(nearest->extent(), size) / size);
+    out.graded[c] = grading > 0.0 && size < grading * distance;
+  }
+  return out;
+}
+
+}  // namespace contact::adapt
