@@ -1,10 +1,14 @@
-// The job handlers: submit, validate, list, get, cancel, delete.
-#include "http_server.hpp"
+// The job routes (routes.hpp): submit, validate, list, get, cancel, delete.
+#include "routes.hpp"
+
+#include "http_transport.hpp"
+#include "request_guard.hpp"
 
 #include "problem_document.hpp"
 #include "util.hpp"
 
 #include <algorithm>
+#include <regex>
 
 namespace contactd {
 
@@ -46,21 +50,21 @@ void send_busy(httplib::Response& res, const std::string& what, const std::strin
 
 }  // namespace
 
-bool HttpServer::read_json_body(const Request& req, Response& res, const ContentReader& reader, std::string& body,
-                                BodyBudget::Slot& slot) {
+bool RouteContext::read_json_body(const Request& req, Response& res, const ContentReader& reader, std::string& body,
+                                  BodyBudget::Slot& slot) const {
   std::uint64_t announced = 0;
   parse_count(trim(req.get_header_value("Content-Length")), UINT64_MAX / 2, announced);
   bool granted = false;
-  slot = budget_.for_body(req.has_header("Transfer-Encoding"), announced, granted);
+  slot = budget.for_body(req.has_header("Transfer-Encoding"), announced, granted);
   if (!granted) {
     res.set_header("Connection", "close");  // the body is not read
     send_busy(res, "large request bodies being read at once", req.path);
     return false;
   }
-  if (announced <= settings_.max_request_bytes) body.reserve(static_cast<std::size_t>(announced));
+  if (announced <= settings.max_request_bytes) body.reserve(static_cast<std::size_t>(announced));
   bool too_large = false;
   const bool read = reader([&](const char* data, std::size_t length) {
-    if (body.size() + length > settings_.max_request_bytes) {  // chunked bodies have no Content-Length to check
+    if (body.size() + length > settings.max_request_bytes) {  // chunked bodies have no Content-Length to check
       too_large = true;
       return false;
     }
@@ -77,7 +81,7 @@ bool HttpServer::read_json_body(const Request& req, Response& res, const Content
     const Exchange* exchange = current_exchange();
     if (exchange && exchange->body_timed_out)
       send_problem(res, 408, "",
-                   "the body did not arrive within " + std::to_string(static_cast<int>(settings_.body_timeout_seconds)) +
+                   "the body did not arrive within " + std::to_string(static_cast<int>(settings.body_timeout_seconds)) +
                        " s",
                    req.path);
     else
@@ -87,15 +91,15 @@ bool HttpServer::read_json_body(const Request& req, Response& res, const Content
   return true;
 }
 
-std::shared_ptr<Job> HttpServer::find_job(const Request& req, Response& res) {
+std::shared_ptr<Job> RouteContext::find_job(const Request& req, Response& res) const {
   const std::string id = req.matches.size() > 1 ? std::string(req.matches[1]) : std::string();
   if (!is_job_id(id)) {  // anything else never reaches the disk
     send_problem(res, 404, "", "no job with id '" + clip(id, 64) + "'", req.path);
     return nullptr;
   }
-  std::shared_ptr<Job> job = queue_.find(id);
+  std::shared_ptr<Job> job = queue.find(id);
   if (!job) {
-    if (auto problem = queue_.damage(id))
+    if (auto problem = queue.damage(id))
       send_problem(res, 500, "corrupt-job", "job " + id + ": " + *problem, req.path);
     else
       send_problem(res, 404, "", "no job with id '" + id + "'", req.path);
@@ -103,7 +107,12 @@ std::shared_ptr<Job> HttpServer::find_job(const Request& req, Response& res) {
   return job;
 }
 
-void HttpServer::handle_submit(const Request& req, Response& res, const ContentReader& reader) {
+namespace {
+
+const std::string kJobPath = R"(/v1/jobs/([^/]+))";
+const std::regex kCancelRoute(kJobPath + "/cancel");
+
+void handle_submit(RouteContext& ctx, const Request& req, Response& res, const ContentReader& reader) {
   const std::string key = req.get_header_value("Idempotency-Key");
   if (req.has_header("Idempotency-Key") &&
       (key.empty() || key.size() > 255 ||
@@ -112,7 +121,7 @@ void HttpServer::handle_submit(const Request& req, Response& res, const ContentR
     send_problem(res, 400, "invalid-request", "Idempotency-Key must be 1 to 255 printable ASCII characters", req.path);
     return;
   }
-  if (stopping_) {
+  if (ctx.state.stopping) {
     res.set_header("Retry-After", "5");
     res.set_header("Connection", "close");
     send_problem(res, 503, "not-ready", "the server is shutting down and accepts no new jobs", req.path);
@@ -120,20 +129,20 @@ void HttpServer::handle_submit(const Request& req, Response& res, const ContentR
   }
   std::string body;
   BodyBudget::Slot body_slot;
-  if (!read_json_body(req, res, reader, body, body_slot)) return;
-  BodyBudget::Slot validation = budget_.for_validation(body.size());
+  if (!ctx.read_json_body(req, res, reader, body, body_slot)) return;
+  BodyBudget::Slot validation = ctx.budget.for_validation(body.size());
   if (!validation) return send_busy(res, "jobs being validated at once", req.path);
-  auto parsed = queue_.validate(body);
+  auto parsed = ctx.queue.validate(body);
   using Outcome = JobQueue::Submission::Outcome;
-  const auto s = queue_.submit(body, std::move(parsed), key);
+  const auto s = ctx.queue.submit(body, std::move(parsed), key);
   switch (s.outcome) {
     case Outcome::accepted:
     case Outcome::replayed: {
       int position = 0;
-      const JobRecord record = queue_.snapshot(*s.job, &position);
+      const JobRecord record = ctx.queue.snapshot(*s.job, &position);
       res.set_header("Location", job_link(record.id));
       if (s.outcome == Outcome::replayed) res.set_header("Idempotent-Replayed", "true");
-      send_json(res, 202, job_resource(record, position));
+      send_json(res, 202, ctx.job_resource(record, position));
       return;
     }
     case Outcome::invalid:
@@ -164,13 +173,13 @@ void HttpServer::handle_submit(const Request& req, Response& res, const ContentR
   }
 }
 
-void HttpServer::handle_validate(const Request& req, Response& res, const ContentReader& reader) {
+void handle_validate(RouteContext& ctx, const Request& req, Response& res, const ContentReader& reader) {
   std::string body;
   BodyBudget::Slot body_slot;
-  if (!read_json_body(req, res, reader, body, body_slot)) return;
-  BodyBudget::Slot validation = budget_.for_validation(body.size());
+  if (!ctx.read_json_body(req, res, reader, body, body_slot)) return;
+  BodyBudget::Slot validation = ctx.budget.for_validation(body.size());
   if (!validation) return send_busy(res, "jobs being validated at once", req.path);
-  const auto parsed = queue_.validate(body);
+  const auto parsed = ctx.queue.validate(body);
   if (!parsed.ok()) return send_invalid_job(res, parsed.errors, req.path);
   const contact::Problem& p = *parsed.problem;
   long dofs = 0;
@@ -188,7 +197,7 @@ void HttpServer::handle_validate(const Request& req, Response& res, const Conten
              {"normalized", p.normalized}});
 }
 
-void HttpServer::handle_list(const Request& req, Response& res) {
+void handle_list(RouteContext& ctx, const Request& req, Response& res) {
   std::optional<JobState> state;
   if (req.has_param("state")) {
     state = job_state_from_string(req.get_param_value("state"));
@@ -216,28 +225,28 @@ void HttpServer::handle_list(const Request& req, Response& res) {
     }
     after = cursor;
   }
-  const auto page = queue_.list(state, static_cast<std::size_t>(page_size), after);
+  const auto page = ctx.queue.list(state, static_cast<std::size_t>(page_size), after);
   nlohmann::json jobs = nlohmann::json::array();
-  for (const auto& record : page.jobs) jobs.push_back(job_resource(record, 0));
+  for (const auto& record : page.jobs) jobs.push_back(ctx.job_resource(record, 0));
   send_json(res, 200, {{"jobs", jobs}, {"next_page_token", page.next ? encode_cursor(*page.next) : std::string()}});
 }
 
-void HttpServer::handle_get(const Request& req, Response& res) {
-  const auto job = find_job(req, res);
+void handle_get(RouteContext& ctx, const Request& req, Response& res) {
+  const auto job = ctx.find_job(req, res);
   if (!job) return;
   int position = 0;
-  const JobRecord record = queue_.snapshot(*job, &position);
-  send_json(res, 200, job_resource(record, position));
+  const JobRecord record = ctx.queue.snapshot(*job, &position);
+  send_json(res, 200, ctx.job_resource(record, position));
 }
 
-void HttpServer::handle_delete(const Request& req, Response& res) {
+void handle_delete(RouteContext& ctx, const Request& req, Response& res) {
   const std::string id = req.matches.size() > 1 ? std::string(req.matches[1]) : std::string();
   if (!is_job_id(id)) {
     send_problem(res, 404, "", "no job with id '" + clip(id, 64) + "'", req.path);
     return;
   }
   std::string detail;
-  switch (queue_.remove(id, detail)) {  // a damaged job can be deleted too
+  switch (ctx.queue.remove(id, detail)) {  // a damaged job can be deleted too
     case JobQueue::RemoveOutcome::removed:
       res.status = 204;
       return;
@@ -245,8 +254,8 @@ void HttpServer::handle_delete(const Request& req, Response& res) {
       send_problem(res, 404, "", "no job with id '" + id + "'", req.path);
       return;
     case JobQueue::RemoveOutcome::not_done: {
-      const auto job = queue_.find(id);
-      const JobRecord record = job ? queue_.snapshot(*job) : JobRecord{};
+      const auto job = ctx.queue.find(id);
+      const JobRecord record = job ? ctx.queue.snapshot(*job) : JobRecord{};
       send_problem(res, 409, "job-not-finished", "cancel the job first, then delete it when it has ended", req.path,
                    {{"state", to_string(record.state)}});
       return;
@@ -257,28 +266,32 @@ void HttpServer::handle_delete(const Request& req, Response& res) {
   }
 }
 
-void HttpServer::handle_cancel(const Request& req, Response& res) {
+}  // namespace
+
+bool is_cancel_path(const std::string& path) { return std::regex_match(path, kCancelRoute); }
+
+void handle_cancel(RouteContext& ctx, const Request& req, Response& res) {
   std::smatch match;
   // Called from the pre-routing handler too (a POST without a body), where req.matches is not set.
   std::string id;
-  if (std::regex_match(req.path, match, cancel_route_)) id = match[1];
-  std::shared_ptr<Job> job = is_job_id(id) ? queue_.find(id) : nullptr;
+  if (std::regex_match(req.path, match, kCancelRoute)) id = match[1];
+  std::shared_ptr<Job> job = is_job_id(id) ? ctx.queue.find(id) : nullptr;
   if (!job) {
-    if (auto problem = is_job_id(id) ? queue_.damage(id) : std::nullopt)
+    if (auto problem = is_job_id(id) ? ctx.queue.damage(id) : std::nullopt)
       send_problem(res, 500, "corrupt-job", "job " + id + ": " + *problem, req.path);
     else
       send_problem(res, 404, "", "no job with id '" + clip(id, 64) + "'", req.path);
     return;
   }
-  const auto outcome = queue_.cancel(id);
+  const auto outcome = ctx.queue.cancel(id);
   int position = 0;
-  const JobRecord record = queue_.snapshot(*job, &position);
+  const JobRecord record = ctx.queue.snapshot(*job, &position);
   switch (outcome) {
     case JobQueue::CancelOutcome::cancelled:
     case JobQueue::CancelOutcome::cancelling:
     case JobQueue::CancelOutcome::already_cancelled:
       res.set_header("Location", job_link(id));
-      send_json(res, 202, job_resource(record, position));
+      send_json(res, 202, ctx.job_resource(record, position));
       return;
     case JobQueue::CancelOutcome::already_done:
       send_problem(res, 409, "job-finished", "the job has already finished", req.path,
@@ -291,6 +304,19 @@ void HttpServer::handle_cancel(const Request& req, Response& res) {
       send_problem(res, 500, "store-error", "the cancellation could not be stored; the job is still queued", req.path);
       return;
   }
+}
+
+void register_job_routes(Router& router, RouteContext& ctx) {
+  router.get("/v1/jobs", [&ctx](const Request& req, Response& res) { handle_list(ctx, req, res); });
+  router.get(kJobPath, [&ctx](const Request& req, Response& res) { handle_get(ctx, req, res); });
+  router.post_body("/v1/jobs", [&ctx](const Request& req, Response& res, const ContentReader& reader) {
+    handle_submit(ctx, req, res, reader);
+  });
+  router.post_body("/v1/validate", [&ctx](const Request& req, Response& res, const ContentReader& reader) {
+    handle_validate(ctx, req, res, reader);
+  });
+  router.post(kJobPath + "/cancel", [&ctx](const Request& req, Response& res) { handle_cancel(ctx, req, res); });
+  router.del(kJobPath, [&ctx](const Request& req, Response& res) { handle_delete(ctx, req, res); });
 }
 
 }  // namespace contactd

@@ -59,10 +59,17 @@ GuardSettings guard_settings(const HttpSettings& s) {
 HttpServer::HttpServer(HttpSettings settings, JobQueue& queue, JobStore& store, Metrics& metrics, BodyBudget& budget)
     : settings_(std::move(settings)),
       guard_(guard_settings(settings_)),
-      queue_(queue),
-      store_(store),
       metrics_(metrics),
-      budget_(budget) {
+      context_{settings_,
+               queue,
+               store,
+               metrics,
+               budget,
+               state_,
+               [this] { return transport_->open_connections(); },
+               [this](Response& res, const std::string& path, std::optional<std::uint64_t> bytes) {
+                 send_too_large(res, path, bytes);
+               }} {
   core_.set_tcp_nodelay(true);
   core_.set_keep_alive_max_count(100);
   core_.set_keep_alive_timeout(static_cast<time_t>(std::max(1.0, settings_.idle_timeout_seconds)));
@@ -92,55 +99,13 @@ HttpServer::HttpServer(HttpSettings settings, JobQueue& queue, JobStore& store, 
       // overflows on a range past the end).
       [](Request& req) { req.ranges.clear(); },
       [this](int status) { metrics_.http_response(status); });
-  register_routes();
+  register_web_routes(router_, context_);
+  register_service_routes(router_, context_);
+  register_job_routes(router_, context_);
+  register_stream_routes(router_, context_);
 }
 
 HttpServer::~HttpServer() { transport_->stop(); }
-
-// ------------------------------------------------------------------------------------------------ routes
-void HttpServer::add_route(const std::string& method, const std::string& pattern) {
-  routes_.push_back({method, std::regex(pattern)});
-}
-
-void HttpServer::register_routes() {
-  const std::string job = R"(/v1/jobs/([^/]+))";
-  auto get = [this](const std::string& pattern, void (HttpServer::*handler)(const Request&, Response&)) {
-    add_route("GET", pattern);
-    core_.Get(pattern, [this, handler](const Request& req, Response& res) { (this->*handler)(req, res); });
-  };
-  get("/", &HttpServer::handle_root);
-  get(R"(/web/[A-Za-z0-9_./-]+)", &HttpServer::handle_web_file);
-  get("/healthz", &HttpServer::handle_healthz);
-  get("/readyz", &HttpServer::handle_readyz);
-  get("/metrics", &HttpServer::handle_metrics);
-  get(R"(/problems/([a-z-]+))", &HttpServer::handle_problem_type);
-  get("/v1/schema", &HttpServer::handle_schema);
-  get(R"(/v1/job\.schema\.json)", &HttpServer::handle_schema);  // so that openapi.yaml's "./job.schema.json" resolves
-  get(R"(/v1/openapi\.yaml)", &HttpServer::handle_openapi);
-  get("/v1/examples", &HttpServer::handle_examples);
-  get(R"(/v1/examples/([A-Za-z0-9_-]{1,64})(?:\.json)?)", &HttpServer::handle_example);
-  get("/v1/jobs", &HttpServer::handle_list);
-  get(job, &HttpServer::handle_get);
-  get(job + "/events", &HttpServer::handle_events);
-  add_route("GET", job + "/result");
-  core_.Get(job + "/result", [this](const Request& req, Response& res) { handle_result(req, res, false); });
-  add_route("GET", job + R"(/result\.xmf)");
-  core_.Get(job + R"(/result\.xmf)", [this](const Request& req, Response& res) { handle_result(req, res, true); });
-
-  add_route("POST", "/v1/jobs");
-  core_.Post("/v1/jobs", [this](const Request& req, Response& res, const ContentReader& reader) {
-    handle_submit(req, res, reader);
-  });
-  add_route("POST", "/v1/validate");
-  core_.Post("/v1/validate", [this](const Request& req, Response& res, const ContentReader& reader) {
-    handle_validate(req, res, reader);
-  });
-  add_route("POST", job + "/cancel");
-  cancel_route_ = std::regex(job + "/cancel");
-  core_.Post(job + "/cancel", [this](const Request& req, Response& res) { handle_cancel(req, res); });
-  add_route("DELETE", job);
-  core_.Delete(job, [this](const Request& req, Response& res) { handle_delete(req, res); });
-}
 
 int HttpServer::bind(std::string& error) { return transport_->bind(settings_.host, settings_.port, error); }
 
@@ -148,19 +113,19 @@ void HttpServer::listen() { transport_->run(); }
 
 void HttpServer::wait_for_streams(std::chrono::milliseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (streams_.load() > 0 && std::chrono::steady_clock::now() < deadline)
+  while (state_.streams.load() > 0 && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
 }
 
 // ------------------------------------------------------------------------------------------------ middleware
-bool HttpServer::authorized(const Request& req) const {
-  if (settings_.token.empty()) return true;
+bool RouteContext::authorized(const Request& req) const {
+  if (settings.token.empty()) return true;
   const std::string header = req.get_header_value("Authorization");
   static const std::string scheme = "bearer ";
   if (header.size() <= scheme.size() || lower(header.substr(0, scheme.size())) != scheme) return false;
   // A control character (a NUL and garbage after the token) is never part of a valid header value.
   if (std::any_of(header.begin(), header.end(), [](unsigned char c) { return c < 0x20 || c == 0x7f; })) return false;
-  return constant_time_equal(trim(header.substr(scheme.size())), settings_.token);
+  return constant_time_equal(trim(header.substr(scheme.size())), settings.token);
 }
 
 Handled HttpServer::pre_route(const Request& req, Response& res) {
@@ -178,7 +143,7 @@ Handled HttpServer::pre_route(const Request& req, Response& res) {
   const bool probe = req.path == "/healthz" || req.path == "/readyz";
   if (!probe)
     if (auto r = check_host(req, guard_)) return refuse(r->status, r->slug, r->detail);
-  if (api && !authorized(req)) {
+  if (api && !context_.authorized(req)) {
     res.set_header("WWW-Authenticate", "Bearer realm=\"contactd\"");
     return refuse(401, "",
                   req.has_header("Authorization") ? "the bearer token is not valid"
@@ -197,12 +162,10 @@ Handled HttpServer::pre_route(const Request& req, Response& res) {
     if (length > 4 * static_cast<std::uint64_t>(settings_.max_request_bytes) + (1u << 20))
       return (send_too_large(res, req.path, length), res.set_header("Connection", "close"), Handled::Handled);
   }
-  if (api && !ready_) return (res.set_header("Retry-After", "1"), refuse(503, "not-ready", "the server is starting"));
+  if (api && !state_.ready) return (res.set_header("Retry-After", "1"), refuse(503, "not-ready", "the server is starting"));
   // Unknown paths (404) and methods (405) are answered here, before httplib reads a body for them.
   const std::string method = req.method == "HEAD" ? std::string("GET") : req.method;
-  if (std::none_of(routes_.begin(), routes_.end(), [&](const Route& route) {
-        return route.method == method && std::regex_match(req.path, route.pattern);
-      })) {
+  if (!router_.known(method, req.path)) {
     method_not_allowed_or_not_found(req, res);
     if (has_body(req)) res.set_header("Connection", "close");
     return Handled::Handled;
@@ -218,8 +181,8 @@ Handled HttpServer::pre_route(const Request& req, Response& res) {
   // A POST without Content-Length or chunked encoding: httplib would read until the client closes. A body-less
   // cancel is fine (curl -X POST); routes that need a body say so (411).
   if (req.method == "POST" && !req.has_header("Content-Length") && !req.has_header("Transfer-Encoding")) {
-    if (std::regex_match(req.path, cancel_route_)) {
-      handle_cancel(req, res);
+    if (is_cancel_path(req.path)) {
+      handle_cancel(context_, req, res);
       return Handled::Handled;
     }
     return refuse(411, "", "send the job with a Content-Length (or chunked transfer encoding)");
@@ -230,7 +193,7 @@ Handled HttpServer::pre_route(const Request& req, Response& res) {
 int HttpServer::expect_continue(const Request& req, Response& res) {
   // "Expect: 100-continue" (curl sends it for large bodies): refuse before the body is sent.
   const bool api = req.path == "/v1" || req.path.rfind("/v1/", 0) == 0;
-  if (api && !authorized(req)) {
+  if (api && !context_.authorized(req)) {
     res.set_header("WWW-Authenticate", "Bearer realm=\"contactd\"");
     send_problem(res, 401, "", "this server requires 'Authorization: Bearer <token>'", req.path);
     return 401;
@@ -258,11 +221,7 @@ void HttpServer::send_too_large(Response& res, const std::string& path, std::opt
 }
 
 void HttpServer::method_not_allowed_or_not_found(const Request& req, Response& res) {
-  std::vector<std::string> allowed;
-  for (const auto& route : routes_)
-    if (std::regex_match(req.path, route.pattern) &&
-        std::find(allowed.begin(), allowed.end(), route.method) == allowed.end())
-      allowed.push_back(route.method);
+  const std::vector<std::string> allowed = router_.allowed(req.path);
   if (allowed.empty()) {
     send_problem(res, 404, "", "no such resource: " + clip(req.path), req.path);
     return;

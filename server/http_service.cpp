@@ -1,6 +1,6 @@
-// The service endpoints (/healthz, /readyz, /metrics, /problems/*, the schema and the API spec) and the job
+// The service routes (routes.hpp: /healthz, /readyz, /metrics, /problems/*, the schema and the API spec) and the job
 // resource shared by the job handlers.
-#include "http_server.hpp"
+#include "routes.hpp"
 
 #include "assets.hpp"
 
@@ -9,7 +9,7 @@
 
 namespace contactd {
 
-nlohmann::json HttpServer::job_resource(const JobRecord& r, int queue_position) const {
+nlohmann::json RouteContext::job_resource(const JobRecord& r, int queue_position) const {
   const std::int64_t now = now_unix_us();
   auto time_or_null = [](std::int64_t us) { return us > 0 ? nlohmann::json(iso8601_us(us)) : nlohmann::json(nullptr); };
   const std::int64_t queued_until = r.started_us > 0 ? r.started_us : (r.finished_us > 0 ? r.finished_us : now);
@@ -52,29 +52,31 @@ nlohmann::json HttpServer::job_resource(const JobRecord& r, int queue_position) 
   return j;
 }
 
-void HttpServer::handle_healthz(const Request&, Response& res) {
-  const double uptime = std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+namespace {
+
+void handle_healthz(RouteContext& ctx, const Request&, Response& res) {
+  const double uptime = std::chrono::duration<double>(std::chrono::steady_clock::now() - ctx.state.started).count();
   send_json(res, 200, {{"status", "ok"}, {"uptime_seconds", uptime}});
 }
 
 // ready (200): serving. degraded (200): serving, but damaged jobs were found (listed; they are not served and
 // never deleted by retention). unavailable (503): the data directory is not writable, the disk is full (the
 // reserve was used), a worker died or is stuck. starting, stopping (503).
-void HttpServer::handle_readyz(const Request&, Response& res) {
-  const bool writable = store_.writable();
-  const int alive = queue_.workers_alive();
-  const QueueHealth health = queue_.health();
-  const bool reserve_used = store_.reserve_used();
+void handle_readyz(RouteContext& ctx, const Request&, Response& res) {
+  const bool writable = ctx.store.writable();
+  const int alive = ctx.queue.workers_alive();
+  const QueueHealth health = ctx.queue.health();
+  const bool reserve_used = ctx.store.reserve_used();
   std::vector<std::string> problems;
   if (!writable) problems.push_back("the data directory is not writable");
   if (reserve_used) problems.push_back("the disk filled up: the reserve was used to store a state change");
-  if (alive != queue_.workers()) problems.push_back("a worker thread has died");
+  if (alive != ctx.queue.workers()) problems.push_back("a worker thread has died");
   if (!health.stuck.empty()) problems.push_back(std::to_string(health.stuck.size()) + " job(s) do not stop when told");
   const bool unavailable = !problems.empty();
   if (!health.damaged.empty())
     problems.push_back(std::to_string(health.damaged.size()) + " job(s) have damaged files in the data directory");
-  std::string status = !ready_      ? "starting"
-                       : stopping_  ? "stopping"
+  std::string status = !ctx.state.ready      ? "starting"
+                       : ctx.state.stopping  ? "stopping"
                        : unavailable ? "unavailable"
                        : !problems.empty() ? "degraded"
                                            : "ready";
@@ -84,7 +86,7 @@ void HttpServer::handle_readyz(const Request&, Response& res) {
   nlohmann::json body = {{"status", status},
                          {"data_dir_writable", writable},
                          {"disk_reserve_used", reserve_used},
-                         {"workers", queue_.workers()},
+                         {"workers", ctx.queue.workers()},
                          {"workers_alive", alive},
                          {"problems", problems},
                          {"damaged_jobs", damaged},
@@ -94,23 +96,23 @@ void HttpServer::handle_readyz(const Request&, Response& res) {
   send_json(res, ok ? 200 : 503, body);
 }
 
-void HttpServer::handle_metrics(const Request&, Response& res) {
+void handle_metrics(RouteContext& ctx, const Request&, Response& res) {
   res.status = 200;
   Metrics::Gauges gauges;
-  gauges.jobs = queue_.counts();
-  gauges.workers = queue_.workers();
-  gauges.workers_busy = queue_.workers_busy();
-  const QueueHealth health = queue_.health();
+  gauges.jobs = ctx.queue.counts();
+  gauges.workers = ctx.queue.workers();
+  gauges.workers_busy = ctx.queue.workers_busy();
+  const QueueHealth health = ctx.queue.health();
   gauges.damaged_jobs = static_cast<std::int64_t>(health.damaged.size());
   gauges.stuck_jobs = static_cast<std::int64_t>(health.stuck.size());
   gauges.jobs_expired_total = health.expired_total;
   gauges.events_dropped_total = health.events_dropped_total;
-  gauges.disk_reserve_used = store_.reserve_used();
-  gauges.connections = static_cast<std::int64_t>(transport_->open_connections());
-  res.set_content(metrics_.render(gauges), "text/plain; version=0.0.4; charset=utf-8");
+  gauges.disk_reserve_used = ctx.store.reserve_used();
+  gauges.connections = static_cast<std::int64_t>(ctx.open_connections());
+  res.set_content(ctx.metrics.render(gauges), "text/plain; version=0.0.4; charset=utf-8");
 }
 
-void HttpServer::handle_problem_type(const Request& req, Response& res) {
+void handle_problem_type(RouteContext&, const Request& req, Response& res) {
   const std::string slug = req.matches[1];
   for (std::size_t k = 0; k < problem_type_count(); ++k) {
     const ProblemType& t = problem_types()[k];
@@ -123,14 +125,29 @@ void HttpServer::handle_problem_type(const Request& req, Response& res) {
   send_problem(res, 404, "", "no problem type '" + clip(slug, 64) + "'", req.path);
 }
 
-void HttpServer::handle_schema(const Request&, Response& res) {
+void handle_schema(RouteContext&, const Request&, Response& res) {
   res.status = 200;
   res.set_content(std::string(assets::job_schema()), "application/schema+json");
 }
 
-void HttpServer::handle_openapi(const Request&, Response& res) {
+void handle_openapi(RouteContext&, const Request&, Response& res) {
   res.status = 200;
   res.set_content(std::string(assets::openapi_yaml()), "application/yaml");
+}
+
+}  // namespace
+
+void register_service_routes(Router& router, RouteContext& ctx) {
+  auto get = [&](const std::string& pattern, void (*handler)(RouteContext&, const Request&, Response&)) {
+    router.get(pattern, [&ctx, handler](const Request& req, Response& res) { handler(ctx, req, res); });
+  };
+  get("/healthz", handle_healthz);
+  get("/readyz", handle_readyz);
+  get("/metrics", handle_metrics);
+  get(R"(/problems/([a-z-]+))", handle_problem_type);
+  get("/v1/schema", handle_schema);
+  get(R"(/v1/job\.schema\.json)", handle_schema);  // so that openapi.yaml's "./job.schema.json" resolves
+  get(R"(/v1/openapi\.yaml)", handle_openapi);
 }
 
 }  // namespace contactd

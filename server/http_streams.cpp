@@ -1,5 +1,9 @@
-// What the API streams: a job's progress events (SSE or NDJSON) and its result files (with ETag and ranges).
-#include "http_server.hpp"
+// The stream routes (routes.hpp): a job's progress events (SSE or NDJSON) and its result files (with ETag and
+// ranges).
+#include "routes.hpp"
+
+#include "http_transport.hpp"
+#include "request_guard.hpp"
 
 #include "events.hpp"
 #include "problem_document.hpp"
@@ -21,20 +25,20 @@ std::string format_sse(const Event& e) {
   return "id: " + std::to_string(e.seq) + "\nevent: " + e.type + "\ndata: " + e.json + "\n\n";
 }
 
-}  // namespace
-
 // One progress stream's position. Owned by the content provider (shared with its releaser).
-struct HttpServer::Stream {
+struct Stream {
   std::shared_ptr<Job> job;
   std::int64_t cursor = 0;  // the last seq sent
   bool ndjson = false;
   std::chrono::steady_clock::time_point last_write;
 };
 
-void HttpServer::handle_result(const Request& req, Response& res, bool sidecar) {
-  const auto job = find_job(req, res);
+bool pump_stream(RouteContext& ctx, Stream& stream, httplib::DataSink& sink);
+
+void handle_result(RouteContext& ctx, const Request& req, Response& res, bool sidecar) {
+  const auto job = ctx.find_job(req, res);
   if (!job) return;
-  const JobRecord record = queue_.snapshot(*job);
+  const JobRecord record = ctx.queue.snapshot(*job);
   if (!is_terminal(record.state)) {
     send_problem(res, 409, "job-not-finished",
                  "the job is " + std::string(to_string(record.state)) + "; the result exists once it has ended",
@@ -49,13 +53,13 @@ void HttpServer::handle_result(const Request& req, Response& res, bool sidecar) 
     return;
   }
   // Never serve what the server did not write: a link, a truncated or replaced file.
-  if (auto problem = store_.check_result(record)) {
-    queue_.report_damage(record.id, *problem);
+  if (auto problem = ctx.store.check_result(record)) {
+    ctx.queue.report_damage(record.id, *problem);
     send_problem(res, 500, "corrupt-job", "job " + record.id + ": " + *problem + "; it is not served", req.path);
     return;
   }
   // The descriptor keeps the file readable even if the job is deleted while it is being sent.
-  const int fd = store_.open_result(record.id, sidecar);
+  const int fd = ctx.store.open_result(record.id, sidecar);
   struct stat st {};
   if (fd < 0 || ::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
     if (fd >= 0) ::close(fd);
@@ -109,8 +113,8 @@ void HttpServer::handle_result(const Request& req, Response& res, bool sidecar) 
       [descriptor](bool) { ::close(*descriptor); });
 }
 
-void HttpServer::handle_events(const Request& req, Response& res) {
-  const auto job = find_job(req, res);
+void handle_events(RouteContext& ctx, const Request& req, Response& res) {
+  const auto job = ctx.find_job(req, res);
   if (!job) return;
   std::string resume = req.get_header_value("Last-Event-ID");
   if (resume.empty() && req.has_param("last_event_id")) resume = req.get_param_value("last_event_id");
@@ -120,14 +124,14 @@ void HttpServer::handle_events(const Request& req, Response& res) {
                  req.path);
     return;
   }
-  if (streams_.fetch_add(1) >= settings_.max_streams) {
-    --streams_;
+  if (ctx.state.streams.fetch_add(1) >= ctx.settings.max_streams) {
+    --ctx.state.streams;
     res.set_header("Retry-After", "5");
     send_problem(res, 503, "too-many-streams",
-                 "the server already serves " + std::to_string(settings_.max_streams) + " progress streams", req.path);
+                 "the server already serves " + std::to_string(ctx.settings.max_streams) + " progress streams", req.path);
     return;
   }
-  metrics_.stream_opened();
+  ctx.metrics.stream_opened();
   auto stream = std::make_shared<Stream>();
   stream->job = job;
   // An id beyond the last event (from a log cut short by a crash) resumes at the end.
@@ -139,17 +143,17 @@ void HttpServer::handle_events(const Request& req, Response& res) {
   res.set_header("X-Accel-Buffering", "no");  // proxies: do not buffer the stream
   res.set_chunked_content_provider(
       stream->ndjson ? "application/x-ndjson" : "text/event-stream",
-      [this, stream](std::size_t, httplib::DataSink& sink) { return pump_stream(*stream, sink); },
-      [this](bool) {
-        --streams_;
-        metrics_.stream_closed();
+      [&ctx, stream](std::size_t, httplib::DataSink& sink) { return pump_stream(ctx, *stream, sink); },
+      [&ctx](bool) {
+        --ctx.state.streams;
+        ctx.metrics.stream_closed();
       });
 }
 
 // Called by httplib again and again on the connection's thread until it returns false (client gone) or calls
 // sink.done(). Sends what is new; otherwise waits for the job's next event for at most a second, so that
 // shutdown and heartbeats are never late; never blocks the worker appending events.
-bool HttpServer::pump_stream(Stream& stream, httplib::DataSink& sink) {
+bool pump_stream(RouteContext& ctx, Stream& stream, httplib::DataSink& sink) {
   const auto events = stream.job->events.read_after(stream.cursor, 256);
   if (!events.empty()) {
     std::string out;
@@ -174,7 +178,7 @@ bool HttpServer::pump_stream(Stream& stream, httplib::DataSink& sink) {
     sink.done();
     return true;
   }
-  if (closing_streams_) {
+  if (ctx.state.closing_streams) {
     if (!stream.ndjson) {
       static const std::string bye = ": the server is shutting down; reconnect with Last-Event-ID to resume\n\n";
       sink.write(bye.data(), bye.size());
@@ -183,7 +187,7 @@ bool HttpServer::pump_stream(Stream& stream, httplib::DataSink& sink) {
     return true;
   }
   const auto now = std::chrono::steady_clock::now();
-  const auto heartbeat = std::chrono::seconds(settings_.heartbeat_seconds);
+  const auto heartbeat = std::chrono::seconds(ctx.settings.heartbeat_seconds);
   if (now - stream.last_write >= heartbeat) {
     // Also how a vanished client is noticed: the write fails.
     static const std::string sse_beat = ": heartbeat\n\n", ndjson_beat = "\n";
@@ -196,6 +200,15 @@ bool HttpServer::pump_stream(Stream& stream, httplib::DataSink& sink) {
   stream.job->events.wait_after(stream.cursor,
                                 std::min(until_beat, std::chrono::milliseconds(1000)) + std::chrono::milliseconds(1));
   return true;
+}
+
+}  // namespace
+
+void register_stream_routes(Router& router, RouteContext& ctx) {
+  const std::string job = R"(/v1/jobs/([^/]+))";
+  router.get(job + "/events", [&ctx](const Request& req, Response& res) { handle_events(ctx, req, res); });
+  router.get(job + "/result", [&ctx](const Request& req, Response& res) { handle_result(ctx, req, res, false); });
+  router.get(job + R"(/result\.xmf)", [&ctx](const Request& req, Response& res) { handle_result(ctx, req, res, true); });
 }
 
 }  // namespace contactd

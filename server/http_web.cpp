@@ -2,7 +2,7 @@
 // files under /web/ and the example jobs under /v1/examples, all compiled into the binary (assets.hpp).
 // The page is static: it talks to the API like any other client (with the bearer token the user gives it), so
 // these handlers know nothing of jobs.
-#include "http_server.hpp"
+#include "routes.hpp"
 
 #include "assets.hpp"
 #include "problem_document.hpp"
@@ -102,9 +102,7 @@ void send_file(const httplib::Request& req, httplib::Response& res, const assets
   res.set_content(std::string(file.data), std::string(file.content_type));
 }
 
-}  // namespace
-
-void HttpServer::handle_root(const Request& req, Response& res) {
+void handle_root(RouteContext&, const Request& req, Response& res) {
   res.set_header("Vary", "Accept");
   // A browser asks for HTML and gets the page; an API client (curl, the Python client) gets the links.
   if (req.get_header_value("Accept").find("text/html") != std::string::npos) {
@@ -130,7 +128,7 @@ void HttpServer::handle_root(const Request& req, Response& res) {
                {"metrics", "/metrics"}}}});
 }
 
-void HttpServer::handle_web_file(const Request& req, Response& res) {
+void handle_web_file(RouteContext&, const Request& req, Response& res) {
   const auto* file = find(assets::web_files(), req.path);
   if (!file) {
     send_problem(res, 404, "", "no such file of the web page: " + clip(req.path), req.path);
@@ -145,7 +143,7 @@ void HttpServer::handle_web_file(const Request& req, Response& res) {
   send_file(req, res, *file);
 }
 
-void HttpServer::handle_examples(const Request&, Response& res) {
+void handle_examples(RouteContext&, const Request&, Response& res) {
   nlohmann::json list = nlohmann::json::array();
   for (const auto& e : served_examples()) {
     const std::string name(e.name);
@@ -154,7 +152,7 @@ void HttpServer::handle_examples(const Request&, Response& res) {
   send_json(res, 200, {{"examples", list}});
 }
 
-void HttpServer::handle_example(const Request& req, Response& res) {
+void handle_example(RouteContext&, const Request& req, Response& res) {
   std::string name = req.matches[1];
   const auto* file = find(served_examples(), name);
   if (!file) {
@@ -162,6 +160,18 @@ void HttpServer::handle_example(const Request& req, Response& res) {
     return;
   }
   send_file(req, res, *file);
+}
+
+}  // namespace
+
+void register_web_routes(Router& router, RouteContext& ctx) {
+  auto get = [&](const std::string& pattern, void (*handler)(RouteContext&, const Request&, Response&)) {
+    router.get(pattern, [&ctx, handler](const Request& req, Response& res) { handler(ctx, req, res); });
+  };
+  get("/", handle_root);
+  get(R"(/web/[A-Za-z0-9_./-]+)", handle_web_file);
+  get("/v1/examples", handle_examples);
+  get(R"(/v1/examples/([A-Za-z0-9_-]{1,64})(?:\.json)?)", handle_example);
 }
 
 }  // namespace contactd
