@@ -2,7 +2,7 @@
 // objects go out as Server-Sent Events and as NDJSON; EventLog adds seq, type and time.
 #pragma once
 
-#include "job.hpp"
+#include "job_record.hpp"
 
 #include "contact/result.hpp"
 

@@ -26,7 +26,7 @@
 #pragma once
 
 #include "body_budget.hpp"
-#include "job.hpp"
+#include "job_record.hpp"
 #include "job_store.hpp"
 #include "metrics.hpp"
 

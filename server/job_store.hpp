@@ -12,7 +12,7 @@
 // writes of one job.
 #pragma once
 
-#include "job.hpp"
+#include "job_record.hpp"
 
 #include <atomic>
 #include <cstdint>

@@ -1,6 +1,6 @@
 #include "metrics.hpp"
 
-#include "job.hpp"
+#include "job_record.hpp"
 
 #include "contact/solve.hpp"
 

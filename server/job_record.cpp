@@ -1,4 +1,4 @@
-#include "job.hpp"
+#include "job_record.hpp"
 
 #include <algorithm>
 #include <cctype>
