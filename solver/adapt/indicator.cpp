@@ -1,5 +1,7 @@
 #include "indicator.hpp"
 
+#include "../common/scoped_timer.hpp"
+
 #include "../bem/bem.hpp"
 #include "../fem/element.hpp"
 
@@ -171,7 +173,7 @@ std::vector<int> boundary_loop(const mesh::Mesh& m) {
 
 IndicatorResult zz_indicator(const Body& body, const fem::BodySolver& solver, const Eigen::VectorXd& u,
                              Normalization normalization) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = Clock::now();
   const auto& m = body.mesh;
   const CellStresses fe = fe_point_stresses(body, solver, u);
   const auto recovered = solver.stresses(u).node;  // nodal averages of the cells' values at their nodes
@@ -187,14 +189,14 @@ IndicatorResult zz_indicator(const Body& body, const fem::BodySolver& solver, co
   }
   IndicatorResult r;
   r.eta = normalised(m, fe, ref, normalization, r);
-  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.seconds = seconds_since(t0);  // (a ScopedTimer would add after the return's copy)
   return r;
 }
 
 IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fem::BodySolver& solver,
                                   const Eigen::VectorXd& u, const Eigen::VectorXd& contact_load,
                                   Normalization normalization, const std::function<bool()>& cancelled) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = Clock::now();
   const auto& m = body.mesh;
   const std::vector<int> loop = boundary_loop(m);
   if (loop.size() < 3) {
@@ -288,7 +290,7 @@ IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fe
     r = zz_indicator(body, solver, u, normalization);
     r.note = "body '" + body.name + "': the boundary-element solve failed (" + e.what() + "); zz indicator used";
   }
-  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.seconds = seconds_since(t0);  // (r is replaced on the way: not a ScopedTimer)
   return r;
 }
 

@@ -17,6 +17,7 @@
 #include <string>
 
 #include "aca.hpp"
+#include "../common/scoped_timer.hpp"
 #include "bem.hpp"
 #include "boundary.hpp"
 #include "cluster_tree.hpp"
@@ -30,10 +31,6 @@ namespace contact::bem {
 namespace {
 
 constexpr int kColumnsPerElement = 8;
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // The boxes of the elements (element e joins node e and node e + 1; the tree is on the nodes, so element e
 // belongs where node e does).
@@ -90,7 +87,7 @@ class HierarchicalCollocation {
         traction_scale_(effective_constants(problem.material).shear_modulus / geometry_.diameter) {}
 
   BoundarySolution run(HierarchicalStats* stats) {
-    const auto t0 = std::chrono::steady_clock::now();
+    const auto t0 = Clock::now();
     const std::vector<BoundingBox> boxes = element_boxes(geometry_);
     check_self_overlap(geometry_, tree_, boxes);
     check_rigid_motions(problem_, geometry_);

@@ -1,4 +1,5 @@
 #include "pair.hpp"
+#include "../common/assert.hpp"
 
 #include "dual_basis.hpp"
 #include "segments.hpp"
@@ -63,6 +64,9 @@ Eigen::VectorXd PairDiscretization::penalty_pressure(const Eigen::VectorXd& g) c
 }
 
 void PairDiscretization::add_forces(const Eigen::VectorXd& z, Eigen::VectorXd& fs, Eigen::VectorXd& fm) const {
+  CONTACT_ASSERT_SIZE(z.size(), n_rows(), "a pair's pressures");
+  CONTACT_ASSERT_SIZE(fs.size(), Gs.cols(), "the slave's load");
+  CONTACT_ASSERT_SIZE(fm.size(), Gm.cols(), "the master's load");
   fs.noalias() -= Gs.transpose() * z;
   fm.noalias() += Gm.transpose() * z;
 }

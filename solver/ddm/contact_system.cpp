@@ -2,6 +2,7 @@
 
 #include "../contact/extent.hpp"
 #include "../contact/segments.hpp"
+#include "../common/scoped_timer.hpp"
 #include "../fem/blas_threads.hpp"
 
 #include <Eigen/QR>
@@ -42,7 +43,7 @@ std::string body_errors(const std::vector<std::pair<std::string, std::string>>& 
 
 ContactSystem::ContactSystem(const Problem& problem, TaskRunner& runner, Factorization factorization)
     : problem_(problem), factorization_(factorization), runner_(runner) {
-  const auto t0 = std::chrono::steady_clock::now();
+  ScopedTimer timer(setup_seconds_);
   fem::limit_blas_threads();
   discretize_pairs();
   bodies_.resize(problem.bodies.size());
@@ -53,7 +54,6 @@ ContactSystem::ContactSystem(const Problem& problem, TaskRunner& runner, Factori
     factorization_seconds_ += bodies_[a]->factorization_seconds();
   }
   append_error(error_, body_errors(failed));
-  setup_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 std::unique_ptr<fem::BodySolver> ContactSystem::make_body(size_t a, bool local) const {

@@ -1,6 +1,8 @@
 #include "body_solver.hpp"
+#include "../common/assert.hpp"
 
 #include "element.hpp"
+#include "../common/scoped_timer.hpp"
 #include "rigid_modes.hpp"
 
 #include <Eigen/QR>
@@ -13,12 +15,6 @@
 
 namespace contact::fem {
 
-namespace {
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-}  // namespace
-
 BodySolver::BodySolver(const Body& body, const Model& model, bool factorize_now, const std::vector<int>& interface_dofs,
                        bool allow_floating, bool local)
     : body_(body),
@@ -28,12 +24,13 @@ BodySolver::BodySolver(const Body& body, const Model& model, bool factorize_now,
       allow_floating_(allow_floating),
       factorize_(factorize_now),
       local_(local) {
-  const auto t0 = std::chrono::steady_clock::now();
-  setup_constraints();
-  if (!ok() || !local) return;
-  assemble_system();
-  setup_history_groups();
-  assembly_seconds_ = seconds_since(t0);
+  {
+    ScopedTimer timer(assembly_seconds_);
+    setup_constraints();
+    if (!ok() || !local) return;
+    assemble_system();
+    setup_history_groups();
+  }
   if (factorize_now) factorize();
 }
 
@@ -279,10 +276,11 @@ std::vector<int> BodySolver::interface_unknowns_of(const std::vector<int>& dofs)
 }
 
 void BodySolver::factorize() {
-  const auto t0 = std::chrono::steady_clock::now();
   if (n_free() == 0) return;  // everything prescribed: nothing to factorise
-  factor_ = std::make_unique<Cholesky>(K_red_, interface_unknowns_of(interface_dofs_));
-  factorization_seconds_ = seconds_since(t0);
+  {
+    ScopedTimer timer(factorization_seconds_);
+    factor_ = std::make_unique<Cholesky>(K_red_, interface_unknowns_of(interface_dofs_));
+  }
   if (!factor_->ok()) {
     std::ostringstream os;
     os << "body '" << body_.name << "': the stiffness matrix (" << n_free() << " unknowns) could not be factorised: "
@@ -329,6 +327,7 @@ Eigen::VectorXd BodySolver::solve_homogeneous(const Eigen::VectorXd& load) const
 }
 
 Eigen::VectorXd BodySolver::solve(const Eigen::VectorXd& extra_load) const {
+  if (extra_load.size() > 0) CONTACT_ASSERT_SIZE(extra_load.size(), n_dofs(), "a body's extra load");
   if (n_free() == 0) return prescribed();
   if (!factor_)
     throw std::logic_error(local_ ? "BodySolver::solve called on a solver built without factorisation"

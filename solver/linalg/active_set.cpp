@@ -1,4 +1,5 @@
 #include "active_set.hpp"
+#include "../common/assert.hpp"
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/Cholesky>
@@ -333,6 +334,10 @@ ActiveSetResult solve_active_set_on(const SparseMatrix& H, const Eigen::VectorXd
 
 ActiveSetResult solve_active_set(const SparseMatrix& H, const Eigen::VectorXd& g, int max_steps,
                                  const StepCallback& on_step, const Eigen::VectorXd* z0, const Equalities& eq) {
+  CONTACT_ASSERT_SIZE(H.rows(), g.size(), "H");
+  CONTACT_ASSERT_SIZE(H.cols(), g.size(), "H");
+  if (z0) CONTACT_ASSERT_SIZE(z0->size(), g.size(), "the start z0");
+  if (!eq.empty()) CONTACT_ASSERT_SIZE(eq.G.cols(), g.size(), "G");
   if (eq.empty()) return solve_active_set_on(H, g, max_steps, on_step, z0, eq);
   // With floating bodies H = B K^+ B^T uses a generalised inverse that fixes a few dofs per body; where those
   // dofs lie on the contact (a body of one or two cells across, contact on two sides) the compliance of a contact

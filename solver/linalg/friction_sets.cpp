@@ -1,4 +1,5 @@
 #include "friction_sets.hpp"
+#include "../common/assert.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -27,6 +28,9 @@ double bound_of(const FrictionRow& r, double normal_trial) {
 
 FrictionSets predict_friction_sets(const Eigen::VectorXd& lambda, const Eigen::VectorXd& h, const Eigen::VectorXd& c,
                                    const std::vector<FrictionRow>& rows, const std::vector<char>& is_tangential) {
+  CONTACT_ASSERT_SIZE(h.size(), lambda.size(), "the gaps and slips");
+  CONTACT_ASSERT_SIZE(c.size(), lambda.size(), "the scaling");
+  CONTACT_ASSERT_SIZE(is_tangential.size(), lambda.size(), "the tangential mask");
   FrictionSets s;
   const Eigen::Index n = lambda.size();
   s.active.assign(static_cast<size_t>(n), 0);

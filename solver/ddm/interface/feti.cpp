@@ -1,5 +1,7 @@
 #include "feti.hpp"
 
+#include "../../common/scoped_timer.hpp"
+
 #include "../../linalg/mprgp.hpp"
 #include "coarse_space.hpp"
 
@@ -44,15 +46,12 @@ class Smalbe {
   std::vector<char> previous_active_;
 };
 
-// Seconds since `start`, added to `total` (the per-iteration costs that docs/parallel.md's model is built from).
-void add_seconds(double& total, std::chrono::steady_clock::time_point start) {
-  total += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 bool Smalbe::apply_H(const Eigen::VectorXd& x, Eigen::VectorXd& y) {
-  const auto start = std::chrono::steady_clock::now();
-  bool stop = qp_.problem.apply(x, y, ctx_.runner);
-  add_seconds(seconds_F_, start);
+  bool stop = false;
+  {
+    ScopedTimer timer(seconds_F_);  // the per-iteration costs docs/parallel.md's model is built from
+    stop = qp_.problem.apply(x, y, ctx_.runner);
+  }
   if (qp_.penalty.size() == m_) y += qp_.penalty.cwiseProduct(x);
   // One process: the token directly; several: only the agreed answer of the sum, the same on every process.
   if (!ctx_.runner.distributed()) stop = stop || ctx_.cancel.cancelled();
@@ -60,14 +59,14 @@ bool Smalbe::apply_H(const Eigen::VectorXd& x, Eigen::VectorXd& y) {
 }
 
 bool Smalbe::apply_A(const Eigen::VectorXd& x, Eigen::VectorXd& y) {
-  auto start = std::chrono::steady_clock::now();
-  const Eigen::VectorXd Px = coarse_.project(x);
-  add_seconds(seconds_coarse_, start);
-  Eigen::VectorXd HPx;
+  Eigen::VectorXd Px, HPx;
+  {
+    ScopedTimer timer(seconds_coarse_);
+    Px = coarse_.project(x);
+  }
   const bool stop = apply_H(Px, HPx);
-  start = std::chrono::steady_clock::now();
+  ScopedTimer timer(seconds_coarse_);
   y = coarse_.project(HPx) + rho_ * (x - Px);
-  add_seconds(seconds_coarse_, start);
   return stop;
 }
 

@@ -1,4 +1,5 @@
 #include "interface_problem.hpp"
+#include "../../common/assert.hpp"
 
 #include <stdexcept>
 
@@ -226,10 +227,12 @@ bool InterfaceProblem::apply_blocks(const Eigen::VectorXd& x, Eigen::VectorXd& y
 }
 
 bool InterfaceProblem::apply(const Eigen::VectorXd& x, Eigen::VectorXd& y, TaskRunner& runner) const {
+  CONTACT_ASSERT_SIZE(x.size(), size(), "the interface vector");
   return apply_blocks(x, y, runner, false);
 }
 
 bool InterfaceProblem::apply_preconditioner(const Eigen::VectorXd& x, Eigen::VectorXd& y, TaskRunner& runner) const {
+  CONTACT_ASSERT_SIZE(x.size(), size(), "the interface vector");
   const bool stop = apply_blocks(inverse_weight_.cwiseProduct(x), y, runner, true);
   y = inverse_weight_.cwiseProduct(y);
   return stop;
@@ -297,6 +300,7 @@ Eigen::VectorXd InterfaceProblem::stack(const Pressures& per_pair) const {
 
 Displacements InterfaceProblem::displacements(const Eigen::VectorXd& z, const Eigen::VectorXd& alpha,
                                               TaskRunner& runner) const {
+  CONTACT_ASSERT_SIZE(z.size(), size(), "the interface multipliers");
   const Pressures q = split_tangential(z);
   Displacements u = system_.solve_bodies(system_.loads_from_pressures(split(z), &q), runner);
   if (alpha.size() == equilibrium_.G.rows())
