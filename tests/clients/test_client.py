@@ -20,6 +20,7 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(HERE, "..", ".."))
+sys.path.insert(0, os.path.join(SRC, "tests"))  # checks.py
 sys.path.insert(0, os.path.join(SRC, "tests", "server"))
 sys.path.insert(0, os.path.join(SRC, "clients"))
 
@@ -27,7 +28,8 @@ import numpy as np  # noqa: E402
 
 import contact_client as cc  # noqa: E402
 import harness  # noqa: E402
-from harness import HOST, Checks, Server, example, flat_patch, long_job  # noqa: E402
+from harness import HOST, Server, example, flat_patch, long_job  # noqa: E402
+from checks import check, finish, section  # noqa: E402
 
 CLIENT = os.path.join(SRC, "clients", "contact_client.py")
 EXAMPLES = os.path.join(SRC, "api", "examples")
@@ -36,8 +38,6 @@ ADAPTIVE = os.path.join(EXAMPLES, "seed_layers_adaptive.json")
 UUID_RE = re.compile(r"^[0-9a-f]{8}-[0-9a-f]{4}-4[0-9a-f]{3}-[89ab][0-9a-f]{3}-[0-9a-f]{12}$")
 UNKNOWN_ID = "00000000-0000-4000-8000-000000000000"
 
-t = Checks()
-check = t.check
 START = time.time()
 
 
@@ -578,31 +578,19 @@ def test_token(tmp):
 
 def main():
     if not os.path.exists(harness.CONTACTD):
-        print(f"FAIL contactd not built: {harness.CONTACTD}")
-        print("0 passed, 1 failed")
-        sys.exit(1)
+        check(f"contactd not built: {harness.CONTACTD}", False)
+        finish()
     with tempfile.TemporaryDirectory(prefix="contact-client-test-") as tmp:
         with Server() as server:
             for name, fn in (("module", lambda: test_module(server, tmp)), ("cli", lambda: test_cli(server, tmp))):
-                t0 = time.time()
-                try:
+                # a crash of one group is a failure, the others still run
+                with section(name, f"{name} tests ran to the end"):
                     fn()
-                except Exception as exc:  # a crash of one group is a failure, the others still run
-                    import traceback
-                    traceback.print_exc()
-                    check(f"{name} tests ran to the end", False, repr(exc))
-                print(f"{name}: {time.time() - t0:.1f} s", flush=True)
         for name, fn in (("unreachable", lambda: test_unreachable(tmp)), ("token", lambda: test_token(tmp))):
-            t0 = time.time()
-            try:
+            with section(name, f"{name} tests ran to the end"):
                 fn()
-            except Exception as exc:
-                import traceback
-                traceback.print_exc()
-                check(f"{name} tests ran to the end", False, repr(exc))
-            print(f"{name}: {time.time() - t0:.1f} s", flush=True)
     print(f"total {time.time() - START:.1f} s", flush=True)
-    t.finish()
+    finish()
 
 
 if __name__ == "__main__":

@@ -20,18 +20,15 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(HERE, "..", ".."))
-sys.path.insert(0, os.path.join(SRC, "tests", "server"))
+sys.path.insert(0, os.path.join(SRC, "tests"))  # checks.py
 sys.path.insert(0, os.path.join(SRC, "clients"))
 
 import contact_client as cc  # noqa: E402
-from harness import Checks  # noqa: E402
+from checks import check, finish  # noqa: E402
 
 CLIENT = os.path.join(SRC, "clients", "contact_client.py")
 JOB_ID = "00000000-0000-4000-8000-000000000000"
 HOST = "127.0.0.1"
-
-t = Checks()
-check = t.check
 
 
 def http(status, body=b"", content_type="application/json", extra=b"", length=None):
@@ -342,4 +339,4 @@ check("python3 -m contact_client works", subprocess.run(
     [sys.executable, "-m", "contact_client", "--help"], capture_output=True, text=True,
     cwd=os.path.join(SRC, "clients")).returncode == 0)
 server.sock.close()
-t.finish()
+finish()

@@ -13,15 +13,15 @@ import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(HERE, "..", ".."))
+sys.path.insert(0, os.path.join(SRC, "tests"))  # checks.py
 sys.path.insert(0, os.path.join(SRC, "tests", "server"))
 sys.path.insert(0, os.path.join(SRC, "clients"))
 
 import contact_client as cc  # noqa: E402
-from harness import Checks, Server  # noqa: E402
+from harness import Server  # noqa: E402
+from checks import check, finish  # noqa: E402
 
 CLIENT = os.path.join(SRC, "clients", "contact_client.py")
-t = Checks()
-check = t.check
 
 # Each job and the pointer the server's error is at.
 SHAPES = {
@@ -56,7 +56,7 @@ def main():
             except cc.ApiError as exc:
                 check(f"{name}: Client.validate raises ApiError with the pointer {pointer}",
                       exc.status == 400 and any(e.get("pointer") == pointer for e in exc.errors), exc.errors)
-    t.finish()
+    finish()
 
 
 if __name__ == "__main__":

@@ -21,6 +21,7 @@ import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(HERE, "..", ".."))
+sys.path.insert(0, os.path.join(SRC, "tests"))  # checks.py
 sys.path.insert(0, os.path.join(SRC, "tests", "server"))
 sys.path.insert(0, os.path.join(SRC, "clients"))
 
@@ -28,11 +29,10 @@ import h5py  # noqa: E402
 import numpy as np  # noqa: E402
 
 import contact_client as cc  # noqa: E402
-from harness import HOST, Checks, Server, example, roller_job  # noqa: E402
+from harness import HOST, Server, example, roller_job  # noqa: E402
+from checks import check, finish  # noqa: E402
 
 CLIENT = os.path.join(SRC, "clients", "contact_client.py")
-t = Checks()
-check = t.check
 
 ROLLER_PAIRS = ("roller.bottom-base.top", "roller.top-plate.bottom")
 
@@ -296,7 +296,7 @@ def main():
     test_frictionless(flat, flat_events)
     test_older_file(pushed, tmp)
     shutil.rmtree(tmp, ignore_errors=True)
-    t.finish()
+    finish()
 
 
 if __name__ == "__main__":

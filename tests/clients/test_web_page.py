@@ -24,22 +24,16 @@ import urllib.request
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(HERE, "..", ".."))
+sys.path.insert(0, os.path.join(SRC, "tests"))  # checks.py
 sys.path.insert(0, os.path.join(SRC, "tests", "server"))
 sys.path.insert(0, os.path.join(SRC, "clients"))
 from contact_client.plot import AXIS_LABELS  # noqa: E402
-from harness import EXAMPLES, Checks, Server, example, long_job, read_all_events, roller_job  # noqa: E402
+from harness import EXAMPLES, Server, example, long_job, read_all_events, roller_job  # noqa: E402
+from checks import check, finish, section, skip  # noqa: E402
 
-checks = Checks()
-check = checks.check
-SKIP = 77
 CHROMIUM_FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
                   "--disable-background-networking", "--disable-component-update", "--disable-sync",
                   "--no-first-run", "--window-size=1400,1000"]
-
-
-def skip(reason):
-    print(f"SKIP: {reason}", flush=True)
-    sys.exit(SKIP)
 
 
 try:
@@ -380,18 +374,12 @@ def main():
     try:
         for name, run in (("without a token", lambda: run_with_server(browser, downloads)),
                           ("with a token", lambda: test_with_token(browser, downloads))):
-            t0 = time.time()
-            try:
+            with section(name):  # a crash of one part is a failure; the other part still runs
                 run()
-            except Exception as exc:  # a crash of one part is a failure; the other part still runs
-                import traceback
-                traceback.print_exc()
-                check(f"{name}: the checks ran to the end", False, repr(exc)[:300])
-            print(f"{name}: {time.time() - t0:.1f} s", flush=True)
     finally:
         browser.quit()
         shutil.rmtree(downloads, ignore_errors=True)
-    checks.finish()
+    finish()
 
 
 if __name__ == "__main__":

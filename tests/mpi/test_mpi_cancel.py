@@ -20,29 +20,20 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(HERE, "..", ".."))
 BIN = os.environ.get("CONTACT_BINARY_DIR", os.path.join(SRC, "build"))
 CLI = os.path.join(BIN, "contact-solve")
+sys.path.insert(0, os.path.join(HERE, ".."))  # tests/: checks.py
 sys.path.insert(0, os.path.join(HERE, "..", "server"))
+from checks import check, finish, skip  # noqa: E402
 from harness import long_job  # noqa: E402
 
 import h5py  # noqa: E402
 
-passed, failed = 0, 0
 STOP_SECONDS = 5  # "every rank ends within a few seconds"
-
-
-def check(name, condition, detail=""):
-    global passed, failed
-    if condition:
-        passed += 1
-    else:
-        failed += 1
-        print(f"FAIL {name}: {detail}")
 
 
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_rmaps_base_oversubscribe="1")
 
 if not shutil.which("mpirun"):
-    print("SKIP: mpirun not found (Debian's openmpi-bin; scripts/setup.sh installs it)")
-    sys.exit(77)
+    skip("mpirun not found (Debian's openmpi-bin; scripts/setup.sh installs it)")
 
 
 class Run:
@@ -134,8 +125,7 @@ with tempfile.TemporaryDirectory() as tmp:
     probe = subprocess.run(["mpirun", "-n", "2", CLI, job_path, "--validate"], capture_output=True, text=True,
                            env=ENV, timeout=120)
     if probe.returncode != 0:
-        print("SKIP: mpirun cannot start contact-solve here\n" + probe.stdout[-300:] + probe.stderr[-300:])
-        sys.exit(77)
+        skip("mpirun cannot start contact-solve here\n" + probe.stdout[-300:] + probe.stderr[-300:])
 
     # When: as soon as the ranks catch the signal (MPI_Init, the job read and parsed), at the header (the bodies
     # being set up), after the first iteration, after 300 iterations.
@@ -178,5 +168,4 @@ with tempfile.TemporaryDirectory() as tmp:
         except (OSError, KeyError) as e:
             check(f"{moment}: the partial result is readable", False, str(e))
 
-print(f"{passed} passed, {failed} failed")
-sys.exit(1 if failed else 0)
+finish()

@@ -18,20 +18,11 @@ BIN = os.environ.get("CONTACT_BINARY_DIR", os.path.join(SRC, "build"))
 CLI = os.path.join(BIN, "contact-solve")
 EXAMPLES = os.path.join(SRC, "api", "examples")
 sys.path.insert(0, HERE)
+sys.path.insert(0, os.path.join(HERE, ".."))  # tests/: checks.py
+from checks import check, finish, skip  # noqa: E402
 from compare_results import max_relative_difference  # noqa: E402
 
 import h5py  # noqa: E402
-
-passed, failed = 0, 0
-
-
-def check(name, condition, detail=""):
-    global passed, failed
-    if condition:
-        passed += 1
-    else:
-        failed += 1
-        print(f"FAIL {name}: {detail}")
 
 
 # mpirun refuses root unless told; more ranks than cores need --oversubscribe.
@@ -44,14 +35,12 @@ def mpirun(ranks, *args, env=None, timeout=300):
 
 
 if not shutil.which("mpirun"):
-    print("SKIP: mpirun not found (Debian's openmpi-bin; scripts/setup.sh installs it)")
-    sys.exit(77)
+    skip("mpirun not found (Debian's openmpi-bin; scripts/setup.sh installs it)")
 
 with tempfile.TemporaryDirectory() as tmp:
     probe = mpirun(2, os.path.join(EXAMPLES, "flat_patch.json"), "-o", os.path.join(tmp, "probe.hdf"), "-q")
     if "MPI ranks" not in probe.stdout:
-        print("SKIP: contact-solve was built without MPI (CONTACT_WITH_MPI off or MPI not found)\n" + probe.stdout[-300:])
-        sys.exit(77)
+        skip("contact-solve was built without MPI (CONTACT_WITH_MPI off or MPI not found)\n" + probe.stdout[-300:])
 
     # An adaptive job, smaller than the example so that three runs stay short.
     with open(os.path.join(EXAMPLES, "seed_layers_adaptive.json")) as f:
@@ -156,5 +145,4 @@ with tempfile.TemporaryDirectory() as tmp:
           "rank 1: body 2" in r.stdout + r.stderr, r.stdout[-400:] + r.stderr[-400:])
     check("a failing rank: no result file", not os.path.exists(out))
 
-print(f"{passed} passed, {failed} failed")
-sys.exit(1 if failed else 0)
+finish()

@@ -15,16 +15,8 @@ import numpy as np
 
 SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
 BIN = os.environ.get("CONTACT_BINARY_DIR", os.path.join(SRC, "build"))
-passed, failed = 0, 0
-
-
-def check(name, condition, detail=""):
-    global passed, failed
-    if condition:
-        passed += 1
-    else:
-        failed += 1
-        print(f"FAIL {name}: {detail}")
+sys.path.insert(0, os.path.join(SRC, "tests"))  # checks.py
+from checks import check, finish  # noqa: E402
 
 
 with tempfile.TemporaryDirectory() as tmp:
@@ -89,5 +81,4 @@ with tempfile.TemporaryDirectory() as tmp:
             check(f"its {path_in} is the last step's", np.array_equal(last["steps/0/" + path_in][()],
                                                                       every[f"steps/{steps[-1]}/" + path_in][()]))
 
-print(f"{passed} passed, {failed} failed")
-sys.exit(1 if failed else 0)
+finish()

@@ -13,17 +13,8 @@ SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(os.path.dirname(__file__
 BIN = os.environ.get("CONTACT_BINARY_DIR", os.path.join(SRC, "build"))
 CLI = os.path.join(BIN, "contact-solve")
 EXAMPLE = os.path.join(SRC, "api", "examples", "flat_patch.json")
-
-passed, failed = 0, 0
-
-
-def check(name, condition, detail=""):
-    global passed, failed
-    if condition:
-        passed += 1
-    else:
-        failed += 1
-        print(f"FAIL {name}: {detail}")
+sys.path.insert(0, os.path.join(SRC, "tests"))  # checks.py
+from checks import check, finish  # noqa: E402
 
 
 def run(*args):
@@ -225,5 +216,4 @@ with tempfile.TemporaryDirectory() as tmp:
           f"{exited - signalled:.2f} s")
     check("the result so far is written", os.path.exists(out) and os.path.getsize(out) > 0)
 
-print(f"{passed} passed, {failed} failed")
-sys.exit(1 if failed else 0)
+finish()

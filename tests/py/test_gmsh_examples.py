@@ -14,17 +14,12 @@ import tempfile
 SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
 EXAMPLES = os.path.join(SRC, "api", "examples")
 VERSION = "4.8.4"
-
-failed = 0
-
-
-def check(name, condition, detail=""):
-    global failed
-    print(("ok   " if condition else "FAIL ") + name + ("" if condition else f": {detail}"), flush=True)
-    failed += not condition
+sys.path.insert(0, os.path.join(SRC, "tests"))  # checks.py
+from checks import check, finish, show_passes, skip  # noqa: E402
 
 
 def main():
+    show_passes()
     geos = sorted(glob.glob(os.path.join(EXAMPLES, "*.geo")))
     check("api/examples has .geo files", bool(geos))
     for geo in geos:
@@ -40,14 +35,11 @@ def main():
 
     gmsh = shutil.which("gmsh")
     if gmsh is None:
-        print("SKIP: gmsh is not installed (bash scripts/setup.sh installs it); the meshes were not remade")
-        sys.exit(77 if not failed else 1)
+        skip("gmsh is not installed (bash scripts/setup.sh installs it); the meshes were not remade")
     r = subprocess.run([gmsh, "--version"], capture_output=True, text=True, timeout=60)  # it prints on stderr
     version = ((r.stdout + r.stderr).strip().splitlines() or [""])[-1]
     if version != VERSION:
-        print(f"SKIP: gmsh {version} is not {VERSION}, which made the checked-in meshes (other versions mesh "
-              "differently)")
-        sys.exit(77 if not failed else 1)
+        skip(f"gmsh {version} is not {VERSION}, which made the checked-in meshes (other versions mesh differently)")
     with tempfile.TemporaryDirectory() as tmp:
         os.makedirs(os.path.join(tmp, "scripts"))
         shutil.copy(os.path.join(SRC, "scripts", "make_gmsh_examples.sh"), os.path.join(tmp, "scripts"))
@@ -60,8 +52,7 @@ def main():
             made = os.path.join(tmp, "api", "examples", name)
             with open(os.path.join(EXAMPLES, name), "rb") as a, open(made, "rb") as b:
                 check(f"{name} is what its .geo makes (else run scripts/make_gmsh_examples.sh)", a.read() == b.read())
-    print("FAILED" if failed else "all passed")
-    sys.exit(1 if failed else 0)
+    finish()
 
 
 if __name__ == "__main__":

@@ -26,11 +26,8 @@ DOC = os.path.join(SRC, "docs", "job-format.md")
 EXAMPLES = os.path.join(SRC, "api", "examples")
 UNKNOWN = "zz_not_a_field"
 
-sys.path.insert(0, os.path.join(SRC, "tests", "server"))
-from harness import Checks  # noqa: E402
-
-checks = Checks()
-check = checks.check
+sys.path.insert(0, os.path.join(SRC, "tests"))  # checks.py
+from checks import check, finish  # noqa: E402
 
 
 # --- the document -------------------------------------------------------------------------------------------
@@ -148,7 +145,7 @@ def solve_normalized(job, tmp, what):
     out = os.path.join(tmp, "normalized.hdf")
     r = run_cli(job, tmp, "-o", out, "-q")
     if not check(f"{what} solves", r.returncode == 0, r.stdout[-400:] + r.stderr[-400:]):
-        sys.exit(checks.finish())
+        finish()
     with h5py.File(out, "r") as f:
         return json.loads(f["input/normalized"].asstr()[()])
 
@@ -337,7 +334,7 @@ def main():
     check("'The examples' lists every file of api/examples/ and no other", listed == files,
           f"missing {sorted(files - listed)}, not a file {sorted(listed - files)}")
 
-    checks.finish()
+    finish()
 
 
 if __name__ == "__main__":

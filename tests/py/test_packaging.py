@@ -14,11 +14,9 @@ import sys
 
 SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
 BIN = os.environ.get("CONTACT_BINARY_DIR", os.path.join(SRC, "build"))
-sys.path.insert(0, os.path.join(SRC, "tests", "server"))
-from harness import Checks  # noqa: E402
+sys.path.insert(0, os.path.join(SRC, "tests"))  # checks.py
+from checks import check, finish  # noqa: E402
 
-checks = Checks()
-check = checks.check
 BASE_IMAGE_PACKAGES = {"libc6", "libgcc-s1", "libstdc++6"}  # in debian:bookworm (apt depends on them)
 
 
@@ -128,4 +126,4 @@ check("quickstart.sh builds only the CLI and the server",
       and "--target contact-solve contactd" in quickstart)
 check("test.sh switches the tests and benchmarks on", "-DCONTACT_BUILD_TESTS=ON -DCONTACT_BUILD_BENCH=ON"
       in read("scripts", "test.sh"))
-checks.finish()
+finish()

@@ -16,6 +16,8 @@ import h5py
 
 SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
 BIN = os.environ.get("CONTACT_BINARY_DIR", os.path.join(SRC, "build"))
+sys.path.insert(0, os.path.join(SRC, "tests"))  # checks.py
+from checks import check, finish, show_passes, skip  # noqa: E402
 
 # Run by pvpython in the result's directory; prints one JSON object.
 PROBE = r"""
@@ -49,34 +51,25 @@ out["hdf_cell_types"] = {str(k): v for k, v in types.items()}
 print("PROBE " + json.dumps(out))
 """
 
-failed = 0
-
-
-def check(name, condition, detail=""):
-    global failed
-    print(("ok   " if condition else "FAIL ") + name + ("" if condition else f": {detail}"), flush=True)
-    failed += not condition
-    return condition
-
 
 def main():
+    show_passes()
     pvpython = shutil.which("pvpython")
     if pvpython is None:
-        print("SKIP: pvpython is not installed (Debian's paraview); ParaView's view of a result was not checked")
-        sys.exit(77)
+        skip("pvpython is not installed (Debian's paraview); ParaView's view of a result was not checked")
     with tempfile.TemporaryDirectory() as tmp:
         job = os.path.join(SRC, "api", "examples", "hertz_cylinder_gmsh.json")
         r = subprocess.run([os.path.join(BIN, "contact-solve"), job, "-o", os.path.join(tmp, "result.hdf"), "-q"],
                            capture_output=True, text=True, timeout=300)
         if not check("contact-solve solves hertz_cylinder_gmsh.json", r.returncode == 0, r.stderr[-800:]):
-            sys.exit(1)
+            finish()
         with open(os.path.join(tmp, "probe.py"), "w") as f:
             f.write(PROBE)
         r = subprocess.run([pvpython, "--force-offscreen-rendering", "probe.py"], cwd=tmp, capture_output=True,
                            text=True, timeout=300)
         line = next((l for l in r.stdout.splitlines() if l.startswith("PROBE ")), None)
         if not check("pvpython reads the result", r.returncode == 0 and line, (r.stdout + r.stderr)[-1500:]):
-            sys.exit(1)
+            finish()
         seen = json.loads(line[len("PROBE "):])
         with h5py.File(os.path.join(tmp, "result.hdf")) as h:
             last = h["steps"][str(h["steps"].attrs["count"] - 1)]
@@ -92,8 +85,7 @@ def main():
     check("/VTKHDF: the bodies' triangles (5) and quadrilaterals (9), the pair's segments (3)",
           types.get("5") == triangles and types.get("5", 0) + types.get("9", 0) == sum(bodies.values())
           and types.get("3") == sum(pairs.values()) and triangles > 0, (types, triangles, bodies, pairs))
-    print("FAILED" if failed else "all passed")
-    sys.exit(1 if failed else 0)
+    finish()
 
 
 if __name__ == "__main__":

@@ -19,6 +19,9 @@ import xml.etree.ElementTree as ET
 import h5py
 import numpy as np
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))  # tests/: checks.py
+import checks  # noqa: E402  (check below is this file's decorator: checks.check counts)
+
 STOP_REASONS = {"converged", "max_iterations", "stagnation", "cancelled", "error"}
 METHODS = {"interface_newton", "neumann", "robin", "monolithic"}
 ENFORCEMENTS = {"exact", "penalty", "augmented_lagrangian"}
@@ -27,6 +30,7 @@ CHECKS = []
 
 
 def check(fn):
+    """Registers a check of a result file: it passes unless it raises (expect)."""
     CHECKS.append(fn)
     return fn
 
@@ -402,22 +406,19 @@ def run_cli(tmp, name, solver="own"):
 
 
 def check_file(context, label):
-    passed = failed = 0
     for fn in CHECKS:
         try:
             fn(context)
-            passed += 1
-            print(f"ok   {label}{fn.__name__}")
+            ok, detail = True, ""
         except Exception as e:
-            failed += 1
+            ok = False
             detail = str(e) if isinstance(e, AssertionError) else traceback.format_exc(limit=2)
-            print(f"FAIL {label}{fn.__name__}: {detail}")
+        checks.check(f"{label}{fn.__name__}", ok, detail)
     context.f.close()
-    return passed, failed
 
 
 def main():
-    passed = failed = 0
+    checks.show_passes()
     with tempfile.TemporaryDirectory() as tmp:
         contexts = []
         try:
@@ -430,16 +431,12 @@ def main():
                     floating = ("middle",) if name == "stack3_floating.json" else ()
                     contexts.append((f"[{solver} {name}] ", Context(path, job_path=job, floating=floating)))
         except Exception as e:  # a file is unavailable: one failure, nothing else to check
-            print(f"FAIL produce a result file: {e}")
-            print("0 passed, 1 failed")
-            return 1
+            checks.check("produce a result file", False, e)
+            checks.finish()
         for label, context in contexts:
-            p, f = check_file(context, label)
-            passed += p
-            failed += f
-    print(f"{passed} passed, {failed} failed")
-    return 0 if failed == 0 else 1
+            check_file(context, label)
+    checks.finish()
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    main()

@@ -22,18 +22,10 @@ SCHEMA_PATH = os.path.join(SOURCE, "api", "job.schema.json")
 EXAMPLES = sorted(glob.glob(os.path.join(SOURCE, "api", "examples", "*.json")))
 EXPECTED_EXAMPLES = {"seed_layers", "seed_layers_curved", "flat_patch", "flat_patch_nonmatching", "hertz", "stack3"}
 
-passed = 0
-failed = 0
+sys.path.insert(0, os.path.join(SOURCE, "tests"))  # checks.py
+from checks import check, finish, show_passes  # noqa: E402
 
-
-def check(name, condition, detail=""):
-    global passed, failed
-    if condition:
-        passed += 1
-        print(f"ok    {name}")
-    else:
-        failed += 1
-        print(f"FAIL  {name}" + (f": {detail}" if detail else ""))
+show_passes()
 
 
 def load(path):
@@ -209,5 +201,4 @@ check("seed_layers.json spells out the paper's scheme (c 0.05, gamma 0.02, eps 0
                 "criterion": "paper", "max_iterations": 2000, "initial_guess": "elastic_layer",
                 "acceleration": "none", "enforcement": "penalty"}, str(paper))
 
-print(f"{passed} passed, {failed} failed")
-sys.exit(1 if failed else 0)
+finish()

@@ -1,5 +1,6 @@
 """Shared helpers of the contactd integration tests: start the real server on a free loopback port with a
-temporary data directory, talk HTTP to it (standard library only), read progress streams, count checks.
+temporary data directory, talk HTTP to it (standard library only), read progress streams. The checks are counted
+by tests/checks.py; when one failed, its finish() prints the logs of the servers started here.
 
 Every wait is bounded; every server started is killed at the end (Server is a context manager)."""
 import atexit
@@ -14,6 +15,9 @@ import subprocess
 import sys
 import tempfile
 import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import checks  # noqa: E402  (tests/checks.py: the checks are counted there, not here)
 
 SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
 BIN = os.environ.get("CONTACT_BINARY_DIR", os.path.join(SRC, "build"))
@@ -84,27 +88,11 @@ def roller_job():
                      {"slave": "roller.top", "master": "plate.bottom", "friction": {"coefficient": 0.2}}]}
 
 
-class Checks:
-    """Counts named checks; prints each failure with its detail."""
-
-    def __init__(self):
-        self.passed = 0
-        self.failed = 0
-
-    def check(self, name, condition, detail=""):
-        if condition:
-            self.passed += 1
-        else:
-            self.failed += 1
-            print(f"FAIL {name}: {str(detail)[:600]}", flush=True)
-        return condition
-
-    def finish(self):
-        if self.failed:
-            for server in _started:
-                print(f"--- contactd log (port {server.port}), last lines:\n{server.output()[-2000:]}", flush=True)
-        print(f"{self.passed} passed, {self.failed} failed", flush=True)
-        sys.exit(1 if self.failed else 0)
+@checks.at_failure
+def _print_logs():
+    """At the end of a failed test (checks.finish()): the last lines of every contactd it started."""
+    for server in _started:
+        print(f"--- contactd log (port {server.port}), last lines:\n{server.output()[-2000:]}", flush=True)
 
 
 class Response:
@@ -193,7 +181,7 @@ class Server:
         return self.start()
 
     def __exit__(self, *exc):
-        self.kill()  # the log and data directory go at exit (Checks.finish shows the logs of a failed run)
+        self.kill()  # the log and data directory go at exit (checks.finish() shows the logs of a failed run)
 
     def kill(self):
         """SIGKILL (if still running) and reap."""

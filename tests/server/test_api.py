@@ -6,15 +6,16 @@ import json
 import os
 import re
 import subprocess
+import sys
 import tempfile
 
 import h5py
 import numpy as np
 
-from harness import (CONTACT_SOLVE, SRC, Checks, Server, Stream, example, flat_patch, read_all_events)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))  # tests/: checks.py
+from harness import (CONTACT_SOLVE, SRC, Server, Stream, example, flat_patch, read_all_events)  # noqa: E402
+from checks import check, finish  # noqa: E402
 
-checks = Checks()
-check = checks.check
 
 # Every field of the solver's IterationReport, BodyReport and PairReport (solver/include/contact/result.hpp).
 ITERATION_FIELDS = {"iteration", "measure", "paper_criterion", "fixed_point_residual", "complementarity",
@@ -325,4 +326,4 @@ with Server() as server, tempfile.TemporaryDirectory() as tmp:
 
     check("server still alive", server.proc.poll() is None)
 
-checks.finish()
+finish()

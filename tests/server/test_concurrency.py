@@ -3,15 +3,17 @@
 none lost or duplicated, every accepted one finishing with its own correct result; a full queue answers 503;
 Idempotency-Key: the same key twice gives one job, with another body 422, and concurrent retries one job."""
 import io
+import os
+import sys
 import threading
 import time
 
 import h5py
 
-from harness import Checks, Server, flat_patch, long_job
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))  # tests/: checks.py
+from harness import Server, flat_patch, long_job  # noqa: E402
+from checks import check, finish  # noqa: E402
 
-checks = Checks()
-check = checks.check
 
 REFERENCE_DISPLACEMENT = -0.001
 
@@ -133,4 +135,4 @@ with Server(args=["--workers", "2"]) as server:
     check("exactly one 'race' job exists", names.count("race") == 1, names)
     check("a key is remembered in the resource", server.job(first.json()["id"])["idempotency_key"] == "order-42")
 
-checks.finish()
+finish()

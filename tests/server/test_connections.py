@@ -4,15 +4,16 @@
 has a deadline (408); header count and size are limited (431), the request line too (414); connections are
 capped in total and per address (503 beyond, after the connection waiting longest is closed to make room); the
 listen backlog is large; keep-alive and pipelining still work."""
+import os
 import re
 import socket
 import subprocess
+import sys
 import time
 
-from harness import HOST, Checks, Server
-
-checks = Checks()
-check = checks.check
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))  # tests/: checks.py
+from harness import HOST, Server  # noqa: E402
+from checks import check, finish  # noqa: E402
 
 
 def timed_get(server, path, timeout=5):
@@ -189,4 +190,4 @@ with Server(args=["--workers", "1", "--max-connections-per-client", "5"]) as ser
     for s in held:
         s.close()
 
-checks.finish()
+finish()

@@ -15,10 +15,10 @@ import sys
 import tempfile
 import time
 
-from harness import Checks, Server, long_job
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))  # tests/: checks.py
+from harness import Server, long_job  # noqa: E402
+from checks import check, finish, skip  # noqa: E402
 
-checks = Checks()
-check = checks.check
 
 mount_point = tempfile.mkdtemp(prefix="contactd-full-")
 holder = subprocess.Popen(["unshare", "--mount", "--propagation", "private", "sh", "-c",
@@ -27,9 +27,9 @@ holder = subprocess.Popen(["unshare", "--mount", "--propagation", "private", "sh
 line = holder.stdout.readline().strip()
 if line != "mounted":
     holder.kill()
-    print(f"SKIP: cannot mount a tmpfs in a private namespace here ({holder.stderr.read().strip()[:200]})")
+    reason = f"cannot mount a tmpfs in a private namespace here ({holder.stderr.read().strip()[:200]})"
     os.rmdir(mount_point)
-    sys.exit(77)  # CTest reports it skipped (SKIP_RETURN_CODE)
+    skip(reason)  # CTest reports it skipped (SKIP_RETURN_CODE)
 
 
 class NamespacedServer(Server):
@@ -104,4 +104,4 @@ finally:
     except OSError:
         pass
 
-checks.finish()
+finish()

@@ -2,13 +2,15 @@
 """Hostile and careless requests against a server with a bearer token: each gets the right 4xx with an RFC 9457
 problem document (status matching), nothing is created, and the server keeps serving (a real job still runs)."""
 import json
+import os
+import sys
 import time
 import uuid
 
-from harness import Checks, Server, example, flat_patch
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))  # tests/: checks.py
+from harness import Server, example, flat_patch  # noqa: E402
+from checks import check, finish  # noqa: E402
 
-checks = Checks()
-check = checks.check
 
 TOKEN = "s3cret-token-for-tests"
 JSON = {"Content-Type": "application/json"}
@@ -152,4 +154,4 @@ with Server(token=TOKEN, args=["--workers", "1", "--max-dofs", "100000"]) as ser
     check(f"at least 30 hostile requests ({count})", count >= 30, count)
     print(f"{count} hostile requests")
 
-checks.finish()
+finish()

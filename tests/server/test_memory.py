@@ -5,13 +5,15 @@ at a time, every request gets its answer (400, or 503 busy with Retry-After), th
 memory is returned afterwards. Also: a 5 MB job of 20 000 bodies is refused at once (it cost 5.6 s of CPU).
 Prints RSS before / peak / after."""
 import json
+import os
+import sys
 import threading
 import time
 
-from harness import Checks, Server, example
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))  # tests/: checks.py
+from harness import Server, example  # noqa: E402
+from checks import check, finish  # noqa: E402
 
-checks = Checks()
-check = checks.check
 
 CLIENTS = 64
 
@@ -84,4 +86,4 @@ with Server(args=["--workers", "1"]) as server:
           (r.status, seconds))
     print(f"a {len(text) / 1e6:.1f} MB job of 20 000 bodies answered in {seconds:.2f} s", flush=True)
 
-checks.finish()
+finish()

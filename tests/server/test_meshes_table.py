@@ -19,23 +19,22 @@ import tempfile
 HERE = os.path.dirname(os.path.abspath(__file__))
 SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(HERE, "..", ".."))
 sys.path.insert(0, os.path.join(SRC, "clients"))
+sys.path.insert(0, os.path.join(HERE, ".."))  # tests/: checks.py
 
 import h5py  # noqa: E402
 import numpy as np  # noqa: E402
 
 import contact_client as cc  # noqa: E402
-from harness import Checks, Server  # noqa: E402
+from harness import Server  # noqa: E402
+from checks import check, finish, skip  # noqa: E402
 
 CLIENT = os.path.join(SRC, "clients", "contact_client.py")
 LIMIT = 8 * 1024 * 1024  # contactd's default --max-request-bytes
 E, NU, D = 2.1e5, 0.3, 0.003
 
 if not shutil.which("gmsh"):
-    print("skipped: no gmsh command to mesh tests/data/stack3_gmsh.geo (Debian's gmsh)")
-    sys.exit(77)
+    skip("no gmsh command to mesh tests/data/stack3_gmsh.geo (Debian's gmsh)")
 
-checks = Checks()
-check = checks.check
 tmp = tempfile.mkdtemp(prefix="meshes-table-")
 msh = os.path.join(tmp, "stack.msh")
 subprocess.run(["gmsh", "-2", os.path.join(SRC, "tests", "data", "stack3_gmsh.geo"), "-format", "msh41", "-o", msh],
@@ -123,4 +122,4 @@ with Server() as server:
           f"(once per body: {len(old_body) / 1e6:.1f} MB), result {len(stored) / 1e6:.1f} MB", flush=True)
 
 shutil.rmtree(tmp, ignore_errors=True)
-checks.finish()
+finish()

@@ -10,30 +10,28 @@ import subprocess
 import sys
 import tempfile
 
-from harness import CONTACT_SOLVE, EXAMPLES, Checks, Server, Stream, example, long_job
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))  # tests/: checks.py
+from harness import CONTACT_SOLVE, EXAMPLES, Server, Stream, example, long_job  # noqa: E402
+from checks import check, finish, skip  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "mpi"))
 from compare_results import max_relative_difference  # noqa: E402
 
 import h5py  # noqa: E402
 
-checks = Checks()
-check = checks.check
 
 # mpirun as root needs its consent; three ranks on two cores need oversubscription (inherited by the child).
 MPI_ENV = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
            "OMPI_MCA_rmaps_base_oversubscribe": "1"}
 
 if not shutil.which("mpirun"):
-    print("SKIP: mpirun not found (Debian's openmpi-bin; scripts/setup.sh installs it)")
-    sys.exit(77)
+    skip("mpirun not found (Debian's openmpi-bin; scripts/setup.sh installs it)")
 with tempfile.TemporaryDirectory() as tmp:
     probe = subprocess.run(["mpirun", "-n", "2", CONTACT_SOLVE, os.path.join(EXAMPLES, "flat_patch.json"), "-o",
                             os.path.join(tmp, "p.hdf"), "-q"], capture_output=True, text=True, timeout=120,
                            env=dict(os.environ, **MPI_ENV))
     if "MPI ranks" not in probe.stdout:
-        print("SKIP: contact-solve was built without MPI")
-        sys.exit(77)
+        skip("contact-solve was built without MPI")
 
 
 def download(server, job_id, path):
@@ -110,4 +108,4 @@ with Server() as plain:
           r.status == 400 and errors and errors[0].get("pointer") == "/parallel/ranks"
           and "--mpi-launcher" in errors[0].get("message", ""), r)
 
-checks.finish()
+finish()

@@ -3,12 +3,14 @@
 202, 204, 404 or 409, never 5xx (the loser of a race learns that the job is gone or not finished), and the store
 stays consistent: every job ends deleted, the counts by state match the listing, and a restart finds the same
 jobs."""
+import os
+import sys
 import threading
 
-from harness import Checks, Server, flat_patch, long_job
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))  # tests/: checks.py
+from harness import Server, flat_patch, long_job  # noqa: E402
+from checks import check, finish  # noqa: E402
 
-checks = Checks()
-check = checks.check
 
 ROUNDS = 3
 JOBS_PER_ROUND = 10
@@ -79,4 +81,4 @@ with Server(args=["--workers", "1", "--max-queued", "100"]) as server:
         ready = again.get("/readyz").json() or {}
         check("after a restart no job is damaged", ready.get("damaged_jobs") == [], ready)
 
-checks.finish()
+finish()

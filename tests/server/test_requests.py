@@ -12,13 +12,14 @@ the right status and a problem document, the server serving throughout:
 import json
 import os
 import subprocess
+import sys
 import tempfile
 import time
 
-from harness import CONTACT_SOLVE, Checks, Server, example, flat_patch
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))  # tests/: checks.py
+from harness import CONTACT_SOLVE, Server, example, flat_patch  # noqa: E402
+from checks import check, finish  # noqa: E402
 
-checks = Checks()
-check = checks.check
 
 TOKEN = "request-test-token"
 JSON = {"Content-Type": "application/json"}
@@ -209,4 +210,4 @@ with Server(args=["--workers", "1"]) as server:
     else:
         check("it is in the log, as 'solver output' lines", "contactd: solver output: CHOLMOD" in log, log[-500:])
 
-checks.finish()
+finish()

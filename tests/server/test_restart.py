@@ -7,14 +7,14 @@ import hashlib
 import json
 import os
 import shutil
+import sys
 import tempfile
 import time
 import uuid
 
-from harness import Checks, Server, Stream, flat_patch, long_job, read_all_events
-
-checks = Checks()
-check = checks.check
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))  # tests/: checks.py
+from harness import Server, Stream, flat_patch, long_job, read_all_events  # noqa: E402
+from checks import check, finish  # noqa: E402
 
 
 def sha256(path):
@@ -146,4 +146,4 @@ try:
 finally:
     shutil.rmtree(data_dir, ignore_errors=True)
 
-checks.finish()
+finish()

@@ -13,13 +13,13 @@ import json
 import os
 import shutil
 import subprocess
+import sys
 import tempfile
 import time
 
-from harness import CONTACTD, Checks, Server, Stream, flat_patch, long_job, read_all_events
-
-checks = Checks()
-check = checks.check
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))  # tests/: checks.py
+from harness import CONTACTD, Server, Stream, flat_patch, long_job, read_all_events  # noqa: E402
+from checks import check, finish  # noqa: E402
 
 
 def job_dir(server, job_id):
@@ -235,4 +235,4 @@ with Server(args=["--workers", "1", "--retention-bytes", str(int(one_job * 2.5))
     check("--retention-bytes: the oldest finished job goes first",
           [server.get(f"/v1/jobs/{j}").status for j in done] == [404, 200, 200])
 
-checks.finish()
+finish()

@@ -3,14 +3,16 @@
 iteration, ends CANCELLED), cancel of a queued job (never starts), a client that disconnects mid-stream, a client
 that stops reading (never blocks the worker), 20 idle streams while /healthz still answers, heartbeats, the
 stream cap, and the per-job time limit."""
+import os
 import socket
+import sys
 import threading
 import time
 
-from harness import HOST, Checks, Server, Stream, flat_patch, long_job, read_all_events
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))  # tests/: checks.py
+from harness import HOST, Server, Stream, flat_patch, long_job, read_all_events  # noqa: E402
+from checks import check, finish  # noqa: E402
 
-checks = Checks()
-check = checks.check
 
 with Server(args=["--workers", "1", "--max-streams", "24"]) as server:
     # --- cancel during a run ----------------------------------------------------------------------------------
@@ -160,4 +162,4 @@ with Server(args=["--workers", "1", "--time-limit-seconds", "1"]) as server:
           "time limit" in final["error"]["message"], final.get("error"))
     check("small jobs are unaffected", server.wait_done(server.submit_id(flat_patch()))["state"] == "SUCCEEDED")
 
-checks.finish()
+finish()

@@ -11,13 +11,14 @@ SUCCEEDED. Now a cancel or the time limit during the worker's parse ends the job
 stop_reason time_limit."""
 import json
 import os
+import sys
 import threading
 import time
 
-from harness import EXAMPLES, Checks, Server, flat_patch
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))  # tests/: checks.py
+from harness import EXAMPLES, Server, flat_patch  # noqa: E402
+from checks import check, finish  # noqa: E402
 
-checks = Checks()
-check = checks.check
 
 LARGE_NAMES = 600_000  # extra Gmsh physical names: a valid 32 MB job that takes about 2 s to validate
 LARGE_CLIENTS = 4
@@ -101,4 +102,4 @@ with Server(args=["--max-request-bytes", str(MAX_BYTES), "--workers", "1", "--ti
     check("a parse longer than the time limit ends FAILED with stop_reason time_limit",
           done.get("state") == "FAILED" and (done.get("error") or {}).get("reason") == "time_limit", done)
 
-checks.finish()
+finish()
