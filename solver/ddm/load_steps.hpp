@@ -1,7 +1,8 @@
 // Load steps (Problem::loading): the same contact problem under growing (or any) load factors. Every prescribed
 // displacement, traction, force and body force is scaled by the step's factor (BodySolver::set_load_factor: the
 // factorisations stay), each step is solved with the chosen method starting from the previous step's answer
-// (interface Newton: its active set; the fixed-point schemes: its displacements), and each step's fields become
+// (the fixed-point schemes: its displacements; interface Newton: its pressures under the penalty, nested coarse
+// solves with exact contact, sparse_direct.cpp), and each step's fields become
 // one result Step with its factor, recorded in `steps` (which keeps all or the last, StepLog). The iteration
 // reports run on across the steps.
 #pragma once

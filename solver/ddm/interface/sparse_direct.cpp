@@ -19,7 +19,12 @@ linalg::ActiveSetResult SparseDirectSolver::solve(const InterfaceQp& qp, const E
     H += D;
   }
   Eigen::VectorXd guess;
-  if (!z0 || z0->size() != m) {
+  // Exact contact: every solve (also a new load step) starts from nested coarse solves, which place the contact
+  // zone's edge to within a node or two; the previous step's active set would move it a node or two per step.
+  // Under the penalty and the augmented Lagrangian the previous pressures stay the start (an update shifts them
+  // little).
+  const bool exact = qp.penalty.size() != m || qp.penalty.cwiseAbs().maxCoeff() == 0;
+  if (!z0 || z0->size() != m || exact) {
     std::vector<std::pair<Eigen::Index, int>> levels;
     guess = linalg::nested_initial_guess(H, qp.g, qp.line, qp.position, qp.equilibrium, &levels);
     if (!levels.empty()) {
