@@ -197,29 +197,27 @@ linalg::ActiveSetResult FrictionDirectSolver::solve(const InterfaceQp& qp, const
                                                     InterfaceSolveContext& context) {
   linalg::ActiveSetResult result;
   const Eigen::Index n = qp.problem.size();
-  if (assembled_for_ != &qp.problem) {
-    F_ = qp.problem.assemble();
-    assembled_for_ = &qp.problem;
-  }
+  const SparseMatrix& F = compliance_.of(qp.problem);
+  const Eigen::VectorXd diagonal = F.diagonal();
+  const double dmax = diagonal.cwiseAbs().maxCoeff();
   // A node whose tangential motion both sides prescribe (on a symmetry line) cannot slip: its row of F is zero and
   // its tangential traction goes into the supports; it is left out (q = 0 there).
   std::vector<FrictionRow> rows;
-  const double tmax = F_.diagonal().cwiseAbs().maxCoeff();
+
   for (const auto& r : friction_rows(qp.problem))
-    if (F_.coeff(r.tangential, r.tangential) > 1e-12 * tmax) rows.push_back(r);
+    if (diagonal[r.tangential] > 1e-12 * dmax) rows.push_back(r);
   const std::vector<char> mask = linalg::tangential_mask(n, rows);
   // c_j: the inverse of the unknown's own compliance (the pressure or traction that would close its gap or slip
   // alone); a row no body can move gets the largest scale.
   Eigen::VectorXd c(n);
-  const double dmax = F_.diagonal().cwiseAbs().maxCoeff();
-  for (Eigen::Index j = 0; j < n; ++j) c[j] = 1.0 / std::max(F_.coeff(j, j), 1e-12 * dmax + 1e-300);
+  for (Eigen::Index j = 0; j < n; ++j) c[j] = 1.0 / std::max(diagonal[j], 1e-12 * dmax + 1e-300);
   if (last_alpha_.size() != qp.equilibrium.G.rows()) last_alpha_.resize(0);
-  FrictionSets sets = first_sets(F_, qp, z0, last_alpha_, c, rows, mask, context.note);
+  FrictionSets sets = first_sets(F, qp, z0, last_alpha_, c, rows, mask, context.note);
   result.z = Eigen::VectorXd::Zero(n);
   bool restarted = false;
   for (int step = 1; step <= context.max_steps; ++step) {
     const linalg::FrictionParametrization p = linalg::parametrize(sets, rows, mask);
-    const SetSolve s = solve_on_sets(F_, qp, p);
+    const SetSolve s = solve_on_sets(F, qp, p);
     if (!s.ok && !restarted && step > 1) {
       // A floating body held by nothing on these sets, which may be a bad guess: once, every node in contact sticks.
       restarted = true;
@@ -235,7 +233,7 @@ linalg::ActiveSetResult FrictionDirectSolver::solve(const InterfaceQp& qp, const
     result.z = s.lambda;
     result.alpha = s.alpha;
     last_alpha_ = s.alpha;
-    result.h = qp.g + F_ * s.lambda;
+    result.h = qp.g + F * s.lambda;
     if (s.alpha.size() > 0) result.h += qp.equilibrium.G.transpose() * s.alpha;
     const FrictionSets next = linalg::predict_friction_sets(result.z, result.h, c, rows, mask);
     linalg::ActiveSetStep info;

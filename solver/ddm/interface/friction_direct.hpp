@@ -22,8 +22,7 @@ class FrictionDirectSolver final : public InterfaceSolver {
   linalg::ActiveSetResult solve(const InterfaceQp& qp, const Eigen::VectorXd* z0, InterfaceSolveContext& context) override;
 
  private:
-  const InterfaceProblem* assembled_for_ = nullptr;
-  SparseMatrix F_;
+  AssembledCompliance compliance_;
   Eigen::VectorXd last_alpha_;  // the floating bodies' rigid amplitudes of the last solve (with its warm start)
 };
 

@@ -42,6 +42,23 @@ struct InterfaceSolveContext {
   std::string note;                     // out: what the first report says (coarse solves, solver chosen)
 };
 
+// F assembled as a sparse matrix once per interface problem, for the direct solvers (augmented-Lagrangian updates
+// and load steps change only the gaps and the penalty diagonal).
+class AssembledCompliance {
+ public:
+  const SparseMatrix& of(const InterfaceProblem& problem) {
+    if (for_ != &problem) {
+      F_ = problem.assemble();
+      for_ = &problem;
+    }
+    return F_;
+  }
+
+ private:
+  const InterfaceProblem* for_ = nullptr;
+  SparseMatrix F_;
+};
+
 class InterfaceSolver {
  public:
   virtual ~InterfaceSolver() = default;

@@ -7,11 +7,7 @@ namespace contact::ddm {
 linalg::ActiveSetResult SparseDirectSolver::solve(const InterfaceQp& qp, const Eigen::VectorXd* z0,
                                                   InterfaceSolveContext& context) {
   const Eigen::Index m = qp.problem.size();
-  if (assembled_for_ != &qp.problem) {
-    F_ = qp.problem.assemble();
-    assembled_for_ = &qp.problem;
-  }
-  SparseMatrix H = F_;
+  SparseMatrix H = F_.of(qp.problem);
   if (qp.penalty.size() == m && qp.penalty.cwiseAbs().maxCoeff() > 0) {
     SparseMatrix D(m, m);
     D.reserve(Eigen::VectorXi::Constant(m, 1));

@@ -15,10 +15,7 @@ class SparseDirectSolver final : public InterfaceSolver {
   linalg::ActiveSetResult solve(const InterfaceQp& qp, const Eigen::VectorXd* z0, InterfaceSolveContext& context) override;
 
  private:
-  // F assembled once per interface problem (augmented-Lagrangian updates and load steps only change g and the
-  // penalty diagonal).
-  const InterfaceProblem* assembled_for_ = nullptr;
-  SparseMatrix F_;
+  AssembledCompliance F_;
 };
 
 }  // namespace contact::ddm
