@@ -103,6 +103,15 @@ class Browser:
             "return Array.from(document.getElementById(arguments[0]).rows)"
             "  .map(r => Array.from(r.cells).map(c => c.textContent));", element_id)
 
+    def click(self, selector, timeout=10):
+        """Finds the element by CSS selector and clicks it, again if the page replaced it in between (the job
+        list is rebuilt whenever the server's list changes, which makes a row found a moment ago stale)."""
+        def attempt():
+            self.driver.find_element(By.CSS_SELECTOR, selector).click()
+            return True
+        if not self.wait(attempt, timeout):
+            raise AssertionError(f"could not click {selector} within {timeout} s")
+
     def set_job_text(self, text):
         box = self.el("job-text")
         box.clear()
@@ -236,7 +245,7 @@ def test_without_token(server, b, downloads):
     check("validate: the same errors", b.wait(lambda: "/bodies/1/material/nu" in b.text("submit-message"), 10))
 
     # 5. Select the cancelled job in the list and delete it through the page.
-    b.driver.find_element(By.CSS_SELECTOR, f'#jobs tr[data-id="{job_id}"]').click()
+    b.click(f'#jobs tr[data-id="{job_id}"]')
     check("select: the list selects the job", b.wait(lambda: b.text("job-id") == job_id, 10), b.text("job-id"))
     check("select: its stream is replayed into the plot", b.wait(lambda: points(b) == long_points, 20),
           (points(b), long_points))
