@@ -16,6 +16,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -337,6 +338,13 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (output.empty()) output = std::filesystem::path(job_path).stem().string() + ".hdf";
-  const int code = solve_and_write(session, problem, output, job_id, quiet, ndjson);
-  return session.broadcast(code);
+  const int code = session.broadcast(solve_and_write(session, problem, output, job_id, quiet, ndjson));
+  if (contact::background_work_running()) {
+    // A cancel left a factorisation running (contact/solve.hpp); the result is written: exit now, not seconds later.
+    std::cout.flush();
+    std::cerr.flush();
+    std::fflush(nullptr);
+    std::_Exit(code);
+  }
+  return code;
 }

@@ -298,6 +298,11 @@ int main(int argc, char** argv) {
     }
     server.stop();
     listener.join();
+    if (!contact::wait_for_background_work(10)) {  // a factorisation a cancel left running (contact/solve.hpp)
+      log_line("stopped (a cancelled job's factorisation still runs: exiting without it)");
+      std::fflush(nullptr);
+      std::_Exit(0);
+    }
     log_line("stopped");
     return 0;
   } catch (const std::exception& e) {

@@ -95,9 +95,15 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
     const auto factorization = problem.solver.method == Method::monolithic         ? ddm::ContactSystem::Factorization::none
                                : problem.solver.method == Method::interface_newton ? ddm::ContactSystem::Factorization::interface
                                                                                    : ddm::ContactSystem::Factorization::plain;
-    ddm::ContactSystem system(active, runner, factorization);
+    ddm::ContactSystem system(active, runner, factorization, &cancel);
     result.setup_seconds = system.setup_seconds();
     result.factorization_seconds = system.factorization_seconds();
+    if (system.cancelled()) {
+      result.stop_reason = StopReason::cancelled;
+      result.message = "cancelled during the set-up (assembly and factorisation of the bodies): nothing solved yet";
+      result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      return result;
+    }
     if (!system.ok()) {
       result.stop_reason = StopReason::error;
       result.message = system.error();

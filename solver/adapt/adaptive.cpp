@@ -277,9 +277,17 @@ ddm::MethodOutcome converge_then_refine(Problem& working, ddm::ContactSystem& sy
     context.observer.on_adaptive_step(report);
     warm = o.u;
     transfer(warm, working, r);
-    system.rebuild(r.changed, context.runner);
+    system.rebuild(r.changed, context.runner, &context.cancel);
     method.reset();
     refined_last = r.refined;
+    if (system.cancelled()) {  // during the refined meshes' assembly or factorisation: they are not solved
+      total.reason = StopReason::cancelled;
+      total.converged = false;
+      total.message = "cancelled during adaptive step " + std::to_string(step + 1) +
+                      " (assembling and factorising its refined meshes; the result holds step " +
+                      std::to_string(step) + "'s solution)";
+      return total;
+    }
     if (!system.ok()) {
       total.reason = StopReason::error;
       total.converged = false;
@@ -359,7 +367,14 @@ ddm::MethodOutcome paper_interleaving(Problem& working, ddm::ContactSystem& syst
       steps.push_back(std::move(st));
       ++step;
       transfer(u_new, working, r);
-      system.rebuild(r.changed, context.runner);
+      system.rebuild(r.changed, context.runner, &context.cancel);
+      if (system.cancelled()) {
+        out.reason = StopReason::cancelled;
+        out.message = "cancelled during the refined meshes' assembly and factorisation (the result holds the "
+                      "steps before)";
+        u = std::move(u_new);
+        break;
+      }
       if (!system.ok()) {
         out.reason = StopReason::error;
         out.message = "adaptive: " + system.error();

@@ -41,26 +41,41 @@ std::string body_errors(const std::vector<std::pair<std::string, std::string>>& 
 
 }  // namespace
 
-ContactSystem::ContactSystem(const Problem& problem, TaskRunner& runner, Factorization factorization)
+ContactSystem::ContactSystem(const Problem& problem, TaskRunner& runner, Factorization factorization,
+                             const CancelToken* cancel)
     : problem_(problem), factorization_(factorization), runner_(runner) {
   ScopedTimer timer(setup_seconds_);
   fem::limit_blas_threads();
   discretize_pairs();
   bodies_.resize(problem.bodies.size());
-  runner.run_bodies(bodies_.size(), [&](size_t a) { bodies_[a] = make_body(a, true); }, body_outcome_share());
+  std::vector<size_t> all(bodies_.size());
+  for (size_t a = 0; a < all.size(); ++a) all[a] = a;
+  build_bodies(all, runner, cancel);
+}
+
+std::unique_ptr<fem::BodySolver> ContactSystem::make_body(size_t a, bool local, const CancelToken* cancel) const {
+  std::function<bool()> cancelled;
+  if (cancel) cancelled = [cancel] { return cancel->cancelled(); };
+  auto b = std::make_unique<fem::BodySolver>(problem_.bodies[a], problem_.model, factorization_ != Factorization::none,
+                                             interface_dofs(a), may_float(a), local, std::move(cancelled));
+  b->set_load_step(load_step_, load_factor_);
+  return b;
+}
+
+void ContactSystem::build_bodies(const std::vector<size_t>& todo, TaskRunner& runner, const CancelToken* cancel) {
+  runner.run_bodies(todo, [&](size_t a) {
+    bodies_[a].reset();  // free the old factorisation first
+    bodies_[a] = make_body(a, true, cancel);
+  }, body_outcome_share());
   std::vector<std::pair<std::string, std::string>> failed;
-  for (size_t a = 0; a < bodies_.size(); ++a) {
-    if (!bodies_[a]->ok()) failed.emplace_back(problem.bodies[a].name, bodies_[a]->error());
+  for (size_t a : todo) {
+    if (bodies_[a]->was_cancelled())
+      cancelled_ = true;  // not an error: the caller sees its token
+    else if (!bodies_[a]->ok())
+      failed.emplace_back(problem_.bodies[a].name, bodies_[a]->error());
     factorization_seconds_ += bodies_[a]->factorization_seconds();
   }
   append_error(error_, body_errors(failed));
-}
-
-std::unique_ptr<fem::BodySolver> ContactSystem::make_body(size_t a, bool local) const {
-  auto b = std::make_unique<fem::BodySolver>(problem_.bodies[a], problem_.model, factorization_ != Factorization::none,
-                                             interface_dofs(a), may_float(a), local);
-  b->set_load_step(load_step_, load_factor_);
-  return b;
 }
 
 BodyShare ContactSystem::body_outcome_share() {
@@ -113,22 +128,13 @@ std::vector<int> ContactSystem::interface_dofs(size_t a) const {
   return dofs;
 }
 
-void ContactSystem::rebuild(const std::vector<char>& changed, TaskRunner& runner) {
+void ContactSystem::rebuild(const std::vector<char>& changed, TaskRunner& runner, const CancelToken* cancel) {
   discretize_pairs();
   std::vector<size_t> todo;
   for (size_t a = 0; a < bodies_.size(); ++a)
     if (changed[a] || (factorization_ == Factorization::interface && interface_dofs(a) != bodies_[a]->interface_dofs()))
       todo.push_back(a);
-  runner.run_bodies(todo, [&](size_t a) {
-    bodies_[a].reset();  // free the old factorisation first
-    bodies_[a] = make_body(a, true);
-  }, body_outcome_share());
-  std::vector<std::pair<std::string, std::string>> failed;
-  for (size_t a : todo) {
-    if (!bodies_[a]->ok()) failed.emplace_back(problem_.bodies[a].name, bodies_[a]->error());
-    factorization_seconds_ += bodies_[a]->factorization_seconds();
-  }
-  append_error(error_, body_errors(failed));
+  build_bodies(todo, runner, cancel);
 }
 
 Pressures ContactSystem::penalty_pressures(const Displacements& u) const {

@@ -30,15 +30,19 @@ class ContactSystem {
   };
 
   // Discretises every pair, then assembles every body and factorises them as asked, in parallel through
-  // `runner`. Check ok() / error().
-  ContactSystem(const Problem& problem, TaskRunner& runner, Factorization factorization = Factorization::plain);
+  // `runner`. Check ok() / error(). With `cancel`, a cancel during the assembly or a factorisation stops the set-up
+  // within a poll (fem/body_solver.hpp): then cancelled() and not ok(), and the system must not be used.
+  ContactSystem(const Problem& problem, TaskRunner& runner, Factorization factorization = Factorization::plain,
+                const CancelToken* cancel = nullptr);
 
   // After the meshes of the bodies flagged in `changed` were refined (in the Problem this system refers to):
   // rediscretises every pair and reassembles and refactorises the changed bodies, and any other body whose
-  // interface unknowns changed (an unchanged body keeps its factorisation). Multipliers are dropped. Check ok().
-  void rebuild(const std::vector<char>& changed, TaskRunner& runner);
+  // interface unknowns changed (an unchanged body keeps its factorisation). Multipliers are dropped. Check ok();
+  // a cancel (as for the constructor) leaves cancelled() true and the system unusable.
+  void rebuild(const std::vector<char>& changed, TaskRunner& runner, const CancelToken* cancel = nullptr);
 
-  bool ok() const { return error_.empty(); }
+  bool ok() const { return error_.empty() && !cancelled_; }
+  bool cancelled() const { return cancelled_; }
   const std::string& error() const { return error_; }
   // Assembly and factorisation seconds of all bodies built so far (summed over bodies).
   double total_factorization_seconds() const { return factorization_seconds_; }
@@ -120,7 +124,9 @@ class ContactSystem {
   // Whether body a may float (held by its contacts): in a pair, and a method that handles it.
   bool may_float(size_t a) const;
   // Body a's solver: assembled and factorised (local), or only its constraints (owned by another process).
-  std::unique_ptr<fem::BodySolver> make_body(size_t a, bool local) const;
+  std::unique_ptr<fem::BodySolver> make_body(size_t a, bool local, const CancelToken* cancel = nullptr) const;
+  // Builds the bodies `todo` (in parallel), then collects their errors and factorisation times.
+  void build_bodies(const std::vector<size_t>& todo, TaskRunner& runner, const CancelToken* cancel);
   BodyShare body_outcome_share();
 
   const Problem& problem_;
@@ -130,6 +136,7 @@ class ContactSystem {
   std::vector<mortar::PairDiscretization> pairs_;
   std::vector<mortar::PenaltyChoice> penalties_;
   std::string error_;
+  bool cancelled_ = false;
   double setup_seconds_ = 0.0, factorization_seconds_ = 0.0;
   double load_factor_ = 1.0;
   size_t load_step_ = 0;

@@ -1,4 +1,6 @@
 #include "body_solver.hpp"
+
+#include "../common/background.hpp"
 #include "../common/assert.hpp"
 
 #include "element.hpp"
@@ -16,22 +18,29 @@
 namespace contact::fem {
 
 BodySolver::BodySolver(const Body& body, const Model& model, bool factorize_now, const std::vector<int>& interface_dofs,
-                       bool allow_floating, bool local)
+                       bool allow_floating, bool local, std::function<bool()> cancelled)
     : body_(body),
       elasticity_(make_elasticity(body.material, model)),
       constraints_(2 * body.mesh.num_nodes()),
       interface_dofs_(interface_dofs),
       allow_floating_(allow_floating),
       factorize_(factorize_now),
-      local_(local) {
+      local_(local),
+      cancelled_(std::move(cancelled)) {
   {
     ScopedTimer timer(assembly_seconds_);
     setup_constraints();
     if (!ok() || !local) return;
     assemble_system();
+    if (!ok()) return;
     setup_history_groups();
   }
   if (factorize_now) factorize();
+}
+
+void BodySolver::stop_cancelled(const char* during) {
+  was_cancelled_ = true;
+  error_ = "body '" + body_.name + "': cancelled during the " + during;
 }
 
 void BodySolver::setup_constraints() {
@@ -224,7 +233,9 @@ void BodySolver::assemble_system() {
 
   // Values and the right-hand side.
   rhs_base_ = T.transpose() * f_ext_;  // T^T f of the tractions; each element adds T^T (f_e - K_e g_e)
+  constexpr int kCellsBetweenPolls = 8192;  // ~10 ms of assembly
   for (int c = 0; c < m.num_cells(); ++c) {
+    if (cancelled_ && c % kCellsBetweenPolls == 0 && cancelled_()) return stop_cancelled("assembly");
     const CellMatrix Ke = cell_stiffness(m, c, elasticity_);
     const CellDofs dofs = cell_dofs(m.cells[static_cast<size_t>(c)]);
     const Eigen::Index nd = dofs.size();
@@ -243,8 +254,8 @@ void BodySolver::assemble_system() {
             entry(static_cast<int>(jj.col()), ki) += ii.value() * jj.value() * Ke(j, i);
       }
   }
-  K_red_ = Eigen::Map<const Eigen::SparseMatrix<double>>(nf, nf, static_cast<Eigen::Index>(values.size()), outer.data(),
-                                                         inner.data(), values.data());
+  K_red_ = std::make_shared<const Eigen::SparseMatrix<double>>(Eigen::Map<const Eigen::SparseMatrix<double>>(
+      nf, nf, static_cast<Eigen::Index>(values.size()), outer.data(), inner.data(), values.data()));
 }
 
 Eigen::SparseMatrix<double> BodySolver::stiffness() const {
@@ -279,8 +290,13 @@ void BodySolver::factorize() {
   if (n_free() == 0) return;  // everything prescribed: nothing to factorise
   {
     ScopedTimer timer(factorization_seconds_);
-    factor_ = std::make_unique<Cholesky>(K_red_, interface_unknowns_of(interface_dofs_));
+    // With a cancel to watch, on a thread of its own that owns its inputs (common/background.hpp).
+    std::function<std::unique_ptr<Cholesky>()> work = [K = K_red_, last = interface_unknowns_of(interface_dofs_)] {
+      return std::make_unique<Cholesky>(*K, last);
+    };
+    factor_ = run_unless_cancelled(std::move(work), cancelled_);
   }
+  if (!factor_) return stop_cancelled("factorisation");
   if (!factor_->ok()) {
     std::ostringstream os;
     os << "body '" << body_.name << "': the stiffness matrix (" << n_free() << " unknowns) could not be factorised: "

@@ -12,6 +12,7 @@
 
 #include <Eigen/SparseCore>
 
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -37,8 +38,11 @@ class BodySolver {
   // local = false: the body belongs to another process (MPI ranks, parallel/task_runner.hpp): only its constraints and
   // rigid modes are set up (the same as on its owner), nothing is assembled or factorised, and the owner's outcome
   // arrives through adopt_outcome(). Its solves throw; its stresses and reactions need no factorisation and work.
+  // cancelled (optional): polled during the assembly and while the factorisation runs on a thread of its own
+  // (common/background.hpp); once it says so the constructor returns within a poll, the body not ok() and
+  // was_cancelled() true, and an unfinished factorisation ends in the background.
   BodySolver(const Body& body, const Model& model, bool factorize = true, const std::vector<int>& interface_dofs = {},
-             bool allow_floating = false, bool local = true);
+             bool allow_floating = false, bool local = true, std::function<bool()> cancelled = {});
 
   bool local() const { return local_; }
   // A body of another process: its owner's error (if any) and factorisation seconds.
@@ -49,6 +53,7 @@ class BodySolver {
 
   bool ok() const { return error_.empty(); }
   const std::string& error() const { return error_; }
+  bool was_cancelled() const { return was_cancelled_; }
 
   int n_dofs() const { return constraints_.n_dofs(); }
   int n_free() const { return constraints_.n_free(); }
@@ -73,7 +78,7 @@ class BodySolver {
   const Constraints& constraints() const { return constraints_; }
   // The stiffness of all dofs, assembled on demand (not kept: the solver needs only the reduced one).
   Eigen::SparseMatrix<double> stiffness() const;
-  const Eigen::SparseMatrix<double>& reduced_stiffness() const { return K_red_; }
+  const Eigen::SparseMatrix<double>& reduced_stiffness() const { return *K_red_; }
   // The body's own loads and prescribed values are scaled by the load factor (load steps; 1 by default): the
   // factorisation does not change, only these. set_load_step also gives every condition with its own history
   // (BoundaryCondition::history) its factor of step `step`, the others the loading's `factor`.
@@ -115,6 +120,7 @@ class BodySolver {
   };
   void setup_constraints();
   void assemble_system();
+  void stop_cancelled(const char* during);
   void factorize();
   void add_condition_load(const BoundaryCondition& bc, Eigen::VectorXd& f) const;
   void setup_history_groups();
@@ -126,10 +132,12 @@ class BodySolver {
   const Body& body_;
   Elasticity elasticity_;
   Constraints constraints_;
-  Eigen::SparseMatrix<double> K_red_;
+  // Shared with a factorisation that a cancel may leave running after this object is gone.
+  std::shared_ptr<const Eigen::SparseMatrix<double>> K_red_ = std::make_shared<const Eigen::SparseMatrix<double>>();
   Eigen::VectorXd f_ext_, rhs_base_;
   std::vector<int> interface_dofs_;
-  bool allow_floating_ = false, factorize_ = true, local_ = true;
+  bool allow_floating_ = false, factorize_ = true, local_ = true, was_cancelled_ = false;
+  std::function<bool()> cancelled_;
   double load_factor_ = 1.0;
   std::vector<LoadGroup> groups_;
   Eigen::MatrixXd rigid_modes_;

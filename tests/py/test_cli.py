@@ -216,4 +216,38 @@ with tempfile.TemporaryDirectory() as tmp:
           f"{exited - signalled:.2f} s")
     check("the result so far is written", os.path.exists(out) and os.path.getsize(out) > 0)
 
+    # SIGTERM right after adaptive step 6 is reported: the refined meshes (~130k + 50k unknowns) are being assembled
+    # and factorised (a second or two; zz estimates in no time, so the run gets there fast). The factorisation
+    # cannot be interrupted: the solver leaves it to finish on its own thread, writes the steps so far and exits.
+    out = os.path.join(tmp, "cancelled_rebuild.hdf")
+    p = subprocess.Popen([CLI, two_cylinders_job(tmp, indicator="zz", stop_tolerance=0, max_steps=9), "-o", out],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, bufsize=1)
+    started = time.monotonic()
+    lines = []
+    for line in p.stdout:
+        lines.append(line)
+        if line.startswith("adaptive step  6"):
+            break
+    running = p.poll() is None
+    signalled = time.monotonic()
+    p.send_signal(signal.SIGTERM)
+    rest, stderr = p.communicate(timeout=60)
+    exited = time.monotonic()
+    stdout = "".join(lines) + rest
+    check("rebuild: still running when signalled", running and lines and lines[-1].startswith("adaptive step  6"),
+          stdout[-400:])
+    stop = [l for l in stdout.splitlines() if l.startswith("stop: ")]
+    match = re.search(r"stop: cancelled after \d+ steps, ([0-9.]+) s", stop[0]) if stop else None
+    check("rebuild: the stop line says the assembly and factorisation of step 7 were cancelled",
+          match is not None and "cancelled during adaptive step 7 (assembling and factorising its refined meshes"
+          in stop[0], stop or stdout[-400:])
+    if match:
+        latency = float(match.group(1)) - (signalled - started)
+        print(f"  SIGTERM {signalled - started:.2f} s after the start, during step 7's assembly and factorisation: "
+              f"the solver stopped {latency:.3f} s later, the process exited {exited - signalled:.2f} s after the signal")
+        check("rebuild: the solver stopped within 1 s of SIGTERM", latency <= 1.0, stop[0])
+    check("rebuild: the process exited within 3 s of SIGTERM", exited - signalled <= 3.0, f"{exited - signalled:.2f} s")
+    check("rebuild: exit code 3 (stopped without converging), no crash at exit", p.returncode == 3, f"{p.returncode} {stderr[-300:]}")
+    check("rebuild: the result so far is written", os.path.exists(out) and os.path.getsize(out) > 0)
+
 finish()

@@ -1,0 +1,51 @@
+#include "background.hpp"
+
+#include "contact/solve.hpp"
+
+namespace contact {
+
+namespace {
+
+struct Registry {
+  std::mutex mutex;
+  std::condition_variable idle;
+  int running = 0;
+};
+
+Registry& registry() {
+  static Registry* r = new Registry;  // never destroyed: a detached thread may finish during the exit
+  return *r;
+}
+
+}  // namespace
+
+namespace detail {
+
+void background_started() {
+  std::lock_guard<std::mutex> lock(registry().mutex);
+  ++registry().running;
+}
+
+void background_finished() {
+  Registry& r = registry();
+  {
+    std::lock_guard<std::mutex> lock(r.mutex);
+    --r.running;
+  }
+  r.idle.notify_all();
+}
+
+}  // namespace detail
+
+bool background_work_running() {
+  std::lock_guard<std::mutex> lock(registry().mutex);
+  return registry().running > 0;
+}
+
+bool wait_for_background_work(double seconds) {
+  Registry& r = registry();
+  std::unique_lock<std::mutex> lock(r.mutex);
+  return r.idle.wait_for(lock, std::chrono::duration<double>(seconds), [&] { return r.running == 0; });
+}
+
+}  // namespace contact
