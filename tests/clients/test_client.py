@@ -18,11 +18,7 @@ import tempfile
 import threading
 import time
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(HERE, "..", ".."))
-sys.path.insert(0, os.path.join(SRC, "tests"))  # checks.py
-sys.path.insert(0, os.path.join(SRC, "tests", "server"))
-sys.path.insert(0, os.path.join(SRC, "clients"))
+from client_paths import CLIENT, EXAMPLES, HERE, SRC  # noqa: E402,F401  (sets the import path)
 
 import numpy as np  # noqa: E402
 
@@ -31,8 +27,6 @@ import harness  # noqa: E402
 from harness import HOST, Server, example, flat_patch, long_job  # noqa: E402
 from checks import check, finish, section  # noqa: E402
 
-CLIENT = os.path.join(SRC, "clients", "contact_client.py")
-EXAMPLES = os.path.join(SRC, "api", "examples")
 SEED = os.path.join(EXAMPLES, "seed_layers.json")
 ADAPTIVE = os.path.join(EXAMPLES, "seed_layers_adaptive.json")
 UUID_RE = re.compile(r"^[0-9a-f]{8}-[0-9a-f]{4}-4[0-9a-f]{3}-[89ab][0-9a-f]{3}-[0-9a-f]{12}$")

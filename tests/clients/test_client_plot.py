@@ -14,19 +14,14 @@ import subprocess
 import sys
 import tempfile
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(HERE, "..", ".."))
-sys.path.insert(0, os.path.join(SRC, "tests"))  # checks.py
-sys.path.insert(0, os.path.join(SRC, "tests", "server"))
-sys.path.insert(0, os.path.join(SRC, "clients"))
+from client_paths import CLIENT, EXAMPLES, HERE, SRC  # noqa: E402,F401  (sets the import path)
 
 import numpy as np  # noqa: E402
 
 import contact_client as cc  # noqa: E402
-from harness import EXAMPLES, HOST, Server  # noqa: E402
+from harness import HOST, Server  # noqa: E402
 from checks import check, finish  # noqa: E402
 
-CLIENT = os.path.join(SRC, "clients", "contact_client.py")
 PAIR = "upper.bottom-lower.top"
 MOST = 0.6  # "shows it across most of the axis": the contact zone spans more than 60 % of the panel's axis
 

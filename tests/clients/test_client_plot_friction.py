@@ -19,11 +19,7 @@ import subprocess
 import sys
 import tempfile
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(HERE, "..", ".."))
-sys.path.insert(0, os.path.join(SRC, "tests"))  # checks.py
-sys.path.insert(0, os.path.join(SRC, "tests", "server"))
-sys.path.insert(0, os.path.join(SRC, "clients"))
+from client_paths import CLIENT, EXAMPLES, HERE, SRC  # noqa: E402,F401  (sets the import path)
 
 import h5py  # noqa: E402
 import numpy as np  # noqa: E402
@@ -32,7 +28,6 @@ import contact_client as cc  # noqa: E402
 from harness import HOST, Server, example, roller_job  # noqa: E402
 from checks import check, finish  # noqa: E402
 
-CLIENT = os.path.join(SRC, "clients", "contact_client.py")
 
 ROLLER_PAIRS = ("roller.bottom-base.top", "roller.top-plate.bottom")
 

@@ -20,10 +20,7 @@ import sys
 import tempfile
 import time
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(HERE, "..", ".."))
-sys.path.insert(0, os.path.join(SRC, "tests"))  # checks.py
-sys.path.insert(0, os.path.join(SRC, "tests", "server"))
+from client_paths import CLIENT, EXAMPLES, HERE, SRC  # noqa: E402,F401  (sets the import path)
 from harness import BIN, Server  # noqa: E402
 from checks import check, finish  # noqa: E402
 

@@ -22,13 +22,9 @@ import tempfile
 import time
 import urllib.request
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(HERE, "..", ".."))
-sys.path.insert(0, os.path.join(SRC, "tests"))  # checks.py
-sys.path.insert(0, os.path.join(SRC, "tests", "server"))
-sys.path.insert(0, os.path.join(SRC, "clients"))
+from client_paths import CLIENT, EXAMPLES, HERE, SRC  # noqa: E402,F401  (sets the import path)
 from contact_client.plot import AXIS_LABELS  # noqa: E402
-from harness import EXAMPLES, Server, example, long_job, read_all_events, roller_job  # noqa: E402
+from harness import Server, example, long_job, read_all_events, roller_job  # noqa: E402
 from checks import check, finish, section, skip  # noqa: E402
 
 CHROMIUM_FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",

@@ -179,75 +179,71 @@ with tempfile.TemporaryDirectory() as tmp:
         check("it stopped by itself after as many refinement steps as lines less one",
               len(stop) == 1 and f"stopped after {len(steps) - 1} refinement steps" in stop[0], stop)
 
+    def sigterm_when(job, out, moment, delay=0.0):
+        """Runs the CLI on `job`, sends SIGTERM `delay` s after moment(line) is true for a line it printed; returns what
+        the run printed, whether it still ran then, and the times of the start, the signal and the exit."""
+        p = subprocess.Popen([CLI, job, "-o", out], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                             bufsize=1)
+        started = time.monotonic()
+        lines = []
+        for line in p.stdout:
+            lines.append(line)
+            if moment(line):
+                break
+        time.sleep(delay)
+        running = p.poll() is None and bool(lines) and moment(lines[-1])
+        signalled = time.monotonic()
+        p.send_signal(signal.SIGTERM)
+        rest, stderr = p.communicate(timeout=60)
+        return {"stdout": "".join(lines) + rest, "stderr": stderr, "code": p.returncode, "running": running,
+                "started": started, "signalled": signalled, "exited": time.monotonic()}
+
+    def check_stopped(run, out, what, expected_stop):
+        """The stop line says `expected_stop`; the solver stopped within 1 s and the process exited (code 3)
+        within 3 s of the signal, having written the result."""
+        check(f"{what}: still running when signalled (else the test measures nothing)", run["running"],
+              run["stdout"][-400:])
+        stop = [l for l in run["stdout"].splitlines() if l.startswith("stop: ")]
+        match = re.search(r"stop: cancelled after \d+ steps, ([0-9.]+) s", stop[0]) if stop else None
+        check(f"{what}: the stop line says {expected_stop}", match is not None and expected_stop in stop[0],
+              stop or run["stdout"][-400:])
+        exit_seconds = run["exited"] - run["signalled"]
+        if match:
+            # The solver's own clock starts after the process (job parsed, meshes read): its stop time minus the
+            # signal's time since the process started bounds the latency from above.
+            latency = float(match.group(1)) - (run["signalled"] - run["started"])
+            print(f"  SIGTERM {run['signalled'] - run['started']:.2f} s after the start, {what}: the solver "
+                  f"stopped {latency:.3f} s later, the process exited {exit_seconds:.2f} s after the signal")
+            check(f"{what}: the solver stopped within 1 s of SIGTERM", latency <= 1.0, stop[0])
+        check(f"{what}: the process exited within 3 s of SIGTERM (result written)", exit_seconds <= 3.0,
+              f"{exit_seconds:.2f} s")
+        check(f"{what}: exit code 3 (stopped without converging), no crash at exit", run["code"] == 3,
+              f"{run['code']} {run['stderr'][-300:]}")
+        check(f"{what}: the result so far is written", os.path.exists(out) and os.path.getsize(out) > 0)
+
     # SIGTERM during a large boundary-element estimate: the run without the stop test goes on to large meshes;
     # once adaptive step 4 is reported, the solve on the refined mesh (~60k + 25k unknowns) follows, and right
     # after its line the estimate of step 5 starts (boundary-element solves and ~130k interior points, a few
-    # seconds): the signal lands inside it. The solver must stop within a second, write the steps so far and exit.
+    # seconds): the signal lands inside it (0.2 s after that line).
+    seen = {"step 4": False}
+
+    def inside_estimate(line):
+        seen["step 4"] = seen["step 4"] or line.startswith("adaptive step  4")
+        return seen["step 4"] and line.startswith("step ")  # the solve on step 5's mesh is done: its estimate runs
+
     out = os.path.join(tmp, "cancelled.hdf")
-    p = subprocess.Popen([CLI, two_cylinders_job(tmp, stop_tolerance=0, max_steps=9), "-o", out], stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE, text=True, bufsize=1)
-    started = time.monotonic()
-    lines, seen_step_4 = [], False
-    for line in p.stdout:
-        lines.append(line)
-        seen_step_4 = seen_step_4 or line.startswith("adaptive step  4")
-        if seen_step_4 and line.startswith("step "):  # the solve on step 5's mesh is done: its estimate runs now
-            break
-    time.sleep(0.2)
-    running = p.poll() is None
-    signalled = time.monotonic()
-    p.send_signal(signal.SIGTERM)
-    rest, stderr = p.communicate(timeout=60)
-    exited = time.monotonic()
-    stdout = "".join(lines) + rest
-    check("still estimating when signalled (else the test measures nothing)", running and seen_step_4, stdout[-400:])
-    stop = [l for l in stdout.splitlines() if l.startswith("stop: ")]
-    match = re.search(r"stop: cancelled after \d+ steps, ([0-9.]+) s", stop[0]) if stop else None
-    check("the stop line says cancelled during adaptive step 5",
-          match is not None and "cancelled during adaptive step 5" in stop[0], stop or stdout[-400:])
-    if match:
-        # The solver's own clock starts after the process (job parsed, meshes read): its stop time minus the
-        # signal's time since the process started bounds the latency from above.
-        latency = float(match.group(1)) - (signalled - started)
-        print(f"  SIGTERM {signalled - started:.2f} s after the start, inside the estimate of step 5: the solver "
-              f"stopped {latency:.3f} s later, the process exited {exited - signalled:.2f} s after the signal")
-        check("the solver stopped within 1 s of SIGTERM", latency <= 1.0, stop[0])
-    check("the process exited within 3 s of SIGTERM (result written)", exited - signalled <= 3.0,
-          f"{exited - signalled:.2f} s")
-    check("the result so far is written", os.path.exists(out) and os.path.getsize(out) > 0)
+    run_estimate = sigterm_when(two_cylinders_job(tmp, stop_tolerance=0, max_steps=9), out, inside_estimate, delay=0.2)
+    check_stopped(run_estimate, out, "inside the estimate of step 5", "cancelled during adaptive step 5")
 
     # SIGTERM right after adaptive step 6 is reported: the refined meshes (~130k + 50k unknowns) are being assembled
     # and factorised (a second or two; zz estimates in no time, so the run gets there fast). The factorisation
     # cannot be interrupted: the solver leaves it to finish on its own thread, writes the steps so far and exits.
+    def after_step_6(line):
+        return line.startswith("adaptive step  6")
+
     out = os.path.join(tmp, "cancelled_rebuild.hdf")
-    p = subprocess.Popen([CLI, two_cylinders_job(tmp, indicator="zz", stop_tolerance=0, max_steps=9), "-o", out],
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, bufsize=1)
-    started = time.monotonic()
-    lines = []
-    for line in p.stdout:
-        lines.append(line)
-        if line.startswith("adaptive step  6"):
-            break
-    running = p.poll() is None
-    signalled = time.monotonic()
-    p.send_signal(signal.SIGTERM)
-    rest, stderr = p.communicate(timeout=60)
-    exited = time.monotonic()
-    stdout = "".join(lines) + rest
-    check("rebuild: still running when signalled", running and lines and lines[-1].startswith("adaptive step  6"),
-          stdout[-400:])
-    stop = [l for l in stdout.splitlines() if l.startswith("stop: ")]
-    match = re.search(r"stop: cancelled after \d+ steps, ([0-9.]+) s", stop[0]) if stop else None
-    check("rebuild: the stop line says the assembly and factorisation of step 7 were cancelled",
-          match is not None and "cancelled during adaptive step 7 (assembling and factorising its refined meshes"
-          in stop[0], stop or stdout[-400:])
-    if match:
-        latency = float(match.group(1)) - (signalled - started)
-        print(f"  SIGTERM {signalled - started:.2f} s after the start, during step 7's assembly and factorisation: "
-              f"the solver stopped {latency:.3f} s later, the process exited {exited - signalled:.2f} s after the signal")
-        check("rebuild: the solver stopped within 1 s of SIGTERM", latency <= 1.0, stop[0])
-    check("rebuild: the process exited within 3 s of SIGTERM", exited - signalled <= 3.0, f"{exited - signalled:.2f} s")
-    check("rebuild: exit code 3 (stopped without converging), no crash at exit", p.returncode == 3, f"{p.returncode} {stderr[-300:]}")
-    check("rebuild: the result so far is written", os.path.exists(out) and os.path.getsize(out) > 0)
+    run_rebuild = sigterm_when(two_cylinders_job(tmp, indicator="zz", stop_tolerance=0, max_steps=9), out, after_step_6)
+    check_stopped(run_rebuild, out, "during step 7's assembly and factorisation",
+                  "cancelled during adaptive step 7 (assembling and factorising its refined meshes")
 
 finish()
