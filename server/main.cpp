@@ -2,12 +2,12 @@
 //   contactd [--host H] [--port P] [--data-dir D] [--workers N] ...   (every flag also has a CONTACTD_* variable)
 // With no configuration it serves http://127.0.0.1:8080 and keeps its jobs in ./contactd-data.
 // SIGTERM or SIGINT: graceful shutdown (docs/server.md, "Shutdown"), exit status 0.
-#include "body_budget.hpp"
+#include "common/log.hpp"
 #include "http_server.hpp"
-#include "job_queue.hpp"
-#include "job_store.hpp"
-#include "metrics.hpp"
-#include "util.hpp"
+#include "jobs/body_budget.hpp"
+#include "jobs/job_queue.hpp"
+#include "metrics/metrics.hpp"
+#include "store/job_store.hpp"
 
 #include "contact/solve.hpp"
 
