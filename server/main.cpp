@@ -41,8 +41,10 @@ struct Config {
   contactd::HttpSettings http;
 };
 
-// Every flag has an environment variable; a flag given on the command line wins.
-void add_flags(CLI::App& app, Config& c) {
+// The flags, in groups. Every flag has an environment variable; a flag given on the command line wins.
+
+// Where it listens and keeps its jobs.
+void add_service_flags(CLI::App& app, Config& c) {
   app.add_option("--host", c.http.host, "address to listen on")->envname("CONTACTD_HOST")->capture_default_str();
   app.add_option("--port", c.http.port, "TCP port (0: any free port, printed at start-up)")
       ->envname("CONTACTD_PORT")
@@ -51,6 +53,10 @@ void add_flags(CLI::App& app, Config& c) {
   app.add_option("--data-dir", c.data_dir, "job store directory (created if missing)")
       ->envname("CONTACTD_DATA_DIR")
       ->capture_default_str();
+}
+
+// How many jobs, and how large.
+void add_job_limit_flags(CLI::App& app, Config& c) {
   app.add_option("--workers", c.queue.workers, "jobs solved at once (0: one per core)")
       ->envname("CONTACTD_WORKERS")
       ->check(CLI::Range(0, 1024))
@@ -58,10 +64,6 @@ void add_flags(CLI::App& app, Config& c) {
   app.add_option("--max-queued", c.queue.max_queued, "queued jobs beyond which submissions get 503")
       ->envname("CONTACTD_MAX_QUEUED")
       ->check(CLI::Range(1, 1000000))
-      ->capture_default_str();
-  app.add_option("--max-request-bytes", c.http.max_request_bytes, "largest request body accepted (413 beyond)")
-      ->envname("CONTACTD_MAX_REQUEST_BYTES")
-      ->check(CLI::Range(1024, 1 << 30))
       ->capture_default_str();
   app.add_option("--max-dofs", c.queue.max_dofs, "largest job accepted, in degrees of freedom over all bodies")
       ->envname("CONTACTD_MAX_DOFS")
@@ -75,6 +77,10 @@ void add_flags(CLI::App& app, Config& c) {
       ->envname("CONTACTD_MAX_CONTACTS")
       ->check(CLI::Range(1, 4000000))
       ->capture_default_str();
+}
+
+// Jobs on MPI ranks (docs/parallel.md).
+void add_mpi_flags(CLI::App& app, Config& c) {
   app.add_option("--mpi-launcher", c.mpi_launcher,
                  "run jobs with parallel.ranks > 1 through this launcher, {ranks} replaced, e.g. 'mpirun -n {ranks}' "
                  "(docs/parallel.md; empty: every job runs in this process)")
@@ -86,6 +92,10 @@ void add_flags(CLI::App& app, Config& c) {
   app.add_option("--solver-binary", c.queue.mpi.solver,
                  "the contact-solve that MPI jobs run (default: the one next to contactd)")
       ->envname("CONTACTD_SOLVER_BINARY");
+}
+
+// How long a job may run, what it keeps, and how long it is kept.
+void add_job_lifetime_flags(CLI::App& app, Config& c) {
   app.add_option("--time-limit-seconds", c.queue.time_limit_seconds, "wall-time limit per run (0: none)")
       ->envname("CONTACTD_TIME_LIMIT_SECONDS")
       ->check(CLI::Range(0.0, 1e9))
@@ -108,8 +118,21 @@ void add_flags(CLI::App& app, Config& c) {
                  "finished jobs beyond this total size are deleted, oldest first (0: no limit)")
       ->envname("CONTACTD_RETENTION_BYTES")
       ->capture_default_str();
+}
+
+// Who may ask: the token, the Host allow-list, the access log.
+void add_access_flags(CLI::App& app, Config& c) {
   app.add_option("--token", c.http.token, "bearer token every /v1 request must carry (prefer the variable)")
       ->envname("CONTACTD_TOKEN");
+  app.add_option("--allowed-hosts", c.allowed_hosts,
+                 "host names the Host header may give, comma-separated ('*': any; default: localhost, 127.0.0.1, "
+                 "[::1] and --host)")
+      ->envname("CONTACTD_ALLOWED_HOSTS");
+  app.add_flag("--access-log", c.http.access_log, "log every request to stderr")->envname("CONTACTD_ACCESS_LOG");
+}
+
+// Progress streams and the threads that serve them.
+void add_stream_flags(CLI::App& app, Config& c) {
   app.add_option("--heartbeat-seconds", c.http.heartbeat_seconds, "progress-stream heartbeat period")
       ->envname("CONTACTD_HEARTBEAT_SECONDS")
       ->check(CLI::Range(1, 3600))
@@ -122,11 +145,10 @@ void add_flags(CLI::App& app, Config& c) {
       ->envname("CONTACTD_HTTP_THREADS")
       ->check(CLI::Range(0, 20000))
       ->capture_default_str();
-  app.add_flag("--access-log", c.http.access_log, "log every request to stderr")->envname("CONTACTD_ACCESS_LOG");
-  app.add_option("--allowed-hosts", c.allowed_hosts,
-                 "host names the Host header may give, comma-separated ('*': any; default: localhost, 127.0.0.1, "
-                 "[::1] and --host)")
-      ->envname("CONTACTD_ALLOWED_HOSTS");
+}
+
+// Connections and request heads (the connection gate).
+void add_connection_flags(CLI::App& app, Config& c) {
   app.add_option("--max-connections", c.http.max_connections, "open connections in total (503 beyond)")
       ->envname("CONTACTD_MAX_CONNECTIONS")
       ->check(CLI::Range(8, 100000))
@@ -163,6 +185,14 @@ void add_flags(CLI::App& app, Config& c) {
       ->envname("CONTACTD_MAX_HEADER_FIELDS")
       ->check(CLI::Range(8, 1000))
       ->capture_default_str();
+}
+
+// Request bodies: their size, and how many are read and validated at once.
+void add_request_body_flags(CLI::App& app, Config& c) {
+  app.add_option("--max-request-bytes", c.http.max_request_bytes, "largest request body accepted (413 beyond)")
+      ->envname("CONTACTD_MAX_REQUEST_BYTES")
+      ->check(CLI::Range(1024, 1 << 30))
+      ->capture_default_str();
   app.add_option("--max-large-bodies", c.http.max_large_bodies,
                  "request bodies over 256 KiB read and validated at once (others wait, then 503)")
       ->envname("CONTACTD_MAX_LARGE_BODIES")
@@ -172,6 +202,17 @@ void add_flags(CLI::App& app, Config& c) {
       ->envname("CONTACTD_MAX_VALIDATIONS")
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
+}
+
+void add_flags(CLI::App& app, Config& c) {
+  add_service_flags(app, c);
+  add_job_limit_flags(app, c);
+  add_mpi_flags(app, c);
+  add_job_lifetime_flags(app, c);
+  add_access_flags(app, c);
+  add_stream_flags(app, c);
+  add_connection_flags(app, c);
+  add_request_body_flags(app, c);
 }
 
 // From here on, what any library prints on standard output (CHOLMOD's warnings, for one) goes to the log as
