@@ -249,6 +249,100 @@ void capture_stdout() {
   }).detach();
 }
 
+// The contact-solve that MPI jobs run: next to contactd (an installation, the Docker image), or one level up (the
+// build tree: build/server/); else the one on the PATH.
+std::string default_solver_binary(const char* argv0) {
+  std::error_code ec;
+  const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  const auto dir = (ec ? std::filesystem::path(argv0) : self).parent_path();
+  for (const auto& candidate : {dir / "contact-solve", dir.parent_path() / "contact-solve"})
+    if (std::filesystem::is_regular_file(candidate, ec)) return candidate.string();
+  return "contact-solve";
+}
+
+// The settings the flags give in another form, or leave to the machine.
+void complete_settings(Config& config, const char* argv0) {
+  if (config.queue.workers == 0)
+    config.queue.workers = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  config.http.allowed_hosts = contactd::parse_host_list(config.allowed_hosts);
+  config.queue.mpi.launcher = contactd::split_launcher(config.mpi_launcher);
+  if (config.queue.mpi.solver.empty()) config.queue.mpi.solver = default_solver_binary(argv0);
+  // Retention is checked a few times per retention period (at most every 10 s).
+  config.queue.janitor_interval_seconds =
+      config.queue.retention_seconds > 0 ? std::min(10.0, std::max(0.2, config.queue.retention_seconds / 4)) : 10.0;
+}
+
+// Signals: blocked in every thread (the mask is inherited) and taken by one sigwait thread, which starts the
+// shutdown outside any signal handler. SIGPIPE is ignored: a vanished client is a failed write, not a death.
+sigset_t block_shutdown_signals() {
+  ::signal(SIGPIPE, SIG_IGN);
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  return signals;
+}
+
+// 1. Refuse new jobs; /readyz says 503. 2. Running jobs stop at their next iteration and are stored back as
+// QUEUED (their streams get that state event). 3. Streams close. 4. The listener stops. The exit status.
+int shut_down(contactd::HttpServer& server, contactd::JobQueue& queue, std::thread& listener) {
+  server.begin_shutdown();
+  const bool workers_stopped = queue.shutdown(std::chrono::seconds(5));
+  server.close_streams();
+  server.wait_for_streams(std::chrono::seconds(2));
+  if (!workers_stopped) {
+    // A solve that does not reach its next iteration in time (a long factorisation): its state on disk says
+    // RUNNING, so the next start runs it again. Exit without waiting for it.
+    contactd::log_line("a worker did not stop in time; exiting anyway (its job runs again at the next start)");
+    std::fflush(stdout);
+    std::_Exit(0);
+  }
+  server.stop();
+  listener.join();
+  contactd::log_line("stopped");
+  return 0;
+}
+
+// Serves until SIGTERM or SIGINT, then shuts down; the exit status. Throws what start-up cannot survive.
+int serve(const Config& config, const sigset_t& signals) {
+  using namespace contactd;
+  JobStore store(config.data_dir);
+  Metrics metrics;
+  BodyBudget budget(config.http.max_large_bodies, BodyBudget::validation_slots(config.http.max_validations),
+                    256 * 1024, std::chrono::seconds(10));
+  JobQueue queue(store, metrics, budget, config.queue);
+  HttpServer server(config.http, queue, store, metrics, budget);
+
+  std::string error;
+  const int port = server.bind(error);
+  if (port < 0) {
+    log_line("cannot listen on " + config.http.host + ":" + std::to_string(config.http.port) + ": " + error);
+    return 1;
+  }
+  // Serve at once (the /v1 routes answer 503 "starting" and /readyz 503 until the store is read back).
+  std::thread listener([&server] { server.listen(); });
+  try {
+    queue.recover();
+    queue.start();
+  } catch (...) {
+    server.stop();
+    listener.join();
+    throw;
+  }
+  server.set_ready();
+  std::printf("contactd %s listening on http://%s:%d (data dir %s, %d workers%s)\n", contact::solver_version(),
+              config.http.host.c_str(), port, config.data_dir.c_str(), config.queue.workers,
+              config.http.token.empty() ? "" : ", bearer token required");
+  std::fflush(stdout);
+  capture_stdout();
+
+  int received = 0;
+  sigwait(&signals, &received);
+  log_line(std::string("received ") + (received == SIGTERM ? "SIGTERM" : "SIGINT") + ": shutting down");
+  return shut_down(server, queue, listener);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -257,92 +351,13 @@ int main(int argc, char** argv) {
   Config config;
   add_flags(app, config);
   CLI11_PARSE(app, argc, argv);
-  if (config.queue.workers == 0)
-    config.queue.workers = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  config.http.allowed_hosts = contactd::parse_host_list(config.allowed_hosts);
-  config.queue.mpi.launcher = contactd::split_launcher(config.mpi_launcher);
-  if (config.queue.mpi.solver.empty()) {
-    // Next to contactd (an installation, the Docker image), or one level up (the build tree: build/server/);
-    // else the one on the PATH.
-    std::error_code ec;
-    const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
-    const auto dir = (ec ? std::filesystem::path(argv[0]) : self).parent_path();
-    config.queue.mpi.solver = "contact-solve";
-    for (const auto& candidate : {dir / "contact-solve", dir.parent_path() / "contact-solve"})
-      if (std::filesystem::is_regular_file(candidate, ec)) {
-        config.queue.mpi.solver = candidate.string();
-        break;
-      }
-  }
-  // Retention is checked a few times per retention period (at most every 10 s).
-  config.queue.janitor_interval_seconds =
-      config.queue.retention_seconds > 0 ? std::min(10.0, std::max(0.2, config.queue.retention_seconds / 4)) : 10.0;
+  complete_settings(config, argv[0]);
   contactd::BodyBudget::configure_allocator();
-
-  // Signals: blocked in every thread (the mask is inherited) and taken by one sigwait thread, which starts the
-  // shutdown outside any signal handler. SIGPIPE is ignored: a vanished client is a failed write, not a death.
-  ::signal(SIGPIPE, SIG_IGN);
-  sigset_t signals;
-  sigemptyset(&signals);
-  sigaddset(&signals, SIGTERM);
-  sigaddset(&signals, SIGINT);
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
-
-  using namespace contactd;
+  const sigset_t signals = block_shutdown_signals();
   try {
-    JobStore store(config.data_dir);
-    Metrics metrics;
-    BodyBudget budget(config.http.max_large_bodies, BodyBudget::validation_slots(config.http.max_validations),
-                      256 * 1024, std::chrono::seconds(10));
-    JobQueue queue(store, metrics, budget, config.queue);
-    HttpServer server(config.http, queue, store, metrics, budget);
-
-    std::string error;
-    const int port = server.bind(error);
-    if (port < 0) {
-      log_line("cannot listen on " + config.http.host + ":" + std::to_string(config.http.port) + ": " + error);
-      return 1;
-    }
-    // Serve at once (the /v1 routes answer 503 "starting" and /readyz 503 until the store is read back).
-    std::thread listener([&server] { server.listen(); });
-    try {
-      queue.recover();
-      queue.start();
-    } catch (...) {
-      server.stop();
-      listener.join();
-      throw;
-    }
-    server.set_ready();
-    std::printf("contactd %s listening on http://%s:%d (data dir %s, %d workers%s)\n", contact::solver_version(),
-                config.http.host.c_str(), port, config.data_dir.c_str(), config.queue.workers,
-                config.http.token.empty() ? "" : ", bearer token required");
-    std::fflush(stdout);
-    capture_stdout();
-
-    int received = 0;
-    sigwait(&signals, &received);
-    log_line(std::string("received ") + (received == SIGTERM ? "SIGTERM" : "SIGINT") + ": shutting down");
-
-    // 1. Refuse new jobs; /readyz says 503. 2. Running jobs stop at their next iteration and are stored back as
-    // QUEUED (their streams get that state event). 3. Streams close. 4. The listener stops.
-    server.begin_shutdown();
-    const bool workers_stopped = queue.shutdown(std::chrono::seconds(5));
-    server.close_streams();
-    server.wait_for_streams(std::chrono::seconds(2));
-    if (!workers_stopped) {
-      // A solve that does not reach its next iteration in time (a long factorisation): its state on disk says
-      // RUNNING, so the next start runs it again. Exit without waiting for it.
-      log_line("a worker did not stop in time; exiting anyway (its job runs again at the next start)");
-      std::fflush(stdout);
-      std::_Exit(0);
-    }
-    server.stop();
-    listener.join();
-    log_line("stopped");
-    return 0;
+    return serve(config, signals);
   } catch (const std::exception& e) {
-    log_line(std::string("fatal: ") + e.what());
+    contactd::log_line(std::string("fatal: ") + e.what());
     return 1;
   }
 }
