@@ -73,7 +73,8 @@ void add_job_limit_flags(CLI::App& app, Config& c) {
       ->envname("CONTACTD_MAX_BODIES")
       ->check(CLI::Range(1, 1000000))
       ->capture_default_str();
-  app.add_option("--max-contacts", c.queue.max_contacts, "most contact pairs a job may have (the command line takes 65536)")
+  app.add_option("--max-contacts", c.queue.max_contacts,
+                 "most contact pairs a job may have (the command line takes 65536)")
       ->envname("CONTACTD_MAX_CONTACTS")
       ->check(CLI::Range(1, 4000000))
       ->capture_default_str();
@@ -110,7 +111,8 @@ void add_job_lifetime_flags(CLI::App& app, Config& c) {
       ->envname("CONTACTD_MAX_EVENT_LOG_BYTES")
       ->check(CLI::Range(std::uint64_t{64} << 10, std::uint64_t{1} << 40))
       ->capture_default_str();
-  app.add_option("--retention-seconds", c.queue.retention_seconds, "finished jobs older than this are deleted (0: kept)")
+  app.add_option("--retention-seconds", c.queue.retention_seconds,
+                 "finished jobs older than this are deleted (0: kept)")
       ->envname("CONTACTD_RETENTION_SECONDS")
       ->check(CLI::Range(0.0, 1e10))
       ->capture_default_str();
@@ -309,8 +311,8 @@ int serve(const Config& config, const sigset_t& signals) {
   using namespace contactd;
   JobStore store(config.data_dir);
   Metrics metrics;
-  BodyBudget budget(config.http.max_large_bodies, BodyBudget::validation_slots(config.http.max_validations),
-                    256 * 1024, std::chrono::seconds(10));
+  BodyBudget budget(config.http.max_large_bodies, BodyBudget::validation_slots(config.http.max_validations), 256 * 1024,
+                    std::chrono::seconds(10));
   JobQueue queue(store, metrics, budget, config.queue);
   HttpServer server(config.http, queue, store, metrics, budget);
 

@@ -134,13 +134,16 @@ JobQueue::CancelOutcome JobQueue::cancel(const std::string& id) {
       break;
   }
   const std::int64_t now = now_unix_us();
-  const bool stored = registry_.commit(job, [now](JobRecord& r) {
-    r.state = JobState::cancelled;
-    r.finished_us = now;
-    r.stop_reason = "cancelled";
-    r.message = "cancelled before it started";
-    r.converged = false;
-  }, /*durable=*/true);
+  const bool stored = registry_.commit(
+      job,
+      [now](JobRecord& r) {
+        r.state = JobState::cancelled;
+        r.finished_us = now;
+        r.stop_reason = "cancelled";
+        r.message = "cancelled before it started";
+        r.converged = false;
+      },
+      /*durable=*/true);
   if (!stored) {
     pool_.restore_after_failed_cancel(job);
     return CancelOutcome::store_error;

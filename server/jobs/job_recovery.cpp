@@ -24,8 +24,7 @@ void JobRecovery::recover(const std::shared_ptr<Job>& job) {
   job->stored = true;
   job->events.load();
   const std::string id = job->record.id;
-  if (const std::string problem = job->events.problem(); !problem.empty())
-    context_.registry.report_damage(id, problem);
+  if (const std::string problem = job->events.problem(); !problem.empty()) context_.registry.report_damage(id, problem);
   std::optional<std::size_t> body_hash;
   if (!job->record.idempotency_key.empty()) {
     try {

@@ -203,8 +203,8 @@ bool JobRegistry::cancel_failed(Job& job) {
   return job.record.state == JobState::queued;
 }
 
-JobRegistry::RemoveOutcome JobRegistry::remove_damaged_locked(std::unique_lock<std::mutex>& lock,
-                                                              const std::string& id, std::string& detail) {
+JobRegistry::RemoveOutcome JobRegistry::remove_damaged_locked(std::unique_lock<std::mutex>& lock, const std::string& id,
+                                                              std::string& detail) {
   // A job whose state cannot be read: deleting it is the way to clear it. Taken out of the registry first, so
   // that a concurrent DELETE finds nothing to remove (404) rather than a directory already gone.
   const auto damaged = damaged_.find(id);
@@ -290,7 +290,7 @@ std::vector<std::string> JobRegistry::expired(double max_age_seconds, std::uint6
   const std::int64_t now = now_unix_us();
   std::int64_t bytes = finished_bytes_;
   for (const auto& [key, job] : by_finished_) {  // oldest first
-    if (damaged_.count(key.second)) continue;     // left for the operator to look at
+    if (damaged_.count(key.second)) continue;    // left for the operator to look at
     const bool too_old = max_age_seconds > 0 && now - key.first > static_cast<std::int64_t>(max_age_seconds * 1e6);
     const bool too_much = max_bytes > 0 && bytes > static_cast<std::int64_t>(max_bytes);
     if (!too_old && !too_much) break;

@@ -121,8 +121,7 @@ class JobRegistry {
  private:
   using TimeKey = std::pair<std::int64_t, std::string>;
 
-  RemoveOutcome remove_damaged_locked(std::unique_lock<std::mutex>& lock, const std::string& id,
-                                      std::string& detail);
+  RemoveOutcome remove_damaged_locked(std::unique_lock<std::mutex>& lock, const std::string& id, std::string& detail);
   void set_state_locked(Job& job, JobState state);
   void register_locked(const std::shared_ptr<Job>& job);
   void unregister_locked(const std::shared_ptr<Job>& job);
@@ -139,7 +138,7 @@ class JobRegistry {
   std::unordered_map<std::string, std::size_t> body_hash_;  // id -> hash of job.json (jobs with a key)
   std::map<std::string, std::string> damaged_;              // id -> problem (see damage())
   std::map<TimeKey, std::shared_ptr<Job>> by_finished_;     // settled jobs by (finished_us, id): retention
-  std::int64_t finished_bytes_ = 0;                          // their disk_bytes, summed
+  std::int64_t finished_bytes_ = 0;                         // their disk_bytes, summed
   std::array<std::int64_t, 5> state_counts_{};
   std::int64_t last_created_us_ = 0;
   std::int64_t events_dropped_total_ = 0;

@@ -96,8 +96,7 @@ contact::Result JobRun::solve() {
 std::optional<contact::Problem> JobRun::parse_again(contact::Result& result) {
   Job& job = *job_;
   const std::string body = context_.store.read_job(id_);
-  BodyBudget::Slot slot =
-      context_.budget.for_validation_until(body.size(), [&job] { return job.cancel.cancelled(); });
+  BodyBudget::Slot slot = context_.budget.for_validation_until(body.size(), [&job] { return job.cancel.cancelled(); });
   if (slot) {
     auto parsed = validate_job(context_.settings, body);
     slot.release();
@@ -117,9 +116,9 @@ std::optional<contact::Problem> JobRun::parse_again(contact::Result& result) {
 contact::Result JobRun::solve_on_ranks(ProgressObserver& observer) {
   const QueueSettings& settings = context_.settings;
   JobStore& store = context_.store;
-  mpi_ = run_mpi_job(settings.mpi, problem_->ranks, store.job_path(id_), store.result_path(id_), id_,
-                     settings.max_dofs, [&](const nlohmann::json& j) { observer.on_iteration_json(j); },
-                     job_->cancel);
+  mpi_ = run_mpi_job(
+      settings.mpi, problem_->ranks, store.job_path(id_), store.result_path(id_), id_, settings.max_dofs,
+      [&](const nlohmann::json& j) { observer.on_iteration_json(j); }, job_->cancel);
   contact::Result result;
   result.stop_reason = mpi_->stop_reason;
   result.message = public_message(mpi_->message, store.data_dir());
@@ -224,13 +223,16 @@ void JobRun::finish(JobRecord outcome) {
 void JobRun::requeue_after_shutdown() {
   context_.store.remove_result(id_);
   const std::string message = "interrupted by a shutdown; it runs again when the server restarts";
-  if (!context_.registry.commit(job_, [&message](JobRecord& r) {
-        r.state = JobState::queued;
-        r.started_us = 0;
-        r.iterations = 0;
-        r.progress = nullptr;
-        r.message = message;
-      }, /*durable=*/true)) {
+  if (!context_.registry.commit(
+          job_,
+          [&message](JobRecord& r) {
+            r.state = JobState::queued;
+            r.started_us = 0;
+            r.iterations = 0;
+            r.progress = nullptr;
+            r.message = message;
+          },
+          /*durable=*/true)) {
     return;  // RUNNING on disk: the next start queues it again (as interrupted)
   }
   const int attempts = context_.registry.snapshot(*job_).attempts;

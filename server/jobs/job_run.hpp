@@ -40,7 +40,7 @@ struct RunContext {
   BodyBudget& budget;  // a run parses its job again under one of its validation slots
   const QueueSettings& settings;
   std::function<bool(std::chrono::milliseconds)> wait_for_stop;  // true once the workers stop
-  std::function<void()> on_settled;                               // a job was settled: retention may run
+  std::function<void()> on_settled;                              // a job was settled: retention may run
 };
 
 // Announces a finished job (its record stored): the `end` event, the event log synced and closed, the job's

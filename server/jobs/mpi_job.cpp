@@ -15,8 +15,8 @@ namespace contactd {
 
 namespace {
 
-constexpr std::size_t kMaxLine = 64u << 20;     // an iteration line of a huge job; more is a broken child
-constexpr std::size_t kStderrTail = 4096;        // the child's last words kept for the message
+constexpr std::size_t kMaxLine = 64u << 20;  // an iteration line of a huge job; more is a broken child
+constexpr std::size_t kStderrTail = 4096;    // the child's last words kept for the message
 
 contact::StopReason stop_reason_of(const std::string& s) {
   for (auto r : {contact::StopReason::converged, contact::StopReason::max_iterations, contact::StopReason::stagnation,
@@ -185,7 +185,8 @@ class MpiRun {
     j.erase("type");
     if (type == "iteration") {
       // The iterations done so far, also for a run that ends without its result object.
-      if (j.contains("iteration") && j["iteration"].is_number_integer()) outcome_.iterations = j["iteration"].get<int>();
+      if (j.contains("iteration") && j["iteration"].is_number_integer())
+        outcome_.iterations = j["iteration"].get<int>();
       on_iteration_(j);
     }
     if (type == "result") result_ = std::move(j);

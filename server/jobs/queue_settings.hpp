@@ -20,7 +20,7 @@ struct QueueSettings {
   double time_limit_seconds = 3600.0;  // per run; 0 = none
   int max_attempts = 3;                // runs cut short by the server dying, after which a job ends FAILED
   std::uint64_t max_event_log_bytes = 256u << 20;  // per job; iteration events beyond are not recorded
-  double stuck_after_seconds = 60.0;   // a job still running this long after it was told to stop is "stuck"
+  double stuck_after_seconds = 60.0;               // a job still running this long after it was told to stop is "stuck"
   double retention_seconds = 7 * 86400.0;          // finished jobs older than this are deleted; 0 = kept
   std::uint64_t retention_bytes = 10ull << 30;     // finished jobs beyond this total are deleted, oldest first
   double janitor_interval_seconds = 10.0;          // how often retention runs
