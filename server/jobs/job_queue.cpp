@@ -120,9 +120,10 @@ JobRecord JobQueue::snapshot(const Job& job, int* queue_position) const {
 }
 
 JobQueue::CancelOutcome JobQueue::cancel(const std::string& id) {
-  const std::shared_ptr<Job> job = registry_.find(id);
-  if (!job) return CancelOutcome::not_found;
-  switch (pool_.cancel(job)) {
+  std::shared_ptr<Job> job;
+  switch (pool_.cancel(id, job)) {
+    case JobRegistry::CancelStep::not_found:
+      return CancelOutcome::not_found;
     case JobRegistry::CancelStep::stop_run:
     case JobRegistry::CancelStep::in_progress:
       return CancelOutcome::cancelling;

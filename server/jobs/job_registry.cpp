@@ -176,8 +176,13 @@ void JobRegistry::settle(const std::shared_ptr<Job>& job, std::optional<std::int
   settled_.notify_all();
 }
 
-JobRegistry::CancelStep JobRegistry::cancel_step(Job& job, bool taken) {
+JobRegistry::CancelStep JobRegistry::cancel_step(const std::string& id, const std::function<bool(const Job&)>& taken,
+                                                 std::shared_ptr<Job>& found) {
   std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = jobs_.find(id);
+  if (it == jobs_.end() || !it->second->stored) return CancelStep::not_found;
+  found = it->second;
+  Job& job = *found;
   switch (job.record.state) {
     case JobState::running:
       return CancelStep::stop_run;
@@ -189,7 +194,7 @@ JobRegistry::CancelStep JobRegistry::cancel_step(Job& job, bool taken) {
     case JobState::queued:
       break;
   }
-  if (taken) return CancelStep::stop_run;  // a worker is storing it as RUNNING: stopped as soon as it starts
+  if (taken(job)) return CancelStep::stop_run;  // a worker is storing it as RUNNING: stopped as soon as it starts
   // Another cancel is storing CANCELLED: one request stores it (a second write could come after a DELETE that
   // followed the first, into a directory that is gone).
   if (job.cancelling_queued) return CancelStep::in_progress;

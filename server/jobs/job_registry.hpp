@@ -84,10 +84,12 @@ class JobRegistry {
   // and retention counts its `disk_bytes` when given.
   void settle(const std::shared_ptr<Job>& job, std::optional<std::int64_t> disk_bytes);
 
-  // What a cancel does with a job, decided under the registry's lock (`taken`: a worker holds it).
-  enum class CancelStep { stop_run, withdraw, in_progress, already_cancelled, already_done };
+  // What a cancel does with the stored job `id` (set in `job`), decided under the registry's lock; `taken(job)`
+  // says whether a worker holds it (the WorkerPool calls this with its own lock held).
+  enum class CancelStep { stop_run, withdraw, in_progress, already_cancelled, already_done, not_found };
   // A QUEUED job nobody holds is marked as being cancelled (withdraw: the caller stores it CANCELLED).
-  CancelStep cancel_step(Job& job, bool taken);
+  CancelStep cancel_step(const std::string& id, const std::function<bool(const Job&)>& taken,
+                         std::shared_ptr<Job>& job);
   // A withdrawn job whose CANCELLED state could not be stored: true when it is still QUEUED.
   bool cancel_failed(Job& job);
 

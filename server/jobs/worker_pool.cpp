@@ -54,10 +54,13 @@ void WorkerPool::enqueue(const std::shared_ptr<Job>& job) {
   work_.notify_one();
 }
 
-JobRegistry::CancelStep WorkerPool::cancel(const std::shared_ptr<Job>& job) {
+JobRegistry::CancelStep WorkerPool::cancel(const std::string& id, std::shared_ptr<Job>& job) {
   std::lock_guard<std::mutex> lock(mutex_);
-  const bool taken = std::find(running_.begin(), running_.end(), job) != running_.end();
-  const JobRegistry::CancelStep step = registry_.cancel_step(*job, taken);
+  const auto taken = [this](const Job& candidate) {
+    return std::any_of(running_.begin(), running_.end(),
+                       [&](const std::shared_ptr<Job>& held) { return held.get() == &candidate; });
+  };
+  const JobRegistry::CancelStep step = registry_.cancel_step(id, taken, job);
   if (step == JobRegistry::CancelStep::stop_run) {
     job->request_cancel(CancelReason::user);  // the solver stops within one iteration
   } else if (step == JobRegistry::CancelStep::withdraw) {

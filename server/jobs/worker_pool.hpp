@@ -43,8 +43,9 @@ class WorkerPool {
 
   // Queues a stored QUEUED job (at the back; nothing while stopping).
   void enqueue(const std::shared_ptr<Job>& job);
-  // A cancel: a job waiting in the queue leaves it (withdraw), a job a worker holds is told to stop.
-  JobRegistry::CancelStep cancel(const std::shared_ptr<Job>& job);
+  // A cancel of the job `id` (set in `job` when found): a job waiting in the queue leaves it (withdraw), a job a
+  // worker holds is told to stop.
+  JobRegistry::CancelStep cancel(const std::string& id, std::shared_ptr<Job>& job);
   // A withdrawn job whose CANCELLED state could not be stored: back in its place by creation time if QUEUED.
   void restore_after_failed_cancel(const std::shared_ptr<Job>& job);
 
