@@ -1,5 +1,5 @@
 // The one entry point the routes use for jobs: a facade over the parts that hold the jobs' state, each with its
-// own lock (docs/architecture.md, "contactd"):
+// own lock (docs/architecture.md, `server/jobs/`):
 //   JobRegistry    the jobs' records, lookups, counts, damage and commit() (job_registry.hpp)
 //   WorkerPool     the queue and the worker threads (worker_pool.hpp); a JobRun is one run of a job (job_run.hpp)
 //   Janitor        time limits, stuck jobs, retention (janitor.hpp)
@@ -14,8 +14,7 @@
 // "interrupted" once that has happened max_attempts times (a job that kills the server).
 //
 // Lock order: WorkerPool's mutex, then JobRegistry's; a job's EventLog lock and the Janitor's are never held while
-// another is taken.
-// None is held while solving, writing result files or waiting for a client.
+// another is taken. None is held while solving, writing result files or waiting for a client.
 //
 // Thread safety: every public member may be called from any thread.
 #pragma once
