@@ -1,7 +1,8 @@
 #include "http_server.hpp"
 
-#include "problem_document.hpp"
-#include "util.hpp"
+#include "common/encoding.hpp"
+#include "common/log.hpp"
+#include "http/problem_document.hpp"
 
 #include <algorithm>
 #include <iomanip>

@@ -10,10 +10,10 @@
 
 // The solver's headers (Eigen) before httplib's: <resolv.h>, which httplib includes, defines a macro `_res`
 // that Eigen uses as a parameter name.
-#include "routes.hpp"
+#include "http/routes.hpp"
 
-#include "http_transport.hpp"
-#include "request_guard.hpp"
+#include "transport/http_transport.hpp"
+#include "transport/request_guard.hpp"
 
 #include <httplib.h>
 

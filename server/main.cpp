@@ -2,12 +2,12 @@
 //   contactd [--host H] [--port P] [--data-dir D] [--workers N] ...   (every flag also has a CONTACTD_* variable)
 // With no configuration it serves http://127.0.0.1:8080 and keeps its jobs in ./contactd-data.
 // SIGTERM or SIGINT: graceful shutdown (docs/server.md, "Shutdown"), exit status 0.
-#include "body_budget.hpp"
+#include "common/log.hpp"
 #include "http_server.hpp"
-#include "job_queue.hpp"
-#include "job_store.hpp"
-#include "metrics.hpp"
-#include "util.hpp"
+#include "jobs/body_budget.hpp"
+#include "jobs/job_queue.hpp"
+#include "metrics/metrics.hpp"
+#include "store/job_store.hpp"
 
 #include "contact/solve.hpp"
 
@@ -41,8 +41,10 @@ struct Config {
   contactd::HttpSettings http;
 };
 
-// Every flag has an environment variable; a flag given on the command line wins.
-void add_flags(CLI::App& app, Config& c) {
+// The flags, in groups. Every flag has an environment variable; a flag given on the command line wins.
+
+// Where it listens and keeps its jobs.
+void add_service_flags(CLI::App& app, Config& c) {
   app.add_option("--host", c.http.host, "address to listen on")->envname("CONTACTD_HOST")->capture_default_str();
   app.add_option("--port", c.http.port, "TCP port (0: any free port, printed at start-up)")
       ->envname("CONTACTD_PORT")
@@ -51,6 +53,10 @@ void add_flags(CLI::App& app, Config& c) {
   app.add_option("--data-dir", c.data_dir, "job store directory (created if missing)")
       ->envname("CONTACTD_DATA_DIR")
       ->capture_default_str();
+}
+
+// How many jobs, and how large.
+void add_job_limit_flags(CLI::App& app, Config& c) {
   app.add_option("--workers", c.queue.workers, "jobs solved at once (0: one per core)")
       ->envname("CONTACTD_WORKERS")
       ->check(CLI::Range(0, 1024))
@@ -58,10 +64,6 @@ void add_flags(CLI::App& app, Config& c) {
   app.add_option("--max-queued", c.queue.max_queued, "queued jobs beyond which submissions get 503")
       ->envname("CONTACTD_MAX_QUEUED")
       ->check(CLI::Range(1, 1000000))
-      ->capture_default_str();
-  app.add_option("--max-request-bytes", c.http.max_request_bytes, "largest request body accepted (413 beyond)")
-      ->envname("CONTACTD_MAX_REQUEST_BYTES")
-      ->check(CLI::Range(1024, 1 << 30))
       ->capture_default_str();
   app.add_option("--max-dofs", c.queue.max_dofs, "largest job accepted, in degrees of freedom over all bodies")
       ->envname("CONTACTD_MAX_DOFS")
@@ -71,10 +73,15 @@ void add_flags(CLI::App& app, Config& c) {
       ->envname("CONTACTD_MAX_BODIES")
       ->check(CLI::Range(1, 1000000))
       ->capture_default_str();
-  app.add_option("--max-contacts", c.queue.max_contacts, "most contact pairs a job may have (the command line takes 65536)")
+  app.add_option("--max-contacts", c.queue.max_contacts,
+                 "most contact pairs a job may have (the command line takes 65536)")
       ->envname("CONTACTD_MAX_CONTACTS")
       ->check(CLI::Range(1, 4000000))
       ->capture_default_str();
+}
+
+// Jobs on MPI ranks (docs/parallel.md).
+void add_mpi_flags(CLI::App& app, Config& c) {
   app.add_option("--mpi-launcher", c.mpi_launcher,
                  "run jobs with parallel.ranks > 1 through this launcher, {ranks} replaced, e.g. 'mpirun -n {ranks}' "
                  "(docs/parallel.md; empty: every job runs in this process)")
@@ -86,6 +93,10 @@ void add_flags(CLI::App& app, Config& c) {
   app.add_option("--solver-binary", c.queue.mpi.solver,
                  "the contact-solve that MPI jobs run (default: the one next to contactd)")
       ->envname("CONTACTD_SOLVER_BINARY");
+}
+
+// How long a job may run, what it keeps, and how long it is kept.
+void add_job_lifetime_flags(CLI::App& app, Config& c) {
   app.add_option("--time-limit-seconds", c.queue.time_limit_seconds, "wall-time limit per run (0: none)")
       ->envname("CONTACTD_TIME_LIMIT_SECONDS")
       ->check(CLI::Range(0.0, 1e9))
@@ -100,7 +111,8 @@ void add_flags(CLI::App& app, Config& c) {
       ->envname("CONTACTD_MAX_EVENT_LOG_BYTES")
       ->check(CLI::Range(std::uint64_t{64} << 10, std::uint64_t{1} << 40))
       ->capture_default_str();
-  app.add_option("--retention-seconds", c.queue.retention_seconds, "finished jobs older than this are deleted (0: kept)")
+  app.add_option("--retention-seconds", c.queue.retention_seconds,
+                 "finished jobs older than this are deleted (0: kept)")
       ->envname("CONTACTD_RETENTION_SECONDS")
       ->check(CLI::Range(0.0, 1e10))
       ->capture_default_str();
@@ -108,8 +120,21 @@ void add_flags(CLI::App& app, Config& c) {
                  "finished jobs beyond this total size are deleted, oldest first (0: no limit)")
       ->envname("CONTACTD_RETENTION_BYTES")
       ->capture_default_str();
+}
+
+// Who may ask: the token, the Host allow-list, the access log.
+void add_access_flags(CLI::App& app, Config& c) {
   app.add_option("--token", c.http.token, "bearer token every /v1 request must carry (prefer the variable)")
       ->envname("CONTACTD_TOKEN");
+  app.add_option("--allowed-hosts", c.allowed_hosts,
+                 "host names the Host header may give, comma-separated ('*': any; default: localhost, 127.0.0.1, "
+                 "[::1] and --host)")
+      ->envname("CONTACTD_ALLOWED_HOSTS");
+  app.add_flag("--access-log", c.http.access_log, "log every request to stderr")->envname("CONTACTD_ACCESS_LOG");
+}
+
+// Progress streams and the threads that serve them.
+void add_stream_flags(CLI::App& app, Config& c) {
   app.add_option("--heartbeat-seconds", c.http.heartbeat_seconds, "progress-stream heartbeat period")
       ->envname("CONTACTD_HEARTBEAT_SECONDS")
       ->check(CLI::Range(1, 3600))
@@ -122,11 +147,10 @@ void add_flags(CLI::App& app, Config& c) {
       ->envname("CONTACTD_HTTP_THREADS")
       ->check(CLI::Range(0, 20000))
       ->capture_default_str();
-  app.add_flag("--access-log", c.http.access_log, "log every request to stderr")->envname("CONTACTD_ACCESS_LOG");
-  app.add_option("--allowed-hosts", c.allowed_hosts,
-                 "host names the Host header may give, comma-separated ('*': any; default: localhost, 127.0.0.1, "
-                 "[::1] and --host)")
-      ->envname("CONTACTD_ALLOWED_HOSTS");
+}
+
+// Connections and request heads (the connection gate).
+void add_connection_flags(CLI::App& app, Config& c) {
   app.add_option("--max-connections", c.http.max_connections, "open connections in total (503 beyond)")
       ->envname("CONTACTD_MAX_CONNECTIONS")
       ->check(CLI::Range(8, 100000))
@@ -163,6 +187,14 @@ void add_flags(CLI::App& app, Config& c) {
       ->envname("CONTACTD_MAX_HEADER_FIELDS")
       ->check(CLI::Range(8, 1000))
       ->capture_default_str();
+}
+
+// Request bodies: their size, and how many are read and validated at once.
+void add_request_body_flags(CLI::App& app, Config& c) {
+  app.add_option("--max-request-bytes", c.http.max_request_bytes, "largest request body accepted (413 beyond)")
+      ->envname("CONTACTD_MAX_REQUEST_BYTES")
+      ->check(CLI::Range(1024, 1 << 30))
+      ->capture_default_str();
   app.add_option("--max-large-bodies", c.http.max_large_bodies,
                  "request bodies over 256 KiB read and validated at once (others wait, then 503)")
       ->envname("CONTACTD_MAX_LARGE_BODIES")
@@ -172,6 +204,17 @@ void add_flags(CLI::App& app, Config& c) {
       ->envname("CONTACTD_MAX_VALIDATIONS")
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
+}
+
+void add_flags(CLI::App& app, Config& c) {
+  add_service_flags(app, c);
+  add_job_limit_flags(app, c);
+  add_mpi_flags(app, c);
+  add_job_lifetime_flags(app, c);
+  add_access_flags(app, c);
+  add_stream_flags(app, c);
+  add_connection_flags(app, c);
+  add_request_body_flags(app, c);
 }
 
 // From here on, what any library prints on standard output (CHOLMOD's warnings, for one) goes to the log as
@@ -208,6 +251,105 @@ void capture_stdout() {
   }).detach();
 }
 
+// The contact-solve that MPI jobs run: next to contactd (an installation, the Docker image), or one level up (the
+// build tree: build/server/); else the one on the PATH.
+std::string default_solver_binary(const char* argv0) {
+  std::error_code ec;
+  const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  const auto dir = (ec ? std::filesystem::path(argv0) : self).parent_path();
+  for (const auto& candidate : {dir / "contact-solve", dir.parent_path() / "contact-solve"})
+    if (std::filesystem::is_regular_file(candidate, ec)) return candidate.string();
+  return "contact-solve";
+}
+
+// The settings the flags give in another form, or leave to the machine.
+void complete_settings(Config& config, const char* argv0) {
+  if (config.queue.workers == 0)
+    config.queue.workers = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  config.http.allowed_hosts = contactd::parse_host_list(config.allowed_hosts);
+  config.queue.mpi.launcher = contactd::split_launcher(config.mpi_launcher);
+  if (config.queue.mpi.solver.empty()) config.queue.mpi.solver = default_solver_binary(argv0);
+  // Retention is checked a few times per retention period (at most every 10 s).
+  config.queue.janitor_interval_seconds =
+      config.queue.retention_seconds > 0 ? std::min(10.0, std::max(0.2, config.queue.retention_seconds / 4)) : 10.0;
+}
+
+// Signals: blocked in every thread (the mask is inherited) and taken by one sigwait thread, which starts the
+// shutdown outside any signal handler. SIGPIPE is ignored: a vanished client is a failed write, not a death.
+sigset_t block_shutdown_signals() {
+  ::signal(SIGPIPE, SIG_IGN);
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  return signals;
+}
+
+// 1. Refuse new jobs; /readyz says 503. 2. Running jobs stop at their next iteration and are stored back as
+// QUEUED (their streams get that state event). 3. Streams close. 4. The listener stops. The exit status.
+int shut_down(contactd::HttpServer& server, contactd::JobQueue& queue, std::thread& listener) {
+  server.begin_shutdown();
+  const bool workers_stopped = queue.shutdown(std::chrono::seconds(5));
+  server.close_streams();
+  server.wait_for_streams(std::chrono::seconds(2));
+  if (!workers_stopped) {
+    // A solve that does not reach its next iteration in time (a long factorisation): its state on disk says
+    // RUNNING, so the next start runs it again. Exit without waiting for it.
+    contactd::log_line("a worker did not stop in time; exiting anyway (its job runs again at the next start)");
+    std::fflush(stdout);
+    std::_Exit(0);
+  }
+  server.stop();
+  listener.join();
+  if (!contact::wait_for_background_work(10)) {  // a factorisation a cancel left running (contact/solve.hpp)
+    contactd::log_line("stopped (a cancelled job's factorisation still runs: exiting without it)");
+    std::fflush(nullptr);
+    std::_Exit(0);
+  }
+  contactd::log_line("stopped");
+  return 0;
+}
+
+// Serves until SIGTERM or SIGINT, then shuts down; the exit status. Throws what start-up cannot survive.
+int serve(const Config& config, const sigset_t& signals) {
+  using namespace contactd;
+  JobStore store(config.data_dir);
+  Metrics metrics;
+  BodyBudget budget(config.http.max_large_bodies, BodyBudget::validation_slots(config.http.max_validations), 256 * 1024,
+                    std::chrono::seconds(10));
+  JobQueue queue(store, metrics, budget, config.queue);
+  HttpServer server(config.http, queue, store, metrics, budget);
+
+  std::string error;
+  const int port = server.bind(error);
+  if (port < 0) {
+    log_line("cannot listen on " + config.http.host + ":" + std::to_string(config.http.port) + ": " + error);
+    return 1;
+  }
+  // Serve at once (the /v1 routes answer 503 "starting" and /readyz 503 until the store is read back).
+  std::thread listener([&server] { server.listen(); });
+  try {
+    queue.recover();
+    queue.start();
+  } catch (...) {
+    server.stop();
+    listener.join();
+    throw;
+  }
+  server.set_ready();
+  std::printf("contactd %s listening on http://%s:%d (data dir %s, %d workers%s)\n", contact::solver_version(),
+              config.http.host.c_str(), port, config.data_dir.c_str(), config.queue.workers,
+              config.http.token.empty() ? "" : ", bearer token required");
+  std::fflush(stdout);
+  capture_stdout();
+
+  int received = 0;
+  sigwait(&signals, &received);
+  log_line(std::string("received ") + (received == SIGTERM ? "SIGTERM" : "SIGINT") + ": shutting down");
+  return shut_down(server, queue, listener);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -216,97 +358,13 @@ int main(int argc, char** argv) {
   Config config;
   add_flags(app, config);
   CLI11_PARSE(app, argc, argv);
-  if (config.queue.workers == 0)
-    config.queue.workers = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  config.http.allowed_hosts = contactd::parse_host_list(config.allowed_hosts);
-  config.queue.mpi.launcher = contactd::split_launcher(config.mpi_launcher);
-  if (config.queue.mpi.solver.empty()) {
-    // Next to contactd (an installation, the Docker image), or one level up (the build tree: build/server/);
-    // else the one on the PATH.
-    std::error_code ec;
-    const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
-    const auto dir = (ec ? std::filesystem::path(argv[0]) : self).parent_path();
-    config.queue.mpi.solver = "contact-solve";
-    for (const auto& candidate : {dir / "contact-solve", dir.parent_path() / "contact-solve"})
-      if (std::filesystem::is_regular_file(candidate, ec)) {
-        config.queue.mpi.solver = candidate.string();
-        break;
-      }
-  }
-  // Retention is checked a few times per retention period (at most every 10 s).
-  config.queue.janitor_interval_seconds =
-      config.queue.retention_seconds > 0 ? std::min(10.0, std::max(0.2, config.queue.retention_seconds / 4)) : 10.0;
+  complete_settings(config, argv[0]);
   contactd::BodyBudget::configure_allocator();
-
-  // Signals: blocked in every thread (the mask is inherited) and taken by one sigwait thread, which starts the
-  // shutdown outside any signal handler. SIGPIPE is ignored: a vanished client is a failed write, not a death.
-  ::signal(SIGPIPE, SIG_IGN);
-  sigset_t signals;
-  sigemptyset(&signals);
-  sigaddset(&signals, SIGTERM);
-  sigaddset(&signals, SIGINT);
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
-
-  using namespace contactd;
+  const sigset_t signals = block_shutdown_signals();
   try {
-    JobStore store(config.data_dir);
-    Metrics metrics;
-    BodyBudget budget(config.http.max_large_bodies, BodyBudget::validation_slots(config.http.max_validations),
-                      256 * 1024, std::chrono::seconds(10));
-    JobQueue queue(store, metrics, budget, config.queue);
-    HttpServer server(config.http, queue, store, metrics, budget);
-
-    std::string error;
-    const int port = server.bind(error);
-    if (port < 0) {
-      log_line("cannot listen on " + config.http.host + ":" + std::to_string(config.http.port) + ": " + error);
-      return 1;
-    }
-    // Serve at once (the /v1 routes answer 503 "starting" and /readyz 503 until the store is read back).
-    std::thread listener([&server] { server.listen(); });
-    try {
-      queue.recover();
-      queue.start();
-    } catch (...) {
-      server.stop();
-      listener.join();
-      throw;
-    }
-    server.set_ready();
-    std::printf("contactd %s listening on http://%s:%d (data dir %s, %d workers%s)\n", contact::solver_version(),
-                config.http.host.c_str(), port, config.data_dir.c_str(), config.queue.workers,
-                config.http.token.empty() ? "" : ", bearer token required");
-    std::fflush(stdout);
-    capture_stdout();
-
-    int received = 0;
-    sigwait(&signals, &received);
-    log_line(std::string("received ") + (received == SIGTERM ? "SIGTERM" : "SIGINT") + ": shutting down");
-
-    // 1. Refuse new jobs; /readyz says 503. 2. Running jobs stop at their next iteration and are stored back as
-    // QUEUED (their streams get that state event). 3. Streams close. 4. The listener stops.
-    server.begin_shutdown();
-    const bool workers_stopped = queue.shutdown(std::chrono::seconds(5));
-    server.close_streams();
-    server.wait_for_streams(std::chrono::seconds(2));
-    if (!workers_stopped) {
-      // A solve that does not reach its next iteration in time (a long factorisation): its state on disk says
-      // RUNNING, so the next start runs it again. Exit without waiting for it.
-      log_line("a worker did not stop in time; exiting anyway (its job runs again at the next start)");
-      std::fflush(stdout);
-      std::_Exit(0);
-    }
-    server.stop();
-    listener.join();
-    if (!contact::wait_for_background_work(10)) {  // a factorisation a cancel left running (contact/solve.hpp)
-      log_line("stopped (a cancelled job's factorisation still runs: exiting without it)");
-      std::fflush(nullptr);
-      std::_Exit(0);
-    }
-    log_line("stopped");
-    return 0;
+    return serve(config, signals);
   } catch (const std::exception& e) {
-    log_line(std::string("fatal: ") + e.what());
+    contactd::log_line(std::string("fatal: ") + e.what());
     return 1;
   }
 }

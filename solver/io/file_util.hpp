@@ -1,4 +1,5 @@
-// Internal to solver/io: atomic file replacement and small facts about the machine.
+// Internal to solver/io: the result files' atomic replacement (contact/files.hpp) with the file named in its
+// errors, and small facts about the machine.
 #pragma once
 
 #include <functional>
@@ -6,12 +7,11 @@
 
 namespace contact::io::detail {
 
-// Calls write(tmp) with tmp = path + ".tmp", syncs tmp to disk, then renames it over `path`. On any failure
-// removes tmp and throws std::runtime_error("cannot write <what> '<path>': <reason>").
+// contact::replace_file_atomically(path, write), durable; any failure is rethrown as
+// std::runtime_error("cannot write <what> '<path>': <reason>").
 void write_atomically(const std::string& path, const std::string& what,
                       const std::function<void(const std::string& tmp)>& write);
 
-std::string utc_now_iso8601();  // "2024-05-01T12:00:00Z"
-std::string host_name();        // "" if unknown
+std::string host_name();  // "" if unknown
 
 }  // namespace contact::io::detail

@@ -2,6 +2,7 @@
 #include "contact/result_file.hpp"
 
 #include "contact/solve.hpp"
+#include "contact/utc_time.hpp"
 #include "view_layout.hpp"
 #include "file_util.hpp"
 #include "h5.hpp"
@@ -427,7 +428,7 @@ void write_contents(hid_t file, const Problem& problem, const Result& result, co
 
 void write_result(const std::string& path, const Problem& problem, const Result& result, const WriteInfo& info) {
   WriteInfo filled = info;
-  if (filled.created.empty()) filled.created = detail::utc_now_iso8601();
+  if (filled.created.empty()) filled.created = iso8601_utc(now_unix_us(), TimePrecision::seconds);
   if (filled.host.empty()) filled.host = detail::host_name();
   detail::write_atomically(path, "result file", [&](const std::string& tmp) {
     h5::QuietErrors quiet;

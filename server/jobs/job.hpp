@@ -1,0 +1,51 @@
+// A job as the server keeps it in memory: its record (store/job_record.hpp, what state.json holds) and the live
+// parts that exist only while the server runs: cancel token, event log, locks.
+#pragma once
+
+#include "jobs/event_log.hpp"
+#include "store/job_record.hpp"
+
+#include "contact/result.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <mutex>
+#include <string>
+
+namespace contactd {
+
+// Why a running job's CancelToken was set; the first reason wins.
+enum class CancelReason : int { none = 0, user = 1, time_limit = 2, shutdown = 3 };
+
+// A job in memory. `record`, `disk_bytes` and `cancelling_queued` are guarded by the JobRegistry's mutex;
+// `deadline` and `cancel_requested_at` by the WorkerPool's (the pool's lock is taken before the registry's, never
+// after). persist_mutex serialises writes of state.json (a writer takes a snapshot of the record after locking
+// it, so the last write carries the latest state).
+struct Job {
+  Job(JobRecord r, const std::string& events_path, std::uint64_t max_event_bytes)
+      : record(std::move(r)), events(events_path, max_event_bytes) {}
+
+  JobRecord record;
+  contact::CancelToken cancel;
+  std::atomic<int> cancel_reason{static_cast<int>(CancelReason::none)};
+  std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
+  EventLog events;
+  std::mutex persist_mutex;
+  std::atomic<bool> settled{false};  // done and its `end` event written: it may be deleted
+  std::atomic<bool> stored{false};   // its files exist: visible to the API (a submission is stored first)
+  std::int64_t disk_bytes = 0;       // what its directory holds once finished (retention)
+  bool cancelling_queued = false;    // a cancel is storing this QUEUED job as CANCELLED
+
+  // Called with the WorkerPool's mutex held.
+  bool request_cancel(CancelReason reason) {
+    int expected = static_cast<int>(CancelReason::none);
+    const bool first = cancel_reason.compare_exchange_strong(expected, static_cast<int>(reason));
+    if (first) cancel_requested_at = std::chrono::steady_clock::now();
+    cancel.cancel();
+    return first;
+  }
+  std::chrono::steady_clock::time_point cancel_requested_at{};  // when the first reason was set
+};
+
+}  // namespace contactd

@@ -1,0 +1,34 @@
+// The settings of the jobs (contactd's command line), and the validation of a job against their limits.
+#pragma once
+
+#include "jobs/mpi_job.hpp"
+
+#include "contact/job.hpp"
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace contactd {
+
+struct QueueSettings {
+  int workers = 1;                     // jobs solved at once
+  std::size_t max_queued = 100;        // QUEUED jobs beyond which submissions are refused (503)
+  long max_dofs = 2'000'000;           // job::Limits::max_dofs
+  int max_bodies = 512;                // job::Limits::max_bodies: a server's share of the machine, a setting
+  int max_contacts = 2048;             // job::Limits::max_contacts
+  double time_limit_seconds = 3600.0;  // per run; 0 = none
+  int max_attempts = 3;                // runs cut short by the server dying, after which a job ends FAILED
+  std::uint64_t max_event_log_bytes = 256u << 20;  // per job; iteration events beyond are not recorded
+  double stuck_after_seconds = 60.0;               // a job still running this long after it was told to stop is "stuck"
+  double retention_seconds = 7 * 86400.0;          // finished jobs older than this are deleted; 0 = kept
+  std::uint64_t retention_bytes = 10ull << 30;     // finished jobs beyond this total are deleted, oldest first
+  double janitor_interval_seconds = 10.0;          // how often retention runs
+  MpiSettings mpi;                                 // jobs with parallel.ranks > 1 (mpi_job.hpp)
+};
+
+// Parses and validates a job body within the settings' limits (the ranks a job may ask for depend on
+// whether MPI jobs are possible).
+contact::job::ParseResult validate_job(const QueueSettings& settings, const std::string& body);
+
+}  // namespace contactd

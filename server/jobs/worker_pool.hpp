@@ -1,0 +1,82 @@
+// The worker threads and the queue of jobs waiting for them. A worker takes the next QUEUED job, stores it
+// RUNNING (not fsync'ed: whether a crash leaves QUEUED or RUNNING on disk, the job is queued again at start-up),
+// gives it its time limit and hands it to `run` (a JobRun), until the pool stops.
+//
+// Thread safety: every public member may be called from any thread. One mutex guards the queue, the jobs the
+// workers hold (taken or running) and their deadlines and cancel requests; the registry's mutex may be taken
+// while it is held (a job's state is read under both), never the other way round. It is never held while a
+// job runs or its state is written.
+#pragma once
+
+#include "jobs/job.hpp"
+#include "jobs/job_registry.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace contactd {
+
+class WorkerPool {
+ public:
+  using Run = std::function<void(const std::shared_ptr<Job>&)>;
+
+  // `workers` threads; a run is stopped by its time limit after `time_limit_seconds` (0: none).
+  WorkerPool(JobRegistry& registry, int workers, double time_limit_seconds, Run run);
+  ~WorkerPool();  // threads shutdown() gave up on are left to the exiting process
+  WorkerPool(const WorkerPool&) = delete;
+  WorkerPool& operator=(const WorkerPool&) = delete;
+
+  void start();
+  // No job starts from now on; running jobs are cancelled (CancelReason::shutdown). Waits up to `grace` for the
+  // workers to exit; returns false if one did not (the caller should then exit without joining).
+  bool shutdown(std::chrono::milliseconds grace);
+  bool stopping() const { return stopping_.load(); }
+  // Waits up to `timeout` for shutdown(); true once the pool stops.
+  bool wait_for_stop(std::chrono::milliseconds timeout) const;
+
+  // Queues a stored QUEUED job (at the back; nothing while stopping).
+  void enqueue(const std::shared_ptr<Job>& job);
+  // A cancel of the job `id` (set in `job` when found): a job waiting in the queue leaves it (withdraw), a job a
+  // worker holds is told to stop.
+  JobRegistry::CancelStep cancel(const std::string& id, std::shared_ptr<Job>& job);
+  // A withdrawn job whose CANCELLED state could not be stored: back in its place by creation time if QUEUED.
+  void restore_after_failed_cancel(const std::shared_ptr<Job>& job);
+
+  // The job's record and its place in the queue (1 = next; 0 when not waiting), consistently.
+  JobRecord snapshot(const Job& job, int& queue_position) const;
+  int busy() const;
+  int alive() const { return workers_alive_.load(); }
+  // Calls `visit` for every job a worker holds, with the pool's lock held (request_cancel may be called).
+  void for_each_running(const std::function<void(Job&)>& visit) const;
+
+ private:
+  void worker_loop();
+  std::shared_ptr<Job> take();  // null once stopping
+  bool store_running(const std::shared_ptr<Job>& job);
+  void release(const std::shared_ptr<Job>& job);
+
+  JobRegistry& registry_;
+  const int workers_;
+  const double time_limit_seconds_;
+  const Run run_;
+
+  mutable std::mutex mutex_;
+  std::condition_variable work_;          // a job was queued, or stopping
+  std::condition_variable idle_;          // a worker finished a job or exited
+  mutable std::condition_variable stop_;  // stopping
+  std::deque<std::shared_ptr<Job>> queue_;
+  std::vector<std::shared_ptr<Job>> running_;  // taken by a worker (stored RUNNING, or being stored)
+  std::vector<std::thread> threads_;
+  std::atomic<int> workers_alive_{0};
+  bool started_ = false;
+  std::atomic<bool> stopping_{false};  // written under mutex_
+};
+
+}  // namespace contactd

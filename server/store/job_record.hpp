@@ -1,0 +1,47 @@
+// A job's record as the store persists it in state.json (JobRecord) and its states. The live job around it (cancel
+// token, event log, locks) is jobs/job.hpp.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+namespace contactd {
+
+enum class JobState { queued, running, succeeded, failed, cancelled };
+
+const char* to_string(JobState state);                            // "QUEUED", ...
+std::optional<JobState> job_state_from_string(std::string text);  // case-insensitive; nullopt if unknown
+inline bool is_terminal(JobState s) {
+  return s == JobState::succeeded || s == JobState::failed || s == JobState::cancelled;
+}
+
+// Everything state.json holds. Times are microseconds since the Unix epoch (0 = not yet).
+struct JobRecord {
+  std::string id;
+  std::string name;  // the job's "name"
+  JobState state = JobState::queued;
+  std::int64_t created_us = 0, started_us = 0, finished_us = 0;
+  int attempts = 0;             // runs started (a run interrupted by a restart or shutdown counts)
+  int interruptions = 0;        // runs cut short by the server dying (found RUNNING at start-up)
+  std::string idempotency_key;  // "" when none was given
+  std::int64_t body_bytes = 0;
+  // The outcome, set when the job is done.
+  std::string stop_reason;  // converged, max_iterations, stagnation, cancelled, error, time_limit
+  std::string message;
+  std::optional<bool> converged;
+  int iterations = 0;             // iterations of the last run so far
+  double solve_seconds = 0.0;     // the solver's own wall time (Result::wall_seconds)
+  bool result_available = false;  // result.hdf and result.xmf exist
+  std::int64_t result_bytes = 0;  // the size of result.hdf as written (checked before it is served)
+  std::int64_t events_dropped = 0;  // iteration events not recorded: the job's event log reached its cap
+  nlohmann::json progress;        // the latest iteration in short (null before the first)
+};
+
+nlohmann::json to_state_json(const JobRecord& record);
+// Throws std::runtime_error (nlohmann's errors included) when `j` is not a state document.
+JobRecord from_state_json(const nlohmann::json& j);
+
+}  // namespace contactd
