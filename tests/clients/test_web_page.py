@@ -197,6 +197,11 @@ def test_without_token(server, b, downloads):
           b.text("job-state"))
     check("cancel: the server says CANCELLED", server.wait_done(job_id, 30)["state"] == "CANCELLED")
     check("cancel: the event log ends with the end event", "end CANCELLED" in b.text("log"), b.text("log")[-300:])
+    # Every iteration the job's stream holds is plotted (the page may still be drawing the last few events when
+    # it shows the state: wait for the plot to catch up rather than read it once).
+    long_iterations = sum(1 for e in read_all_events(server, job_id) if e["type"] == "iteration")
+    check("cancel: every iteration of the stream is plotted", b.wait(lambda: points(b) == long_iterations, 10),
+          (points(b), long_iterations))
     long_points = points(b)
 
     # 3. An example picked from the list, submitted, solved; its result downloadable from the page.
