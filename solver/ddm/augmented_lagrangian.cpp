@@ -16,7 +16,8 @@ namespace contact::ddm {
 // projected onto lambda >= 0, restarted when a mixed update makes the residual ten times worse).
 MethodOutcome run_augmented_lagrangian(ContactSystem& system, const SolverSettings& settings, RunContext& context,
                                        ContactMethod& method, int& updates) {
-  MethodOutcome total;
+  OutcomeAccumulator updates_so_far;
+  MethodOutcome& total = updates_so_far.total();
   Displacements warm;
   const auto& al = settings.augmented_lagrangian;
   const auto& pairs = system.pairs();
@@ -30,24 +31,18 @@ MethodOutcome run_augmented_lagrangian(ContactSystem& system, const SolverSettin
   double best = std::numeric_limits<double>::infinity();
 
   for (int update = 1; update <= al.max_updates; ++update) {
-    OffsetObserver observer(context.observer, total.iterations, update);
-    RunContext inner{observer, context.cancel, context.runner, context.start, warm.empty() ? nullptr : &warm};
-    MethodOutcome o = method.run(inner);
+    updates_so_far.run(context, warm.empty() ? nullptr : &warm, InnerMarks{update, {}},
+                       [&](RunContext& inner) { return method.run(inner); });
     updates = update;
-    for (auto& r : o.history) {
-      r.iteration += total.iterations;
-      r.update = update;
-      total.history.push_back(std::move(r));
-    }
-    total.iterations += o.iterations;
-    total.add_work(o);
-    total.gamma = o.gamma;
-    total.u = std::move(o.u);
-    total.z = std::move(o.z);
-    if (o.reason != StopReason::converged) {
-      total.reason = o.reason;
-      total.message = "augmented Lagrangian update " + std::to_string(update) + ": " + o.message;
-      return total;
+    // The updates' stop is their own (below); their answer is the displacements and pressures alone, without
+    // rigid amplitudes or tangential multipliers (friction needs exact contact).
+    total.converged = false;
+    total.rigid_amplitudes.clear();
+    total.q.clear();
+    const std::string inner_message = std::move(total.message);
+    if (total.reason != StopReason::converged) {
+      total.message = "augmented Lagrangian update " + std::to_string(update) + ": " + inner_message;
+      return updates_so_far.take();
     }
     // P(lambda): the pressures of this solve.
     const Pressures solved = total.z.empty() ? system.penalty_pressures(total.u) : total.z;
@@ -62,9 +57,9 @@ MethodOutcome run_augmented_lagrangian(ContactSystem& system, const SolverSettin
       total.reason = StopReason::converged;
       std::ostringstream os;
       os << "augmented Lagrangian: pressures settled (relative change " << change << " <= " << al.tolerance << ") after "
-         << update << " updates; last inner solve: " << o.message;
+         << update << " updates; last inner solve: " << inner_message;
       total.message = os.str();
-      return total;
+      return updates_so_far.take();
     }
     // Anderson-mixed Uzawa update.
     if (residual.norm() > 10 * best) {
@@ -88,7 +83,7 @@ MethodOutcome run_augmented_lagrangian(ContactSystem& system, const SolverSettin
       total.message = os.str();
     }
   }
-  return total;
+  return updates_so_far.take();
 }
 
 

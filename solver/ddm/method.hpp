@@ -37,14 +37,6 @@ struct MethodOutcome {
   std::string interface_solver;    // interface_newton: "direct" or "iterative" (the last one used)
   long interface_iterations = 0;   // the iterative interface solver's products with the interface operator
   std::vector<IterationReport> history;
-
-  // Adds the work of an inner run (a load step, an update, an adaptive step) to this total: solves, interface
-  // iterations, the solver used (iterations and history are renumbered by the caller).
-  void add_work(const MethodOutcome& inner) {
-    solves_per_body += inner.solves_per_body;
-    interface_iterations += inner.interface_iterations;
-    if (!inner.interface_solver.empty()) interface_solver = inner.interface_solver;
-  }
 };
 
 // A contact method on a ContactSystem: run() solves once on the pairs' current gaps (and augmented-Lagrangian
