@@ -25,6 +25,7 @@ ddm::MethodOutcome inner_solve(ddm::RunContext& context, int iterations, int sol
     out.history.push_back(r);
   }
   out.iterations = iterations;
+  out.updates = 1;
   out.solves_per_body = solves;
   out.interface_iterations = 10 * solves;
   out.interface_solver = solver;
@@ -64,6 +65,7 @@ TEST(OutcomeAccumulator, InnerIterationsRunOnMarkedAndTheWorkAddsUp) {
     EXPECT_EQ(t.history[static_cast<size_t>(k)].bodies[0].elements_refined, refined);
   }
   EXPECT_EQ(t.iterations, 5);
+  EXPECT_EQ(t.updates, 2);
   EXPECT_EQ(t.solves_per_body, 7);
   EXPECT_EQ(t.interface_iterations, 70);
   EXPECT_EQ(t.interface_solver, "direct");  // an inner solve that names none keeps the last one named

@@ -196,14 +196,14 @@ bool any_cancelled(const std::vector<IndicatorResult>& eta) {
 // refined before it); returns the total, whose answer and stop are now this solve's.
 const ddm::MethodOutcome& solve_step(ddm::ContactSystem& system, const Problem& working, ddm::RunContext& context,
                                      ddm::ContactMethod& method, ddm::OutcomeAccumulator& solves,
-                                     std::vector<int>& refined_last, const ddm::Displacements& warm, int& updates) {
+                                     std::vector<int>& refined_last, const ddm::Displacements& warm) {
   return solves.run(context, warm.empty() ? nullptr : &warm, ddm::InnerMarks{0, std::exchange(refined_last, {})},
-                    [&](ddm::RunContext& inner) { return ddm::run_enforced(system, working.solver, inner, method, updates); });
+                    [&](ddm::RunContext& inner) { return ddm::run_enforced(system, working.solver, inner, method); });
 }
 
 // Solve, estimate, report the step, and stop (stop test, max_steps, nothing refinable, cancellation) or refine.
 ddm::MethodOutcome converge_then_refine(Problem& working, ddm::ContactSystem& system, ddm::RunContext& context,
-                                        ddm::ContactMethod& method, ddm::StepLog& steps, int& updates) {
+                                        ddm::ContactMethod& method, ddm::StepLog& steps) {
   const auto& s = working.adaptivity;
   ddm::OutcomeAccumulator solves;
   ddm::MethodOutcome& total = solves.total();
@@ -211,7 +211,7 @@ ddm::MethodOutcome converge_then_refine(Problem& working, ddm::ContactSystem& sy
   ddm::Displacements warm;
   StepMeasures previous;
   for (int step = 0;; ++step) {
-    const ddm::MethodOutcome& o = solve_step(system, working, context, method, solves, refined_last, warm, updates);
+    const ddm::MethodOutcome& o = solve_step(system, working, context, method, solves, refined_last, warm);
     if (o.u.empty()) return solves.take();
     if (context.cancel.cancelled()) {  // stopped inside the solve: keep what it reached, skip the estimate
       steps.push_back(make_step(system, o.u, o.z, total.iterations, step, {}));
@@ -370,10 +370,9 @@ ddm::MethodOutcome paper_interleaving(Problem& working, ddm::ContactSystem& syst
 }  // namespace
 
 ddm::MethodOutcome run_adaptive(Problem& working, ddm::ContactSystem& system, ddm::RunContext& context,
-                                ddm::ContactMethod& method, ddm::StepLog& steps, int& updates) {
-  updates = 0;
+                                ddm::ContactMethod& method, ddm::StepLog& steps) {
   if (working.adaptivity.strategy == AdaptStrategy::paper) return paper_interleaving(working, system, context, steps);
-  return converge_then_refine(working, system, context, method, steps, updates);
+  return converge_then_refine(working, system, context, method, steps);
 }
 
 }  // namespace contact::adapt

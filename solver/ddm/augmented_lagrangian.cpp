@@ -72,7 +72,7 @@ class UzawaMultipliers {
 // Plain Uzawa converges linearly and slowly where points at the edge of the contact zone have both gap and
 // multiplier near zero (100 updates on stack3), so the multiplier fixed point is Anderson-mixed (UzawaMultipliers).
 MethodOutcome run_augmented_lagrangian(ContactSystem& system, const SolverSettings& settings, RunContext& context,
-                                       ContactMethod& method, int& updates) {
+                                       ContactMethod& method) {
   OutcomeAccumulator updates_so_far;
   MethodOutcome& total = updates_so_far.total();
   Displacements warm;
@@ -81,7 +81,7 @@ MethodOutcome run_augmented_lagrangian(ContactSystem& system, const SolverSettin
   for (int update = 1; update <= al.max_updates; ++update) {
     updates_so_far.run(context, warm.empty() ? nullptr : &warm, InnerMarks{update, {}},
                        [&](RunContext& inner) { return method.run(inner); });
-    updates = update;
+    total.updates = update;
     // The updates' stop is their own (below); their answer is the displacements and pressures alone, without
     // rigid amplitudes or tangential multipliers (friction needs exact contact).
     total.converged = false;

@@ -7,7 +7,7 @@
 namespace contact::ddm {
 
 MethodOutcome run_enforced(ContactSystem& system, const SolverSettings& settings, RunContext& context,
-                           ContactMethod& method, int& updates) {
+                           ContactMethod& method) {
   if (settings.enforcement == Enforcement::exact &&
       (settings.method == Method::neumann || settings.method == Method::robin)) {
     MethodOutcome out;
@@ -17,12 +17,8 @@ MethodOutcome run_enforced(ContactSystem& system, const SolverSettings& settings
                   "augmented_lagrangian for exact contact in the limit; or method interface_newton)";
     return out;
   }
-  if (settings.enforcement == Enforcement::augmented_lagrangian) {
-    int these_updates = 0;
-    MethodOutcome out = run_augmented_lagrangian(system, settings, context, method, these_updates);
-    updates += these_updates;
-    return out;
-  }
+  if (settings.enforcement == Enforcement::augmented_lagrangian)
+    return run_augmented_lagrangian(system, settings, context, method);
   return method.run(context);
 }
 

@@ -9,8 +9,8 @@
 
 namespace contact::ddm {
 
-// The method, inside augmented-Lagrangian updates if the settings ask for them (how many is added to `updates`).
+// The method, inside augmented-Lagrangian updates if the settings ask for them (the outcome counts them).
 MethodOutcome run_enforced(ContactSystem& system, const SolverSettings& settings, RunContext& context,
-                           ContactMethod& method, int& updates);
+                           ContactMethod& method);
 
 }  // namespace contact::ddm

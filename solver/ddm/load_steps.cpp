@@ -4,15 +4,14 @@
 namespace contact::ddm {
 
 MethodOutcome run_load_steps(ContactSystem& system, const SolverSettings& settings, const std::vector<double>& factors,
-                             RunContext& context, ContactMethod& method, StepLog& steps, int& updates) {
+                             RunContext& context, ContactMethod& method, StepLog& steps) {
   OutcomeAccumulator steps_so_far;
   MethodOutcome& total = steps_so_far.total();
   Displacements warm;
-  updates = 0;
   for (size_t k = 0; k < factors.size(); ++k) {
     system.set_load_step(k, factors[k]);
     steps_so_far.run(context, warm.empty() ? nullptr : &warm, InnerMarks{},
-                     [&](RunContext& inner) { return run_enforced(system, settings, inner, method, updates); });
+                     [&](RunContext& inner) { return run_enforced(system, settings, inner, method); });
     const std::string prefix = factors.size() == 1 ? std::string()
                                                    : "load step " + std::to_string(k + 1) + " of " +
                                                          std::to_string(factors.size()) + ": ";

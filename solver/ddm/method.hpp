@@ -31,6 +31,7 @@ struct MethodOutcome {
   StopReason reason = StopReason::error;
   std::string message;
   int iterations = 0;
+  int updates = 0;  // augmented-Lagrangian updates (0 for the penalty or exact problem alone)
   double gamma = 0.0;
   int solves_per_body = 0;  // subdomain solves (back-substitutions) per body, initial guess included
   double indicator_seconds = 0.0;  // adaptivity: time spent estimating (BEM solves and evaluations)

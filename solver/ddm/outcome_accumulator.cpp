@@ -30,6 +30,7 @@ void OutcomeAccumulator::append(MethodOutcome inner, const InnerMarks& marks) {
     total_.history.push_back(std::move(r));
   }
   total_.iterations += inner.iterations;
+  total_.updates += inner.updates;
   total_.solves_per_body += inner.solves_per_body;
   total_.interface_iterations += inner.interface_iterations;
   if (!inner.interface_solver.empty()) total_.interface_solver = std::move(inner.interface_solver);

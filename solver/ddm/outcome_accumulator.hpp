@@ -30,7 +30,7 @@ class OffsetObserver final : public Observer {
 
 // A loop's total over its inner solves. run() gives the inner solve a context whose observer numbers the reports
 // on from the iterations so far, then append() folds the inner outcome in: its history renumbered and marked the
-// same way, its iterations and work (subdomain solves, interface iterations, the interface solver used) added, and
+// same way, its iterations and work (augmented-Lagrangian updates, subdomain solves, interface iterations, the interface solver used) added, and
 // the last solve's answer (u, z, q, rigid amplitudes, gamma) and stop (reason, converged, message) written over
 // the total's. The loop then says what it adds itself (a prefix to the message, its own stop).
 class OutcomeAccumulator {
