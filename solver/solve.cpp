@@ -112,14 +112,13 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
     }
     ddm::RunContext context{observer, cancel, runner, start};
     const std::unique_ptr<ddm::ContactMethod> method = ddm::make_method(system, active.solver);
-    int updates = 0;
     ddm::StepLog steps(problem.output.steps);  // every step's scalars; the fields the job keeps
     ddm::MethodOutcome outcome;
     if (adaptive) {
       system.set_load_step(problem.loading.factors.size() - 1, problem.loading.factors.back());
-      outcome = adapt::run_adaptive(working, system, context, *method, steps, updates);
+      outcome = adapt::run_adaptive(working, system, context, *method, steps);
     } else {
-      outcome = ddm::run_load_steps(system, problem.solver, problem.loading.factors, context, *method, steps, updates);
+      outcome = ddm::run_load_steps(system, problem.solver, problem.loading.factors, context, *method, steps);
     }
     result.converged = outcome.converged;
     result.stop_reason = outcome.reason;
@@ -129,14 +128,14 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
     result.subdomain_solves = outcome.solves_per_body;
     result.interface_solver = outcome.interface_solver;
     result.interface_iterations = outcome.interface_iterations;
-    result.updates = updates;
+    result.updates = outcome.updates;
     result.indicator_seconds = outcome.indicator_seconds;
     result.history = std::move(outcome.history);
     result.factorization_seconds = system.total_factorization_seconds();
     result.steps = steps.take_steps();
     result.step_history = steps.take_summaries();
     if (problem.solver.method == Method::monolithic) refuse_unheld_bodies(active, result);
-    if (updates > 0 && !result.steps.empty()) {
+    if (outcome.updates > 0 && !result.steps.empty()) {
       std::ostringstream os;
       os << "; remaining penetration " << max_penetration(result.steps.back());
       result.message += os.str();

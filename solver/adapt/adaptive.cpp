@@ -9,6 +9,7 @@
 #include <functional>
 #include <sstream>
 #include <string>
+#include <utility>
 
 namespace contact::adapt {
 
@@ -191,49 +192,32 @@ bool any_cancelled(const std::vector<IndicatorResult>& eta) {
   return false;
 }
 
-// One solve on the current meshes (run_enforced), its iterations appended to `total`.
-ddm::MethodOutcome solve_step(ddm::ContactSystem& system, const Problem& working, ddm::RunContext& context,
-                              ddm::ContactMethod& method, ddm::MethodOutcome& total, std::vector<int>& refined_last,
-                              const ddm::Displacements& warm, int& updates) {
-  ddm::OffsetObserver observer(context.observer, total.iterations, 0, refined_last);
-  ddm::RunContext inner{observer, context.cancel, context.runner, context.start, warm.empty() ? nullptr : &warm};
-  int step_updates = 0;
-  ddm::MethodOutcome o = ddm::run_enforced(system, working.solver, inner, method, step_updates);
-  updates += step_updates;
-  for (auto& r : o.history) {
-    r.iteration += total.iterations;
-    if (!refined_last.empty())
-      for (size_t a = 0; a < r.bodies.size(); ++a) r.bodies[a].elements_refined = refined_last[a];
-    refined_last.clear();
-    total.history.push_back(std::move(r));
-  }
-  total.iterations += o.iterations;
-  total.add_work(o);
-  total.gamma = o.gamma;
-  total.u = o.u;
-  total.z = o.z;
-  total.reason = o.reason;
-  total.converged = o.converged;
-  total.message = o.message;
-  return o;
+// One solve on the current meshes (run_enforced), folded into `solves` (its first report carries the elements
+// refined before it); returns the total, whose answer and stop are now this solve's.
+const ddm::MethodOutcome& solve_step(ddm::ContactSystem& system, const Problem& working, ddm::RunContext& context,
+                                     ddm::ContactMethod& method, ddm::OutcomeAccumulator& solves,
+                                     std::vector<int>& refined_last, const ddm::Displacements& warm) {
+  return solves.run(context, warm.empty() ? nullptr : &warm, ddm::InnerMarks{0, std::exchange(refined_last, {})},
+                    [&](ddm::RunContext& inner) { return ddm::run_enforced(system, working.solver, inner, method); });
 }
 
 // Solve, estimate, report the step, and stop (stop test, max_steps, nothing refinable, cancellation) or refine.
 ddm::MethodOutcome converge_then_refine(Problem& working, ddm::ContactSystem& system, ddm::RunContext& context,
-                                        ddm::ContactMethod& method, ddm::StepLog& steps, int& updates) {
+                                        ddm::ContactMethod& method, ddm::StepLog& steps) {
   const auto& s = working.adaptivity;
-  ddm::MethodOutcome total;
+  ddm::OutcomeAccumulator solves;
+  ddm::MethodOutcome& total = solves.total();
   std::vector<int> refined_last;
   ddm::Displacements warm;
   StepMeasures previous;
   for (int step = 0;; ++step) {
-    const ddm::MethodOutcome o = solve_step(system, working, context, method, total, refined_last, warm, updates);
-    if (o.u.empty()) return total;
+    const ddm::MethodOutcome& o = solve_step(system, working, context, method, solves, refined_last, warm);
+    if (o.u.empty()) return solves.take();
     if (context.cancel.cancelled()) {  // stopped inside the solve: keep what it reached, skip the estimate
       steps.push_back(make_step(system, o.u, o.z, total.iterations, step, {}));
       total.reason = StopReason::cancelled;
       total.converged = false;
-      return total;
+      return solves.take();
     }
     const ddm::Displacements loads = o.z.empty() ? system.contact_loads(o.u) : system.loads_from_pressures(o.z);
     const auto eta = estimate(working, system, o.u, loads, context.runner, &context.cancel);
@@ -246,7 +230,7 @@ ddm::MethodOutcome converge_then_refine(Problem& working, ddm::ContactSystem& sy
     const auto finish = [&](const std::string& message) {
       if (!message.empty()) total.message = message;
       context.observer.on_adaptive_step(report);
-      return total;
+      return solves.take();
     };
     if (context.cancel.cancelled() || any_cancelled(eta)) {
       if (any_cancelled(eta)) report.estimate = report.estimate_change = std::nan("");  // only partly estimated
@@ -292,7 +276,7 @@ ddm::MethodOutcome converge_then_refine(Problem& working, ddm::ContactSystem& sy
       total.reason = StopReason::error;
       total.converged = false;
       total.message = "adaptive: " + system.error();
-      return total;
+      return solves.take();
     }
   }
 }
@@ -401,10 +385,9 @@ ddm::MethodOutcome paper_interleaving(Problem& working, ddm::ContactSystem& syst
 }  // namespace
 
 ddm::MethodOutcome run_adaptive(Problem& working, ddm::ContactSystem& system, ddm::RunContext& context,
-                                ddm::ContactMethod& method, ddm::StepLog& steps, int& updates) {
-  updates = 0;
+                                ddm::ContactMethod& method, ddm::StepLog& steps) {
   if (working.adaptivity.strategy == AdaptStrategy::paper) return paper_interleaving(working, system, context, steps);
-  return converge_then_refine(working, system, context, method, steps, updates);
+  return converge_then_refine(working, system, context, method, steps);
 }
 
 }  // namespace contact::adapt

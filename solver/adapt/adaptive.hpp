@@ -15,6 +15,6 @@ namespace contact::adapt {
 
 // `working` is the problem the system was built from; its meshes are refined in place.
 ddm::MethodOutcome run_adaptive(Problem& working, ddm::ContactSystem& system, ddm::RunContext& context,
-                                ddm::ContactMethod& method, ddm::StepLog& steps, int& updates);
+                                ddm::ContactMethod& method, ddm::StepLog& steps);
 
 }  // namespace contact::adapt

@@ -193,39 +193,40 @@ IndicatorResult zz_indicator(const Body& body, const fem::BodySolver& solver, co
   return r;
 }
 
-IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fem::BodySolver& solver,
-                                  const Eigen::VectorXd& u, const Eigen::VectorXd& contact_load,
-                                  Normalization normalization, const std::function<bool()>& cancelled) {
-  const auto t0 = Clock::now();
-  const auto& m = body.mesh;
-  const std::vector<int> loop = boundary_loop(m);
-  if (loop.size() < 3) {
-    IndicatorResult r = zz_indicator(body, solver, u, normalization);
-    r.note = "body '" + body.name + "': its boundary is not one closed polygon; zz indicator used instead of fem_bem";
-    return r;
-  }
-  // Boundary conditions per side, from the body's edge sets (vertex conditions hold no side).
+namespace {
+
+// The body's edge conditions per boundary side (vertex conditions hold no side), each condition's edge length
+// (for a total force spread over its edge), and whether any edge prescribes a displacement.
+struct SideConditions {
   std::map<std::pair<int, int>, const BoundaryCondition*> condition;
-  std::map<const BoundaryCondition*, double> edge_length;  // for a total force spread over its edge
+  std::map<const BoundaryCondition*, double> edge_length;
   bool any_support = false;
+};
+
+SideConditions side_conditions(const Body& body) {
+  const auto& m = body.mesh;
+  SideConditions out;
   for (const auto& bc : body.boundary) {
     if (!bc.vertex.empty()) continue;
     auto it = m.edge_sets.find(bc.edge);
     if (it == m.edge_sets.end()) continue;
-    any_support = any_support || prescribes_displacement(bc);
+    out.any_support = out.any_support || prescribes_displacement(bc);
     for (const auto& e : it->second) {
       const auto n = m.edge_nodes(e);
-      condition[key(n[0], n[1])] = &bc;
-      edge_length[&bc] += (m.nodes[static_cast<size_t>(n[1])] - m.nodes[static_cast<size_t>(n[0])]).norm();
+      out.condition[key(n[0], n[1])] = &bc;
+      out.edge_length[&bc] += (m.nodes[static_cast<size_t>(n[1])] - m.nodes[static_cast<size_t>(n[0])]).norm();
     }
   }
-  if (!any_support) {
-    // Tractions all round (a floating body, or one held at vertices only): the boundary-element problem is
-    // determined only up to a rigid motion, which this collocation does not remove.
-    IndicatorResult r = zz_indicator(body, solver, u, normalization);
-    r.note = "body '" + body.name + "': no edge with a prescribed displacement; zz indicator used instead of fem_bem";
-    return r;
-  }
+  return out;
+}
+
+// The boundary-element problem on the boundary loop: on each side the prescribed displacement components take the
+// FE displacement, the others the applied traction plus the contact and point forces (nodal forces lumped over
+// the sides next to their node), all at the body's current load factor.
+bem::BoundaryProblem boundary_problem(const Body& body, const Model& model, const fem::BodySolver& solver,
+                                      const Eigen::VectorXd& u, const Eigen::VectorXd& contact_load,
+                                      const std::vector<int>& loop, SideConditions& sides) {
+  const auto& m = body.mesh;
   const double factor = solver.load_factor();
   // Point loads join the contact forces: both are nodal forces, lumped over the sides next to their node.
   Eigen::VectorXd nodal_load = contact_load.size() ? contact_load : Eigen::VectorXd::Zero(2 * m.num_nodes());
@@ -248,14 +249,14 @@ IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fe
   for (size_t i = 0; i < nb; ++i) {
     const int a = loop[i], b = loop[(i + 1) % nb];
     auto& el = bp.elements[i];
-    auto c = condition.find(key(a, b));
-    const BoundaryCondition* bc = c == condition.end() ? nullptr : c->second;
+    auto c = sides.condition.find(key(a, b));
+    const BoundaryCondition* bc = c == sides.condition.end() ? nullptr : c->second;
     const Eigen::Vector2d pa = m.nodes[static_cast<size_t>(a)], pb = m.nodes[static_cast<size_t>(b)];
     const Eigen::Vector2d outward((pb - pa).y(), -(pb - pa).x());
     Eigen::Vector2d traction = Eigen::Vector2d::Zero();
     if (bc && bc->kind == BoundaryCondition::Kind::traction)
       traction = bc->normal_pressure ? Eigen::Vector2d(-bc->pressure * outward.normalized()) : bc->traction;
-    if (bc && bc->kind == BoundaryCondition::Kind::force) traction = bc->force / (edge_length[bc] * thickness);
+    if (bc && bc->kind == BoundaryCondition::Kind::force) traction = bc->force / (sides.edge_length[bc] * thickness);
     traction *= factor;
     for (int comp = 0; comp < 2; ++comp) {
       const bool prescribed = bc && (comp == 0 ? bc->ux : bc->uy);
@@ -272,6 +273,15 @@ IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fe
       }
     }
   }
+  return bp;
+}
+
+// Solves the boundary-element problem, evaluates its stresses at the cell centres and compares them with the FE
+// stresses there (a cancel gives a cancelled result; a failed solve the zz indicator).
+IndicatorResult compare_with_bem(const Body& body, const fem::BodySolver& solver, const Eigen::VectorXd& u,
+                                 const bem::BoundaryProblem& bp, Normalization normalization,
+                                 const std::function<bool()>& cancelled) {
+  const auto& m = body.mesh;
   IndicatorResult r;
   try {
     bem::HierarchicalOptions options;
@@ -290,6 +300,31 @@ IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fe
     r = zz_indicator(body, solver, u, normalization);
     r.note = "body '" + body.name + "': the boundary-element solve failed (" + e.what() + "); zz indicator used";
   }
+  return r;
+}
+
+}  // namespace
+
+IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fem::BodySolver& solver,
+                                  const Eigen::VectorXd& u, const Eigen::VectorXd& contact_load,
+                                  Normalization normalization, const std::function<bool()>& cancelled) {
+  const auto t0 = Clock::now();
+  const std::vector<int> loop = boundary_loop(body.mesh);
+  if (loop.size() < 3) {
+    IndicatorResult r = zz_indicator(body, solver, u, normalization);
+    r.note = "body '" + body.name + "': its boundary is not one closed polygon; zz indicator used instead of fem_bem";
+    return r;
+  }
+  SideConditions sides = side_conditions(body);
+  if (!sides.any_support) {
+    // Tractions all round (a floating body, or one held at vertices only): the boundary-element problem is
+    // determined only up to a rigid motion, which this collocation does not remove.
+    IndicatorResult r = zz_indicator(body, solver, u, normalization);
+    r.note = "body '" + body.name + "': no edge with a prescribed displacement; zz indicator used instead of fem_bem";
+    return r;
+  }
+  const bem::BoundaryProblem bp = boundary_problem(body, model, solver, u, contact_load, loop, sides);
+  IndicatorResult r = compare_with_bem(body, solver, u, bp, normalization, cancelled);
   r.seconds = seconds_since(t0);  // (r is replaced on the way: not a ScopedTimer)
   return r;
 }

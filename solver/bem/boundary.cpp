@@ -52,9 +52,8 @@ bool segments_touch(const Eigen::Vector2d& p1, const Eigen::Vector2d& p2, const 
          on_segment(p1, p2, p4, d4);
 }
 
-}  // namespace
-
-BoundaryGeometry check_problem(const BoundaryProblem& problem, bool self_overlap) {
+// The sizes, the material and finite input.
+void check_input(const BoundaryProblem& problem) {
   const std::size_t n = problem.nodes.size();
   if (n < 3) fail("the boundary needs at least 3 nodes, got " + std::to_string(n));
   if (problem.elements.size() != n)
@@ -70,7 +69,11 @@ BoundaryGeometry check_problem(const BoundaryProblem& problem, bool self_overlap
     if (!problem.nodes[i].allFinite()) fail("node " + std::to_string(i) + " has a non-finite coordinate");
   for (std::size_t e = 0; e < n; ++e)
     if (!problem.elements[e].value.allFinite()) fail("element " + std::to_string(e) + " has a non-finite value");
+}
 
+// The elements' lengths, tangents and normals, the diameter and the shortest element (none of zero length).
+BoundaryGeometry element_geometry(const BoundaryProblem& problem) {
+  const std::size_t n = problem.nodes.size();
   BoundaryGeometry geometry;
   Eigen::Vector2d lo = problem.nodes[0], hi = problem.nodes[0];
   for (const auto& p : problem.nodes) {
@@ -95,7 +98,12 @@ BoundaryGeometry check_problem(const BoundaryProblem& problem, bool self_overlap
     el.normal = Eigen::Vector2d(el.tangent.y(), -el.tangent.x());
     geometry.min_length = std::min(geometry.min_length, el.length);
   }
+  return geometry;
+}
 
+// A simple counter-clockwise polygon: no elements folding back, no non-adjacent ones touching (if `self_overlap`).
+void check_polygon(const BoundaryGeometry& geometry, bool self_overlap) {
+  const std::size_t n = geometry.elements.size();
   // Self-overlap: adjacent elements that fold back, non-adjacent elements that touch or cross.
   for (std::size_t e = 0; e < n; ++e) {
     const BoundaryElement& a = geometry.elements[e];
@@ -113,8 +121,11 @@ BoundaryGeometry check_problem(const BoundaryProblem& problem, bool self_overlap
   if (twice_area <= 0.0)
     fail("the polygon is clockwise (signed area " + std::to_string(0.5 * twice_area) +
          "): list the nodes counter-clockwise, with the body on the left");
+}
 
-  // Prescribed displacements of two elements at their common node must agree.
+// Prescribed displacements of two elements at their common node must agree.
+void check_prescribed_agree(const BoundaryProblem& problem) {
+  const std::size_t n = problem.nodes.size();
   double largest = 0.0;
   for (const auto& data : problem.elements)
     for (int c = 0; c < 2; ++c)
@@ -135,6 +146,15 @@ BoundaryGeometry check_problem(const BoundaryProblem& problem, bool self_overlap
       }
     }
   }
+}
+
+}  // namespace
+
+BoundaryGeometry check_problem(const BoundaryProblem& problem, bool self_overlap) {
+  check_input(problem);
+  BoundaryGeometry geometry = element_geometry(problem);
+  check_polygon(geometry, self_overlap);
+  check_prescribed_agree(problem);
   return geometry;
 }
 

@@ -8,78 +8,104 @@
 
 namespace contact::ddm {
 
+namespace {
+
+// The contact multipliers of all pairs as one vector lambda, and their Uzawa update, Anderson-mixed (depth 5,
+// projected onto lambda >= 0, restarted when a mixed update makes the residual ten times worse).
+class UzawaMultipliers {
+ public:
+  explicit UzawaMultipliers(const ContactSystem& system)
+      : pairs_(system.pairs()), offset_(pairs_.size() + 1, 0), history_(5) {
+    for (size_t k = 0; k < pairs_.size(); ++k) offset_[k + 1] = offset_[k] + pairs_[k].n_rows();
+    sqrt_w_.resize(offset_.back());
+    for (size_t k = 0; k < pairs_.size(); ++k) sqrt_w_.segment(offset_[k], pairs_[k].n_rows()) = pairs_[k].area.cwiseSqrt();
+    lambda_ = Eigen::VectorXd::Zero(offset_.back());
+  }
+
+  // P(lambda): a solve's pressures, all pairs stacked.
+  Eigen::VectorXd image(const Pressures& solved) const {
+    Eigen::VectorXd out(offset_.back());
+    for (size_t k = 0; k < pairs_.size(); ++k) out.segment(offset_[k], pairs_[k].n_rows()) = solved[k];
+    return out;
+  }
+
+  // The fixed-point residual P(lambda) - lambda, weighted by the square roots of the rows' areas.
+  Eigen::VectorXd residual(const Eigen::VectorXd& image) const { return sqrt_w_.cwiseProduct(image - lambda_); }
+
+  // Its norm relative to the image's (0 for no pressure at all).
+  double relative_change(const Eigen::VectorXd& image, const Eigen::VectorXd& residual) const {
+    const double scale = sqrt_w_.cwiseProduct(image).norm();
+    return scale > 0 ? residual.norm() / scale : 0.0;
+  }
+
+  // lambda <- the Anderson-mixed image, projected onto lambda >= 0, and given to the system's pairs.
+  void update(ContactSystem& system, const Eigen::VectorXd& image, const Eigen::VectorXd& residual) {
+    if (residual.norm() > 10 * best_) {
+      history_.clear();
+      previous_lambda_.resize(0);
+    }
+    best_ = std::min(best_, residual.norm());
+    if (previous_lambda_.size()) history_.push(residual - previous_residual_, image - previous_image_);
+    previous_lambda_ = lambda_;
+    previous_residual_ = residual;
+    previous_image_ = image;
+    Eigen::VectorXd next = image;
+    history_.mix(residual, [&](double c, const Eigen::VectorXd& d_image) { next -= c * d_image; });
+    lambda_ = next.cwiseMax(0.0);
+    for (size_t k = 0; k < pairs_.size(); ++k) system.set_multipliers(k, lambda_.segment(offset_[k], pairs_[k].n_rows()));
+  }
+
+ private:
+  const std::vector<mortar::PairDiscretization>& pairs_;
+  std::vector<Eigen::Index> offset_;  // per pair, into lambda
+  Eigen::VectorXd sqrt_w_, lambda_;
+  linalg::AndersonHistory<Eigen::VectorXd> history_;  // multiplier fixed point: image differences
+  Eigen::VectorXd previous_lambda_, previous_residual_, previous_image_;
+  double best_ = std::numeric_limits<double>::infinity();
+};
+
+}  // namespace
+
 // Augmented Lagrangian (Uzawa): solve the penalty problem on the gaps shifted by theta lambda, then set lambda
 // to the resulting pressures P(lambda) = max(0, lambda - g / theta); repeat until the pressures settle. The fixed
 // point has g >= 0 where lambda = 0 and g = 0 where lambda > 0: exact non-penetration, for any theta.
 // Plain Uzawa converges linearly and slowly where points at the edge of the contact zone have both gap and
-// multiplier near zero (100 updates on stack3), so the multiplier fixed point is Anderson-mixed (depth 5,
-// projected onto lambda >= 0, restarted when a mixed update makes the residual ten times worse).
+// multiplier near zero (100 updates on stack3), so the multiplier fixed point is Anderson-mixed (UzawaMultipliers).
 MethodOutcome run_augmented_lagrangian(ContactSystem& system, const SolverSettings& settings, RunContext& context,
-                                       ContactMethod& method, int& updates) {
-  MethodOutcome total;
+                                       ContactMethod& method) {
+  OutcomeAccumulator updates_so_far;
+  MethodOutcome& total = updates_so_far.total();
   Displacements warm;
   const auto& al = settings.augmented_lagrangian;
-  const auto& pairs = system.pairs();
-  std::vector<Eigen::Index> offset(pairs.size() + 1, 0);
-  for (size_t k = 0; k < pairs.size(); ++k) offset[k + 1] = offset[k] + pairs[k].n_rows();
-  Eigen::VectorXd sqrt_w(offset.back());
-  for (size_t k = 0; k < pairs.size(); ++k) sqrt_w.segment(offset[k], pairs[k].n_rows()) = pairs[k].area.cwiseSqrt();
-  Eigen::VectorXd lambda = Eigen::VectorXd::Zero(offset.back());
-  linalg::AndersonHistory<Eigen::VectorXd> history(5);  // multiplier fixed point: image differences
-  Eigen::VectorXd previous_lambda, previous_residual, previous_image;
-  double best = std::numeric_limits<double>::infinity();
-
+  UzawaMultipliers multipliers(system);
   for (int update = 1; update <= al.max_updates; ++update) {
-    OffsetObserver observer(context.observer, total.iterations, update);
-    RunContext inner{observer, context.cancel, context.runner, context.start, warm.empty() ? nullptr : &warm};
-    MethodOutcome o = method.run(inner);
-    updates = update;
-    for (auto& r : o.history) {
-      r.iteration += total.iterations;
-      r.update = update;
-      total.history.push_back(std::move(r));
+    updates_so_far.run(context, warm.empty() ? nullptr : &warm, InnerMarks{update, {}},
+                       [&](RunContext& inner) { return method.run(inner); });
+    total.updates = update;
+    // The updates' stop is their own (below); their answer is the displacements and pressures alone, without
+    // rigid amplitudes or tangential multipliers (friction needs exact contact).
+    total.converged = false;
+    total.rigid_amplitudes.clear();
+    total.q.clear();
+    const std::string inner_message = std::move(total.message);
+    if (total.reason != StopReason::converged) {
+      total.message = "augmented Lagrangian update " + std::to_string(update) + ": " + inner_message;
+      return updates_so_far.take();
     }
-    total.iterations += o.iterations;
-    total.add_work(o);
-    total.gamma = o.gamma;
-    total.u = std::move(o.u);
-    total.z = std::move(o.z);
-    if (o.reason != StopReason::converged) {
-      total.reason = o.reason;
-      total.message = "augmented Lagrangian update " + std::to_string(update) + ": " + o.message;
-      return total;
-    }
-    // P(lambda): the pressures of this solve.
-    const Pressures solved = total.z.empty() ? system.penalty_pressures(total.u) : total.z;
-    Eigen::VectorXd image(offset.back());
-    for (size_t k = 0; k < pairs.size(); ++k) image.segment(offset[k], pairs[k].n_rows()) = solved[k];
-    const Eigen::VectorXd residual = sqrt_w.cwiseProduct(image - lambda);
-    const double scale = sqrt_w.cwiseProduct(image).norm();
-    const double change = scale > 0 ? residual.norm() / scale : 0.0;
+    const Eigen::VectorXd image = multipliers.image(total.z.empty() ? system.penalty_pressures(total.u) : total.z);
+    const Eigen::VectorXd residual = multipliers.residual(image);
+    const double change = multipliers.relative_change(image, residual);
     if (change <= al.tolerance) {
       // Keep the multipliers the last solve used, so that the reported pressures are exactly its pressures.
       total.converged = true;
       total.reason = StopReason::converged;
       std::ostringstream os;
       os << "augmented Lagrangian: pressures settled (relative change " << change << " <= " << al.tolerance << ") after "
-         << update << " updates; last inner solve: " << o.message;
+         << update << " updates; last inner solve: " << inner_message;
       total.message = os.str();
-      return total;
+      return updates_so_far.take();
     }
-    // Anderson-mixed Uzawa update.
-    if (residual.norm() > 10 * best) {
-      history.clear();
-      previous_lambda.resize(0);
-    }
-    best = std::min(best, residual.norm());
-    if (previous_lambda.size()) history.push(residual - previous_residual, image - previous_image);
-    previous_lambda = lambda;
-    previous_residual = residual;
-    previous_image = image;
-    Eigen::VectorXd next = image;
-    history.mix(residual, [&](double c, const Eigen::VectorXd& d_image) { next -= c * d_image; });
-    lambda = next.cwiseMax(0.0);
-    for (size_t k = 0; k < pairs.size(); ++k) system.set_multipliers(k, lambda.segment(offset[k], pairs[k].n_rows()));
+    multipliers.update(system, image, residual);
     warm = total.u;
     if (update == al.max_updates) {
       total.reason = StopReason::max_iterations;
@@ -88,8 +114,7 @@ MethodOutcome run_augmented_lagrangian(ContactSystem& system, const SolverSettin
       total.message = os.str();
     }
   }
-  return total;
+  return updates_so_far.take();
 }
-
 
 }  // namespace contact::ddm

@@ -6,8 +6,8 @@
 namespace contact::ddm {
 
 // Augmented Lagrangian (Uzawa): solve the penalty problem on the gaps shifted by theta lambda, then set lambda to
-// the resulting pressures; repeat until the pressures settle (augmented_lagrangian.cpp). updates receives how many.
+// the resulting pressures; repeat until the pressures settle (augmented_lagrangian.cpp). The outcome counts the updates.
 MethodOutcome run_augmented_lagrangian(ContactSystem& system, const SolverSettings& settings, RunContext& context,
-                                       ContactMethod& method, int& updates);
+                                       ContactMethod& method);
 
 }  // namespace contact::ddm

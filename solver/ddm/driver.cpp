@@ -6,20 +6,8 @@
 
 namespace contact::ddm {
 
-void OffsetObserver::on_iteration(const IterationReport& r) {
-  IterationReport copy = r;
-  copy.iteration += offset_;
-  if (update_ > 0) copy.update = update_;
-  if (!refined_.empty()) {
-    for (size_t a = 0; a < copy.bodies.size() && a < refined_.size(); ++a) copy.bodies[a].elements_refined = refined_[a];
-    refined_.clear();
-  }
-  inner_.on_iteration(copy);
-}
-
 MethodOutcome run_enforced(ContactSystem& system, const SolverSettings& settings, RunContext& context,
-                           ContactMethod& method, int& updates) {
-  updates = 0;
+                           ContactMethod& method) {
   if (settings.enforcement == Enforcement::exact &&
       (settings.method == Method::neumann || settings.method == Method::robin)) {
     MethodOutcome out;
@@ -30,7 +18,7 @@ MethodOutcome run_enforced(ContactSystem& system, const SolverSettings& settings
     return out;
   }
   if (settings.enforcement == Enforcement::augmented_lagrangian)
-    return run_augmented_lagrangian(system, settings, context, method, updates);
+    return run_augmented_lagrangian(system, settings, context, method);
   return method.run(context);
 }
 

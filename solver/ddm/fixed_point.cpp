@@ -3,8 +3,10 @@
 #include "../linalg/anderson.hpp"
 
 #include <cmath>
+#include <limits>
 #include <random>
 #include <sstream>
+#include <utility>
 
 namespace contact::ddm {
 
@@ -100,180 +102,251 @@ double estimate_spectral_radius(const ContactSystem& system, BodyMap& map, int i
   return rho;
 }
 
-MethodOutcome run_fixed_point(const ContactSystem& system, const SolverSettings& settings, RunContext& context,
-                              BodyMap& map, Displacements u) {
-  MethodOutcome out;
-  const size_t n = system.n_bodies();
-  int solves = 0;
-  double gamma = settings.gamma;
-  std::string pending_note;
-  if (settings.gamma_auto) {
-    // Eigenvalues of the relaxed map are 1 - gamma (1 - lambda) for F's eigenvalues lambda in [-rho, rho'];
-    // gamma = 2 / (2 + rho) balances the stiffest and the slowest modes. 0.9 of it covers the estimate's error.
-    const double rho = estimate_spectral_radius(system, map, 12, solves);
-    gamma = std::min(1.0, 1.8 / (2.0 + rho));
-    pending_note = format("gamma auto: spectral radius %.4g of the interface map, gamma = %.4g", rho, gamma);
+namespace {
+
+// The map's image of the current iterate and how far it moved: the interface residual r (contact-zone normal
+// displacements), its relative norm, and the whole-body difference R = u~ - u.
+struct Image {
+  Eigen::VectorXd r;
+  double residual = 0.0;
+  Displacements R;
+};
+
+// One run of the relaxed fixed point: the iterate, the relaxation with its safeguards (gamma backing off, Anderson
+// restarts) and the record of residuals the stop tests read. run() is the loop; each member below is one phase.
+class FixedPointIteration {
+ public:
+  FixedPointIteration(const ContactSystem& system, const SolverSettings& settings, RunContext& context, BodyMap& map,
+                      Displacements u)
+      : system_(system), settings_(settings), context_(context), map_(map), n_(system.n_bodies()),
+        gamma_(settings.gamma), anderson_requested_(settings.acceleration == Acceleration::anderson),
+        anderson_(anderson_requested_), u_(std::move(u)), zone_(stacked_zone_normals(system, u_)),
+        zone_per_body_(n_), history_(static_cast<size_t>(std::max(1, settings.anderson_depth))), best_u_(u_) {
+    for (size_t a = 0; a < n_; ++a) zone_per_body_[a] = system.zone_normals(a, u_[a]);
   }
-  const bool anderson_requested = settings.acceleration == Acceleration::anderson;
-  bool anderson = anderson_requested;
-  const size_t depth = static_cast<size_t>(std::max(1, settings.anderson_depth));
 
-  std::vector<std::vector<char>> active;
-  Eigen::VectorXd zone = stacked_zone_normals(system, u);
-  std::vector<Eigen::VectorXd> zone_per_body(n);
-  for (size_t a = 0; a < n; ++a) zone_per_body[a] = system.zone_normals(a, u[a]);
-
-  // Anderson history: iterate and residual differences (full bodies) and interface-residual differences.
-  linalg::AndersonHistory<std::pair<Displacements, Displacements>> history(depth);
-  Displacements previous_u, previous_R;
-  Eigen::VectorXd previous_r;
-  int failed_restarts = 0, growth = 0, backoffs = 0;
-  double smallest_residual = std::numeric_limits<double>::infinity(), last_residual = smallest_residual;
-  double best_at_restart = smallest_residual;
-  const int max_backoffs = 8;
-  Displacements best_u = u;
-  int best_iteration = 0;
-  double marked_best = std::numeric_limits<double>::infinity();  // the residual at best_iteration
-  const int stagnation_window = 100;
-
-  for (int k = 1; k <= settings.max_iterations; ++k) {
-    if (context.cancel.cancelled()) {
-      out.reason = StopReason::cancelled;
-      out.message = "cancelled";
-      break;
+  MethodOutcome run() {
+    choose_gamma();
+    for (int k = 1; k <= settings_.max_iterations; ++k) {
+      if (context_.cancel.cancelled()) {
+        out_.reason = StopReason::cancelled;
+        out_.message = "cancelled";
+        break;
+      }
+      const Image image = apply_map();
+      std::string note = std::move(pending_note_);
+      pending_note_.clear();
+      record_progress(k, image.residual);
+      const double paper = advance(next_iterate(k, image, note));
+      report(k, paper, image.residual, note);
+      if (test_for_stop(k, paper, image.residual)) break;
     }
-    const Displacements u_tilde = map.apply(u);
-    ++solves;
-    const Eigen::VectorXd zone_tilde = stacked_zone_normals(system, u_tilde);
-    const Eigen::VectorXd r = zone_tilde - zone;
-    const double scale = std::max(zone.norm(), zone_tilde.norm());
-    const double residual = scale > 0 ? r.norm() / scale : 0.0;
-    const Displacements R = difference(u_tilde, u);
-    std::string note = std::move(pending_note);
-    pending_note.clear();
+    if (anderson_requested_ && !anderson_) out_.message += " (Anderson acceleration was abandoned for plain relaxation)";
+    out_.u = std::move(u_);
+    out_.gamma = gamma_;
+    out_.solves_per_body = solves_;
+    return std::move(out_);
+  }
 
-    // Progress is a 0.1 % improvement on the residual at the last marked best (not on the running minimum,
-    // which a slow steady decrease would move every step without ever counting as progress).
-    if (residual < 0.999 * marked_best) {
-      best_iteration = k;
-      marked_best = residual;
-      best_u = u;
+ private:
+  static constexpr int max_backoffs = 8;
+  static constexpr int stagnation_window = 100;
+
+  // gamma "auto": the eigenvalues of the relaxed map are 1 - gamma (1 - lambda) for F's eigenvalues lambda in
+  // [-rho, rho']; gamma = 2 / (2 + rho) balances the stiffest and the slowest modes. 0.9 of it covers the
+  // estimate's error.
+  void choose_gamma() {
+    if (!settings_.gamma_auto) return;
+    const double rho = estimate_spectral_radius(system_, map_, 12, solves_);
+    gamma_ = std::min(1.0, 1.8 / (2.0 + rho));
+    pending_note_ = format("gamma auto: spectral radius %.4g of the interface map, gamma = %.4g", rho, gamma_);
+  }
+
+  // u~ = F(u) (one solve per body) and the residual it leaves.
+  Image apply_map() {
+    const Displacements u_tilde = map_.apply(u_);
+    ++solves_;
+    const Eigen::VectorXd zone_tilde = stacked_zone_normals(system_, u_tilde);
+    Image image;
+    image.r = zone_tilde - zone_;
+    const double scale = std::max(zone_.norm(), zone_tilde.norm());
+    image.residual = scale > 0 ? image.r.norm() / scale : 0.0;
+    image.R = difference(u_tilde, u_);
+    return image;
+  }
+
+  // Progress is a 0.1 % improvement on the residual at the last marked best (not on the running minimum, which a
+  // slow steady decrease would move every step without ever counting as progress).
+  void record_progress(int k, double residual) {
+    if (residual < 0.999 * marked_best_) {
+      best_iteration_ = k;
+      marked_best_ = residual;
+      best_u_ = u_;
     }
-    growth = residual > last_residual ? growth + 1 : 0;
-    last_residual = residual;
-    smallest_residual = std::min(smallest_residual, residual);
+    growth_ = residual > last_residual_ ? growth_ + 1 : 0;
+    last_residual_ = residual;
+    smallest_residual_ = std::min(smallest_residual_, residual);
+  }
 
-    Displacements next;
+  // The next iterate: backed off if the residual grows or stalls under gamma "auto", else Anderson-mixed or the
+  // plain relaxation of paper (17).
+  Displacements next_iterate(int k, const Image& image, std::string& note) {
     // Anderson residuals are not monotone (its own restart handles overshoots), so under it only a large
     // growth counts.
+    const double residual = image.residual;
     const bool growing = !std::isfinite(residual) ||
-                         (anderson ? residual > 100.0 * smallest_residual
-                                   : growth >= 3 && residual > 1.5 * smallest_residual);
-    const bool stalled = k - best_iteration >= stagnation_window / 2;
-    if (settings.gamma_auto && backoffs < max_backoffs && (growing || stalled)) {
-      // Back off: a smaller gamma from the best iterate, history forgotten. A stall counts too: the penalty
-      // switching points on and off can hold a too-large gamma in a cycle without any growth.
-      gamma *= 0.5;
-      ++backoffs;
-      note = format(growing ? "gamma reduced to %.4g: the residual grew from %.3g to %.3g"
-                            : "gamma reduced to %.4g: no progress below %.3g (now %.3g)",
-                    gamma, smallest_residual, residual);
-      best_iteration = k;
-      next = best_u;
-      history.clear();
-      previous_u.clear();
-      growth = 0;
-    } else if (anderson) {
-      if (!previous_u.empty()) history.push(r - previous_r, {difference(u, previous_u), difference(R, previous_R)});
-      previous_u = u;
-      previous_R = R;
-      previous_r = r;
-      next = axpy(u, gamma, R);
-      // min || r - dr c || by QR; columns that make it ill-conditioned are dropped (oldest first).
-      history.mix(r, [&](double c, const std::pair<Displacements, Displacements>& d) {
-        for (size_t a = 0; a < n; ++a) next[a] -= c * (d.first[a] + gamma * d.second[a]);
-      });
-      // Safeguard: an accelerated residual ten times the best restarts the history from the best iterate;
-      // four restarts in a row without a 10 % improvement of the best in between fall back to plain relaxation.
-      if (residual > 10.0 * smallest_residual && !history.empty()) {
-        failed_restarts = smallest_residual < 0.9 * best_at_restart ? 0 : failed_restarts + 1;
-        best_at_restart = smallest_residual;
-        note = "Anderson restarted (residual " + format("%.3g", residual) + " above ten times the best)";
-        if (failed_restarts >= 4) {
-          anderson = false;
-          note = "Anderson acceleration abandoned after 4 restarts without progress: plain relaxation";
-        }
-        history.clear();
-        previous_u.clear();
-        next = axpy(best_u, gamma, difference(map.apply(best_u), best_u));
-        ++solves;
+                         (anderson_ ? residual > 100.0 * smallest_residual_
+                                    : growth_ >= 3 && residual > 1.5 * smallest_residual_);
+    const bool stalled = k - best_iteration_ >= stagnation_window / 2;
+    if (settings_.gamma_auto && backoffs_ < max_backoffs && (growing || stalled)) return back_off(k, growing, residual, note);
+    if (anderson_) return mix(image, note);
+    return axpy(u_, gamma_, image.R);  // paper (17)
+  }
+
+  // Back off: a smaller gamma from the best iterate, history forgotten. A stall counts too: the penalty switching
+  // points on and off can hold a too-large gamma in a cycle without any growth.
+  Displacements back_off(int k, bool growing, double residual, std::string& note) {
+    gamma_ *= 0.5;
+    ++backoffs_;
+    note = format(growing ? "gamma reduced to %.4g: the residual grew from %.3g to %.3g"
+                          : "gamma reduced to %.4g: no progress below %.3g (now %.3g)",
+                  gamma_, smallest_residual_, residual);
+    best_iteration_ = k;
+    history_.clear();
+    previous_u_.clear();
+    growth_ = 0;
+    return best_u_;
+  }
+
+  // Anderson mixing of the relaxed update: min || r - dr c || by QR; columns that make it ill-conditioned are
+  // dropped (oldest first).
+  Displacements mix(const Image& image, std::string& note) {
+    if (!previous_u_.empty())
+      history_.push(image.r - previous_r_, {difference(u_, previous_u_), difference(image.R, previous_R_)});
+    previous_u_ = u_;
+    previous_R_ = image.R;
+    previous_r_ = image.r;
+    Displacements next = axpy(u_, gamma_, image.R);
+    history_.mix(image.r, [&](double c, const std::pair<Displacements, Displacements>& d) {
+      for (size_t a = 0; a < n_; ++a) next[a] -= c * (d.first[a] + gamma_ * d.second[a]);
+    });
+    // Safeguard: an accelerated residual ten times the best restarts the history from the best iterate; four
+    // restarts in a row without a 10 % improvement of the best in between fall back to plain relaxation.
+    if (image.residual > 10.0 * smallest_residual_ && !history_.empty()) {
+      failed_restarts_ = smallest_residual_ < 0.9 * best_at_restart_ ? 0 : failed_restarts_ + 1;
+      best_at_restart_ = smallest_residual_;
+      note = "Anderson restarted (residual " + format("%.3g", image.residual) + " above ten times the best)";
+      if (failed_restarts_ >= 4) {
+        anderson_ = false;
+        note = "Anderson acceleration abandoned after 4 restarts without progress: plain relaxation";
       }
-    } else {
-      // Paper (17).
-      next = axpy(u, gamma, R);
+      history_.clear();
+      previous_u_.clear();
+      next = axpy(best_u_, gamma_, difference(map_.apply(best_u_), best_u_));
+      ++solves_;
     }
+    return next;
+  }
 
+  // u <- next; returns the paper's criterion: the largest relative change of a body's contact-zone displacements.
+  double advance(Displacements next) {
     double paper = 0.0;
-    for (size_t a = 0; a < n; ++a) {
-      const Eigen::VectorXd z_new = system.zone_normals(a, next[a]);
-      paper = std::max(paper, relative_change(z_new, zone_per_body[a]));
-      zone_per_body[a] = z_new;
+    for (size_t a = 0; a < n_; ++a) {
+      const Eigen::VectorXd z_new = system_.zone_normals(a, next[a]);
+      paper = std::max(paper, relative_change(z_new, zone_per_body_[a]));
+      zone_per_body_[a] = z_new;
     }
-    u = std::move(next);
-    zone = stacked_zone_normals(system, u);
+    u_ = std::move(next);
+    zone_ = stacked_zone_normals(system_, u_);
+    return paper;
+  }
 
-    IterationReport rep = system.report(k, u, active);
+  void report(int k, double paper, double residual, const std::string& note) {
+    IterationReport rep = system_.report(k, u_, active_);
     rep.paper_criterion = paper;
     rep.fixed_point_residual = residual;
-    rep.gamma = gamma;
+    rep.gamma = gamma_;
     rep.note = note;
-    rep.elapsed_seconds = context.elapsed();
-    context.observer.on_iteration(rep);
-    out.history.push_back(std::move(rep));
-    out.iterations = k;
+    rep.elapsed_seconds = context_.elapsed();
+    context_.observer.on_iteration(rep);
+    out_.history.push_back(std::move(rep));
+    out_.iterations = k;
+  }
 
-    const double measure = settings.criterion == Criterion::paper ? paper : residual;
-    if (measure <= settings.tolerance) {
-      out.converged = true;
-      out.reason = StopReason::converged;
+  // Converged, stagnating, diverging (fixed gamma) or out of iterations: sets the outcome's stop; true to stop now.
+  bool test_for_stop(int k, double paper, double residual) {
+    const double measure = settings_.criterion == Criterion::paper ? paper : residual;
+    if (measure <= settings_.tolerance) {
+      out_.converged = true;
+      out_.reason = StopReason::converged;
       std::ostringstream os;
-      os << (settings.criterion == Criterion::paper ? "paper's criterion " : "fixed-point residual ") << measure
-         << " <= " << settings.tolerance;
-      out.message = os.str();
-      break;
+      os << (settings_.criterion == Criterion::paper ? "paper's criterion " : "fixed-point residual ") << measure
+         << " <= " << settings_.tolerance;
+      out_.message = os.str();
+      return true;
     }
-    if (k - best_iteration >= stagnation_window) {
+    if (k - best_iteration_ >= stagnation_window) {
       // A relaxation above the stability bound does not always blow up: the penalty switching contact on and
       // off can lock it into a cycle (seen with gamma = 1 on seed_layers).
       std::ostringstream os;
-      os << "the iteration stagnates: the fixed-point residual has not fallen below " << smallest_residual
-         << " (reached at iteration " << best_iteration << ") in " << stagnation_window << " iterations";
-      if (smallest_residual > 1e-6) os << "; gamma = " << gamma << " is probably above the stability bound: reduce it";
-      out.reason = StopReason::stagnation;
-      out.message = os.str();
-      break;
+      os << "the iteration stagnates: the fixed-point residual has not fallen below " << smallest_residual_
+         << " (reached at iteration " << best_iteration_ << ") in " << stagnation_window << " iterations";
+      if (smallest_residual_ > 1e-6) os << "; gamma = " << gamma_ << " is probably above the stability bound: reduce it";
+      out_.reason = StopReason::stagnation;
+      out_.message = os.str();
+      return true;
     }
-    if (!settings.gamma_auto &&
-        (!std::isfinite(residual) || (k > 5 && residual > 1e3 * smallest_residual && residual > 1.0))) {
+    if (!settings_.gamma_auto &&
+        (!std::isfinite(residual) || (k > 5 && residual > 1e3 * smallest_residual_ && residual > 1.0))) {
       std::ostringstream os;
-      os << "the iteration diverges: the fixed-point residual grew from " << smallest_residual << " to " << residual
-         << " at iteration " << k << "; reduce gamma (now " << gamma << ") or use gamma \"auto\"";
-      out.reason = StopReason::error;
-      out.message = os.str();
-      break;
+      os << "the iteration diverges: the fixed-point residual grew from " << smallest_residual_ << " to " << residual
+         << " at iteration " << k << "; reduce gamma (now " << gamma_ << ") or use gamma \"auto\"";
+      out_.reason = StopReason::error;
+      out_.message = os.str();
+      return true;
     }
-    if (k == settings.max_iterations) {
-      out.reason = StopReason::max_iterations;
+    if (k == settings_.max_iterations) {
+      out_.reason = StopReason::max_iterations;
       std::ostringstream os;
       os << "max_iterations = " << k << " reached; fixed-point residual " << residual << ", paper's criterion " << paper;
-      out.message = os.str();
+      out_.message = os.str();
     }
+    return false;
   }
-  if (anderson_requested && !anderson) out.message += " (Anderson acceleration was abandoned for plain relaxation)";
-  out.u = std::move(u);
-  out.gamma = gamma;
-  out.solves_per_body = solves;
-  return out;
+
+  const ContactSystem& system_;
+  const SolverSettings& settings_;
+  RunContext& context_;
+  BodyMap& map_;
+  const size_t n_;
+  MethodOutcome out_;
+  int solves_ = 0;
+  double gamma_;
+  std::string pending_note_;  // for the first report: how gamma was chosen
+  const bool anderson_requested_;
+  bool anderson_;  // false once Anderson was abandoned for plain relaxation
+  std::vector<std::vector<char>> active_;  // per pair, the contact nodes in contact at the last report
+  Displacements u_;
+  Eigen::VectorXd zone_;                       // u's contact-zone normal displacements, all bodies stacked
+  std::vector<Eigen::VectorXd> zone_per_body_;  // the same per body
+  // Anderson history: iterate and residual differences (full bodies) and interface-residual differences.
+  linalg::AndersonHistory<std::pair<Displacements, Displacements>> history_;
+  Displacements previous_u_, previous_R_;
+  Eigen::VectorXd previous_r_;
+  int failed_restarts_ = 0, growth_ = 0, backoffs_ = 0;
+  double smallest_residual_ = std::numeric_limits<double>::infinity();
+  double last_residual_ = std::numeric_limits<double>::infinity();
+  double best_at_restart_ = std::numeric_limits<double>::infinity();
+  Displacements best_u_;
+  int best_iteration_ = 0;
+  double marked_best_ = std::numeric_limits<double>::infinity();  // the residual at best_iteration_
+};
+
+}  // namespace
+
+MethodOutcome run_fixed_point(const ContactSystem& system, const SolverSettings& settings, RunContext& context,
+                              BodyMap& map, Displacements u) {
+  return FixedPointIteration(system, settings, context, map, std::move(u)).run();
 }
 
 }  // namespace contact::ddm

@@ -13,6 +13,6 @@
 namespace contact::ddm {
 
 MethodOutcome run_load_steps(ContactSystem& system, const SolverSettings& settings, const std::vector<double>& factors,
-                             RunContext& context, ContactMethod& method, StepLog& steps, int& updates);
+                             RunContext& context, ContactMethod& method, StepLog& steps);
 
 }  // namespace contact::ddm

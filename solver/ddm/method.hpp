@@ -31,20 +31,13 @@ struct MethodOutcome {
   StopReason reason = StopReason::error;
   std::string message;
   int iterations = 0;
+  int updates = 0;  // augmented-Lagrangian updates (0 for the penalty or exact problem alone)
   double gamma = 0.0;
   int solves_per_body = 0;  // subdomain solves (back-substitutions) per body, initial guess included
   double indicator_seconds = 0.0;  // adaptivity: time spent estimating (BEM solves and evaluations)
   std::string interface_solver;    // interface_newton: "direct" or "iterative" (the last one used)
   long interface_iterations = 0;   // the iterative interface solver's products with the interface operator
   std::vector<IterationReport> history;
-
-  // Adds the work of an inner run (a load step, an update, an adaptive step) to this total: solves, interface
-  // iterations, the solver used (iterations and history are renumbered by the caller).
-  void add_work(const MethodOutcome& inner) {
-    solves_per_body += inner.solves_per_body;
-    interface_iterations += inner.interface_iterations;
-    if (!inner.interface_solver.empty()) interface_solver = inner.interface_solver;
-  }
 };
 
 // A contact method on a ContactSystem: run() solves once on the pairs' current gaps (and augmented-Lagrangian

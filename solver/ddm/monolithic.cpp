@@ -182,6 +182,25 @@ bool solve_sets(const Stacked& s, const linalg::FrictionParametrization& p, Eige
   return true;
 }
 
+bool any_floating(const ContactSystem& system) {
+  bool floating = false;
+  for (size_t a = 0; a < system.n_bodies(); ++a) floating = floating || system.body(a).floating();
+  return floating;
+}
+
+// The paper's criterion: the largest relative change of a body's contact-zone normal displacements from `zone`
+// to u's (0 unless `measure`); `zone` becomes u's.
+double zone_change(const ContactSystem& system, const Displacements& u, std::vector<Eigen::VectorXd>& zone,
+                   bool measure = true) {
+  double paper = 0.0;
+  for (size_t a = 0; a < system.n_bodies(); ++a) {
+    const Eigen::VectorXd zn = system.zone_normals(a, u[a]);
+    if (measure) paper = std::max(paper, relative_change(zn, zone[a]));
+    zone[a] = zn;
+  }
+  return paper;
+}
+
 MethodOutcome run_exact(const ContactSystem& system, const SolverSettings& settings, RunContext& context) {
   MethodOutcome out;
   const Stacked s = stack(system, false);
@@ -192,8 +211,7 @@ MethodOutcome run_exact(const ContactSystem& system, const SolverSettings& setti
   // A floating body is held only by its contacts: start with every contact node active (the saddle-point system
   // of an empty active set would be singular), and let the active set shrink to the nodes that press. Nodes in
   // contact start sticking.
-  bool floating = false;
-  for (size_t a = 0; a < system.n_bodies(); ++a) floating = floating || system.body(a).floating();
+  const bool floating = any_floating(system);
   linalg::FrictionSets sets;
   sets.active.assign(static_cast<size_t>(m), 0);
   for (Eigen::Index r = 0; r < m; ++r) sets.active[static_cast<size_t>(r)] = floating && !mask[static_cast<size_t>(r)];
@@ -220,12 +238,7 @@ MethodOutcome run_exact(const ContactSystem& system, const SolverSettings& setti
     const Eigen::VectorXd h = s.g0 + s.B * x;
     linalg::FrictionSets next = linalg::predict_friction_sets(lambda, h, c, s.friction, mask);
     const Displacements u = to_bodies(system, s, x);
-    double paper = 0.0;
-    for (size_t a = 0; a < system.n_bodies(); ++a) {
-      const Eigen::VectorXd zn = system.zone_normals(a, u[a]);
-      if (!first) paper = std::max(paper, relative_change(zn, zone[a]));
-      zone[a] = zn;
-    }
+    const double paper = zone_change(system, u, zone, !first);
     const Pressures z = split_rows(system, s, lambda);
     IterationReport r = system.report(k, u, z, report_active);
     if (!s.friction.empty()) system.report_friction(z, split_tangential(system, s, lambda), r);
@@ -261,6 +274,57 @@ MethodOutcome run_exact(const ContactSystem& system, const SolverSettings& setti
   return out;
 }
 
+// The penalty problem on the stacked system: the convex energy
+// E(x) = 1/2 x^T K x - b^T x + sum_r 1 / (2 theta D_r) min(0, g_r(x))^2, its gradient and its Newton matrix.
+struct PenaltyEnergy {
+  const Stacked& s;
+  Eigen::VectorXd w_over_theta;  // 1 / (theta D_r): the penalty stiffness of row r
+
+  PenaltyEnergy(const ContactSystem& system, const Stacked& stacked) : s(stacked), w_over_theta(stacked.D.size()) {
+    for (Eigen::Index r = 0; r < s.D.size(); ++r)
+      w_over_theta[r] = 1.0 / (system.pairs()[static_cast<size_t>(s.row_pair[static_cast<size_t>(r)])].theta * s.D[r]);
+  }
+
+  double operator()(const Eigen::VectorXd& x) const {
+    double e = 0.5 * x.dot(s.K * x) - s.b.dot(x);
+    const Eigen::VectorXd g = s.g0 + s.B * x;
+    for (Eigen::Index r = 0; r < g.size(); ++r)
+      if (g[r] < 0) e += 0.5 * w_over_theta[r] * g[r] * g[r];
+    return e;
+  }
+
+  Eigen::VectorXd gradient(const Eigen::VectorXd& x) const {
+    const Eigen::VectorXd g = s.g0 + s.B * x;
+    const Eigen::VectorXd f = w_over_theta.cwiseProduct(g.cwiseMin(0.0));
+    return Eigen::VectorXd(s.K * x - s.b + s.B.transpose() * f);
+  }
+
+  // K + B^T W_A B on the active set of x (g < 0; with `touching`, g <= 0: a floating body's first step counts
+  // the touching nodes too, or the matrix would be singular).
+  SpMat newton_matrix(const Eigen::VectorXd& x, bool touching) const {
+    const Eigen::VectorXd g = s.g0 + s.B * x;
+    Eigen::VectorXd wa = Eigen::VectorXd::Zero(g.size());
+    for (Eigen::Index r = 0; r < g.size(); ++r)
+      if (g[r] < 0 || (touching && g[r] <= 0)) wa[r] = w_over_theta[r];
+    return s.K + SpMat(s.B.transpose() * wa.asDiagonal() * s.B);
+  }
+};
+
+// Backtracking (Armijo) line search on the convex energy from x along `step` (grad: the gradient at x); moves x
+// and returns the step length taken.
+double line_search(const PenaltyEnergy& energy, Eigen::VectorXd& x, const Eigen::VectorXd& step,
+                   const Eigen::VectorXd& grad) {
+  const double e0 = energy(x), slope = grad.dot(step);
+  double alpha = 1.0;
+  Eigen::VectorXd x_new = x + step;
+  for (int ls = 0; ls < 30 && energy(x_new) > e0 + 1e-4 * alpha * slope + 1e-15 * std::abs(e0); ++ls) {
+    alpha *= 0.5;
+    x_new = x + alpha * step;
+  }
+  x = x_new;
+  return alpha;
+}
+
 MethodOutcome run_penalty(const ContactSystem& system, const SolverSettings& settings, RunContext& context) {
   MethodOutcome out;
   const Stacked s = stack(system, true);
@@ -269,33 +333,12 @@ MethodOutcome run_penalty(const ContactSystem& system, const SolverSettings& set
     out.message = "monolithic: friction needs exact contact (enforcement exact)";
     return out;
   }
-  const Eigen::Index n = s.b.size();
-  Eigen::VectorXd w_over_theta(s.D.size());  // 1 / (theta D_r): the penalty stiffness of row r
-  for (Eigen::Index r = 0; r < s.D.size(); ++r)
-    w_over_theta[r] = 1.0 / (system.pairs()[static_cast<size_t>(s.row_pair[static_cast<size_t>(r)])].theta * s.D[r]);
-
-  auto energy = [&](const Eigen::VectorXd& x) {
-    double e = 0.5 * x.dot(s.K * x) - s.b.dot(x);
-    const Eigen::VectorXd g = s.g0 + s.B * x;
-    for (Eigen::Index r = 0; r < g.size(); ++r)
-      if (g[r] < 0) e += 0.5 * w_over_theta[r] * g[r] * g[r];
-    return e;
-  };
-  auto gradient = [&](const Eigen::VectorXd& x) {
-    const Eigen::VectorXd g = s.g0 + s.B * x;
-    const Eigen::VectorXd f = w_over_theta.cwiseProduct(g.cwiseMin(0.0));
-    return Eigen::VectorXd(s.K * x - s.b + s.B.transpose() * f);
-  };
-
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
-  bool floating = false;
-  for (size_t a = 0; a < system.n_bodies(); ++a) floating = floating || system.body(a).floating();
+  const PenaltyEnergy energy(system, s);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(s.b.size());
+  const bool floating = any_floating(system);
   std::vector<std::vector<char>> active_report;
   std::vector<Eigen::VectorXd> zone(system.n_bodies());
-  {
-    const Displacements u0 = to_bodies(system, s, x);
-    for (size_t a = 0; a < system.n_bodies(); ++a) zone[a] = system.zone_normals(a, u0[a]);
-  }
+  zone_change(system, to_bodies(system, s, x), zone, false);  // the start's zones
   const double b_norm = std::max(s.b.norm(), 1e-300);
   Eigen::CholmodDecomposition<SpMat, Eigen::Lower> factor;
   const int max_newton = std::max(settings.max_iterations, 1);
@@ -305,15 +348,9 @@ MethodOutcome run_penalty(const ContactSystem& system, const SolverSettings& set
       out.message = "cancelled";
       break;
     }
-    // Newton matrix on the current active set: K + B^T W_A B. With a floating body the first step also counts
-    // the touching nodes (g = 0) as active, or the matrix would be singular.
-    const Eigen::VectorXd g = s.g0 + s.B * x;
-    Eigen::VectorXd wa = Eigen::VectorXd::Zero(g.size());
-    for (Eigen::Index r = 0; r < g.size(); ++r)
-      if (g[r] < 0 || (k == 1 && floating && g[r] <= 0)) wa[r] = w_over_theta[r];
-    const SpMat H = s.K + SpMat(s.B.transpose() * wa.asDiagonal() * s.B);
-    const Eigen::VectorXd grad = gradient(x);
-    factor.compute(H);
+    // Newton step on the current active set, then the line search.
+    const Eigen::VectorXd grad = energy.gradient(x);
+    factor.compute(energy.newton_matrix(x, k == 1 && floating));
     if (factor.info() != Eigen::Success) {
       out.reason = StopReason::error;
       out.message = std::string("monolithic: the Newton matrix could not be factorised") +
@@ -321,23 +358,11 @@ MethodOutcome run_penalty(const ContactSystem& system, const SolverSettings& set
       break;
     }
     const Eigen::VectorXd step = factor.solve(-grad);
-    // Backtracking (Armijo) line search on the convex energy.
-    const double e0 = energy(x), slope = grad.dot(step);
-    double alpha = 1.0;
-    Eigen::VectorXd x_new = x + step;
-    for (int ls = 0; ls < 30 && energy(x_new) > e0 + 1e-4 * alpha * slope + 1e-15 * std::abs(e0); ++ls) {
-      alpha *= 0.5;
-      x_new = x + alpha * step;
-    }
-    x = x_new;
+    const double alpha = line_search(energy, x, step, grad);
+    // Report: the paper's criterion and the relative energy gradient.
     const Displacements u = to_bodies(system, s, x);
-    double paper = 0.0;
-    for (size_t a = 0; a < system.n_bodies(); ++a) {
-      const Eigen::VectorXd zn = system.zone_normals(a, u[a]);
-      paper = std::max(paper, relative_change(zn, zone[a]));
-      zone[a] = zn;
-    }
-    const double residual = gradient(x).norm() / b_norm;
+    const double paper = zone_change(system, u, zone);
+    const double residual = energy.gradient(x).norm() / b_norm;
     IterationReport r = system.report(k, u, active_report);
     r.paper_criterion = paper;
     r.measure = Measure::gradient;
@@ -347,6 +372,7 @@ MethodOutcome run_penalty(const ContactSystem& system, const SolverSettings& set
     context.observer.on_iteration(r);
     out.history.push_back(std::move(r));
     out.iterations = k;
+    // Stop: the active set unchanged and the gradient or the step negligible.
     const double step_size = alpha * step.norm() / std::max(x.norm(), 1e-300);
     if (k > 1 && changed == 0 && (residual <= 1e-12 || step_size <= 1e-13)) {
       out.converged = true;

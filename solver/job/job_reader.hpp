@@ -83,6 +83,13 @@ bool has_edge(const MeshInput& m, const std::string& name);
 // its edges (vertices); nullopt otherwise.
 std::optional<std::string> gmsh_elsewhere(const MeshInput& m, const std::string& name, bool vertex = false);
 
+// Reads a node index of an explicit mesh, checked against its node count (out of range: an error, nullopt).
+struct NodeIndex {
+  size_t node_count;
+  Errors& errors;
+  std::optional<int> operator()(const json& v, const std::string& ptr, const std::string& what) const;
+};
+
 class JobReader {
  public:
   JobReader(const json& job, const Limits& limits) : job_(job), limits_(limits), normalized_(job), gmsh_(limits) {}
@@ -100,8 +107,15 @@ class JobReader {
 
   // read_options.cpp: solver, adaptivity, loading, parallel, output
   void read_solver(const Fields& top);
+  void read_solver_fields(const json& value, const std::string& pointer, json& out);
+  void read_method(const json& value, const std::string& pointer);
+  void read_gamma(const json& value, const std::string& pointer);
+  void read_enforcement(const json& value, const std::string& pointer);
+  void write_solver_defaults(json& out);
   void resolve_method_defaults();
   void read_adaptivity(const json& value, const std::string& pointer);
+  void read_adaptive_bodies(const json& value, const std::string& pointer);
+  void write_adaptivity_defaults(json& out);
   void read_robin(const json& value, const std::string& pointer);
   void read_augmented_lagrangian(const json& value, const std::string& pointer);
   void read_interface_solver(const json& value, const std::string& pointer);
@@ -115,6 +129,13 @@ class JobReader {
   void read_body(const json& value, BodyInput& in, json& out);
   void read_material(const json& value, const std::string& pointer, Material& material);
   void read_boundary(const json& value, const std::string& pointer, BodyInput& in);
+  void read_condition(const json& value, const std::string& pointer, BodyInput& in,
+                      std::map<std::string, std::string>& first_pointer_of_place);
+  void read_condition_place(const Fields& f, bool at_vertex, const MeshInput& mesh, BoundaryCondition& bc,
+                            std::map<std::string, std::string>& first_pointer_of_place);
+  bool condition_kinds_allowed(const Fields& f, const std::string& pointer, bool at_vertex);
+  void read_condition_values(const Fields& f, const std::string& pointer, BoundaryCondition& bc);
+  void check_loads_off_supports(const Fields& f, const std::string& pointer, const BoundaryCondition& bc);
   void check_restrained(BodyInput& in);
   void check_loads_reach_the_body(const BodyInput& in);
   void check_floating_bodies();
@@ -122,10 +143,18 @@ class JobReader {
   // read_meshes.cpp: blocks and their curves, explicit arrays, Gmsh surfaces; building and checking the meshes
   void read_mesh(const json& value, const std::string& pointer, MeshInput& m, json& out);
   void read_block(const json& value, const std::string& pointer, MeshInput& m);
+  bool read_block_corners(const Fields& f, mesh::BlockSpec& spec);
+  void read_block_size(const Fields& f, MeshInput& m);
+  void read_block_grading(const json& value, const std::string& pointer, mesh::BlockSpec& spec);
+  void fit_block_curves(MeshInput& m);
   void read_gmsh(const json& value, const std::string& pointer, MeshInput& m, json& out);
   std::optional<long long> read_count(const json& value, const std::string& pointer, const std::string& what);
   void read_curve(const json& value, const std::string& pointer, const std::string& edge, MeshInput& m);
   void read_arrays(const json& value, const std::string& pointer, MeshInput& m, json& out);
+  size_t read_nodes(const json& nodes, const std::string& pointer, MeshInput& m);
+  void read_quads(const json& quads, const std::string& pointer, const NodeIndex& index, MeshInput& m);
+  void read_named_edges(const Fields& f, bool nodes_ok, const NodeIndex& index, MeshInput& m, json& out);
+  void read_named_vertices(const Fields& f, bool nodes_ok, const NodeIndex& index, MeshInput& m, json& out);
   bool no_side_twice(const std::string& name, const std::vector<std::array<int, 2>>& pairs,
                      const std::string& pointer);
   template <typename Index>

@@ -117,100 +117,129 @@ void JobReader::read_boundary(const json& value, const std::string& pointer, Bod
     return;
   }
   std::map<std::string, std::string> first_pointer_of_place;
-  for (size_t j = 0; j < value.size(); ++j) {
-    const std::string bp = child(pointer, j);
-    Fields f(value[j], bp, "a boundary condition", {"edge", "vertex", "displacement", "traction", "force", "free", "history"},
-             errors_);
-    if (!f.ok()) continue;
-    const size_t before = errors_.size();
-    BoundaryCondition bc;
-    if (f.has("edge") == f.has("vertex")) {
-      errors_.add(bp, "give exactly one of edge (a named edge of the body) and vertex (a named vertex)");
-      continue;
-    }
-    const bool at_vertex = f.has("vertex");
-    const std::string place_key = at_vertex ? "vertex" : "edge";
-    const std::vector<std::string>& names = at_vertex ? in.mesh.vertex_names : in.mesh.edge_names;
-    if (const json* e = f.find(place_key))
-      if (auto s = read::string(*e, f.at(place_key), place_key, errors_)) {
-        (at_vertex ? bc.vertex : bc.edge) = *s;
-        const bool known = std::find(names.begin(), names.end(), *s) != names.end();
-        if (in.mesh.edges_known && !known) {
-          const auto elsewhere = gmsh_elsewhere(in.mesh, *s, at_vertex);
-          errors_.add(f.at(place_key),
-                      elsewhere.value_or("the body has no " + place_key + " '" + read::shown(*s) + "'; " +
-                                         (names.empty() ? std::string("it has no named ") + place_key + "s"
-                                                        : "its " + std::string(at_vertex ? "vertices" : "edges") +
-                                                              " are " + join_names(names))));
-        } else {
-          auto [it, inserted] = first_pointer_of_place.emplace(place_key + ":" + *s, bp);
-          if (!inserted)
-            errors_.add(f.at(place_key), place_key + " '" + *s + "' already has a condition at " + it->second +
-                                             "; give each " + place_key +
-                                             " one condition (displacement fixes only its given components)");
-        }
-      }
-    const int loads = int(f.has("traction")) + int(f.has("force"));
-    const int kinds = int(f.has("displacement")) + loads + int(f.has("free"));
-    if (kinds == 0 || loads > 1 || (f.has("free") && kinds > 1)) {
-      errors_.add(bp, "give a displacement, a load (traction or force), a displacement with a load on the other "
-                      "component, or free");
-      continue;
-    }
-    if (at_vertex && (f.has("traction") || f.has("free"))) {
-      errors_.add(bp, "a vertex takes a displacement (a point support) or a force (a point load), not " +
-                          std::string(f.has("traction") ? "a traction (a force per length)" : "free"));
-      continue;
-    }
-    if (const json* d = f.find("displacement")) {
-      bc.kind = BoundaryCondition::Kind::displacement;
-      Fields df(*d, f.at("displacement"), "displacement", {"x", "y"}, errors_);
-      if (df.ok() && !df.has("x") && !df.has("y"))
-        errors_.add(f.at("displacement"), "give at least one of the components x and y");
-      if (const json* x = df.find("x")) bc.ux = read::number(*x, df.at("x"), "displacement x", errors_);
-      if (const json* y = df.find("y")) bc.uy = read::number(*y, df.at("y"), "displacement y", errors_);
-      if (loads && bc.ux && bc.uy)
-        errors_.add(bp, "both displacement components are prescribed: a load here would go straight into the support");
-    }
-    if (const json* t = f.find("traction")) {
-      bc.kind = BoundaryCondition::Kind::traction;
-      if (t->is_object()) {
-        Fields tf(*t, f.at("traction"), "traction", {"normal"}, errors_);
-        if (const json* p = tf.require("normal", "the normal pressure, positive pushing into the body")) {
-          bc.normal_pressure = true;
-          bc.pressure = read::number(*p, tf.at("normal"), "normal pressure", errors_).value_or(0.0);
-        }
-      } else if (t->is_array()) {
-        if (auto v = read::pair(*t, f.at("traction"), "traction", errors_)) bc.traction = *v;
-      } else {
-        errors_.add(f.at("traction"),
-                    "traction must be a vector [tx, ty] or {\"normal\": p}, got " + read::type_name(*t));
-      }
-    } else if (const json* fo = f.find("force")) {
-      bc.kind = BoundaryCondition::Kind::force;
-      if (auto v = read::pair(*fo, f.at("force"), "force", errors_)) bc.force = *v;
-    } else if (f.has("free")) {
-      bc.kind = BoundaryCondition::Kind::free;
-      auto b = read::boolean(*f.find("free"), f.at("free"), "free", errors_);
-      if (b && !*b) errors_.add(f.at("free"), "free must be true (an edge without a condition is free anyway)");
-    }
-    if (f.has("displacement") && bc.normal_pressure)
-      errors_.add(bp, "a normal pressure cannot be combined with a displacement (part of it would go into the "
-                      "support); give the traction as a vector [tx, ty] along the free component");
-    // A load component along a prescribed displacement component would go straight into the support.
-    const Eigen::Vector2d load = bc.kind == BoundaryCondition::Kind::force ? bc.force
-                                 : bc.kind == BoundaryCondition::Kind::traction && !bc.normal_pressure ? bc.traction
-                                                                                                       : Eigen::Vector2d::Zero();
-    for (int c = 0; c < 2; ++c)
-      if ((c == 0 ? bc.ux : bc.uy) && load[c] != 0.0)
-        errors_.add(bp, std::string("the load's ") + (c == 0 ? "x" : "y") + " component acts where the " +
-                            (c == 0 ? "x" : "y") + " displacement is prescribed: it would go straight into the support");
-    read_history(f, bc);
-    if (errors_.size() == before) {
-      in.body.boundary.push_back(bc);
-      in.condition_pointers.push_back(bp);
-    }
+  for (size_t j = 0; j < value.size(); ++j) read_condition(value[j], child(pointer, j), in, first_pointer_of_place);
+}
+
+// One boundary condition: where (an edge or a vertex), what (displacement, load, both on different components,
+// free), its load history; kept in the body only if all of it reads without error.
+void JobReader::read_condition(const json& value, const std::string& bp, BodyInput& in,
+                               std::map<std::string, std::string>& first_pointer_of_place) {
+  Fields f(value, bp, "a boundary condition", {"edge", "vertex", "displacement", "traction", "force", "free", "history"},
+           errors_);
+  if (!f.ok()) return;
+  const size_t before = errors_.size();
+  BoundaryCondition bc;
+  if (f.has("edge") == f.has("vertex")) {
+    errors_.add(bp, "give exactly one of edge (a named edge of the body) and vertex (a named vertex)");
+    return;
   }
+  const bool at_vertex = f.has("vertex");
+  read_condition_place(f, at_vertex, in.mesh, bc, first_pointer_of_place);
+  if (!condition_kinds_allowed(f, bp, at_vertex)) return;
+  read_condition_values(f, bp, bc);
+  check_loads_off_supports(f, bp, bc);
+  read_history(f, bc);
+  if (errors_.size() == before) {
+    in.body.boundary.push_back(bc);
+    in.condition_pointers.push_back(bp);
+  }
+}
+
+// The condition's edge or vertex: a named one of the body's mesh, and the first condition there.
+void JobReader::read_condition_place(const Fields& f, bool at_vertex, const MeshInput& mesh, BoundaryCondition& bc,
+                                     std::map<std::string, std::string>& first_pointer_of_place) {
+  const std::string bp = f.pointer();
+  const std::string place_key = at_vertex ? "vertex" : "edge";
+  const std::vector<std::string>& names = at_vertex ? mesh.vertex_names : mesh.edge_names;
+  if (const json* e = f.find(place_key))
+    if (auto s = read::string(*e, f.at(place_key), place_key, errors_)) {
+      (at_vertex ? bc.vertex : bc.edge) = *s;
+      const bool known = std::find(names.begin(), names.end(), *s) != names.end();
+      if (mesh.edges_known && !known) {
+        const auto elsewhere = gmsh_elsewhere(mesh, *s, at_vertex);
+        errors_.add(f.at(place_key),
+                    elsewhere.value_or("the body has no " + place_key + " '" + read::shown(*s) + "'; " +
+                                       (names.empty() ? std::string("it has no named ") + place_key + "s"
+                                                      : "its " + std::string(at_vertex ? "vertices" : "edges") +
+                                                            " are " + join_names(names))));
+      } else {
+        auto [it, inserted] = first_pointer_of_place.emplace(place_key + ":" + *s, bp);
+        if (!inserted)
+          errors_.add(f.at(place_key), place_key + " '" + *s + "' already has a condition at " + it->second +
+                                           "; give each " + place_key +
+                                           " one condition (displacement fixes only its given components)");
+      }
+    }
+}
+
+// One kind of condition or a displacement with a load; at a vertex no traction and no "free". False (reported)
+// if not.
+bool JobReader::condition_kinds_allowed(const Fields& f, const std::string& bp, bool at_vertex) {
+  const int loads = int(f.has("traction")) + int(f.has("force"));
+  const int kinds = int(f.has("displacement")) + loads + int(f.has("free"));
+  if (kinds == 0 || loads > 1 || (f.has("free") && kinds > 1)) {
+    errors_.add(bp, "give a displacement, a load (traction or force), a displacement with a load on the other "
+                    "component, or free");
+    return false;
+  }
+  if (at_vertex && (f.has("traction") || f.has("free"))) {
+    errors_.add(bp, "a vertex takes a displacement (a point support) or a force (a point load), not " +
+                        std::string(f.has("traction") ? "a traction (a force per length)" : "free"));
+    return false;
+  }
+  return true;
+}
+
+// The prescribed displacement components, the traction (a vector or a normal pressure), the force, or "free".
+void JobReader::read_condition_values(const Fields& f, const std::string& bp, BoundaryCondition& bc) {
+  const bool loads = f.has("traction") || f.has("force");
+  if (const json* d = f.find("displacement")) {
+    bc.kind = BoundaryCondition::Kind::displacement;
+    Fields df(*d, f.at("displacement"), "displacement", {"x", "y"}, errors_);
+    if (df.ok() && !df.has("x") && !df.has("y"))
+      errors_.add(f.at("displacement"), "give at least one of the components x and y");
+    if (const json* x = df.find("x")) bc.ux = read::number(*x, df.at("x"), "displacement x", errors_);
+    if (const json* y = df.find("y")) bc.uy = read::number(*y, df.at("y"), "displacement y", errors_);
+    if (loads && bc.ux && bc.uy)
+      errors_.add(bp, "both displacement components are prescribed: a load here would go straight into the support");
+  }
+  if (const json* t = f.find("traction")) {
+    bc.kind = BoundaryCondition::Kind::traction;
+    if (t->is_object()) {
+      Fields tf(*t, f.at("traction"), "traction", {"normal"}, errors_);
+      if (const json* p = tf.require("normal", "the normal pressure, positive pushing into the body")) {
+        bc.normal_pressure = true;
+        bc.pressure = read::number(*p, tf.at("normal"), "normal pressure", errors_).value_or(0.0);
+      }
+    } else if (t->is_array()) {
+      if (auto v = read::pair(*t, f.at("traction"), "traction", errors_)) bc.traction = *v;
+    } else {
+      errors_.add(f.at("traction"),
+                  "traction must be a vector [tx, ty] or {\"normal\": p}, got " + read::type_name(*t));
+    }
+  } else if (const json* fo = f.find("force")) {
+    bc.kind = BoundaryCondition::Kind::force;
+    if (auto v = read::pair(*fo, f.at("force"), "force", errors_)) bc.force = *v;
+  } else if (f.has("free")) {
+    bc.kind = BoundaryCondition::Kind::free;
+    auto b = read::boolean(*f.find("free"), f.at("free"), "free", errors_);
+    if (b && !*b) errors_.add(f.at("free"), "free must be true (an edge without a condition is free anyway)");
+  }
+}
+
+// A load may not act where the displacement is prescribed: it would go straight into the support.
+void JobReader::check_loads_off_supports(const Fields& f, const std::string& bp, const BoundaryCondition& bc) {
+  if (f.has("displacement") && bc.normal_pressure)
+    errors_.add(bp, "a normal pressure cannot be combined with a displacement (part of it would go into the "
+                    "support); give the traction as a vector [tx, ty] along the free component");
+  // A load component along a prescribed displacement component would go straight into the support.
+  const Eigen::Vector2d load = bc.kind == BoundaryCondition::Kind::force ? bc.force
+                               : bc.kind == BoundaryCondition::Kind::traction && !bc.normal_pressure ? bc.traction
+                                                                                                     : Eigen::Vector2d::Zero();
+  for (int c = 0; c < 2; ++c)
+    if ((c == 0 ? bc.ux : bc.uy) && load[c] != 0.0)
+      errors_.add(bp, std::string("the load's ") + (c == 0 ? "x" : "y") + " component acts where the " +
+                          (c == 0 ? "x" : "y") + " displacement is prescribed: it would go straight into the support");
 }
 
 // Phase 4: the rigid motions a body's displacement conditions leave free. A body that some are free for may

@@ -75,8 +75,20 @@ void JobReader::read_block(const json& value, const std::string& pointer, MeshIn
   const size_t before = errors_.size();
   Fields f(value, pointer, "block", {"corners", "nx", "ny", "edges", "grading"}, errors_);
   if (!f.ok()) return;
-  mesh::BlockSpec& spec = m.block;
+  const bool corners_ok = read_block_corners(f, m.block);
+  read_block_size(f, m);
+  if (const json* e = f.find("edges")) {
+    Fields edges(*e, f.at("edges"), "block edges", {"bottom", "right", "top", "left"}, errors_);
+    for (const char* name : kBlockEdges)
+      if (const json* c = edges.find(name)) read_curve(*c, edges.at(name), name, m);
+  }
+  if (const json* g = f.find("grading")) read_block_grading(*g, f.at("grading"), m.block);
+  if (corners_ok) fit_block_curves(m);
+  m.valid = errors_.size() == before;
+}
 
+// The block's four corners, counter-clockwise; false (reported) unless all four are read and enclose an area.
+bool JobReader::read_block_corners(const Fields& f, mesh::BlockSpec& spec) {
   bool corners_ok = false;
   if (const json* c = f.require("corners", "four points [[x, y], ...] counter-clockwise, from the bottom-left")) {
     if (!c->is_array() || c->size() != 4) {
@@ -110,7 +122,12 @@ void JobReader::read_block(const json& value, const std::string& pointer, MeshIn
       corners_ok = false;
     }
   }
+  return corners_ok;
+}
 
+// nx and ny, and the DOF count they give.
+void JobReader::read_block_size(const Fields& f, MeshInput& m) {
+  mesh::BlockSpec& spec = m.block;
   std::optional<long long> nx, ny;
   if (const json* v = f.require("nx", "the number of elements along the bottom edge, an integer >= 1"))
     nx = read_count(*v, f.at("nx"), "nx");
@@ -127,40 +144,34 @@ void JobReader::read_block(const json& value, const std::string& pointer, MeshIn
       spec.ny = static_cast<int>(*ny);
     }
   }
+}
 
-  if (const json* e = f.find("edges")) {
-    Fields edges(*e, f.at("edges"), "block edges", {"bottom", "right", "top", "left"}, errors_);
-    for (const char* name : kBlockEdges)
-      if (const json* c = edges.find(name)) read_curve(*c, edges.at(name), name, m);
-  }
+// Grading ratios towards named edges, at most one per direction.
+void JobReader::read_block_grading(const json& value, const std::string& pointer, mesh::BlockSpec& spec) {
+  Fields grading(value, pointer, "grading", {"bottom", "right", "top", "left"}, errors_);
+  for (const char* name : kBlockEdges)
+    if (const json* r = grading.find(name))
+      if (auto x = positive(*r, grading.at(name), std::string("grading ratio towards ") + name, errors_))
+        spec.grading[name] = *x;
+  if (grading.has("bottom") && grading.has("top"))
+    errors_.add(pointer,
+                "grading towards both bottom and top: give at most one of them per direction "
+                "(the ratio grades the whole block from the named edge)");
+  if (grading.has("left") && grading.has("right"))
+    errors_.add(pointer,
+                "grading towards both left and right: give at most one of them per direction "
+                "(the ratio grades the whole block from the named edge)");
+}
 
-  if (const json* g = f.find("grading")) {
-    Fields grading(*g, f.at("grading"), "grading", {"bottom", "right", "top", "left"}, errors_);
-    for (const char* name : kBlockEdges)
-      if (const json* r = grading.find(name))
-        if (auto x = positive(*r, grading.at(name), std::string("grading ratio towards ") + name, errors_))
-          spec.grading[name] = *x;
-    if (grading.has("bottom") && grading.has("top"))
-      errors_.add(f.at("grading"),
-                  "grading towards both bottom and top: give at most one of them per direction "
-                  "(the ratio grades the whole block from the named edge)");
-    if (grading.has("left") && grading.has("right"))
-      errors_.add(f.at("grading"),
-                  "grading towards both left and right: give at most one of them per direction "
-                  "(the ratio grades the whole block from the named edge)");
+// Fit the curves to the corners they join (the order matches make_block's parametrisation).
+void JobReader::fit_block_curves(MeshInput& m) {
+  const auto& P = m.block.corners;
+  const std::map<std::string, std::pair<Point, Point>> ends = {
+      {"bottom", {P[0], P[1]}}, {"right", {P[1], P[2]}}, {"top", {P[3], P[2]}}, {"left", {P[0], P[3]}}};
+  for (auto& [name, curve] : m.block.curves) {
+    const auto& [p, q] = ends.at(name);
+    if (auto message = mesh::fit_curve(curve, p, q)) errors_.add(m.curve_pointers.at(name), *message);
   }
-
-  // Fit the curves to the corners they join (the order matches make_block's parametrisation).
-  if (corners_ok) {
-    const auto& P = spec.corners;
-    const std::map<std::string, std::pair<Point, Point>> ends = {
-        {"bottom", {P[0], P[1]}}, {"right", {P[1], P[2]}}, {"top", {P[3], P[2]}}, {"left", {P[0], P[3]}}};
-    for (auto& [name, curve] : spec.curves) {
-      const auto& [p, q] = ends.at(name);
-      if (auto message = mesh::fit_curve(curve, p, q)) errors_.add(m.curve_pointers.at(name), *message);
-    }
-  }
-  m.valid = errors_.size() == before;
 }
 
 // {"gmsh": {...}}: the file (or data) is read and the surface's mesh built here, so that its edge names are
@@ -278,109 +289,124 @@ void JobReader::read_edge_set(const std::string& name, const json& value, const 
   if (ok) m.edge_pairs.emplace_back(name, std::move(pairs));
 }
 
+std::optional<int> NodeIndex::operator()(const json& v, const std::string& ptr, const std::string& what) const {
+  auto n = read::integer(v, ptr, what, errors);
+  if (!n) return std::nullopt;
+  if (*n < 0 || *n >= static_cast<long long>(node_count)) {
+    errors.add(ptr, what + " = " + std::to_string(*n) + " is out of range: the mesh has " + std::to_string(node_count) +
+                        " nodes, indices 0.." + std::to_string(node_count - 1));
+    return std::nullopt;
+  }
+  return static_cast<int>(*n);
+}
+
 void JobReader::read_arrays(const json& value, const std::string& pointer, MeshInput& m, json& out) {
   m.kind = MeshInput::Kind::arrays;
   const size_t before = errors_.size();
   Fields f(value, pointer, "mesh", {"nodes", "quads", "edges", "vertices"}, errors_);
   const json* nodes = f.require("nodes", "an array of points [[x, y], ...], or use {\"block\": {...}}");
   const json* quads = f.require("quads", "an array of quads [[i, j, k, l], ...] (node indices, counter-clockwise)");
-  size_t node_count = 0;
   const size_t before_nodes = errors_.size();
-  if (nodes) {
-    if (!nodes->is_array() || nodes->empty()) {
-      errors_.add(f.at("nodes"), "nodes must be a non-empty array of points [x, y]");
-    } else {
-      node_count = nodes->size();
-      m.dofs = 2.0 * static_cast<double>(node_count);
-      // Keep reading the coordinates only while they might be used: a mesh over the DOF limit is refused anyway.
-      if (m.dofs <= static_cast<double>(limits_.max_dofs)) {
-        m.nodes.reserve(node_count);
-        for (size_t k = 0; k < node_count; ++k) {
-          auto p = read::pair((*nodes)[k], child(f.at("nodes"), k), "node " + std::to_string(k), errors_);
-          m.nodes.push_back(p.value_or(Point::Zero()));
-        }
-      }
-    }
-  }
+  const size_t node_count = nodes ? read_nodes(*nodes, f.at("nodes"), m) : 0;
   // Indices are checked against the nodes only when those were read cleanly.
   const bool nodes_ok = nodes && node_count > 0 && errors_.size() == before_nodes;
-  auto index = [&](const json& v, const std::string& ptr, const std::string& what) -> std::optional<int> {
-    auto n = read::integer(v, ptr, what, errors_);
-    if (!n) return std::nullopt;
-    if (*n < 0 || *n >= static_cast<long long>(node_count)) {
-      errors_.add(ptr, what + " = " + std::to_string(*n) + " is out of range: the mesh has " +
-                           std::to_string(node_count) + " nodes, indices 0.." + std::to_string(node_count - 1));
-      return std::nullopt;
-    }
-    return static_cast<int>(*n);
-  };
+  const NodeIndex index{node_count, errors_};
+  if (quads && nodes_ok) read_quads(*quads, f.at("quads"), index, m);
+  read_named_edges(f, nodes_ok, index, m, out);
+  read_named_vertices(f, nodes_ok, index, m, out);
+  m.valid = errors_.size() == before && nodes_ok && !m.quads.empty();
+}
 
-  if (quads && nodes_ok) {
-    if (!quads->is_array() || quads->empty()) {
-      errors_.add(f.at("quads"), "quads must be a non-empty array of [i, j, k, l]");
-    } else {
-      for (size_t q = 0; q < quads->size(); ++q) {
-        const json& quad = (*quads)[q];
-        const std::string qp = child(f.at("quads"), q);
-        if (!quad.is_array() || quad.size() != 4) {
-          errors_.add(qp, "quad " + std::to_string(q) + " must be an array of four node indices [i, j, k, l]");
-          continue;
-        }
-        mesh::Cell cell(-1, -1, -1, -1);
-        bool ok = true;
-        for (size_t k = 0; k < 4; ++k) {
-          auto n = index(quad[k], child(qp, k), "node index");
-          if (n)
-            cell[k] = *n;
-          else
-            ok = false;
-        }
-        if (!ok) continue;
-        std::set<int> distinct(cell.begin(), cell.end());
-        if (distinct.size() != 4) {
-          errors_.add(qp, "quad " + std::to_string(q) + " repeats a node: its four node indices must be distinct");
-          continue;
-        }
-        m.quads.push_back(cell);
-      }
+// An explicit mesh's "nodes": their count (0 if not a non-empty array), and the points unless the mesh is over
+// the DOF limit (refused anyway, so the coordinates are not read).
+size_t JobReader::read_nodes(const json& nodes, const std::string& pointer, MeshInput& m) {
+  if (!nodes.is_array() || nodes.empty()) {
+    errors_.add(pointer, "nodes must be a non-empty array of points [x, y]");
+    return 0;
+  }
+  const size_t node_count = nodes.size();
+  m.dofs = 2.0 * static_cast<double>(node_count);
+  if (m.dofs <= static_cast<double>(limits_.max_dofs)) {
+    m.nodes.reserve(node_count);
+    for (size_t k = 0; k < node_count; ++k) {
+      auto p = read::pair(nodes[k], child(pointer, k), "node " + std::to_string(k), errors_);
+      m.nodes.push_back(p.value_or(Point::Zero()));
     }
   }
+  return node_count;
+}
 
-  if (const json* e = f.find("edges")) {
-    // Edge names are the user's own, so there is no fixed key set to check against.
-    if (!e->is_object()) {
-      errors_.add(f.at("edges"),
-                  "edges must be an object {\"name\": [[i, j], ...], ...}, got " + read::type_name(*e));
-    } else {
-      m.edges_known = true;
-      for (const auto& item : e->items())
-        read_edge_set(item.key(), item.value(), child(f.at("edges"), item.key()), nodes_ok, index, m);
+// An explicit mesh's "quads": four distinct node indices each; the bad ones are reported and left out.
+void JobReader::read_quads(const json& quads, const std::string& pointer, const NodeIndex& index, MeshInput& m) {
+  if (!quads.is_array() || quads.empty()) {
+    errors_.add(pointer, "quads must be a non-empty array of [i, j, k, l]");
+    return;
+  }
+  for (size_t q = 0; q < quads.size(); ++q) {
+    const json& quad = quads[q];
+    const std::string qp = child(pointer, q);
+    if (!quad.is_array() || quad.size() != 4) {
+      errors_.add(qp, "quad " + std::to_string(q) + " must be an array of four node indices [i, j, k, l]");
+      continue;
     }
-  } else {
+    mesh::Cell cell(-1, -1, -1, -1);
+    bool ok = true;
+    for (size_t k = 0; k < 4; ++k) {
+      auto n = index(quad[k], child(qp, k), "node index");
+      if (n)
+        cell[k] = *n;
+      else
+        ok = false;
+    }
+    if (!ok) continue;
+    std::set<int> distinct(cell.begin(), cell.end());
+    if (distinct.size() != 4) {
+      errors_.add(qp, "quad " + std::to_string(q) + " repeats a node: its four node indices must be distinct");
+      continue;
+    }
+    m.quads.push_back(cell);
+  }
+}
+
+// An explicit mesh's "edges" {"name": [[i, j], ...]} (default: none).
+void JobReader::read_named_edges(const Fields& f, bool nodes_ok, const NodeIndex& index, MeshInput& m, json& out) {
+  const json* e = f.find("edges");
+  if (!e) {
     m.edges_known = true;
     set_default(out, "edges", json::object());
+    return;
   }
-  // Named vertices {"name": node index}: where point loads and point supports go.
-  if (const json* v = f.find("vertices")) {
-    if (!v->is_object()) {
-      errors_.add(f.at("vertices"),
-                  "vertices must be an object {\"name\": node index, ...}, got " + read::type_name(*v));
-    } else {
-      for (const auto& item : v->items()) {
-        const std::string vp = child(f.at("vertices"), item.key());
-        if (auto problem = name_problem(item.key(), "vertex name", limits_.max_name_length, false)) {
-          errors_.add(vp, *problem);
-          continue;
-        }
-        m.vertex_names.push_back(item.key());
-        if (!nodes_ok) continue;
-        if (auto n = index(item.value(), vp, "vertex '" + item.key() + "' node index")) m.vertices[item.key()] = *n;
-      }
-    }
-  } else {
+  // Edge names are the user's own, so there is no fixed key set to check against.
+  if (!e->is_object()) {
+    errors_.add(f.at("edges"), "edges must be an object {\"name\": [[i, j], ...], ...}, got " + read::type_name(*e));
+    return;
+  }
+  m.edges_known = true;
+  for (const auto& item : e->items())
+    read_edge_set(item.key(), item.value(), child(f.at("edges"), item.key()), nodes_ok, index, m);
+}
+
+// An explicit mesh's named vertices {"name": node index}: where point loads and point supports go (default: none).
+void JobReader::read_named_vertices(const Fields& f, bool nodes_ok, const NodeIndex& index, MeshInput& m, json& out) {
+  const json* v = f.find("vertices");
+  if (!v) {
     set_default(out, "vertices", json::object());
+    return;
   }
-  m.valid = errors_.size() == before && nodes_ok && !m.quads.empty();
+  if (!v->is_object()) {
+    errors_.add(f.at("vertices"), "vertices must be an object {\"name\": node index, ...}, got " + read::type_name(*v));
+    return;
+  }
+  for (const auto& item : v->items()) {
+    const std::string vp = child(f.at("vertices"), item.key());
+    if (auto problem = name_problem(item.key(), "vertex name", limits_.max_name_length, false)) {
+      errors_.add(vp, *problem);
+      continue;
+    }
+    m.vertex_names.push_back(item.key());
+    if (!nodes_ok) continue;
+    if (auto n = index(item.value(), vp, "vertex '" + item.key() + "' node index")) m.vertices[item.key()] = *n;
+  }
 }
 
 void JobReader::build_mesh(BodyInput& in) {

@@ -10,77 +10,95 @@ namespace contact::job::detail {
 
 void JobReader::read_solver(const Fields& top) {
   json& out = sub_object(normalized_, "solver");
+  if (const json* v = top.find("solver")) read_solver_fields(*v, top.at("solver"), out);
+  write_solver_defaults(out);
+}
+
+// The fields of "solver" the job gives (the defaults of the others: write_solver_defaults).
+void JobReader::read_solver_fields(const json& value, const std::string& pointer, json& out) {
   SolverSettings& s = problem_.solver;
-  if (const json* v = top.find("solver")) {
-    Fields f(*v, top.at("solver"), "solver",
-             {"method", "penalty", "gamma", "tolerance", "criterion", "max_iterations", "initial_guess", "threads",
-              "acceleration", "anderson_depth", "robin", "enforcement", "augmented_lagrangian", "interface"},
-             errors_);
-    if (const json* m = f.find("method")) {
-      method_pointer_ = f.at("method");
-      if (auto x = choice(*m, f.at("method"), "method", {"neumann", "monolithic", "interface_newton", "robin"}, errors_)) {
-        s.method = *x == "monolithic"         ? Method::monolithic
-                   : *x == "interface_newton" ? Method::interface_newton
-                   : *x == "robin"            ? Method::robin
-                                              : Method::neumann;
-        method_given_ = true;
-      }
+  Fields f(value, pointer, "solver",
+           {"method", "penalty", "gamma", "tolerance", "criterion", "max_iterations", "initial_guess", "threads",
+            "acceleration", "anderson_depth", "robin", "enforcement", "augmented_lagrangian", "interface"},
+           errors_);
+  if (const json* m = f.find("method")) read_method(*m, f.at("method"));
+  if (const json* p = f.find("penalty")) read_penalty(*p, f.at("penalty"), sub_object(out, "penalty"));
+  if (const json* g = f.find("gamma")) read_gamma(*g, f.at("gamma"));
+  if (const json* t = f.find("tolerance"))
+    if (auto x = positive(*t, f.at("tolerance"), "tolerance", errors_)) s.tolerance = *x;
+  if (const json* c = f.find("criterion"))
+    if (auto x = choice(*c, f.at("criterion"), "criterion", {"paper", "residual"}, errors_))
+      s.criterion = *x == "residual" ? Criterion::residual : Criterion::paper;
+  if (const json* n = f.find("max_iterations"))
+    if (auto x = bounded_int(*n, f.at("max_iterations"), "max_iterations", 1, errors_)) s.max_iterations = *x;
+  if (const json* g = f.find("initial_guess"))
+    if (auto x = choice(*g, f.at("initial_guess"), "initial_guess", {"zero", "elastic_layer"}, errors_))
+      s.initial_guess = *x == "zero" ? InitialGuess::zero : InitialGuess::elastic_layer;
+  if (const json* t = f.find("threads"))
+    if (auto x = bounded_int(*t, f.at("threads"), "threads", 0, errors_)) s.threads = *x;
+  if (const json* a = f.find("acceleration"))
+    if (auto x = choice(*a, f.at("acceleration"), "acceleration", {"none", "anderson"}, errors_))
+      s.acceleration = *x == "anderson" ? Acceleration::anderson : Acceleration::none;
+  if (const json* d = f.find("anderson_depth")) {
+    if (auto x = bounded_int(*d, f.at("anderson_depth"), "anderson_depth", 1, errors_)) {
+      if (*x > 50)
+        errors_.add(f.at("anderson_depth"), "anderson_depth = " + std::to_string(*x) + " is above 50");
+      else
+        s.anderson_depth = *x;
     }
-    if (const json* p = f.find("penalty")) read_penalty(*p, f.at("penalty"), sub_object(out, "penalty"));
-    if (const json* g = f.find("gamma")) {
-      if (g->is_string()) {
-        if (g->get<std::string>() == "auto")
-          s.gamma_auto = true;
-        else
-          errors_.add(f.at("gamma"), "gamma must be a number in (0, 2) or \"auto\", got \"" + read::shown(g->get<std::string>()) + "\"");
-      } else {
-        auto x = read::number(*g, f.at("gamma"), "gamma", errors_);
-        if (x && !(*x > 0 && *x < 2))
-          errors_.add(f.at("gamma"),
-                      "gamma = " + format_number(*x) +
-                          " is outside (0, 2): the relaxation weight must be greater than 0 and less than 2");
-        else if (x) {
-          s.gamma = *x;
-          s.gamma_auto = false;
-        }
-      }
-    }
-    if (const json* t = f.find("tolerance"))
-      if (auto x = positive(*t, f.at("tolerance"), "tolerance", errors_)) s.tolerance = *x;
-    if (const json* c = f.find("criterion"))
-      if (auto x = choice(*c, f.at("criterion"), "criterion", {"paper", "residual"}, errors_))
-        s.criterion = *x == "residual" ? Criterion::residual : Criterion::paper;
-    if (const json* n = f.find("max_iterations"))
-      if (auto x = bounded_int(*n, f.at("max_iterations"), "max_iterations", 1, errors_)) s.max_iterations = *x;
-    if (const json* g = f.find("initial_guess"))
-      if (auto x = choice(*g, f.at("initial_guess"), "initial_guess", {"zero", "elastic_layer"}, errors_))
-        s.initial_guess = *x == "zero" ? InitialGuess::zero : InitialGuess::elastic_layer;
-    if (const json* t = f.find("threads"))
-      if (auto x = bounded_int(*t, f.at("threads"), "threads", 0, errors_)) s.threads = *x;
-    if (const json* a = f.find("acceleration"))
-      if (auto x = choice(*a, f.at("acceleration"), "acceleration", {"none", "anderson"}, errors_))
-        s.acceleration = *x == "anderson" ? Acceleration::anderson : Acceleration::none;
-    if (const json* d = f.find("anderson_depth")) {
-      if (auto x = bounded_int(*d, f.at("anderson_depth"), "anderson_depth", 1, errors_)) {
-        if (*x > 50)
-          errors_.add(f.at("anderson_depth"), "anderson_depth = " + std::to_string(*x) + " is above 50");
-        else
-          s.anderson_depth = *x;
-      }
-    }
-    if (const json* r = f.find("robin")) read_robin(*r, f.at("robin"));
-    if (const json* e = f.find("enforcement")) {
-      enforcement_pointer_ = f.at("enforcement");
-      if (auto x = choice(*e, f.at("enforcement"), "enforcement", {"exact", "penalty", "augmented_lagrangian"}, errors_)) {
-        s.enforcement = *x == "augmented_lagrangian" ? Enforcement::augmented_lagrangian
-                        : *x == "penalty"            ? Enforcement::penalty
-                                                     : Enforcement::exact;
-        enforcement_given_ = true;
-      }
-    }
-    if (const json* a = f.find("augmented_lagrangian")) read_augmented_lagrangian(*a, f.at("augmented_lagrangian"));
-    if (const json* i = f.find("interface")) read_interface_solver(*i, f.at("interface"));
   }
+  if (const json* r = f.find("robin")) read_robin(*r, f.at("robin"));
+  if (const json* e = f.find("enforcement")) read_enforcement(*e, f.at("enforcement"));
+  if (const json* a = f.find("augmented_lagrangian")) read_augmented_lagrangian(*a, f.at("augmented_lagrangian"));
+  if (const json* i = f.find("interface")) read_interface_solver(*i, f.at("interface"));
+}
+
+// "method": remembered as given (resolve_method_defaults fills it in otherwise).
+void JobReader::read_method(const json& value, const std::string& pointer) {
+  method_pointer_ = pointer;
+  if (auto x = choice(value, pointer, "method", {"neumann", "monolithic", "interface_newton", "robin"}, errors_)) {
+    problem_.solver.method = *x == "monolithic"         ? Method::monolithic
+                             : *x == "interface_newton" ? Method::interface_newton
+                             : *x == "robin"            ? Method::robin
+                                                        : Method::neumann;
+    method_given_ = true;
+  }
+}
+
+// "gamma": a relaxation weight in (0, 2) or "auto".
+void JobReader::read_gamma(const json& value, const std::string& pointer) {
+  SolverSettings& s = problem_.solver;
+  if (value.is_string()) {
+    if (value.get<std::string>() == "auto")
+      s.gamma_auto = true;
+    else
+      errors_.add(pointer, "gamma must be a number in (0, 2) or \"auto\", got \"" + read::shown(value.get<std::string>()) + "\"");
+  } else {
+    auto x = read::number(value, pointer, "gamma", errors_);
+    if (x && !(*x > 0 && *x < 2))
+      errors_.add(pointer,
+                  "gamma = " + format_number(*x) +
+                      " is outside (0, 2): the relaxation weight must be greater than 0 and less than 2");
+    else if (x) {
+      s.gamma = *x;
+      s.gamma_auto = false;
+    }
+  }
+}
+
+// "enforcement": remembered as given (resolve_method_defaults fills it in otherwise).
+void JobReader::read_enforcement(const json& value, const std::string& pointer) {
+  enforcement_pointer_ = pointer;
+  if (auto x = choice(value, pointer, "enforcement", {"exact", "penalty", "augmented_lagrangian"}, errors_)) {
+    problem_.solver.enforcement = *x == "augmented_lagrangian" ? Enforcement::augmented_lagrangian
+                                  : *x == "penalty"            ? Enforcement::penalty
+                                                               : Enforcement::exact;
+    enforcement_given_ = true;
+  }
+}
+
+// Every default of "solver" into the normalized copy.
+void JobReader::write_solver_defaults(json& out) {
   set_default(out, "penalty", json{{"c", 0.05}});
   set_default(out, "gamma", "auto");
   set_default(out, "tolerance", 1e-8);
@@ -187,31 +205,39 @@ void JobReader::read_adaptivity(const json& value, const std::string& pointer) {
       else
         a.stop_tolerance = *x;
     }
-  if (const json* b = f.find("bodies")) {
-    const std::string bp = f.at("bodies");
-    if (!b->is_array()) {
-      errors_.add(bp, "bodies must be an array of body names, got " + read::type_name(*b));
-    } else {
-      for (size_t i = 0; i < b->size(); ++i) {
-        const std::string ip = child(bp, i);
-        if (!(*b)[i].is_string()) {
-          errors_.add(ip, "a body name must be a string, got " + read::type_name((*b)[i]));
-          continue;
-        }
-        const std::string name = (*b)[i].get<std::string>();
-        int found = -1;
-        std::vector<std::string> known;
-        for (size_t k = 0; k < inputs_.size(); ++k) {
-          if (inputs_[k].has_name && inputs_[k].body.name == name) found = static_cast<int>(k);
-          if (inputs_[k].has_name) known.push_back(inputs_[k].body.name);
-        }
-        if (found < 0)
-          errors_.add(ip, "unknown body '" + read::shown(name) + "'; the bodies are " + join_names(known));
-        else if (std::find(a.bodies.begin(), a.bodies.end(), found) == a.bodies.end())
-          a.bodies.push_back(found);
-      }
-    }
+  if (const json* b = f.find("bodies")) read_adaptive_bodies(*b, f.at("bodies"));
+  write_adaptivity_defaults(out);
+}
+
+// "bodies": the names of the bodies to refine, as indices (each once).
+void JobReader::read_adaptive_bodies(const json& value, const std::string& pointer) {
+  AdaptivitySettings& a = problem_.adaptivity;
+  if (!value.is_array()) {
+    errors_.add(pointer, "bodies must be an array of body names, got " + read::type_name(value));
+    return;
   }
+  for (size_t i = 0; i < value.size(); ++i) {
+    const std::string ip = child(pointer, i);
+    if (!value[i].is_string()) {
+      errors_.add(ip, "a body name must be a string, got " + read::type_name(value[i]));
+      continue;
+    }
+    const std::string name = value[i].get<std::string>();
+    int found = -1;
+    std::vector<std::string> known;
+    for (size_t k = 0; k < inputs_.size(); ++k) {
+      if (inputs_[k].has_name && inputs_[k].body.name == name) found = static_cast<int>(k);
+      if (inputs_[k].has_name) known.push_back(inputs_[k].body.name);
+    }
+    if (found < 0)
+      errors_.add(ip, "unknown body '" + read::shown(name) + "'; the bodies are " + join_names(known));
+    else if (std::find(a.bodies.begin(), a.bodies.end(), found) == a.bodies.end())
+      a.bodies.push_back(found);
+  }
+}
+
+// Every default of "adaptivity" into the normalized copy (bodies: all named ones).
+void JobReader::write_adaptivity_defaults(json& out) {
   set_default(out, "indicator", "fem_bem");
   set_default(out, "normalization", "rms");
   set_default(out, "delta", 0.1);

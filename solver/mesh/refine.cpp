@@ -2,6 +2,7 @@
 #include "contact/mesh.hpp"
 
 #include <algorithm>
+#include <array>
 #include <set>
 
 namespace contact::mesh {
@@ -32,28 +33,13 @@ std::map<std::pair<int, int>, std::vector<int>> sides_of(const Mesh& m) {
   return out;
 }
 
-}  // namespace
-
-std::map<int, std::pair<int, int>> hanging_nodes(const Mesh& m) {
-  std::map<int, std::pair<int, int>> out;
-  for (int c = 0; c < m.num_cells(); ++c)
-    for (int s = 0; s < m.cells[static_cast<size_t>(c)].size(); ++s) {
-      const auto n = m.edge_nodes({c, s});
-      auto it = m.edge_midpoint.find(key(n[0], n[1]));
-      // The side is active on this (coarser) cell but split on the other side: its midpoint hangs.
-      if (it != m.edge_midpoint.end()) out[it->second] = {n[0], n[1]};
-    }
-  return out;
-}
-
-RefinementResult refine(Mesh& m, const std::vector<int>& marked_in, int max_level) {
-  RefinementResult result;
+// The marked cells below max_level, closed: refining a cell whose side is half of a coarser neighbour's side
+// would put two hanging nodes on that neighbour's side, so the neighbour is refined too (and so on). Counts the
+// cells the closure added in `closure_cells`.
+std::vector<char> mark_with_closure(const Mesh& m, const std::vector<int>& marked_in, int max_level, int& closure_cells) {
   std::vector<char> marked(static_cast<size_t>(m.num_cells()), 0);
   for (int c : marked_in)
     if (c >= 0 && c < m.num_cells() && m.level[static_cast<size_t>(c)] < max_level) marked[static_cast<size_t>(c)] = 1;
-
-  // Closure: refining a cell whose side is half of a coarser neighbour's side would put two hanging nodes on
-  // that neighbour's side, so the neighbour is refined too (and so on).
   std::map<int, std::pair<int, int>> parent_edge;  // midpoint -> split edge
   for (const auto& [edge, mid] : m.edge_midpoint) parent_edge[mid] = edge;
   const auto sides = sides_of(m);
@@ -76,53 +62,27 @@ RefinementResult refine(Mesh& m, const std::vector<int>& marked_in, int max_leve
         for (int nb : coarse->second)
           if (!marked[static_cast<size_t>(nb)]) {
             marked[static_cast<size_t>(nb)] = 1;
-            ++result.closure_cells;
+            ++closure_cells;
             queue.push_back(nb);
           }
       }
     }
   }
+  return marked;
+}
 
-  const auto names = boundary_side_names(m);
-  auto add_node = [&](const Point& x, std::vector<std::pair<int, double>> parents) {
-    const int id = m.num_nodes();
-    m.nodes.push_back(x);
-    result.new_nodes.push_back({id, std::move(parents)});
-    return id;
-  };
-  auto midpoint = [&](int a, int b) {
-    auto it = m.edge_midpoint.find(key(a, b));
-    if (it != m.edge_midpoint.end()) return it->second;
-    const Point& pa = m.nodes[static_cast<size_t>(a)];
-    const Point& pb = m.nodes[static_cast<size_t>(b)];
-    Point x = 0.5 * (pa + pb);
-    auto named = names.find(key(a, b));
-    if (named != names.end()) {
-      auto curve = m.edge_curves.find(named->second);
-      if (curve != m.edge_curves.end()) x = curve->second.between(pa, pb, 0.5);  // on the true curve
-    }
-    auto side = m.side_curves.find(key(a, b));
-    if (side != m.side_curves.end()) x = side->second.between(pa, pb, 0.5);
-    const int id = add_node(x, {{a, 0.5}, {b, 0.5}});
-    m.edge_midpoint[key(a, b)] = id;
-    if (side != m.side_curves.end()) {  // the halves lie on the same curve
-      const Curve curve = side->second;
-      m.side_curves.erase(side);
-      m.side_curves[key(a, id)] = curve;
-      m.side_curves[key(id, b)] = curve;
-    }
-    return id;
-  };
+// Splits cells of one mesh into four, adding the nodes (side midpoints, on the true curve where the side lies on
+// one; quad centres) and recording each new node's parents in the result.
+class CellSplitter {
+ public:
+  CellSplitter(Mesh& m, RefinementResult& result) : m_(m), result_(result), names_(boundary_side_names(m)) {}
 
   // Child k of a refined cell holds its corner k at local node k (the fourth child of a triangle is the middle
   // one), so side s of the parent is side s of children s and (s + 1) % n. The first child keeps the parent's
-  // index; the others are appended.
-  const int n_before = m.num_cells();
-  std::vector<std::array<int, 4>> children(static_cast<size_t>(n_before), {-1, -1, -1, -1});
-  for (int c = 0; c < n_before; ++c) {
-    if (!marked[static_cast<size_t>(c)]) continue;
-    const Cell q = m.cells[static_cast<size_t>(c)];
-    const int level = m.level[static_cast<size_t>(c)] + 1;
+  // index; the others are appended. Returns the children's indices.
+  std::array<int, 4> split(int c) {
+    const Cell q = m_.cells[static_cast<size_t>(c)];
+    const int level = m_.level[static_cast<size_t>(c)] + 1;
     std::vector<Cell> split;
     if (q.is_triangle()) {
       const int m01 = midpoint(q[0], q[1]), m12 = midpoint(q[1], q[2]), m20 = midpoint(q[2], q[0]);
@@ -130,23 +90,66 @@ RefinementResult refine(Mesh& m, const std::vector<int>& marked_in, int max_leve
     } else {
       const int m01 = midpoint(q[0], q[1]), m12 = midpoint(q[1], q[2]), m23 = midpoint(q[2], q[3]), m30 = midpoint(q[3], q[0]);
       // Centre: the bilinear centre corrected for curved sides (equal to the corner mean for straight ones).
-      const Point centre = 0.5 * (m.nodes[static_cast<size_t>(m01)] + m.nodes[static_cast<size_t>(m12)] +
-                                  m.nodes[static_cast<size_t>(m23)] + m.nodes[static_cast<size_t>(m30)]) -
-                           0.25 * (m.nodes[static_cast<size_t>(q[0])] + m.nodes[static_cast<size_t>(q[1])] +
-                                   m.nodes[static_cast<size_t>(q[2])] + m.nodes[static_cast<size_t>(q[3])]);
+      const auto& x = m_.nodes;
+      const Point centre = 0.5 * (x[static_cast<size_t>(m01)] + x[static_cast<size_t>(m12)] +
+                                  x[static_cast<size_t>(m23)] + x[static_cast<size_t>(m30)]) -
+                           0.25 * (x[static_cast<size_t>(q[0])] + x[static_cast<size_t>(q[1])] +
+                                   x[static_cast<size_t>(q[2])] + x[static_cast<size_t>(q[3])]);
       const int ctr = add_node(centre, {{q[0], 0.25}, {q[1], 0.25}, {q[2], 0.25}, {q[3], 0.25}});
       split = {{q[0], m01, ctr, m30}, {m01, q[1], m12, ctr}, {ctr, m12, q[2], m23}, {m30, ctr, m23, q[3]}};
     }
-    m.cells[static_cast<size_t>(c)] = split[0];
-    m.level[static_cast<size_t>(c)] = level;
-    children[static_cast<size_t>(c)][0] = c;
+    std::array<int, 4> children{c, -1, -1, -1};
+    m_.cells[static_cast<size_t>(c)] = split[0];
+    m_.level[static_cast<size_t>(c)] = level;
     for (size_t k = 1; k < 4; ++k) {
-      children[static_cast<size_t>(c)][k] = m.num_cells();
-      m.cells.push_back(split[k]);
-      m.level.push_back(level);
+      children[k] = m_.num_cells();
+      m_.cells.push_back(split[k]);
+      m_.level.push_back(level);
     }
-    ++result.refined_cells;
+    ++result_.refined_cells;
+    return children;
   }
+
+ private:
+  int add_node(const Point& x, std::vector<std::pair<int, double>> parents) {
+    const int id = m_.num_nodes();
+    m_.nodes.push_back(x);
+    result_.new_nodes.push_back({id, std::move(parents)});
+    return id;
+  }
+
+  // The midpoint of side (a, b): the existing one if a neighbour split it, else a new node.
+  int midpoint(int a, int b) {
+    auto it = m_.edge_midpoint.find(key(a, b));
+    if (it != m_.edge_midpoint.end()) return it->second;
+    const Point& pa = m_.nodes[static_cast<size_t>(a)];
+    const Point& pb = m_.nodes[static_cast<size_t>(b)];
+    Point x = 0.5 * (pa + pb);
+    auto named = names_.find(key(a, b));
+    if (named != names_.end()) {
+      auto curve = m_.edge_curves.find(named->second);
+      if (curve != m_.edge_curves.end()) x = curve->second.between(pa, pb, 0.5);  // on the true curve
+    }
+    auto side = m_.side_curves.find(key(a, b));
+    if (side != m_.side_curves.end()) x = side->second.between(pa, pb, 0.5);
+    const int id = add_node(x, {{a, 0.5}, {b, 0.5}});
+    m_.edge_midpoint[key(a, b)] = id;
+    if (side != m_.side_curves.end()) {  // the halves lie on the same curve
+      const Curve curve = side->second;
+      m_.side_curves.erase(side);
+      m_.side_curves[key(a, id)] = curve;
+      m_.side_curves[key(id, b)] = curve;
+    }
+    return id;
+  }
+
+  Mesh& m_;
+  RefinementResult& result_;
+  const std::map<std::pair<int, int>, std::string> names_;
+};
+
+// Every named edge set's refined sides become the two children's sides (cells before the split: n_before).
+void split_edge_sets(Mesh& m, const std::vector<std::array<int, 4>>& children, int n_before) {
   for (auto& [name, refs] : m.edge_sets) {
     std::vector<EdgeRef> out;
     out.reserve(refs.size() * 2);
@@ -162,8 +165,11 @@ RefinementResult refine(Mesh& m, const std::vector<int>& marked_in, int max_leve
     }
     refs = std::move(out);
   }
-  // Split edges no longer carry a hanging node once both sides are refined; keep the map only for sides that
-  // are still active on some cell (it is also how the next refinement finds coarser neighbours).
+}
+
+// Split edges no longer carry a hanging node once both sides are refined; keep the map only for sides that are
+// still active on some cell (it is also how the next refinement finds coarser neighbours).
+void forget_inactive_midpoints(Mesh& m) {
   std::set<std::pair<int, int>> active;
   for (int c = 0; c < m.num_cells(); ++c)
     for (int s = 0; s < m.cells[static_cast<size_t>(c)].size(); ++s) {
@@ -176,6 +182,32 @@ RefinementResult refine(Mesh& m, const std::vector<int>& marked_in, int max_leve
     else
       ++it;
   }
+}
+
+}  // namespace
+
+std::map<int, std::pair<int, int>> hanging_nodes(const Mesh& m) {
+  std::map<int, std::pair<int, int>> out;
+  for (int c = 0; c < m.num_cells(); ++c)
+    for (int s = 0; s < m.cells[static_cast<size_t>(c)].size(); ++s) {
+      const auto n = m.edge_nodes({c, s});
+      auto it = m.edge_midpoint.find(key(n[0], n[1]));
+      // The side is active on this (coarser) cell but split on the other side: its midpoint hangs.
+      if (it != m.edge_midpoint.end()) out[it->second] = {n[0], n[1]};
+    }
+  return out;
+}
+
+RefinementResult refine(Mesh& m, const std::vector<int>& marked_in, int max_level) {
+  RefinementResult result;
+  const std::vector<char> marked = mark_with_closure(m, marked_in, max_level, result.closure_cells);
+  CellSplitter splitter(m, result);
+  const int n_before = m.num_cells();
+  std::vector<std::array<int, 4>> children(static_cast<size_t>(n_before), {-1, -1, -1, -1});
+  for (int c = 0; c < n_before; ++c)
+    if (marked[static_cast<size_t>(c)]) children[static_cast<size_t>(c)] = splitter.split(c);
+  split_edge_sets(m, children, n_before);
+  forget_inactive_midpoints(m);
   return result;
 }
 

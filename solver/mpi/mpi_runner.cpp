@@ -20,81 +20,84 @@ MpiTaskRunner::MpiTaskRunner(MPI_Comm comm, std::vector<int> owner, unsigned thr
     if (r < 0 || r >= size_) throw std::invalid_argument("MpiTaskRunner: a body's owner is not a rank of the communicator");
 }
 
-void MpiTaskRunner::run_bodies(const std::vector<size_t>& bodies, const std::function<void(size_t)>& task,
-                               const ddm::BodyShare& share) {
-  std::vector<size_t> mine;
-  for (size_t a : bodies)
-    if (owns(a)) mine.push_back(a);
-  // This rank's tasks, each failure kept with its body (a failing rank must still meet the others below).
-  std::vector<std::string> failure(mine.size());
-  std::vector<char> failed(mine.size(), 0);
-  local_.run(mine.size(), [&](size_t i) {
-    try {
-      if (static_cast<long>(mine[i]) == fail_body_)
-        throw std::runtime_error("rank " + std::to_string(rank_) + ": body " + std::to_string(mine[i]) +
-                                 ": failure injected by CONTACT_MPI_FAIL_BODY");
-      task(mine[i]);
-    } catch (const std::bad_alloc&) {
-      failure[i] = "out of memory";
-      failed[i] = 1;
-    } catch (const std::exception& e) {
-      failure[i] = e.what();
-      failed[i] = 1;
-    }
-  });
+namespace {
 
-  // This rank's message: its cancel request, then per own body its outcome and packed outputs.
+// This rank's own bodies and, per body, whether its task failed and why.
+struct OwnOutcome {
+  std::vector<size_t> bodies;
+  std::vector<std::string> failure;
+  std::vector<char> failed;
+};
+
+// This rank's message: its cancel request, then per own body its outcome and packed outputs (a body whose outputs
+// fail to pack counts as failed). Every failure is also recorded in `errors`, by body.
+std::vector<char> pack_message(bool cancel_requested, OwnOutcome& own, const ddm::BodyShare& share,
+                               std::map<size_t, std::string>& errors) {
   std::vector<char> out;
   ddm::Packer put(out);
-  put.put(static_cast<std::int64_t>(request_ && request_->load() ? 1 : 0));
-  put.put(static_cast<std::int64_t>(mine.size()));
-  std::map<size_t, std::string> errors;  // by body: every rank picks the same (lowest) one
-  for (size_t i = 0; i < mine.size(); ++i) {
+  put.put(static_cast<std::int64_t>(cancel_requested ? 1 : 0));
+  put.put(static_cast<std::int64_t>(own.bodies.size()));
+  for (size_t i = 0; i < own.bodies.size(); ++i) {
     std::vector<char> payload;
-    if (!failed[i] && share.pack) {
+    if (!own.failed[i] && share.pack) {
       ddm::Packer p(payload);
       try {
-        share.pack(mine[i], p);
+        share.pack(own.bodies[i], p);
       } catch (const std::exception& e) {
-        failure[i] = e.what();
-        failed[i] = 1;
+        own.failure[i] = e.what();
+        own.failed[i] = 1;
       }
     }
-    put.put(static_cast<std::int64_t>(mine[i]));
-    put.put(static_cast<std::int64_t>(failed[i]));
-    if (failed[i]) {
-      put.put(failure[i]);
-      errors[mine[i]] = failure[i];
+    put.put(static_cast<std::int64_t>(own.bodies[i]));
+    put.put(static_cast<std::int64_t>(own.failed[i]));
+    if (own.failed[i]) {
+      put.put(own.failure[i]);
+      errors[own.bodies[i]] = own.failure[i];
       continue;
     }
     put.put(static_cast<std::int64_t>(payload.size()));
     out.insert(out.end(), payload.begin(), payload.end());
   }
+  return out;
+}
 
-  // Sizes first (every rank learns every size, so all agree when the total is too large for one call).
+// Every rank's message, gathered on every rank: rank r's bytes are all[displs[r], displs[r] + sizes[r]).
+struct Gathered {
+  std::vector<char> all;
+  std::vector<std::int64_t> sizes;
+  std::vector<int> displs;
+};
+
+// Sizes first (every rank learns every size, so all agree when the total is too large for one call), then the
+// messages in one MPI_Allgatherv.
+Gathered all_gather(MPI_Comm comm, int ranks, const std::vector<char>& out) {
+  Gathered g;
   std::int64_t size = static_cast<std::int64_t>(out.size());
-  std::vector<std::int64_t> sizes(static_cast<size_t>(size_));
-  MPI_Allgather(&size, 1, MPI_INT64_T, sizes.data(), 1, MPI_INT64_T, comm_);
+  g.sizes.resize(static_cast<size_t>(ranks));
+  MPI_Allgather(&size, 1, MPI_INT64_T, g.sizes.data(), 1, MPI_INT64_T, comm);
   std::int64_t total = 0;
-  std::vector<int> counts(static_cast<size_t>(size_)), displs(static_cast<size_t>(size_));
-  for (int r = 0; r < size_; ++r) {
-    displs[static_cast<size_t>(r)] = static_cast<int>(std::min<std::int64_t>(total, INT_MAX));
-    counts[static_cast<size_t>(r)] = static_cast<int>(std::min<std::int64_t>(sizes[static_cast<size_t>(r)], INT_MAX));
-    total += sizes[static_cast<size_t>(r)];
+  std::vector<int> counts(static_cast<size_t>(ranks));
+  g.displs.resize(static_cast<size_t>(ranks));
+  for (int r = 0; r < ranks; ++r) {
+    g.displs[static_cast<size_t>(r)] = static_cast<int>(std::min<std::int64_t>(total, INT_MAX));
+    counts[static_cast<size_t>(r)] = static_cast<int>(std::min<std::int64_t>(g.sizes[static_cast<size_t>(r)], INT_MAX));
+    total += g.sizes[static_cast<size_t>(r)];
   }
   if (total > INT_MAX)
     throw std::runtime_error("one exchange between the MPI ranks would move " + std::to_string(total) +
                              " bytes, more than MPI_Allgatherv takes (2 GiB): use more, smaller bodies");
-  std::vector<char> all(static_cast<size_t>(total));
-  MPI_Allgatherv(out.data(), static_cast<int>(out.size()), MPI_CHAR, all.data(), counts.data(), displs.data(), MPI_CHAR,
-                 comm_);
-  ++exchanges_;
-  bytes_sent_ += size;
-  bytes_received_ += total - size;
+  g.all.resize(static_cast<size_t>(total));
+  MPI_Allgatherv(out.data(), static_cast<int>(out.size()), MPI_CHAR, g.all.data(), counts.data(), g.displs.data(),
+                 MPI_CHAR, comm);
+  return g;
+}
 
+// Reads every rank's message: the other ranks' failures into `errors`, their bodies' outputs through
+// share.unpack (a body that fails to unpack is an error too). Returns whether some rank asked to cancel.
+bool unpack_messages(const Gathered& g, int rank, const ddm::BodyShare& share, std::map<size_t, std::string>& errors) {
   bool cancel = false;
-  for (int r = 0; r < size_; ++r) {
-    ddm::Unpacker in(all.data() + displs[static_cast<size_t>(r)], static_cast<size_t>(sizes[static_cast<size_t>(r)]));
+  for (size_t r = 0; r < g.sizes.size(); ++r) {
+    ddm::Unpacker in(g.all.data() + g.displs[r], static_cast<size_t>(g.sizes[r]));
     // Read whatever the flags before said: every message starts with its flag, and a flag left unread would be
     // taken for the message's entry count (its bodies' outputs lost, or read from the wrong bytes).
     const bool asked = in.get_int() != 0;
@@ -105,20 +108,55 @@ void MpiTaskRunner::run_bodies(const std::vector<size_t>& bodies, const std::fun
       const bool body_failed = in.get_int() != 0;
       if (body_failed) {
         std::string message = in.get_string();
-        if (r != rank_) errors[body] = std::move(message);
+        if (static_cast<int>(r) != rank) errors[body] = std::move(message);
         continue;
       }
       ddm::Unpacker payload = in.take(static_cast<size_t>(in.get_int()));
-      if (r == rank_ || !share.unpack || errors.count(body)) continue;
+      if (static_cast<int>(r) == rank || !share.unpack || errors.count(body)) continue;
       try {
         share.unpack(body, payload);
         if (!payload.done()) throw std::runtime_error("body data from another process has unread bytes");
       } catch (const std::exception& ex) {
-        errors[body] = std::string("rank ") + std::to_string(rank_) + ": cannot take the outputs of body " +
+        errors[body] = std::string("rank ") + std::to_string(rank) + ": cannot take the outputs of body " +
                        std::to_string(body) + " from rank " + std::to_string(r) + ": " + ex.what();
       }
     }
   }
+  return cancel;
+}
+
+}  // namespace
+
+void MpiTaskRunner::run_bodies(const std::vector<size_t>& bodies, const std::function<void(size_t)>& task,
+                               const ddm::BodyShare& share) {
+  // This rank's tasks, each failure kept with its body (a failing rank must still meet the others below).
+  OwnOutcome own;
+  for (size_t a : bodies)
+    if (owns(a)) own.bodies.push_back(a);
+  own.failure.resize(own.bodies.size());
+  own.failed.assign(own.bodies.size(), 0);
+  local_.run(own.bodies.size(), [&](size_t i) {
+    try {
+      if (static_cast<long>(own.bodies[i]) == fail_body_)
+        throw std::runtime_error("rank " + std::to_string(rank_) + ": body " + std::to_string(own.bodies[i]) +
+                                 ": failure injected by CONTACT_MPI_FAIL_BODY");
+      task(own.bodies[i]);
+    } catch (const std::bad_alloc&) {
+      own.failure[i] = "out of memory";
+      own.failed[i] = 1;
+    } catch (const std::exception& e) {
+      own.failure[i] = e.what();
+      own.failed[i] = 1;
+    }
+  });
+  std::map<size_t, std::string> errors;  // by body: every rank picks the same (lowest) one
+  const std::vector<char> out = pack_message(request_ && request_->load(), own, share, errors);
+  const Gathered gathered = all_gather(comm_, size_, out);
+  ++exchanges_;
+  const auto size = static_cast<std::int64_t>(out.size());
+  bytes_sent_ += size;
+  bytes_received_ += static_cast<std::int64_t>(gathered.all.size()) - size;
+  const bool cancel = unpack_messages(gathered, rank_, share, errors);
   if (cancel && agreed_) agreed_->cancel();
   if (!errors.empty()) throw std::runtime_error(errors.begin()->second);
 }
