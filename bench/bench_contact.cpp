@@ -81,7 +81,7 @@ json seed_layers(int nx) {
 Figures one_solve(const json& job) {
   const Problem p = bench::parse_or_exit(job);
   const double t0 = now();
-  ddm::ThreadTaskRunner runner(ddm::choose_threads(0, p.bodies.size()));
+  parallel::ThreadTaskRunner runner(parallel::choose_threads(0, p.bodies.size()));
   ddm::ContactSystem system(p, runner, ddm::ContactSystem::Factorization::plain);
   const auto u = system.solve_bodies(ddm::Displacements(p.bodies.size()), runner);
   Figures f;

@@ -29,7 +29,7 @@ Problem make(json job, const json& solver) {
 
 double one_solve_seconds(const Problem& p) {
   const double t0 = now();
-  ddm::ThreadTaskRunner runner(ddm::choose_threads(0, p.bodies.size()));
+  parallel::ThreadTaskRunner runner(parallel::choose_threads(0, p.bodies.size()));
   ddm::ContactSystem system(p, runner);
   const auto u = system.solve_bodies(ddm::Displacements(p.bodies.size()), runner);
   (void)u;

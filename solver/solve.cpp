@@ -63,7 +63,7 @@ void refuse_unheld_bodies(const Problem& problem, Result& result) {
 
 Result solve(const Problem& problem, Observer& observer, const CancelToken& cancel) {
   try {
-    ddm::ThreadTaskRunner runner(ddm::choose_threads(problem.solver.threads, problem.bodies.size()));
+    parallel::ThreadTaskRunner runner(parallel::choose_threads(problem.solver.threads, problem.bodies.size()));
     return solve(problem, observer, cancel, runner);
   } catch (const std::exception& e) {  // no thread for the pool
     Result result;
@@ -73,7 +73,7 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
   }
 }
 
-Result solve(const Problem& problem, Observer& observer, const CancelToken& cancel, ddm::TaskRunner& runner) {
+Result solve(const Problem& problem, Observer& observer, const CancelToken& cancel, parallel::TaskRunner& runner) {
   const auto start = std::chrono::steady_clock::now();
   Result result;
   result.method = method_name(problem.solver.method);

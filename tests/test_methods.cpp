@@ -232,7 +232,7 @@ TEST(InterfaceNewton, ClosesStack3sLowerInterfaceThatTheFreeResponseLeavesOpen) 
   auto parsed = job::parse(job);
   ASSERT_TRUE(parsed.ok());
   const Problem& p = *parsed.problem;
-  ddm::ThreadTaskRunner runner(1);
+  parallel::ThreadTaskRunner runner(1);
   ddm::ContactSystem system(p, runner, ddm::ContactSystem::Factorization::interface);
   ASSERT_TRUE(system.ok()) << system.error();
   const ddm::InterfaceProblem interface(system, runner);

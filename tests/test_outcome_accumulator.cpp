@@ -41,7 +41,7 @@ ddm::MethodOutcome inner_solve(ddm::RunContext& context, int iterations, int sol
 TEST(OutcomeAccumulator, InnerIterationsRunOnMarkedAndTheWorkAddsUp) {
   Recorder recorder;
   CancelToken cancel;
-  ddm::ThreadTaskRunner runner(1);
+  parallel::ThreadTaskRunner runner(1);
   ddm::RunContext context{recorder, cancel, runner};
   ddm::OutcomeAccumulator total;
   total.run(context, nullptr, ddm::InnerMarks{1, {7}},

@@ -22,9 +22,9 @@ bool adapts(const AdaptivitySettings& s, size_t body) {
 // Indicator of every adaptive body (empty vector for the others).
 std::vector<IndicatorResult> estimate(const Problem& problem, const ddm::ContactSystem& system,
                                       const ddm::Displacements& u, const ddm::Displacements& contact_loads,
-                                      ddm::TaskRunner& runner, const CancelToken* cancel = nullptr) {
+                                      parallel::TaskRunner& runner, const CancelToken* cancel = nullptr) {
   std::vector<IndicatorResult> out(problem.bodies.size());
-  const ddm::BodyShare share{[&](size_t a, ddm::Packer& p) {
+  const parallel::BodyShare share{[&](size_t a, parallel::Packer& p) {
                                p.put(out[a].eta);
                                p.put(out[a].note);
                                p.put(out[a].seconds);
@@ -32,7 +32,7 @@ std::vector<IndicatorResult> estimate(const Problem& problem, const ddm::Contact
                                p.put(out[a].reference2);
                                p.put(out[a].cancelled ? 1.0 : 0.0);
                              },
-                             [&](size_t a, ddm::Unpacker& in) {
+                             [&](size_t a, parallel::Unpacker& in) {
                                out[a].eta = in.get_vector();
                                out[a].note = in.get_string();
                                out[a].seconds = in.get_double();

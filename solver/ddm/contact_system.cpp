@@ -41,7 +41,7 @@ std::string body_errors(const std::vector<std::pair<std::string, std::string>>& 
 
 }  // namespace
 
-ContactSystem::ContactSystem(const Problem& problem, TaskRunner& runner, Factorization factorization,
+ContactSystem::ContactSystem(const Problem& problem, parallel::TaskRunner& runner, Factorization factorization,
                              const CancelToken* cancel)
     : problem_(problem), factorization_(factorization), runner_(runner) {
   ScopedTimer timer(setup_seconds_);
@@ -62,7 +62,7 @@ std::unique_ptr<fem::BodySolver> ContactSystem::make_body(size_t a, bool local, 
   return b;
 }
 
-void ContactSystem::build_bodies(const std::vector<size_t>& todo, TaskRunner& runner, const CancelToken* cancel) {
+void ContactSystem::build_bodies(const std::vector<size_t>& todo, parallel::TaskRunner& runner, const CancelToken* cancel) {
   runner.run_bodies(todo, [&](size_t a) {
     bodies_[a].reset();  // free the old factorisation first
     bodies_[a] = make_body(a, true, cancel);
@@ -78,14 +78,14 @@ void ContactSystem::build_bodies(const std::vector<size_t>& todo, TaskRunner& ru
   append_error(error_, body_errors(failed));
 }
 
-BodyShare ContactSystem::body_outcome_share() {
+parallel::BodyShare ContactSystem::body_outcome_share() {
   // The owner's outcome (an error such as a singular stiffness, the factorisation time); the other processes set
   // up the body's constraints and rigid modes themselves (the same on every process).
-  return {[this](size_t a, Packer& out) {
+  return {[this](size_t a, parallel::Packer& out) {
             out.put(bodies_[a]->error());
             out.put(bodies_[a]->factorization_seconds());
           },
-          [this](size_t a, Unpacker& in) {
+          [this](size_t a, parallel::Unpacker& in) {
             bodies_[a] = make_body(a, false);
             const std::string error = in.get_string();
             bodies_[a]->adopt_outcome(error, in.get_double());
@@ -128,7 +128,7 @@ std::vector<int> ContactSystem::interface_dofs(size_t a) const {
   return dofs;
 }
 
-void ContactSystem::rebuild(const std::vector<char>& changed, TaskRunner& runner, const CancelToken* cancel) {
+void ContactSystem::rebuild(const std::vector<char>& changed, parallel::TaskRunner& runner, const CancelToken* cancel) {
   discretize_pairs();
   std::vector<size_t> todo;
   for (size_t a = 0; a < bodies_.size(); ++a)
@@ -198,17 +198,17 @@ Eigen::VectorXd ContactSystem::zone_normals(size_t a, const Eigen::VectorXd& u_a
   return out;
 }
 
-Displacements ContactSystem::solve_bodies(const Displacements& loads, TaskRunner& runner) const {
+Displacements ContactSystem::solve_bodies(const Displacements& loads, parallel::TaskRunner& runner) const {
   Displacements u(bodies_.size());
   runner.run_bodies(bodies_.size(), [&](size_t a) { u[a] = bodies_[a]->solve(loads[a]); }, share_vectors(u));
   return u;
 }
 
-BodyShare share_vectors(std::vector<Eigen::VectorXd>& v) {
-  return {[&v](size_t a, Packer& out) { out.put(v[a]); }, [&v](size_t a, Unpacker& in) { v[a] = in.get_vector(); }};
+parallel::BodyShare share_vectors(std::vector<Eigen::VectorXd>& v) {
+  return {[&v](size_t a, parallel::Packer& out) { out.put(v[a]); }, [&v](size_t a, parallel::Unpacker& in) { v[a] = in.get_vector(); }};
 }
 
-Displacements ContactSystem::elastic_layer_guess(TaskRunner& runner) const {
+Displacements ContactSystem::elastic_layer_guess(parallel::TaskRunner& runner) const {
   // Each body's response to its own loads with free contact zones; where the rigid approach (the overlap of
   // these free responses) exceeds the gap, each layer of height h_a under uniaxial strain (modulus M_a)
   // carries the pressure (approach - d) / (h_1/M_1 + h_2/M_2); the initial displacements are each body's
@@ -341,13 +341,13 @@ Step ContactSystem::fields(const Displacements& u, const Pressures& z, int itera
   // Stresses and support reactions on each body's owner (the reactions need its assembled loads).
   std::vector<fem::StressFields> stress(bodies_.size());
   std::vector<Eigen::VectorXd> reaction(bodies_.size());
-  const BodyShare share{[&](size_t a, Packer& out) {
+  const parallel::BodyShare share{[&](size_t a, parallel::Packer& out) {
                           out.put(stress[a].cell);
                           out.put(stress[a].node);
                           out.put(stress[a].von_mises_cell);
                           out.put(reaction[a]);
                         },
-                        [&](size_t a, Unpacker& in) {
+                        [&](size_t a, parallel::Unpacker& in) {
                           stress[a].cell = in.get_matrix();
                           stress[a].node = in.get_matrix();
                           stress[a].von_mises_cell = in.get_vector();

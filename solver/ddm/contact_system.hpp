@@ -32,14 +32,14 @@ class ContactSystem {
   // Discretises every pair, then assembles every body and factorises them as asked, in parallel through
   // `runner`. Check ok() / error(). With `cancel`, a cancel during the assembly or a factorisation stops the set-up
   // within a poll (fem/body_solver.hpp): then cancelled() and not ok(), and the system must not be used.
-  ContactSystem(const Problem& problem, TaskRunner& runner, Factorization factorization = Factorization::plain,
+  ContactSystem(const Problem& problem, parallel::TaskRunner& runner, Factorization factorization = Factorization::plain,
                 const CancelToken* cancel = nullptr);
 
   // After the meshes of the bodies flagged in `changed` were refined (in the Problem this system refers to):
   // rediscretises every pair and reassembles and refactorises the changed bodies, and any other body whose
   // interface unknowns changed (an unchanged body keeps its factorisation). Multipliers are dropped. Check ok();
   // a cancel (as for the constructor) leaves cancelled() true and the system unusable.
-  void rebuild(const std::vector<char>& changed, TaskRunner& runner, const CancelToken* cancel = nullptr);
+  void rebuild(const std::vector<char>& changed, parallel::TaskRunner& runner, const CancelToken* cancel = nullptr);
 
   bool ok() const { return error_.empty() && !cancelled_; }
   bool cancelled() const { return cancelled_; }
@@ -88,10 +88,10 @@ class ContactSystem {
   Eigen::VectorXd zone_normals(size_t a, const Eigen::VectorXd& u_a) const;
 
   // Each body solved with the given loads, in parallel.
-  Displacements solve_bodies(const Displacements& loads, TaskRunner& runner) const;
+  Displacements solve_bodies(const Displacements& loads, parallel::TaskRunner& runner) const;
 
   // The "elastic layer" initial guess (paper section 4, ALGORITHM.md section 5).
-  Displacements elastic_layer_guess(TaskRunner& runner) const;
+  Displacements elastic_layer_guess(parallel::TaskRunner& runner) const;
 
   // Per-iteration report for pressures z and nodal gaps g (per pair, per row); `previous_active` holds each
   // pair's active flags of the previous report and is updated. The other forms take the gaps of displacements
@@ -126,12 +126,12 @@ class ContactSystem {
   // Body a's solver: assembled and factorised (local), or only its constraints (owned by another process).
   std::unique_ptr<fem::BodySolver> make_body(size_t a, bool local, const CancelToken* cancel = nullptr) const;
   // Builds the bodies `todo` (in parallel), then collects their errors and factorisation times.
-  void build_bodies(const std::vector<size_t>& todo, TaskRunner& runner, const CancelToken* cancel);
-  BodyShare body_outcome_share();
+  void build_bodies(const std::vector<size_t>& todo, parallel::TaskRunner& runner, const CancelToken* cancel);
+  parallel::BodyShare body_outcome_share();
 
   const Problem& problem_;
   Factorization factorization_ = Factorization::plain;
-  TaskRunner& runner_;  // the one it was built with (fields() runs per-body work on it)
+  parallel::TaskRunner& runner_;  // the one it was built with (fields() runs per-body work on it)
   std::vector<std::unique_ptr<fem::BodySolver>> bodies_;
   std::vector<mortar::PairDiscretization> pairs_;
   std::vector<mortar::PenaltyChoice> penalties_;
@@ -143,7 +143,7 @@ class ContactSystem {
 };
 
 // How one full vector per body (displacements, loads) moves from its owner to the other processes.
-BodyShare share_vectors(std::vector<Eigen::VectorXd>& per_body);
+parallel::BodyShare share_vectors(std::vector<Eigen::VectorXd>& per_body);
 
 // Relative norm used by both stopping tests: ||a - b|| / max(||a||, ||b||), 0 when both vanish.
 double relative_change(const Eigen::VectorXd& now, const Eigen::VectorXd& before);

@@ -40,13 +40,13 @@ double estimate_spectral_radius(const ContactSystem& system, BodyMap& map, int i
 // The Neumann map of paper (16): each body with the penalty tractions of u.
 class NeumannMap final : public BodyMap {
  public:
-  NeumannMap(const ContactSystem& system, TaskRunner& runner) : system_(system), runner_(runner) {}
+  NeumannMap(const ContactSystem& system, parallel::TaskRunner& runner) : system_(system), runner_(runner) {}
   Displacements apply(const Displacements& u) override;
   Displacements linear_response(const Displacements& du) override;
 
  private:
   const ContactSystem& system_;
-  TaskRunner& runner_;
+  parallel::TaskRunner& runner_;
 };
 
 // Pressures of every pair's contact nodes for an interface perturbation du with all nodes in contact:

@@ -16,7 +16,7 @@ namespace contact::ddm {
 struct RunContext {
   Observer& observer;
   const CancelToken& cancel;
-  TaskRunner& runner;
+  parallel::TaskRunner& runner;
   std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
   const std::vector<Eigen::VectorXd>* warm_start = nullptr;  // start of the iterative methods, if given
   double elapsed() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); }

@@ -20,7 +20,7 @@ using Factor = Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::L
 
 class RobinMap final : public BodyMap {
  public:
-  RobinMap(const ContactSystem& system, const SolverSettings& settings, TaskRunner& runner)
+  RobinMap(const ContactSystem& system, const SolverSettings& settings, parallel::TaskRunner& runner)
       : system_(system), settings_(settings), runner_(runner), psi_(system.n_bodies()), factor_(system.n_bodies()),
         remote_(system.n_bodies(), 0), active_(system.pairs().size()) {}
 
@@ -90,7 +90,7 @@ class RobinMap final : public BodyMap {
       if (factor_[a]->info() != Eigen::Success)
         throw std::runtime_error("robin: the stiffness of body '" + system_.problem().bodies[a].name +
                                  "' plus the Robin term could not be factorised");
-    }, BodyShare{[](size_t, Packer&) {}, [this](size_t a, Unpacker&) { psi_[a].resize(0, 0); remote_[a] = 1; }});
+    }, parallel::BodyShare{[](size_t, parallel::Packer&) {}, [this](size_t a, parallel::Unpacker&) { psi_[a].resize(0, 0); remote_[a] = 1; }});
     factorizations_ += static_cast<int>(todo.size());
   }
 
@@ -119,7 +119,7 @@ class RobinMap final : public BodyMap {
 
   const ContactSystem& system_;
   const SolverSettings& settings_;
-  TaskRunner& runner_;
+  parallel::TaskRunner& runner_;
   std::vector<Eigen::SparseMatrix<double>> psi_;
   std::vector<std::unique_ptr<Factor>> factor_;
   std::vector<char> remote_;  // set up by another process (its factor_ stays empty here)

@@ -31,16 +31,16 @@ struct OwnOutcome {
 
 // This rank's message: its cancel request, then per own body its outcome and packed outputs (a body whose outputs
 // fail to pack counts as failed). Every failure is also recorded in `errors`, by body.
-std::vector<char> pack_message(bool cancel_requested, OwnOutcome& own, const ddm::BodyShare& share,
+std::vector<char> pack_message(bool cancel_requested, OwnOutcome& own, const parallel::BodyShare& share,
                                std::map<size_t, std::string>& errors) {
   std::vector<char> out;
-  ddm::Packer put(out);
+  parallel::Packer put(out);
   put.put(static_cast<std::int64_t>(cancel_requested ? 1 : 0));
   put.put(static_cast<std::int64_t>(own.bodies.size()));
   for (size_t i = 0; i < own.bodies.size(); ++i) {
     std::vector<char> payload;
     if (!own.failed[i] && share.pack) {
-      ddm::Packer p(payload);
+      parallel::Packer p(payload);
       try {
         share.pack(own.bodies[i], p);
       } catch (const std::exception& e) {
@@ -94,10 +94,10 @@ Gathered all_gather(MPI_Comm comm, int ranks, const std::vector<char>& out) {
 
 // Reads every rank's message: the other ranks' failures into `errors`, their bodies' outputs through
 // share.unpack (a body that fails to unpack is an error too). Returns whether some rank asked to cancel.
-bool unpack_messages(const Gathered& g, int rank, const ddm::BodyShare& share, std::map<size_t, std::string>& errors) {
+bool unpack_messages(const Gathered& g, int rank, const parallel::BodyShare& share, std::map<size_t, std::string>& errors) {
   bool cancel = false;
   for (size_t r = 0; r < g.sizes.size(); ++r) {
-    ddm::Unpacker in(g.all.data() + g.displs[r], static_cast<size_t>(g.sizes[r]));
+    parallel::Unpacker in(g.all.data() + g.displs[r], static_cast<size_t>(g.sizes[r]));
     // Read whatever the flags before said: every message starts with its flag, and a flag left unread would be
     // taken for the message's entry count (its bodies' outputs lost, or read from the wrong bytes).
     const bool asked = in.get_int() != 0;
@@ -111,7 +111,7 @@ bool unpack_messages(const Gathered& g, int rank, const ddm::BodyShare& share, s
         if (static_cast<int>(r) != rank) errors[body] = std::move(message);
         continue;
       }
-      ddm::Unpacker payload = in.take(static_cast<size_t>(in.get_int()));
+      parallel::Unpacker payload = in.take(static_cast<size_t>(in.get_int()));
       if (static_cast<int>(r) == rank || !share.unpack || errors.count(body)) continue;
       try {
         share.unpack(body, payload);
@@ -128,7 +128,7 @@ bool unpack_messages(const Gathered& g, int rank, const ddm::BodyShare& share, s
 }  // namespace
 
 void MpiTaskRunner::run_bodies(const std::vector<size_t>& bodies, const std::function<void(size_t)>& task,
-                               const ddm::BodyShare& share) {
+                               const parallel::BodyShare& share) {
   // This rank's tasks, each failure kept with its body (a failing rank must still meet the others below).
   OwnOutcome own;
   for (size_t a : bodies)

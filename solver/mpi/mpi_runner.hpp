@@ -20,15 +20,15 @@
 
 namespace contact::mpi {
 
-class MpiTaskRunner final : public ddm::TaskRunner {
+class MpiTaskRunner final : public parallel::TaskRunner {
  public:
   // owner[a]: the rank of body a (the same vector on every rank). threads: this rank's threads for its bodies.
   MpiTaskRunner(MPI_Comm comm, std::vector<int> owner, unsigned threads);
 
   void run(size_t n, const std::function<void(size_t)>& task) override { local_.run(n, task); }
   void run_bodies(const std::vector<size_t>& bodies, const std::function<void(size_t)>& task,
-                  const ddm::BodyShare& share) override;
-  using ddm::TaskRunner::run_bodies;
+                  const parallel::BodyShare& share) override;
+  using parallel::TaskRunner::run_bodies;
   bool owns(size_t body) const override { return owner_.at(body) == rank_; }
   bool distributed() const override { return size_ > 1; }
   bool is_root() const override { return rank_ == 0; }
@@ -52,7 +52,7 @@ class MpiTaskRunner final : public ddm::TaskRunner {
   MPI_Comm comm_;
   int rank_ = 0, size_ = 1;
   std::vector<int> owner_;
-  ddm::ThreadTaskRunner local_;
+  parallel::ThreadTaskRunner local_;
   const std::atomic<bool>* request_ = nullptr;
   CancelToken* agreed_ = nullptr;
   std::int64_t exchanges_ = 0, bytes_sent_ = 0, bytes_received_ = 0;

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-namespace contact::ddm {
+namespace contact::parallel {
 
 class Packer {
  public:
@@ -107,4 +107,4 @@ struct BodyShare {
   std::function<void(size_t body, Unpacker&)> unpack;  // on every other process, in the same order
 };
 
-}  // namespace contact::ddm
+}  // namespace contact::parallel

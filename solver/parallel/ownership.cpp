@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <numeric>
 
-namespace contact::ddm {
+namespace contact::parallel {
 
 std::vector<int> assign_bodies(const Problem& problem, int ranks) {
   const size_t n = problem.bodies.size();
@@ -39,4 +39,4 @@ std::vector<int> assign_bodies(const Problem& problem, int ranks) {
   return owner;
 }
 
-}  // namespace contact::ddm
+}  // namespace contact::parallel

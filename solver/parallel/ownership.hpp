@@ -5,7 +5,7 @@
 
 #include <vector>
 
-namespace contact::ddm {
+namespace contact::parallel {
 
 // Owner rank of every body, for `ranks` processes: balanced by degrees of freedom (largest body first, each to
 // the least loaded rank), and a body goes to a rank that already holds one of its contact partners when that
@@ -13,4 +13,4 @@ namespace contact::ddm {
 // More ranks than bodies leaves the extra ranks without bodies.
 std::vector<int> assign_bodies(const Problem& problem, int ranks);
 
-}  // namespace contact::ddm
+}  // namespace contact::parallel

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-namespace contact::ddm {
+namespace contact::parallel {
 
 ThreadTaskRunner::ThreadTaskRunner(unsigned threads) {
   for (unsigned i = 1; i < threads; ++i) workers_.emplace_back([this] { work_loop(); });
@@ -91,4 +91,4 @@ unsigned choose_threads(int requested, size_t n_tasks) {
   return static_cast<unsigned>(std::max<size_t>(1, std::min<size_t>(n_tasks, hw)));
 }
 
-}  // namespace contact::ddm
+}  // namespace contact::parallel

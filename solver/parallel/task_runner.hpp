@@ -11,7 +11,7 @@
 #include <thread>
 #include <vector>
 
-namespace contact::ddm {
+namespace contact::parallel {
 
 class TaskRunner {
  public:
@@ -72,4 +72,4 @@ class ThreadTaskRunner final : public TaskRunner {
 // Threads for n independent bodies: `requested` if > 0, else min(n, hardware threads).
 unsigned choose_threads(int requested, size_t n_tasks);
 
-}  // namespace contact::ddm
+}  // namespace contact::parallel

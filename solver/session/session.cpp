@@ -71,21 +71,21 @@ int Session::broadcast(int value) const {
 
 namespace {
 
-std::unique_ptr<ddm::TaskRunner> make_runner(const Problem& problem, bool mpi, int rank, int size,
+std::unique_ptr<parallel::TaskRunner> make_runner(const Problem& problem, bool mpi, int rank, int size,
                                              const std::atomic<bool>* request, CancelToken* agreed) {
 #ifdef CONTACT_WITH_MPI
   if (mpi && size > 1) {
-    const std::vector<int> owner = ddm::assign_bodies(problem, size);
+    const std::vector<int> owner = parallel::assign_bodies(problem, size);
     size_t mine = 0;
     for (int r : owner) mine += r == rank ? 1 : 0;
     auto runner = std::make_unique<mpi::MpiTaskRunner>(MPI_COMM_WORLD, owner,
-                                                       ddm::choose_threads(problem.solver.threads, std::max<size_t>(mine, 1)));
+                                                       parallel::choose_threads(problem.solver.threads, std::max<size_t>(mine, 1)));
     runner->watch_cancel(request, agreed);
     return runner;
   }
 #endif
   (void)mpi, (void)rank, (void)size, (void)request, (void)agreed;
-  return std::make_unique<ddm::ThreadTaskRunner>(ddm::choose_threads(problem.solver.threads, problem.bodies.size()));
+  return std::make_unique<parallel::ThreadTaskRunner>(parallel::choose_threads(problem.solver.threads, problem.bodies.size()));
 }
 
 }  // namespace
@@ -98,7 +98,7 @@ Result Session::solve(const Problem& problem, Observer& observer, const std::ato
 
 std::string Session::placement(const Problem& problem) const {
   if (size_ <= 1) return "";
-  const std::vector<int> owner = ddm::assign_bodies(problem, size_);
+  const std::vector<int> owner = parallel::assign_bodies(problem, size_);
   std::ostringstream os;
   for (int r = 0; r < size_; ++r) {
     os << (r ? "; " : "") << "rank " << r << ":";

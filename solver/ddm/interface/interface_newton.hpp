@@ -18,7 +18,7 @@ namespace contact::ddm {
 
 class InterfaceNewton {
  public:
-  InterfaceNewton(const ContactSystem& system, const SolverSettings& settings, TaskRunner& runner)
+  InterfaceNewton(const ContactSystem& system, const SolverSettings& settings, parallel::TaskRunner& runner)
       : system_(system),
         kind_(choose_interface_solver(settings.interface, system, runner)),
         problem_(system, runner, interface_options(kind_, settings.interface, system.has_friction())),

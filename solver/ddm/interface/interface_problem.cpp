@@ -105,7 +105,7 @@ void InterfaceProblem::compute_body(size_t a, BodyParts& out) const {
   }
 }
 
-InterfaceProblem::InterfaceProblem(const ContactSystem& system, TaskRunner& runner, const Options& options)
+InterfaceProblem::InterfaceProblem(const ContactSystem& system, parallel::TaskRunner& runner, const Options& options)
     : system_(system), options_(options) {
   const auto& pairs = system.pairs();
   offset_.assign(pairs.size() + 1, 0);
@@ -134,7 +134,7 @@ InterfaceProblem::InterfaceProblem(const ContactSystem& system, TaskRunner& runn
   for (size_t a = 0; a < n_bodies; ++a) parts[a].rows = body_rows(system, a, offset_, tangential_offset_);
   // Each body's part on its owner; the blocks move to every process only when they are replicated.
   const bool replicate = options_.replicate_blocks;
-  const BodyShare share{[&](size_t a, Packer& out) {
+  const parallel::BodyShare share{[&](size_t a, parallel::Packer& out) {
                           out.put(replicate ? parts[a].F : Eigen::MatrixXd());
                           out.put(replicate ? parts[a].preconditioner : Eigen::MatrixXd());
                           out.put(parts[a].G);
@@ -142,7 +142,7 @@ InterfaceProblem::InterfaceProblem(const ContactSystem& system, TaskRunner& runn
                           out.put(parts[a].e);
                           out.put(parts[a].diagonal);
                         },
-                        [&](size_t a, Unpacker& in) {
+                        [&](size_t a, parallel::Unpacker& in) {
                           parts[a].F = in.get_matrix();
                           parts[a].preconditioner = in.get_matrix();
                           parts[a].G = in.get_matrix();
@@ -203,7 +203,7 @@ SparseMatrix InterfaceProblem::assemble() const {
   return F;
 }
 
-bool InterfaceProblem::apply_blocks(const Eigen::VectorXd& x, Eigen::VectorXd& y, TaskRunner& runner,
+bool InterfaceProblem::apply_blocks(const Eigen::VectorXd& x, Eigen::VectorXd& y, parallel::TaskRunner& runner,
                                     bool preconditioner) const {
   y = Eigen::VectorXd::Zero(size());
   Eigen::VectorXd local, product;
@@ -226,12 +226,12 @@ bool InterfaceProblem::apply_blocks(const Eigen::VectorXd& x, Eigen::VectorXd& y
   return runner.sum(y.data(), static_cast<size_t>(y.size()));
 }
 
-bool InterfaceProblem::apply(const Eigen::VectorXd& x, Eigen::VectorXd& y, TaskRunner& runner) const {
+bool InterfaceProblem::apply(const Eigen::VectorXd& x, Eigen::VectorXd& y, parallel::TaskRunner& runner) const {
   CONTACT_ASSERT_SIZE(x.size(), size(), "the interface vector");
   return apply_blocks(x, y, runner, false);
 }
 
-bool InterfaceProblem::apply_preconditioner(const Eigen::VectorXd& x, Eigen::VectorXd& y, TaskRunner& runner) const {
+bool InterfaceProblem::apply_preconditioner(const Eigen::VectorXd& x, Eigen::VectorXd& y, parallel::TaskRunner& runner) const {
   CONTACT_ASSERT_SIZE(x.size(), size(), "the interface vector");
   const bool stop = apply_blocks(inverse_weight_.cwiseProduct(x), y, runner, true);
   y = inverse_weight_.cwiseProduct(y);
@@ -247,14 +247,14 @@ Eigen::VectorXd InterfaceProblem::free_gap() const {
   return g;
 }
 
-void InterfaceProblem::refresh_loads(TaskRunner& runner) {
+void InterfaceProblem::refresh_loads(parallel::TaskRunner& runner) {
   const size_t n_bodies = system_.n_bodies();
   std::vector<Eigen::VectorXd> g(n_bodies), e(n_bodies);
-  const BodyShare share{[&](size_t a, Packer& out) {
+  const parallel::BodyShare share{[&](size_t a, parallel::Packer& out) {
                           out.put(g[a]);
                           out.put(e[a]);
                         },
-                        [&](size_t a, Unpacker& in) {
+                        [&](size_t a, parallel::Unpacker& in) {
                           g[a] = in.get_vector();
                           e[a] = in.get_vector();
                         }};
@@ -299,7 +299,7 @@ Eigen::VectorXd InterfaceProblem::stack(const Pressures& per_pair) const {
 }
 
 Displacements InterfaceProblem::displacements(const Eigen::VectorXd& z, const Eigen::VectorXd& alpha,
-                                              TaskRunner& runner) const {
+                                              parallel::TaskRunner& runner) const {
   CONTACT_ASSERT_SIZE(z.size(), size(), "the interface multipliers");
   const Pressures q = split_tangential(z);
   Displacements u = system_.solve_bodies(system_.loads_from_pressures(split(z), &q), runner);

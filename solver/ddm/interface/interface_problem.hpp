@@ -48,8 +48,8 @@ class InterfaceProblem {
 
   // Needs a system built with Factorization::interface. Free responses and Schur complements, bodies in
   // parallel through `runner`.
-  InterfaceProblem(const ContactSystem& system, TaskRunner& runner) : InterfaceProblem(system, runner, Options{}) {}
-  InterfaceProblem(const ContactSystem& system, TaskRunner& runner, const Options& options);
+  InterfaceProblem(const ContactSystem& system, parallel::TaskRunner& runner) : InterfaceProblem(system, runner, Options{}) {}
+  InterfaceProblem(const ContactSystem& system, parallel::TaskRunner& runner, const Options& options);
 
   Eigen::Index size() const { return size_; }
   Eigen::Index normal_size() const { return static_cast<Eigen::Index>(offset_.back()); }
@@ -60,7 +60,7 @@ class InterfaceProblem {
   Eigen::VectorXd free_gap() const;
   // Recomputes the bodies' free responses for the current loads: needed when a step's loads are not a multiple of
   // the previous ones (conditions with their own history). One solve per body.
-  void refresh_loads(TaskRunner& runner);
+  void refresh_loads(parallel::TaskRunner& runner);
   const Eigen::VectorXd& weights() const { return D_; }       // area of every row, stacked
   Eigen::Index offset(size_t pair) const { return offset_[pair]; }
   const ContactSystem& system() const { return system_; }
@@ -78,9 +78,9 @@ class InterfaceProblem {
   SparseMatrix assemble() const;
   // y = F x from the blocks this process holds, summed over the processes by `runner` (returns its cancel
   // answer, TaskRunner::sum).
-  bool apply(const Eigen::VectorXd& x, Eigen::VectorXd& y, TaskRunner& runner) const;
+  bool apply(const Eigen::VectorXd& x, Eigen::VectorXd& y, parallel::TaskRunner& runner) const;
   // y = sum_a B_a X_a B_a^T x with the preconditioner blocks, scaled to approximate F^-1 (feti.hpp).
-  bool apply_preconditioner(const Eigen::VectorXd& x, Eigen::VectorXd& y, TaskRunner& runner) const;
+  bool apply_preconditioner(const Eigen::VectorXd& x, Eigen::VectorXd& y, parallel::TaskRunner& runner) const;
   // The diagonal of F (every process holds all of it).
   const Eigen::VectorXd& diagonal() const { return diagonal_; }
 
@@ -101,13 +101,13 @@ class InterfaceProblem {
 
   // The bodies' displacements for pressures z and rigid-mode amplitudes alpha (empty without floating bodies):
   // one solve per body, in parallel.
-  Displacements displacements(const Eigen::VectorXd& z, const Eigen::VectorXd& alpha, TaskRunner& runner) const;
+  Displacements displacements(const Eigen::VectorXd& z, const Eigen::VectorXd& alpha, parallel::TaskRunner& runner) const;
 
  private:
   struct BodyParts;  // what one body's task computes
   void compute_body(size_t a, BodyParts& out) const;
   void assemble_equilibrium(const std::vector<BodyParts>& parts);
-  bool apply_blocks(const Eigen::VectorXd& x, Eigen::VectorXd& y, TaskRunner& runner, bool preconditioner) const;
+  bool apply_blocks(const Eigen::VectorXd& x, Eigen::VectorXd& y, parallel::TaskRunner& runner, bool preconditioner) const;
 
   const ContactSystem& system_;
   Options options_;

@@ -19,7 +19,7 @@ constexpr Eigen::Index max_direct_rows = 40000;
 }  // namespace
 
 InterfaceSolverKind choose_interface_solver(const InterfaceSolverSettings& settings, const ContactSystem& system,
-                                            const TaskRunner& runner) {
+                                            const parallel::TaskRunner& runner) {
   // By size only, not by the number of processes: the same job takes the same solver on any number of ranks, so
   // its answer does not depend on them (the direct solver runs replicated on every rank; docs/parallel.md).
   (void)runner;

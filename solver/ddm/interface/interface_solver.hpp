@@ -35,7 +35,7 @@ struct InterfaceQp {
 };
 
 struct InterfaceSolveContext {
-  TaskRunner& runner;
+  parallel::TaskRunner& runner;
   const CancelToken& cancel;
   const linalg::StepCallback& on_step;  // after every active-set step / outer iteration; false cancels
   int max_steps = 100;                  // active-set steps / outer iterations
@@ -71,7 +71,7 @@ class InterfaceSolver {
 // where the direct one's dense Schur complement on the floating bodies' rows (r x r) or its sparse factor would be
 // large, the direct one otherwise (by size alone: the same on any number of processes).
 InterfaceSolverKind choose_interface_solver(const InterfaceSolverSettings& settings, const ContactSystem& system,
-                                            const TaskRunner& runner);
+                                            const parallel::TaskRunner& runner);
 // How the interface problem must be built for that solver (blocks replicated or not, preconditioner, tangential
 // rows for friction).
 InterfaceProblem::Options interface_options(InterfaceSolverKind kind, const InterfaceSolverSettings& settings,

@@ -14,7 +14,7 @@
 
 namespace contact {
 
-namespace ddm {
+namespace parallel {
 class TaskRunner;
 }
 
@@ -44,7 +44,7 @@ class Session {
  private:
   int rank_ = 0, size_ = 1;
   bool mpi_ = false;
-  std::unique_ptr<ddm::TaskRunner> runner_;  // the last solve's
+  std::unique_ptr<parallel::TaskRunner> runner_;  // the last solve's
 };
 
 }  // namespace contact

@@ -6,7 +6,7 @@
 
 namespace contact {
 
-namespace ddm {
+namespace parallel {
 class TaskRunner;
 }
 
@@ -20,7 +20,7 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
 // The same on the caller's executor of the per-body work: MPI ranks (solver/mpi/mpi_runner.hpp), where every
 // rank calls solve() with the same problem and a `cancel` that the runner keeps equal on all ranks; each rank
 // returns the same Result (the root reports progress and writes the file).
-Result solve(const Problem& problem, Observer& observer, const CancelToken& cancel, ddm::TaskRunner& runner);
+Result solve(const Problem& problem, Observer& observer, const CancelToken& cancel, parallel::TaskRunner& runner);
 
 // Factorisations a cancel left running (each ends within seconds and frees its memory). A program about to exit
 // waits for them (wait_for_background_work with a bound) or, if it must exit at once, ends with std::_Exit after
