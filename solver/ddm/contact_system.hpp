@@ -118,6 +118,14 @@ class ContactSystem {
   Step fields(const Displacements& u, int iteration) const { return fields(u, penalty_pressures(u), iteration); }
 
  private:
+  // fields() in phases (system_fields.cpp): the bodies' stresses and support reactions (on their owners), one
+  // body's field, one pair's field.
+  void stresses_and_reactions(const Displacements& u, const Displacements& loads, std::vector<fem::StressFields>& stress,
+                              std::vector<Eigen::VectorXd>& reaction) const;
+  BodyField body_field(size_t a, const Eigen::VectorXd& u, fem::StressFields stress, const Eigen::VectorXd& reaction,
+                       const Eigen::VectorXd* rigid_amplitudes) const;
+  PairField pair_field(size_t k, const Displacements& u, const Eigen::VectorXd& z, const Eigen::VectorXd* q) const;
+
   void discretize_pairs();
   // Full dofs of body a that some pair's operators act on (empty unless Factorization::interface).
   std::vector<int> interface_dofs(size_t a) const;
