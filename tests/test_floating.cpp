@@ -49,6 +49,22 @@ TEST(Floating, FreeCylinderPressedByAForceMatchesHertzForThatForce) {
   EXPECT_NEAR(cylinder.rigid_motion.z(), 0.0, 1e-12);
 }
 
+TEST(Floating, TheAugmentedLagrangianReportsTheFloatingBodysRigidMotionAsExactContactDoes) {
+  // The same job with the augmented Lagrangian: it converges to exact non-penetration, so the cylinder's rigid
+  // motion (its sinking) must be the exact method's up to the updates' tolerance, not left out.
+  const json job = example("hertz_force.json");
+  json al = job;
+  al["solver"]["enforcement"] = "augmented_lagrangian";
+  const Result exact = run(job), augmented = run(al);
+  ASSERT_TRUE(exact.converged) << exact.message;
+  ASSERT_TRUE(augmented.converged) << augmented.message;
+  const BodyField& e = body(exact.steps.back(), "cylinder");
+  const BodyField& a = body(augmented.steps.back(), "cylinder");
+  ASSERT_LT(e.rigid_motion.y(), 0.0);
+  EXPECT_NEAR(a.rigid_motion.y(), e.rigid_motion.y(), 1e-3 * std::abs(e.rigid_motion.y()));
+  EXPECT_NEAR(a.rigid_motion.z(), 0.0, 1e-12);
+}
+
 TEST(Floating, MiddleBlockHeldOnlyByItsContactsIsInEquilibrium) {
   // api/examples/stack3_floating.json: the middle block has only the symmetry condition u_x = 0.
   const Result r = run(example("stack3_floating.json"));

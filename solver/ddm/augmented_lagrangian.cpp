@@ -82,10 +82,10 @@ MethodOutcome run_augmented_lagrangian(ContactSystem& system, const SolverSettin
     updates_so_far.run(context, warm.empty() ? nullptr : &warm, InnerMarks{update, {}},
                        [&](RunContext& inner) { return method.run(inner); });
     total.updates = update;
-    // The updates' stop is their own (below); their answer is the displacements and pressures alone, without
-    // rigid amplitudes or tangential multipliers (friction needs exact contact).
+    // The updates' stop is their own (below); their answer is the last solve's displacements, pressures and
+    // floating bodies' rigid amplitudes (the result's rigid motion), without tangential multipliers (friction
+    // needs exact contact).
     total.converged = false;
-    total.rigid_amplitudes.clear();
     total.q.clear();
     const std::string inner_message = std::move(total.message);
     if (total.reason != StopReason::converged) {
