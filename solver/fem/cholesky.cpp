@@ -61,8 +61,13 @@ Cholesky::Cholesky(const Eigen::SparseMatrix<double>& A_in, const std::vector<in
   Eigen::SparseMatrix<double> A = A_in;
   A.makeCompressed();
   cholmod_sparse a = view_symmetric(A);
+  impl_->common.supernodal = CHOLMOD_SUPERNODAL;  // LL^T in supernodal form always: the trailing block is read from it
+  if (!analyse(&a, last) || !factorize_numerically(&a)) return;
+  if (!last.empty()) read_trailing_block(last);
+}
+
+bool Cholesky::analyse(cholmod_sparse* a, const std::vector<int>& last) {
   cholmod_common& c = impl_->common;
-  c.supernodal = CHOLMOD_SUPERNODAL;  // LL^T in supernodal form always: the trailing block is read from it
   if (!last.empty()) {
     std::vector<char> member(static_cast<size_t>(n_), 0);
     std::vector<int> perm(static_cast<size_t>(n_));
@@ -75,9 +80,9 @@ Cholesky::Cholesky(const Eigen::SparseMatrix<double>& A_in, const std::vector<in
     // with its 1025 contact unknowns this stores 3 % more than the unconstrained default ordering (CAMD with Z
     // as the last constraint set: 49 % more) and factorises no slower.
     std::vector<int> nested(static_cast<size_t>(n_)), parent(static_cast<size_t>(n_)), component(static_cast<size_t>(n_));
-    if (cholmod_nested_dissection(&a, nullptr, 0, nested.data(), parent.data(), component.data(), &c) < 0) {
+    if (cholmod_nested_dissection(a, nullptr, 0, nested.data(), parent.data(), component.data(), &c) < 0) {
       error_ = "the fill-reducing ordering (nested dissection) failed";
-      return;
+      return false;
     }
     size_t k = 0;
     for (int i : nested)
@@ -88,30 +93,34 @@ Cholesky::Cholesky(const Eigen::SparseMatrix<double>& A_in, const std::vector<in
     c.nmethods = 1;
     c.method[0].ordering = CHOLMOD_GIVEN;
     c.postorder = 0;
-    impl_->factor = cholmod_analyze_p(&a, perm.data(), nullptr, 0, &c);
+    impl_->factor = cholmod_analyze_p(a, perm.data(), nullptr, 0, &c);
   } else {
-    impl_->factor = cholmod_analyze(&a, &c);
+    impl_->factor = cholmod_analyze(a, &c);
   }
-  if (!impl_->factor) {
-    error_ = "the symbolic analysis failed (out of memory?)";
-    return;
-  }
-  cholmod_factorize(&a, impl_->factor, &c);
+  if (!impl_->factor) error_ = "the symbolic analysis failed (out of memory?)";
+  return impl_->factor != nullptr;
+}
+
+bool Cholesky::factorize_numerically(cholmod_sparse* a) {
+  cholmod_common& c = impl_->common;
+  cholmod_factorize(a, impl_->factor, &c);
   cholmod_factor* L = impl_->factor;
   if (c.status == CHOLMOD_NOT_POSDEF || L->minor < L->n) {
     std::ostringstream os;
     os << "the matrix is not positive definite (pivot " << L->minor << " of " << n_ << ")";
     error_ = os.str();
-    return;
+    return false;
   }
   if (c.status < CHOLMOD_OK) {
     error_ = c.status == CHOLMOD_OUT_OF_MEMORY ? "out of memory in the factorisation" : "the factorisation failed";
-    return;
+    return false;
   }
   factor_entries_ = static_cast<double>(L->is_super ? L->xsize : L->nzmax);
-  if (last.empty()) return;
+  return true;
+}
 
-  // The trailing block of the (supernodal, LL^T) factor.
+void Cholesky::read_trailing_block(const std::vector<int>& last) {
+  const cholmod_factor* L = impl_->factor;
   const int nz = static_cast<int>(last.size()), first = n_ - nz;
   const int* P = static_cast<const int*>(L->Perm);
   trailing_order_.resize(static_cast<size_t>(nz));

@@ -19,6 +19,9 @@
 #include <string>
 #include <vector>
 
+struct cholmod_sparse_struct;
+using cholmod_sparse = cholmod_sparse_struct;
+
 namespace contact::fem {
 
 class Cholesky {
@@ -47,6 +50,12 @@ class Cholesky {
   double factor_entries() const { return factor_entries_; }
 
  private:
+  // The constructor's phases: the ordering and symbolic analysis (with `last` behind everything else), the
+  // numerical factorisation, the trailing block of the factor. The first two return false with error_ set.
+  bool analyse(cholmod_sparse* a, const std::vector<int>& last);
+  bool factorize_numerically(cholmod_sparse* a);
+  void read_trailing_block(const std::vector<int>& last);
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
   int n_ = 0;
