@@ -281,21 +281,65 @@ ddm::MethodOutcome converge_then_refine(Problem& working, ddm::ContactSystem& sy
   }
 }
 
-// The paper's interleaving: one Neumann update, then estimate and refine, every iteration.
+// The paper's (17) with relaxation gamma, and both stopping measures of the step from u to u_tilde: the paper's
+// criterion (the zone normals' relative change over u -> u_new) and the fixed-point residual.
+struct RelaxedUpdate {
+  ddm::Displacements u_new;
+  double residual = 0.0, paper = 0.0;
+};
+
+RelaxedUpdate relaxed_update(const ddm::ContactSystem& system, const ddm::Displacements& u,
+                             const ddm::Displacements& u_tilde, double gamma) {
+  RelaxedUpdate out;
+  out.u_new.resize(u.size());
+  double diff2 = 0, base2 = 0;
+  for (size_t a = 0; a < u.size(); ++a) {
+    const Eigen::VectorXd z = system.zone_normals(a, u[a]), zt = system.zone_normals(a, u_tilde[a]);
+    diff2 += (zt - z).squaredNorm();
+    base2 += std::max(z.squaredNorm(), zt.squaredNorm());
+    out.u_new[a] = gamma * u_tilde[a] + (1 - gamma) * u[a];
+    out.paper = std::max(out.paper, ddm::relative_change(system.zone_normals(a, out.u_new[a]), z));
+  }
+  out.residual = base2 > 0 ? std::sqrt(diff2 / base2) : 0.0;
+  return out;
+}
+
+// gamma: the job's, or with "auto" from the Neumann map's spectral radius (as the fixed-point methods choose it).
+double paper_gamma(const ddm::ContactSystem& system, const SolverSettings& settings, ddm::RunContext& context,
+                   int& solves_per_body) {
+  if (!settings.gamma_auto) return settings.gamma;
+  ddm::NeumannMap map(system, context.runner);
+  int solves = 0;
+  const double gamma = std::min(1.0, 1.8 / (2.0 + ddm::estimate_spectral_radius(system, map, 12, solves)));
+  solves_per_body += solves;
+  return gamma;
+}
+
+// After a refinement: the iterate carried to the new meshes and the system rebuilt on them. An empty message when
+// it went well, else why the loop stops (the reason in `reason`).
+std::string rebuild_after_refinement(Problem& working, ddm::ContactSystem& system, ddm::RunContext& context,
+                                     const RefineOutcome& r, ddm::Displacements& u, StopReason& reason) {
+  transfer(u, working, r);
+  system.rebuild(r.changed, context.runner, &context.cancel);
+  if (system.cancelled()) {
+    reason = StopReason::cancelled;
+    return "cancelled during the refined meshes' assembly and factorisation (the result holds the steps before)";
+  }
+  if (!system.ok()) {
+    reason = StopReason::error;
+    return "adaptive: " + system.error();
+  }
+  return "";
+}
+
+// The paper's interleaving: one Neumann update (16)-(17), then estimate and refine, every iteration; it stops when
+// the DDM criterion holds and no cell is marked.
 ddm::MethodOutcome paper_interleaving(Problem& working, ddm::ContactSystem& system, ddm::RunContext& context,
                                       ddm::StepLog& steps) {
   const SolverSettings& settings = working.solver;
   ddm::MethodOutcome out;
-  const size_t n = working.bodies.size();
   ddm::Displacements u = ddm::initial_iterate(system, settings, context, out.solves_per_body);
-  double gamma = settings.gamma;
-  if (settings.gamma_auto) {
-    ddm::NeumannMap map(system, context.runner);
-    int solves = 0;
-    gamma = std::min(1.0, 1.8 / (2.0 + ddm::estimate_spectral_radius(system, map, 12, solves)));
-    out.solves_per_body += solves;
-  }
-  out.gamma = gamma;
+  out.gamma = paper_gamma(system, settings, context, out.solves_per_body);
   std::vector<std::vector<char>> active;
   int step = 0;
   for (int k = 1; k <= settings.max_iterations; ++k) {
@@ -304,70 +348,45 @@ ddm::MethodOutcome paper_interleaving(Problem& working, ddm::ContactSystem& syst
       out.message = "cancelled";
       break;
     }
-    // (16) on the current meshes, then (17).
+    // (16) on the current meshes, then (17); the estimate on the body solutions of (16) with the contact tractions
+    // they were solved with.
     const ddm::Displacements loads = system.contact_loads(u);
     const ddm::Displacements u_tilde = system.solve_bodies(loads, context.runner);
     ++out.solves_per_body;
-    double diff2 = 0, base2 = 0, paper = 0;
-    ddm::Displacements u_new(n);
-    for (size_t a = 0; a < n; ++a) {
-      const Eigen::VectorXd z = system.zone_normals(a, u[a]), zt = system.zone_normals(a, u_tilde[a]);
-      diff2 += (zt - z).squaredNorm();
-      base2 += std::max(z.squaredNorm(), zt.squaredNorm());
-      u_new[a] = gamma * u_tilde[a] + (1 - gamma) * u[a];
-      paper = std::max(paper, ddm::relative_change(system.zone_normals(a, u_new[a]), z));
-    }
-    const double residual = base2 > 0 ? std::sqrt(diff2 / base2) : 0.0;
-    const bool ddm_converged = (settings.criterion == Criterion::paper ? paper : residual) <= settings.tolerance;
-    // Estimate on the body solutions of (16) with the contact tractions they were solved with.
+    RelaxedUpdate update = relaxed_update(system, u, u_tilde, out.gamma);
+    const bool ddm_converged =
+        (settings.criterion == Criterion::paper ? update.paper : update.residual) <= settings.tolerance;
     const auto eta = estimate(working, system, u_tilde, loads, context.runner);
     for (const auto& e : eta) out.indicator_seconds += e.seconds;
-    IterationReport rep = system.report(k, u_new, active);
-    rep.paper_criterion = paper;
-    rep.fixed_point_residual = residual;
-    rep.gamma = gamma;
+    IterationReport rep = system.report(k, update.u_new, active);
+    rep.paper_criterion = update.paper;
+    rep.fixed_point_residual = update.residual;
+    rep.gamma = out.gamma;
     // Record the mesh state (before it is refined), then refine.
-    Step st = make_step(system, u_new, {}, k, step, eta);
-    RefineOutcome r = mark_and_refine(working, eta, st);
-    for (size_t a = 0; a < n; ++a) rep.bodies[a].elements_refined = r.refined[a];
+    Step st = make_step(system, update.u_new, {}, k, step, eta);
+    const RefineOutcome r = mark_and_refine(working, eta, st);
+    for (size_t a = 0; a < rep.bodies.size(); ++a) rep.bodies[a].elements_refined = r.refined[a];
     rep.note = r.note;
     rep.elapsed_seconds = context.elapsed();
     context.observer.on_iteration(rep);
     out.history.push_back(std::move(rep));
     out.iterations = k;
-    if (!r.any) {
-      if (ddm_converged) {
-        steps.push_back(std::move(st));
-        out.converged = true;
-        out.reason = StopReason::converged;
-        std::ostringstream os;
-        os << "adaptive (paper): the DDM criterion holds and no cell is marked (" << step << " refinements)";
-        out.message = os.str();
-        u = std::move(u_new);
-        break;
-      }
-      u = std::move(u_new);
-    } else {
+    u = std::move(update.u_new);
+    if (!r.any && ddm_converged) {
+      steps.push_back(std::move(st));
+      out.converged = true;
+      out.reason = StopReason::converged;
+      out.message = "adaptive (paper): the DDM criterion holds and no cell is marked (" + std::to_string(step) +
+                    " refinements)";
+      break;
+    }
+    if (r.any) {
       steps.push_back(std::move(st));
       ++step;
-      transfer(u_new, working, r);
-      system.rebuild(r.changed, context.runner, &context.cancel);
-      if (system.cancelled()) {
-        out.reason = StopReason::cancelled;
-        out.message = "cancelled during the refined meshes' assembly and factorisation (the result holds the "
-                      "steps before)";
-        u = std::move(u_new);
-        break;
-      }
-      if (!system.ok()) {
-        out.reason = StopReason::error;
-        out.message = "adaptive: " + system.error();
-        u = std::move(u_new);
-        break;
-      }
-      u = std::move(u_new);
+      out.message = rebuild_after_refinement(working, system, context, r, u, out.reason);
+      if (!out.message.empty()) break;
     }
-    if (!std::isfinite(residual)) {
+    if (!std::isfinite(update.residual)) {
       out.reason = StopReason::error;
       out.message = "the iteration diverges; reduce gamma";
       break;
