@@ -88,32 +88,44 @@ std::int64_t EventLog::load() {
   types_.clear();
   recent_.clear();
   file_size_ = 0;
+  const int fd = open_for_load();
+  if (fd < 0) return 0;  // no events yet
+  const LoadScan scan = index_lines(fd);
+  file_size_ = scan.good_bytes;
+  if (scan.damaged)
+    set_damaged_file_aside(fd);
+  else if (scan.torn)
+    cut_torn_line(fd, scan.read_bytes);
+  ::close(fd);
+  return static_cast<std::int64_t>(offsets_.size());
+}
+
+int EventLog::open_for_load() {
   const int fd = ::open(path_.c_str(), O_RDWR | O_NOFOLLOW | O_CLOEXEC);
-  if (fd < 0) {
-    if (errno == ELOOP) {  // a symbolic link planted in the store: moved aside (the link, not its target)
-      const std::string aside = path_ + ".damaged-" + std::to_string(now_unix_us() / 1000000);
-      problem_ = "events.ndjson was a symbolic link (moved to " + aside.substr(aside.rfind('/') + 1) + ")";
-      if (::rename(path_.c_str(), aside.c_str()) != 0) problem_ += "; cannot move it: " + std::string(std::strerror(errno));
-      log_line("events: " + path_ + ": " + problem_);
-    }
-    return 0;  // no events yet
+  if (fd < 0 && errno == ELOOP) {  // a symbolic link planted in the store: moved aside (the link, not its target)
+    const std::string aside = path_ + ".damaged-" + std::to_string(now_unix_us() / 1000000);
+    problem_ = "events.ndjson was a symbolic link (moved to " + aside.substr(aside.rfind('/') + 1) + ")";
+    if (::rename(path_.c_str(), aside.c_str()) != 0) problem_ += "; cannot move it: " + std::string(std::strerror(errno));
+    log_line("events: " + path_ + ": " + problem_);
   }
+  return fd;
+}
+
+EventLog::LoadScan EventLog::index_lines(int fd) {
   // One pass in chunks of 1 MiB: each complete line is indexed by its prefix; the lines are never all in memory.
   constexpr std::size_t kChunk = 1 << 20;
   constexpr std::size_t kLongestLine = 64u << 20;  // no event is this long: a file without newlines is damage
-  constexpr std::int64_t kMaxGap = 1'000'000;
   std::vector<char> chunk(kChunk);
   std::string line;  // the current line, possibly spanning chunks
-  std::uint64_t read_at = 0, line_start = 0;
-  bool damaged = false, torn = false;
-  while (!damaged) {
-    const ssize_t n = ::pread(fd, chunk.data(), chunk.size(), static_cast<off_t>(read_at));
+  LoadScan scan;
+  while (!scan.damaged) {
+    const ssize_t n = ::pread(fd, chunk.data(), chunk.size(), static_cast<off_t>(scan.read_bytes));
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) {
-      torn = !line.empty();  // the crash hit the one write() of the last line
+      scan.torn = !line.empty();  // the crash hit the one write() of the last line
       break;
     }
-    read_at += static_cast<std::uint64_t>(n);
+    scan.read_bytes += static_cast<std::uint64_t>(n);
     std::size_t from = 0;
     while (from < static_cast<std::size_t>(n)) {
       const char* begin = chunk.data() + from;
@@ -124,52 +136,59 @@ std::int64_t EventLog::load() {
       from += take;
       if (!nl) break;
       ++from;  // the newline
-      std::int64_t seq = 0;
-      std::string type;
-      const auto next = static_cast<std::int64_t>(offsets_.size()) + 1;
-      // A gap is events lost to write errors (a full disk): they stay missing. A seq that goes back, or a jump no
-      // write error explains, is not this log's.
-      if (!parse_prefix(line, seq, type) || seq < next || seq > next + kMaxGap || line.back() != '}') {
-        damaged = true;
+      if (!index_line(line, scan.good_bytes)) {
+        scan.damaged = true;
         break;
       }
-      while (static_cast<std::int64_t>(offsets_.size()) + 1 < seq) {
-        offsets_.push_back(kUnwritten);
-        types_.push_back(0);
-      }
-      offsets_.push_back(line_start);
-      types_.push_back(type_index(type));
-      line_start += line.size() + 1;  // events read back stay on disk only: a finished job costs no memory
+      scan.good_bytes += line.size() + 1;  // events read back stay on disk only: a finished job costs no memory
       line.clear();
     }
-    if (line.size() > kLongestLine) damaged = true;
+    if (line.size() > kLongestLine) scan.damaged = true;
   }
-  file_size_ = line_start;
-  if (damaged) {
-    // Not a crash artefact (every line is written whole by one write()): keep the file as it is, continue on a
-    // copy of the good part.
-    const std::string aside = path_ + ".damaged-" + std::to_string(now_unix_us() / 1000000);
-    problem_ = "events.ndjson is damaged after event " + std::to_string(offsets_.size()) + " (byte " +
-               std::to_string(line_start) + "); the file is kept as " + aside.substr(aside.rfind('/') + 1) +
-               " and the events before the damage are served";
-    log_line("events: " + path_ + ": " + problem_);
-    const std::string copy = path_ + ".tmp";
+  return scan;
+}
+
+bool EventLog::index_line(const std::string& line, std::uint64_t offset) {
+  constexpr std::int64_t kMaxGap = 1'000'000;
+  std::int64_t seq = 0;
+  std::string type;
+  const auto next = static_cast<std::int64_t>(offsets_.size()) + 1;
+  // A gap is events lost to write errors (a full disk): they stay missing. A seq that goes back, or a jump no
+  // write error explains, is not this log's.
+  if (!parse_prefix(line, seq, type) || seq < next || seq > next + kMaxGap || line.back() != '}') return false;
+  while (static_cast<std::int64_t>(offsets_.size()) + 1 < seq) {
+    offsets_.push_back(kUnwritten);
+    types_.push_back(0);
+  }
+  offsets_.push_back(offset);
+  types_.push_back(type_index(type));
+  return true;
+}
+
+void EventLog::set_damaged_file_aside(int fd) {
+  // Not a crash artefact (every line is written whole by one write()): keep the file as it is, continue on a
+  // copy of the good part.
+  const std::string aside = path_ + ".damaged-" + std::to_string(now_unix_us() / 1000000);
+  problem_ = "events.ndjson is damaged after event " + std::to_string(offsets_.size()) + " (byte " +
+             std::to_string(file_size_) + "); the file is kept as " + aside.substr(aside.rfind('/') + 1) +
+             " and the events before the damage are served";
+  log_line("events: " + path_ + ": " + problem_);
+  const std::string copy = path_ + ".tmp";
+  ::unlink(copy.c_str());
+  if (!copy_prefix(fd, copy, file_size_) || ::rename(path_.c_str(), aside.c_str()) != 0 ||
+      ::rename(copy.c_str(), path_.c_str()) != 0) {
+    log_line("events: cannot set " + path_ + " aside (" + std::strerror(errno) +
+             "); it is served up to the damage and never written to");
     ::unlink(copy.c_str());
-    if (!copy_prefix(fd, copy, line_start) || ::rename(path_.c_str(), aside.c_str()) != 0 ||
-        ::rename(copy.c_str(), path_.c_str()) != 0) {
-      log_line("events: cannot set " + path_ + " aside (" + std::strerror(errno) +
-               "); it is served up to the damage and never written to");
-      ::unlink(copy.c_str());
-      if (::access(path_.c_str(), F_OK) != 0) ::rename(aside.c_str(), path_.c_str());
-      frozen_ = true;
-    }
-  } else if (torn) {
-    log_line("events: cut " + std::to_string(read_at - line_start) + " bytes of a torn last line from " + path_);
-    if (::ftruncate(fd, static_cast<off_t>(line_start)) != 0)
-      log_line("events: cannot truncate " + path_ + ": " + std::strerror(errno));
+    if (::access(path_.c_str(), F_OK) != 0) ::rename(aside.c_str(), path_.c_str());
+    frozen_ = true;
   }
-  ::close(fd);
-  return static_cast<std::int64_t>(offsets_.size());
+}
+
+void EventLog::cut_torn_line(int fd, std::uint64_t read_bytes) {
+  log_line("events: cut " + std::to_string(read_bytes - file_size_) + " bytes of a torn last line from " + path_);
+  if (::ftruncate(fd, static_cast<off_t>(file_size_)) != 0)
+    log_line("events: cannot truncate " + path_ + ": " + std::strerror(errno));
 }
 
 std::string EventLog::problem() const {
@@ -257,6 +276,53 @@ std::int64_t EventLog::append(const std::string& type, const nlohmann::json& fie
   return seq;
 }
 
+std::string EventLog::read_range(std::uint64_t begin, std::uint64_t end) const {
+  std::string bytes(end - begin, '\0');
+  const int fd = ::open(path_.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
+  std::size_t got = 0;
+  if (fd >= 0) {
+    while (got < bytes.size()) {
+      const ssize_t n = ::pread(fd, bytes.data() + got, bytes.size() - got, static_cast<off_t>(begin + got));
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) break;
+      got += static_cast<std::size_t>(n);
+    }
+    ::close(fd);
+  }
+  bytes.resize(got);
+  return bytes;
+}
+
+bool EventLog::events_from_file(const std::string& bytes, std::uint64_t begin, std::int64_t seq,
+                                const std::vector<std::uint64_t>& offsets, const std::vector<std::uint8_t>& types,
+                                std::vector<Event>& events) const {
+  for (std::size_t k = 0; k < offsets.size(); ++k) {
+    if (offsets[k] == kUnwritten) continue;  // lost to a write error: skipped
+    const std::size_t from = offsets[k] - begin;
+    if (from >= bytes.size()) break;
+    const std::size_t newline = bytes.find('\n', from);
+    if (newline == std::string::npos) break;
+    const std::int64_t event_seq = seq + static_cast<std::int64_t>(k);
+    std::string line = bytes.substr(from, newline - from);
+    // Only whole events are served: a line changed on disk since it was written is reported, not sent.
+    std::int64_t line_seq = 0;
+    std::string line_type;
+    if (!parse_prefix(line, line_seq, line_type) || line_seq != event_seq || !nlohmann::json::accept(line)) {
+      std::function<void(const std::string&)> report;
+      {
+        std::lock_guard<std::mutex> relock(mutex_);
+        damaged_locked(event_seq, "events.ndjson: the line of event " + std::to_string(event_seq) +
+                                      " is not a valid event; the stream stops before it");
+        report = on_damage_;
+      }
+      if (report) report(problem());
+      return false;
+    }
+    events.push_back({event_seq, kTypes[types[k]], std::move(line)});
+  }
+  return true;
+}
+
 std::vector<Event> EventLog::read_after(std::int64_t after, std::size_t max_count) const {
   std::vector<Event> events;
   if (after < 0) after = 0;
@@ -286,45 +352,9 @@ std::vector<Event> EventLog::read_after(std::int64_t after, std::size_t max_coun
     std::vector<std::uint8_t> types(types_.begin() + (seq - 1), types_.begin() + file_until);
     std::vector<std::uint64_t> offsets(offsets_.begin() + (seq - 1), offsets_.begin() + file_until);
     lock.unlock();  // the file part is read without the lock: the worker keeps appending meanwhile
-    if (begin != kUnwritten && end > begin) {
-      std::string bytes(end - begin, '\0');
-      const int fd = ::open(path_.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
-      std::size_t got = 0;
-      if (fd >= 0) {
-        while (got < bytes.size()) {
-          const ssize_t n = ::pread(fd, bytes.data() + got, bytes.size() - got, static_cast<off_t>(begin + got));
-          if (n < 0 && errno == EINTR) continue;
-          if (n <= 0) break;
-          got += static_cast<std::size_t>(n);
-        }
-        ::close(fd);
-      }
-      bytes.resize(got);
-      for (std::size_t k = 0; k < offsets.size(); ++k) {
-        if (offsets[k] == kUnwritten) continue;  // lost to a write error: skipped
-        const std::size_t from = offsets[k] - begin;
-        if (from >= bytes.size()) break;
-        const std::size_t newline = bytes.find('\n', from);
-        if (newline == std::string::npos) break;
-        const std::int64_t event_seq = seq + static_cast<std::int64_t>(k);
-        std::string line = bytes.substr(from, newline - from);
-        // Only whole events are served: a line changed on disk since it was written is reported, not sent.
-        std::int64_t line_seq = 0;
-        std::string line_type;
-        if (!parse_prefix(line, line_seq, line_type) || line_seq != event_seq || !nlohmann::json::accept(line)) {
-          std::function<void(const std::string&)> report;
-          {
-            std::lock_guard<std::mutex> relock(mutex_);
-            damaged_locked(event_seq, "events.ndjson: the line of event " + std::to_string(event_seq) +
-                                          " is not a valid event; the stream stops before it");
-            report = on_damage_;
-          }
-          if (report) report(problem());
-          return events;
-        }
-        events.push_back({event_seq, kTypes[types[k]], std::move(line)});
-      }
-    }
+    if (begin != kUnwritten && end > begin &&
+        !events_from_file(read_range(begin, end), begin, seq, offsets, types, events))
+      return events;
     seq = file_until + 1;
     if (seq > until) return events;
     lock.lock();

@@ -77,6 +77,26 @@ class EventLog {
   bool discarded() const;
 
  private:
+  // load() in phases (under the lock): open the file (a planted symbolic link is moved aside), index its lines
+  // (a line is indexed by index_line when its prefix is this log's next event), then set a damaged file aside
+  // (serving a copy of the good part) or cut a torn last line.
+  struct LoadScan {
+    std::uint64_t read_bytes = 0, good_bytes = 0;  // read, and up to the end of the last good line
+    bool damaged = false, torn = false;
+  };
+  int open_for_load();
+  LoadScan index_lines(int fd);
+  bool index_line(const std::string& line, std::uint64_t offset);
+  void set_damaged_file_aside(int fd);
+  void cut_torn_line(int fd, std::uint64_t read_bytes);
+  // read_after's file part (without the lock): the bytes [begin, end) of the file, then the events in them from
+  // `seq` on (their offsets and types copied under the lock); false when a line is not the event it should be
+  // (the log is then marked damaged and on_damage_ told).
+  std::string read_range(std::uint64_t begin, std::uint64_t end) const;
+  bool events_from_file(const std::string& bytes, std::uint64_t begin, std::int64_t seq,
+                        const std::vector<std::uint64_t>& offsets, const std::vector<std::uint8_t>& types,
+                        std::vector<Event>& events) const;
+
   void open_for_append_locked();
   void damaged_locked(std::int64_t seq, const std::string& problem) const;  // found by a read: mutable state
 
