@@ -150,6 +150,72 @@ std::string read_file(const std::string& path) {
 }
 
 
+// The summary lines of the last step: per pair its force, resultant, peak pressure and penetration (and friction),
+// per supported body its reactions (per displacement condition, the components it prescribes, and the total).
+void print_final_step(const contact::Step& step) {
+  for (const auto& p : step.pairs) {
+    double p_max = 0, penetration = 0;
+    for (Eigen::Index j = 0; j < p.pressure.size(); ++j) {
+      p_max = std::max(p_max, p.pressure[j]);
+      penetration = std::max(penetration, p.penetration[j]);
+    }
+    if (p.enforcement == "exact")
+      std::printf("pair %s: exact contact, force %.8g, resultant (%.8g, %.8g), max pressure %.8g, max penetration %.4g\n",
+                  p.name.c_str(), p.force, p.resultant.x(), p.resultant.y(), p_max, penetration);
+    else
+      std::printf("pair %s: %s, theta %.4g, force %.8g, resultant (%.8g, %.8g), max pressure %.8g, max penetration %.4g\n",
+                  p.name.c_str(), p.enforcement.c_str(), p.theta, p.force, p.resultant.x(), p.resultant.y(), p_max,
+                  penetration);
+    if (p.friction != "none") {
+      const long stick = p.stick.size() ? p.stick.cast<long>().sum() : 0, in_contact = p.active.cast<long>().sum();
+      std::printf("pair %s: %s friction (%s %.4g), tangential force %.8g, %ld of %ld nodes in contact sticking\n",
+                  p.name.c_str(), p.friction.c_str(), p.friction == "coulomb" ? "mu" : "bound",
+                  p.friction == "coulomb" ? p.friction_coefficient : p.friction_bound, p.tangential_force, stick,
+                  in_contact);
+    }
+  }
+  for (const auto& b : step.bodies) {
+    if (b.support_reactions.empty()) continue;
+    std::printf("body %s: reactions total (%.8g, %.8g)", b.name.c_str(), b.reaction_total.x(), b.reaction_total.y());
+    for (const auto& s : b.support_reactions)
+      std::printf("; %s (%.8g, %.8g)", s.where.c_str(), s.force.x(), s.force.y());
+    std::printf("\n");
+  }
+}
+
+// The result file and its XDMF sidecar; throws what cannot be written.
+void write_files(const std::string& output, const contact::Problem& problem, const contact::Result& result,
+                 const std::string& job_id, bool ndjson) {
+  contact::io::WriteInfo info;
+  info.job_id = job_id;
+  contact::io::write_result(output, problem, result, info);
+  std::filesystem::path xmf = std::filesystem::path(output).replace_extension(".xmf");
+  contact::io::write_xdmf(xmf.string(), std::filesystem::path(output).filename().string(), result);
+  // ParaView's Xdmf3 readers abort on a bare file name (they join it with the data file's name): "./x.xmf".
+  if (!xmf.has_parent_path()) xmf = std::filesystem::path(".") / xmf;
+  if (!ndjson)
+    std::printf("wrote %s and %s (in ParaView, open %s with the Xdmf3 Reader)\n", output.c_str(), xmf.string().c_str(),
+                xmf.string().c_str());
+}
+
+// What the command says before solving: the job's shape, the method, and under MPI the ranks and placement.
+void print_header(const contact::Session& session, const contact::Problem& problem) {
+  std::printf("%s: %zu bodies, %zu contact pairs, method %s, enforcement %s\n", problem.name.c_str(),
+              problem.bodies.size(), problem.contacts.size(), method_name(problem.solver.method),
+              enforcement_name(problem.solver.enforcement));
+  if (session.size() > 1) std::printf("%d MPI ranks (%s)\n", session.size(), session.placement(problem).c_str());
+  std::fflush(stdout);
+}
+
+// Whether the method's outer loop counts active-set steps (else iterations), for the stop line.
+bool counts_active_set_steps(const contact::Problem& problem) {
+  const bool fixed_point = problem.solver.method == contact::Method::neumann || problem.solver.method == contact::Method::robin;
+  const bool adaptive_paper = problem.adaptivity.enabled && problem.adaptivity.strategy == contact::AdaptStrategy::paper;
+  return !fixed_point && !adaptive_paper &&
+         (problem.solver.method == contact::Method::interface_newton ||
+          problem.solver.enforcement == contact::Enforcement::exact);
+}
+
 // Everything after the job is parsed: solve on this process's share, report and write on rank 0. Returns the
 // exit code (rank 0's decides for all).
 int solve_and_write(contact::Session& session, contact::Problem& problem, const std::string& output,
@@ -160,19 +226,7 @@ int solve_and_write(contact::Session& session, contact::Problem& problem, const 
     g_direct_cancel = &cancel;
     if (g_stop_request) cancel.cancel();  // asked before the token existed
   }
-
-  const bool fixed_point = problem.solver.method == contact::Method::neumann || problem.solver.method == contact::Method::robin;
-  const bool adaptive_paper = problem.adaptivity.enabled && problem.adaptivity.strategy == contact::AdaptStrategy::paper;
-  const bool active_set = !fixed_point && !adaptive_paper &&
-                          (problem.solver.method == contact::Method::interface_newton ||
-                           problem.solver.enforcement == contact::Enforcement::exact);
-  if (root && !ndjson) {
-    std::printf("%s: %zu bodies, %zu contact pairs, method %s, enforcement %s\n", problem.name.c_str(),
-                problem.bodies.size(), problem.contacts.size(), method_name(problem.solver.method),
-                enforcement_name(problem.solver.enforcement));
-    if (session.size() > 1) std::printf("%d MPI ranks (%s)\n", session.size(), session.placement(problem).c_str());
-    std::fflush(stdout);
-  }
+  if (root && !ndjson) print_header(session, problem);
   ProgressPrinter printer(quiet, ndjson);
   Silent silent;
   const contact::Result result =
@@ -183,8 +237,8 @@ int solve_and_write(contact::Session& session, contact::Problem& problem, const 
 
   if (!ndjson) {
     std::printf("stop: %s after %d %s, %.3f s (setup %.3f s): %s\n", contact::to_string(result.stop_reason),
-                result.iterations, active_set ? "steps" : "iterations", result.wall_seconds, result.setup_seconds,
-                result.message.c_str());
+                result.iterations, counts_active_set_steps(problem) ? "steps" : "iterations", result.wall_seconds,
+                result.setup_seconds, result.message.c_str());
     if (!traffic.empty()) std::printf("mpi: %s\n", traffic.c_str());
   }
   nlohmann::json summary = {{"type", "result"},
@@ -206,47 +260,9 @@ int solve_and_write(contact::Session& session, contact::Problem& problem, const 
     std::cerr << "error: " << result.message << "\n";
     return finish(1);
   }
-  for (const auto& p : result.steps.back().pairs) {
-    if (ndjson) break;
-    double p_max = 0, penetration = 0;
-    for (Eigen::Index j = 0; j < p.pressure.size(); ++j) {
-      p_max = std::max(p_max, p.pressure[j]);
-      penetration = std::max(penetration, p.penetration[j]);
-    }
-    if (p.enforcement == "exact")
-      std::printf("pair %s: exact contact, force %.8g, resultant (%.8g, %.8g), max pressure %.8g, max penetration %.4g\n",
-                  p.name.c_str(), p.force, p.resultant.x(), p.resultant.y(), p_max, penetration);
-    else
-      std::printf("pair %s: %s, theta %.4g, force %.8g, resultant (%.8g, %.8g), max pressure %.8g, max penetration %.4g\n",
-                  p.name.c_str(), p.enforcement.c_str(), p.theta, p.force, p.resultant.x(), p.resultant.y(), p_max,
-                  penetration);
-    if (p.friction != "none") {
-      const long stick = p.stick.size() ? p.stick.cast<long>().sum() : 0, in_contact = p.active.cast<long>().sum();
-      std::printf("pair %s: %s friction (%s %.4g), tangential force %.8g, %ld of %ld nodes in contact sticking\n",
-                  p.name.c_str(), p.friction.c_str(), p.friction == "coulomb" ? "mu" : "bound",
-                  p.friction == "coulomb" ? p.friction_coefficient : p.friction_bound, p.tangential_force, stick,
-                  in_contact);
-    }
-  }
-  // Support reactions: per displacement condition (the components it prescribes) and the body's total.
-  for (const auto& b : result.steps.back().bodies) {
-    if (ndjson || b.support_reactions.empty()) continue;
-    std::printf("body %s: reactions total (%.8g, %.8g)", b.name.c_str(), b.reaction_total.x(), b.reaction_total.y());
-    for (const auto& s : b.support_reactions)
-      std::printf("; %s (%.8g, %.8g)", s.where.c_str(), s.force.x(), s.force.y());
-    std::printf("\n");
-  }
+  if (!ndjson) print_final_step(result.steps.back());
   try {
-    contact::io::WriteInfo info;
-    info.job_id = job_id;
-    contact::io::write_result(output, problem, result, info);
-    std::filesystem::path xmf = std::filesystem::path(output).replace_extension(".xmf");
-    contact::io::write_xdmf(xmf.string(), std::filesystem::path(output).filename().string(), result);
-    // ParaView's Xdmf3 readers abort on a bare file name (they join it with the data file's name): "./x.xmf".
-    if (!xmf.has_parent_path()) xmf = std::filesystem::path(".") / xmf;
-    if (!ndjson)
-      std::printf("wrote %s and %s (in ParaView, open %s with the Xdmf3 Reader)\n", output.c_str(),
-                  xmf.string().c_str(), xmf.string().c_str());
+    write_files(output, problem, result, job_id, ndjson);
     summary["result_written"] = true;
     for (const auto& step : result.step_history) summary["steps"].push_back(contact::io::step_json(step));
   } catch (const std::exception& e) {
