@@ -118,6 +118,7 @@ long first_at_target(const std::vector<Point>& points) {
 void adaptive_run(const char* label, const json& adaptivity, const Profile& reference, const std::vector<Point>& uniform) {
   json job = seed(8, 2);
   job["adaptivity"] = adaptivity;
+  job["output"] = {{"steps", "all"}};  // every step's fields (adaptive jobs keep only the last by default)
   const double t0 = now();
   const Result r = run(job);
   const double wall = now() - t0;
