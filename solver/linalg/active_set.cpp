@@ -134,18 +134,23 @@ Eigen::VectorXd solve_nonnegative_qp(const SparseMatrix& H, const Eigen::VectorX
   return z;
 }
 
-Eigen::VectorXd nested_initial_guess(const SparseMatrix& H, const Eigen::VectorXd& g, const std::vector<int>& line,
-                                     const Eigen::VectorXd& position, const Equalities& equalities,
-                                     std::vector<std::pair<Eigen::Index, int>>* levels, Eigen::Index coarsest) {
-  const Eigen::Index n = g.size();
-  if (n <= coarsest) return Eigen::VectorXd::Zero(n);
-  // Coarse unknowns: every other one of each line, its first and last always.
+std::vector<Eigen::Index> coarse_unknowns(const std::vector<int>& line) {
+  const auto n = static_cast<Eigen::Index>(line.size());
   std::vector<Eigen::Index> keep;
   for (Eigen::Index j = 0; j < n; ++j) {
     const bool first = j == 0 || line[static_cast<size_t>(j)] != line[static_cast<size_t>(j) - 1];
     const bool last = j + 1 == n || line[static_cast<size_t>(j) + 1] != line[static_cast<size_t>(j)];
     if (first || last || (!keep.empty() && j - keep.back() >= 2)) keep.push_back(j);
   }
+  return keep;
+}
+
+Eigen::VectorXd nested_initial_guess(const SparseMatrix& H, const Eigen::VectorXd& g, const std::vector<int>& line,
+                                     const Eigen::VectorXd& position, const Equalities& equalities,
+                                     std::vector<std::pair<Eigen::Index, int>>* levels, Eigen::Index coarsest) {
+  const Eigen::Index n = g.size();
+  if (n <= coarsest) return Eigen::VectorXd::Zero(n);
+  const std::vector<Eigen::Index> keep = coarse_unknowns(line);
   const Eigen::Index nc = static_cast<Eigen::Index>(keep.size());
   if (nc >= n) return Eigen::VectorXd::Zero(n);
   // P: n x nc, identity on the kept unknowns, linear interpolation between them (sparse: two entries a row).

@@ -75,6 +75,10 @@ ActiveSetResult solve_active_set(const SparseMatrix& H, const Eigen::VectorXd& g
 // The QP method on its own (for the fallback and for tests): min 1/2 z^T H z + g^T z, z >= 0.
 Eigen::VectorXd solve_nonnegative_qp(const SparseMatrix& H, const Eigen::VectorXd& g, int max_steps = 0);
 
+// The unknowns a coarser multiplier space keeps: every other one of each line (line[j], consecutive per line), its
+// first and last always.
+std::vector<Eigen::Index> coarse_unknowns(const std::vector<int>& line);
+
 // A first guess for the active set from the same problem on coarser multiplier spaces (nested iteration): the
 // unknowns lie on lines (line[j], consecutive and ordered by position[j] along each line, e.g. the contact nodes
 // of each pair along its slave edge); every other one is kept per line (the ends always), the rest interpolated

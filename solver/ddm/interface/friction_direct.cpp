@@ -1,6 +1,6 @@
 #include "friction_direct.hpp"
 
-#include <Eigen/UmfPackSupport>
+#include "../../linalg/friction_nested.hpp"
 
 #include <cmath>
 #include <limits>
@@ -13,89 +13,13 @@ namespace {
 using linalg::Contact;
 using linalg::FrictionRow;
 using linalg::FrictionSets;
-using Rows = std::vector<Eigen::Index>;
-
-// Rows `rows` of a column-major sparse matrix A (in that order).
-SparseMatrix select_rows(const SparseMatrix& A, const Rows& rows) {
-  std::vector<Eigen::Index> position(static_cast<size_t>(A.rows()), -1);
-  for (size_t i = 0; i < rows.size(); ++i) position[static_cast<size_t>(rows[i])] = static_cast<Eigen::Index>(i);
-  std::vector<Eigen::Triplet<double>> entries;
-  for (int col = 0; col < A.outerSize(); ++col)
-    for (SparseMatrix::InnerIterator it(A, col); it; ++it)
-      if (const Eigen::Index i = position[static_cast<size_t>(it.row())]; i >= 0) entries.emplace_back(i, col, it.value());
-  SparseMatrix out(static_cast<Eigen::Index>(rows.size()), A.cols());
-  out.setFromTriplets(entries.begin(), entries.end());
-  return out;
-}
-
-// The Newton step on the sets: lambda, alpha and whether the system could be solved.
-struct SetSolve {
-  Eigen::VectorXd lambda, alpha;
-  bool ok = false;
-};
-
-SetSolve solve_on_sets(const SparseMatrix& F, const InterfaceQp& qp, const linalg::FrictionParametrization& p) {
-  const Eigen::Index na = static_cast<Eigen::Index>(p.rows.size()), r = qp.equilibrium.G.rows();
-  const SparseMatrix RFP = select_rows(SparseMatrix(F * p.P), p.rows);
-  const SparseMatrix RGt = select_rows(SparseMatrix(qp.equilibrium.G.transpose()), p.rows);
-  const SparseMatrix GP = r > 0 ? SparseMatrix(qp.equilibrium.G * p.P) : SparseMatrix(0, na);
-  std::vector<Eigen::Triplet<double>> entries;
-  auto put = [&](const SparseMatrix& A, Eigen::Index row0, Eigen::Index col0) {
-    for (int col = 0; col < A.outerSize(); ++col)
-      for (SparseMatrix::InnerIterator it(A, col); it; ++it) entries.emplace_back(row0 + it.row(), col0 + col, it.value());
-  };
-  put(RFP, 0, 0);
-  put(RGt, 0, na);
-  put(GP, na, 0);
-  SparseMatrix M(na + r, na + r);
-  M.setFromTriplets(entries.begin(), entries.end());
-  M.makeCompressed();
-  Eigen::VectorXd rhs(na + r);
-  const Eigen::VectorXd h0 = qp.g + F * p.lambda0;
-  for (Eigen::Index i = 0; i < na; ++i) rhs[i] = -h0[p.rows[static_cast<size_t>(i)]];
-  if (r > 0) rhs.tail(r) = qp.equilibrium.e - qp.equilibrium.G * p.lambda0;
-  SetSolve out;
-  if (na + r == 0) {
-    out.lambda = p.lambda0;
-    out.alpha = Eigen::VectorXd::Zero(r);
-    out.ok = true;
-    return out;
-  }
-  Eigen::UmfPackLU<SparseMatrix> lu(M);
-  if (lu.info() != Eigen::Success) return out;
-  Eigen::VectorXd y = lu.solve(rhs);
-  y += lu.solve(Eigen::VectorXd(rhs - M * y));  // one step of refinement: the system mixes F's scales and G's
-  if (!y.allFinite()) return out;
-  out.lambda = p.P * y.head(na) + p.lambda0;
-  out.alpha = y.tail(r);
-  out.ok = true;
-  return out;
-}
-
-// The floating bodies' equilibrium as far as normal pressures alone can give it: the columns of the normal rows,
-// without the rows they cannot meet (a motion that only friction holds: sliding along a flat contact, a roller's
-// spin).
-linalg::Equalities normal_equalities(const linalg::Equalities& all, Eigen::Index m) {
-  if (all.empty()) return all;
-  const SparseMatrix Gn = all.G.leftCols(m);
-  std::vector<Eigen::Index> keep;
-  const Eigen::VectorXd normal_part = (Gn.cwiseAbs2() * Eigen::VectorXd::Ones(m)).cwiseSqrt();
-  const Eigen::VectorXd whole = (all.G.cwiseAbs2() * Eigen::VectorXd::Ones(all.G.cols())).cwiseSqrt();
-  for (Eigen::Index i = 0; i < Gn.rows(); ++i)
-    if (normal_part[i] > 1e-8 * whole[i]) keep.push_back(i);
-  linalg::Equalities out;
-  out.G = select_rows(Gn, keep);
-  out.e.resize(static_cast<Eigen::Index>(keep.size()));
-  for (size_t i = 0; i < keep.size(); ++i) out.e[static_cast<Eigen::Index>(i)] = all.e[keep[i]];
-  return out;
-}
 
 // The first sets: the frictionless normal problem's (with the equilibrium normal pressures can meet; from nested
 // coarse solves, which keeps the number of steps independent of the mesh, also at a new load step, where the
 // previous step's sets would move the zone's edge by a few nodes per step); where that fails, the warm start's
 // prediction, or every normal row active (floating bodies) or those that overlap. Every node in contact sticks:
-// the tied problem under the loads is well posed (friction holds the floating bodies), and the slip zones grow
-// from it (predicting slip from the previous step's tractions can start far off).
+// the tied problem under the loads is well posed (friction holds the floating bodies). The solver then predicts
+// better sets from coarse friction solves (first_sets_from_coarse) and comes back here if those fail.
 FrictionSets first_sets(const SparseMatrix& F, const InterfaceQp& qp, const Eigen::VectorXd* z0,
                         const Eigen::VectorXd& alpha0, const Eigen::VectorXd& c, const std::vector<FrictionRow>& rows,
                         const std::vector<char>& mask, std::string& note) {
@@ -103,7 +27,7 @@ FrictionSets first_sets(const SparseMatrix& F, const InterfaceQp& qp, const Eige
   Eigen::VectorXd lambda = Eigen::VectorXd::Zero(n);
   const SparseMatrix Fnn = F.topLeftCorner(m, m);
   const Eigen::VectorXd gn = qp.g.head(m);
-  const linalg::Equalities held = normal_equalities(qp.equilibrium, m);
+  const linalg::Equalities held = linalg::normal_equalities(qp.equilibrium, m);
   const std::vector<int> line(qp.line.begin(), qp.line.begin() + m);
   const Eigen::VectorXd guess = linalg::nested_initial_guess(Fnn, gn, line, qp.position.head(m), held);
   const linalg::StepCallback quiet = [](const Eigen::VectorXd&, const Eigen::VectorXd&, const linalg::ActiveSetStep&) { return true; };
@@ -193,6 +117,30 @@ std::vector<FrictionRow> friction_rows(const InterfaceProblem& problem) {
   return rows;
 }
 
+namespace {
+
+// The first sets from coarse friction solves (linalg/friction_nested.hpp) over the sticking start: false (and the
+// sets unchanged) when there is no coarser level or a coarse problem could not be solved.
+bool first_sets_from_coarse(const SparseMatrix& F, const InterfaceQp& qp, const std::vector<FrictionRow>& rows,
+                            FrictionSets& sets, std::string& note) {
+  const Eigen::Index m = qp.problem.normal_size();
+  if (static_cast<Eigen::Index>(qp.line.size()) < m || qp.position.size() < m) return false;
+  const std::vector<int> line(qp.line.begin(), qp.line.begin() + m);  // the normal rows' (tangential: on none)
+  const Eigen::VectorXd position = qp.position.head(m);
+  const linalg::FrictionLevel level{F, qp.g, qp.equilibrium, rows, m, line, position};
+  std::vector<int> coarse_steps;
+  FrictionSets nested;
+  if (!linalg::nested_friction_sets(level, nested, &coarse_steps)) return false;
+  sets = std::move(nested);
+  std::string steps;
+  for (int k : coarse_steps) steps += (steps.empty() ? "" : ", ") + std::to_string(k);
+  note += std::string(note.empty() ? "" : "; ") + "stick and slip sets from coarse friction solves (" + steps +
+          " steps, finest first)";
+  return true;
+}
+
+}  // namespace
+
 linalg::ActiveSetResult FrictionDirectSolver::solve(const InterfaceQp& qp, const Eigen::VectorXd* z0,
                                                     InterfaceSolveContext& context) {
   linalg::ActiveSetResult result;
@@ -212,12 +160,20 @@ linalg::ActiveSetResult FrictionDirectSolver::solve(const InterfaceQp& qp, const
   Eigen::VectorXd c(n);
   for (Eigen::Index j = 0; j < n; ++j) c[j] = 1.0 / std::max(diagonal[j], 1e-12 * dmax + 1e-300);
   if (last_alpha_.size() != qp.equilibrium.G.rows()) last_alpha_.resize(0);
-  FrictionSets sets = first_sets(F, qp, z0, last_alpha_, c, rows, mask, context.note);
+  const FrictionSets sticking = first_sets(F, qp, z0, last_alpha_, c, rows, mask, context.note);
+  FrictionSets sets = sticking;
+  bool from_coarse = first_sets_from_coarse(F, qp, rows, sets, context.note);
   result.z = Eigen::VectorXd::Zero(n);
   bool restarted = false;
   for (int step = 1; step <= context.max_steps; ++step) {
     const linalg::FrictionParametrization p = linalg::parametrize(sets, rows, mask);
-    const SetSolve s = solve_on_sets(F, qp, p);
+    const linalg::FrictionStepSolve s = linalg::solve_on_friction_sets(F, qp.g, qp.equilibrium, p);
+    if (!s.ok && from_coarse && step == 1) {  // the coarse guess leaves a floating body unheld: start as without it
+      from_coarse = false;
+      sets = sticking;
+      --step;
+      continue;
+    }
     if (!s.ok && !restarted && step > 1) {
       // A floating body held by nothing on these sets, which may be a bad guess: once, every node in contact sticks.
       restarted = true;

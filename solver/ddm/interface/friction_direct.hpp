@@ -5,9 +5,10 @@
 // the predicted stick and slip sets with the floating bodies' equilibrium,
 //   [R F P   R G^T] [y    ]   [-R (g + F lambda0)]
 //   [G P     0    ] [alpha] = [ e - G lambda0    ],
-// by UMFPACK (sparse LU), until the sets repeat. Without a warm start the normal problem is first solved without
-// friction (the frictionless direct solver's nested coarse start) where no body floats, which makes the first
-// sets nearly right. Floating bodies may be held by friction alone; a floating body whose loads pull it along its
+// by UMFPACK (sparse LU), until the sets repeat. The normal problem is first solved without friction (the
+// frictionless direct solver's nested coarse start), then the friction problem on coarser multiplier spaces
+// (linalg/friction_nested.hpp), which makes the first stick and slip sets nearly right. Floating bodies may be
+// held by friction alone; a floating body whose loads pull it along its
 // only contact harder than friction can hold is refused before the solve, naming the pair and the ratio.
 #pragma once
 
