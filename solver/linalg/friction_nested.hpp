@@ -45,7 +45,8 @@ struct FrictionLevel {
 // a roller's spin).
 Equalities normal_equalities(const Equalities& all, Eigen::Index m);
 
-// c_j = 1 / F_jj (a row no body can move gets the largest scale), as the fine solver uses.
+// c_j = 1 / F_jj, the inverse of the unknown's own compliance (the pressure or traction that would close its gap
+// or slip alone); a row no body can move gets the largest scale. Every level's friction Newton uses it.
 Eigen::VectorXd friction_scaling(const SparseMatrix& F);
 
 // The first sets of `level` predicted from the coarse levels' solution, or false when there is no coarser level

@@ -157,8 +157,7 @@ linalg::ActiveSetResult FrictionDirectSolver::solve(const InterfaceQp& qp, const
   const std::vector<char> mask = linalg::tangential_mask(n, rows);
   // c_j: the inverse of the unknown's own compliance (the pressure or traction that would close its gap or slip
   // alone); a row no body can move gets the largest scale.
-  Eigen::VectorXd c(n);
-  for (Eigen::Index j = 0; j < n; ++j) c[j] = 1.0 / std::max(diagonal[j], 1e-12 * dmax + 1e-300);
+  const Eigen::VectorXd c = linalg::friction_scaling(F);
   if (last_alpha_.size() != qp.equilibrium.G.rows()) last_alpha_.resize(0);
   const FrictionSets sticking = first_sets(F, qp, z0, last_alpha_, c, rows, mask, context.note);
   FrictionSets sets = sticking;
