@@ -1,35 +1,47 @@
 #!/usr/bin/python3
 """Writes a contact job for a masonry wall: rows of bricks in a running bond (every other row shifted by half a
 brick, with half bricks at its ends) on a clamped base, pressed from above by a uniform pressure on the top row.
-The bed joints are frictionless contacts: a brick's bottom edge against the top edge of each brick it rests on,
-listed explicitly as pairs. Each brick is held sideways at one corner (a dowel: x fixed at its bottom-left
-vertex) and otherwise floats - its vertical position and its rotation are held by its contacts alone - so the
-job exercises many-body contact and the floating-body equilibrium far past three bodies.
+The bed joints are contacts: a brick's bottom edge against the top edge of each brick it rests on, listed
+explicitly as pairs.
 
-    scripts/make_brick_wall.py [--rows 8] [--bricks 8] [--cells 4] [--abutments] [-o api/examples/brick_wall.json]
+    scripts/make_brick_wall.py [--rows 8] [--bricks 8] [--cells 4] [--abutments | --head-joints]
+                               [--friction MU [--shear S]] [-o api/examples/brick_wall.json]
 
-The default, 8 rows of 8 bricks, has 68 bricks, 69 bodies and 120 contact pairs (docs/parallel.md).
+Frictionless (the default): each brick is held sideways at one corner (a dowel: x fixed at its bottom-left vertex)
+and otherwise floats - its vertical position and its rotation are held by its contacts alone - so the job
+exercises many-body contact and the floating-body equilibrium far past three bodies. The default, 8 rows of 8
+bricks, has 68 bricks, 69 bodies and 120 contact pairs (docs/parallel.md).
 
-With --abutments the bricks have no dowels: two clamped side walls (abutments) and frictionless head joints
-(each brick's right edge against the next one's left edge, the end bricks against the abutments) hold them
-sideways, so every brick floats in all three rigid motions and every head joint is a zero-gap contact closed by
-the Poisson expansion under the load alone (8 x 8: 71 bodies, 196 pairs)."""
+With --abutments the bricks have no dowels: two clamped side walls (abutments) and head joints (each brick's right
+edge against the next one's left edge, the end bricks against the abutments) hold them sideways, so every brick
+floats in all three rigid motions and every head joint is a zero-gap contact closed by the Poisson expansion under
+the load alone (8 x 8: 71 bodies, 196 pairs). --head-joints gives the head joints between the bricks without the
+abutments (the ends of every course free).
+
+Masonry (docs/friction.md): --friction MU makes every joint a Coulomb contact with coefficient MU and removes the
+dowels: friction alone holds the bricks sideways (--head-friction gives the head joints their own coefficient, 0
+for frictionless ones). The load is then a path of two steps: the precompression (the
+top pressure) in step 1, held in step 2 while a horizontal point load at the top-left corner of every top-row
+brick grows from 0 to --shear S times that brick's vertical load (its `history`). Statics: every bed joint carries
+the shear S V over the normal load V, so the wall holds for S < MU and its courses slide for S > MU."""
 import argparse
 import json
 import sys
 
 
-def wall(rows, bricks, cells, length=0.24, height=0.07, pressure=2.0, abutments=False):
+def wall(rows, bricks, cells, length=0.24, height=0.07, pressure=2.0, abutments=False, head_joints=False,
+         friction=None, shear=0.0, head_friction=None):
     E, nu = 1.0e4, 0.2            # MPa: brick
     E_base, nu_base = 3.0e4, 0.2  # concrete base
     width = bricks * length
+    dowels = not abutments and friction is None
     bodies, contacts = [], []
 
     def brick(name, x0, y0, x1, y1, nx):
         bodies.append({"name": name, "material": {"E": E, "nu": nu},
                        "mesh": {"block": {"corners": [[x0, y0], [x1, y0], [x1, y1], [x0, y1]], "nx": nx,
                                           "ny": max(1, cells // 2)}},
-                       "boundary": [] if abutments else [{"vertex": "bottom_left", "displacement": {"x": 0}}]})
+                       "boundary": [{"vertex": "bottom_left", "displacement": {"x": 0}}] if dowels else []})
 
     base_t = 0.1
     bodies.append({"name": "base", "material": {"E": E_base, "nu": nu_base},
@@ -51,8 +63,13 @@ def wall(rows, bricks, cells, length=0.24, height=0.07, pressure=2.0, abutments=
             row.append((name, xs[i], xs[i + 1]))
         layout.append(row)
 
-    def pair(slave, master):
-        contacts.append({"slave": slave, "master": master})
+    def pair(slave, master, mu=friction):
+        contact = {"slave": slave, "master": master}
+        if mu:
+            contact["friction"] = {"coefficient": mu}
+        contacts.append(contact)
+
+    head_mu = friction if head_friction is None else head_friction
 
     for r, row in enumerate(layout):
         for name, x0, x1 in row:
@@ -70,17 +87,30 @@ def wall(rows, bricks, cells, length=0.24, height=0.07, pressure=2.0, abutments=
                                               "ny": rows * max(1, cells // 2)}},
                            "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}},
                                         {"edge": side, "displacement": {"x": 0}}]})
+    if abutments or head_joints:
         for row in layout:
-            pair(f"{row[0][0]}.left", "abutment_left.right")
+            if abutments:
+                pair(f"{row[0][0]}.left", "abutment_left.right", head_mu)
             for (name, _, _), (right, _, _) in zip(row, row[1:]):
-                pair(f"{name}.right", f"{right}.left")
-            pair(f"{row[-1][0]}.right", "abutment_right.left")
-    for name, _, _ in layout[-1]:
-        next(b for b in bodies if b["name"] == name)["boundary"].append({"edge": "top", "traction": {"normal": pressure}})
+                pair(f"{name}.right", f"{right}.left", head_mu)
+            if abutments:
+                pair(f"{row[-1][0]}.right", "abutment_right.left", head_mu)
+    stepped = friction is not None
+    for name, x0, x1 in layout[-1]:
+        boundary = next(b for b in bodies if b["name"] == name)["boundary"]
+        boundary.append({"edge": "top", "traction": {"normal": pressure}})
+        if stepped:
+            boundary[-1]["history"] = [1, 1]
+            # The shear: S times the brick's vertical load (pressure x its length), growing in step 2.
+            boundary.append({"vertex": "top_left", "force": [shear * pressure * (x1 - x0), 0], "history": [0, 1]})
 
-    return {"name": f"brick_wall_{rows}x{bricks}" + ("_abutments" if abutments else ""), "version": 1, "model": {"plane": "strain"},
-            "bodies": bodies, "contacts": contacts,
-            "solver": {"method": "interface_newton", "enforcement": "exact"}}
+    kind = "_abutments" if abutments else "_head_joints" if head_joints else ""
+    name = f"brick_wall_{rows}x{bricks}{kind}" + (f"_mu{friction:g}_shear{shear:g}" if stepped else "")
+    job = {"name": name, "version": 1, "model": {"plane": "strain"}, "bodies": bodies, "contacts": contacts,
+           "solver": {"method": "interface_newton", "enforcement": "exact"}}
+    if stepped:
+        job["loading"] = {"factors": [1, 1]}
+    return job
 
 
 def main():
@@ -88,13 +118,33 @@ def main():
     p.add_argument("--rows", type=int, default=8)
     p.add_argument("--bricks", type=int, default=8, help="full bricks per row")
     p.add_argument("--cells", type=int, default=4, help="elements along a full brick (half as many across)")
-    p.add_argument("--abutments", action="store_true",
-                   help="no dowels: abutments and head-joint contacts hold the bricks sideways")
+    joints = p.add_mutually_exclusive_group()
+    joints.add_argument("--abutments", action="store_true",
+                        help="no dowels: abutments and head-joint contacts hold the bricks sideways")
+    joints.add_argument("--head-joints", action="store_true",
+                        help="head-joint contacts between the bricks of a course, the ends of the courses free")
+    p.add_argument("--friction", type=float, metavar="MU",
+                   help="Coulomb friction MU on every joint, no dowels; precompression, then shear (two steps)")
+    p.add_argument("--shear", type=float, default=0.0, metavar="S",
+                   help="with --friction: the horizontal load on each top brick in step 2, as a share of its vertical load")
+    p.add_argument("--head-friction", type=float, metavar="MU",
+                   help="with --friction: the head joints' coefficient (default MU; 0: frictionless head joints)")
     p.add_argument("-o", "--output", default="-")
     a = p.parse_args()
     if a.rows < 1 or a.bricks < 1 or a.cells < 2:
         p.error("rows and bricks must be >= 1, cells >= 2")
-    job = wall(a.rows, a.bricks, a.cells, abutments=a.abutments)
+    if a.friction is not None and not a.friction >= 0:
+        p.error("--friction must be >= 0")
+    if a.friction is None and a.shear:
+        p.error("--shear needs --friction (a frictionless wall without dowels cannot carry a shear)")
+    if a.friction is None and a.head_friction is not None:
+        p.error("--head-friction needs --friction")
+    if a.head_friction is not None and not a.head_friction >= 0:
+        p.error("--head-friction must be >= 0")
+    if a.friction is None and a.head_joints:
+        p.error("--head-joints needs --friction or --abutments: frictionless courses with free ends are not held sideways")
+    job = wall(a.rows, a.bricks, a.cells, abutments=a.abutments, head_joints=a.head_joints, friction=a.friction,
+               shear=a.shear, head_friction=a.head_friction)
     text = json.dumps(job, indent=1) + "\n"
     if a.output == "-":
         sys.stdout.write(text)
