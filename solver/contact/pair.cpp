@@ -10,6 +10,7 @@
 #include <limits>
 #include <map>
 #include <optional>
+#include <set>
 
 namespace contact::mortar {
 
@@ -48,6 +49,57 @@ bool normal_is_prescribed(const std::array<bool, 2>& p, const Eigen::Vector2d& n
   if (p[0] && p[1]) return true;
   const double cos10 = 0.984807753;
   return (p[0] && std::abs(n.x()) >= cos10) || (p[1] && std::abs(n.y()) >= cos10);
+}
+
+// The end nodes of a slave edge where another contact edge of the same body meets it (a corner of the body where
+// its joints turn: a brick's bottom and right edge, or the top of a head joint under the bed joint of the course
+// above), with the other edge's unit tangent there, whether that edge is another pair's master edge facing a third
+// body, and whether friction is involved (this pair's or the other's).
+//
+// Why: where three bodies meet at one point, each pair ties two of them there, and with friction the ties close a
+// loop: at a brick's corner on a bed joint, the two bed joints' tangential rows and the head joint's normal row
+// all tie the x-displacements of the same three bodies at one point, the two bed joints' normal rows and the head
+// joint's tangential row their y-displacements. The multipliers are then redundant and the stick and slip systems
+// singular (or nearly: pressures of 1e7 that cancel). The pair therefore drops, at such a corner, its tangential
+// row (against another slave edge of the same body: the corner of the brick) or its multiplier altogether (against
+// a master edge facing a third body: the top of a head joint), the crosspoint treatment of the dual mortar
+// literature restricted to where friction makes it necessary. Frictionless contact has no such loop (its rows tie
+// along the normals only) and is left as it was.
+struct Corner {
+  Eigen::Vector2d tangent = Eigen::Vector2d::Zero();
+  bool third_body = false;  // the other edge is a master edge facing a body other than this pair's master
+  bool friction = false;
+};
+
+std::map<int, Corner> slave_corners(const Problem& problem, const ContactPair& pair, const std::vector<int>& nodes) {
+  std::map<int, Corner> out;
+  if (nodes.size() < 2) return out;
+  const auto& mesh = problem.bodies[static_cast<size_t>(pair.slave_body)].mesh;
+  auto meet = [&](const std::string& edge, bool third_body, bool friction) {
+    const std::vector<int> others = mesh.edge_set_nodes(edge);
+    if (others.size() < 2) return;
+    for (size_t end : {size_t{0}, nodes.size() - 1})
+      for (size_t j : {size_t{0}, others.size() - 1}) {
+        if (others[j] != nodes[end]) continue;
+        const size_t next = j == 0 ? 1 : j - 1;
+        Corner& c = out[nodes[end]];
+        c.tangent = (mesh.nodes[static_cast<size_t>(others[next])] - mesh.nodes[static_cast<size_t>(others[j])]).normalized();
+        c.third_body = c.third_body || third_body;
+        c.friction = c.friction || friction || pair.friction.active();
+      }
+  };
+  for (const auto& other : problem.contacts) {
+    if (other.slave_body == pair.slave_body && other.slave_edge != pair.slave_edge)
+      meet(other.slave_edge, false, other.friction.active());
+    if (other.master_body == pair.slave_body && other.master_edge != pair.slave_edge)
+      meet(other.master_edge, other.slave_body != pair.master_body, other.friction.active());
+  }
+  return out;
+}
+
+// Whether the other edge turns away from this one at the node (more than 10 degrees between the tangents).
+bool turns(const Eigen::Vector2d& own, const Eigen::Vector2d& other) {
+  return std::abs(own.x() * other.y() - own.y() * other.x()) > 0.17364817766;  // sin 10 degrees
 }
 
 // Three-point Gauss-Legendre on [0, 1]: exact to degree 5 (the products here are at most cubic).
@@ -185,7 +237,8 @@ namespace {
 class PairBuilder {
  public:
   PairBuilder(const Problem& problem, int pair_index, double theta)
-      : pair_(problem.contacts[static_cast<size_t>(pair_index)]),
+      : problem_(problem),
+        pair_(problem.contacts[static_cast<size_t>(pair_index)]),
         slave_(problem.bodies[static_cast<size_t>(pair_.slave_body)]),
         master_(problem.bodies[static_cast<size_t>(pair_.master_body)]),
         thickness_(problem.model.plane == Plane::stress ? problem.model.thickness : 1.0) {
@@ -254,6 +307,7 @@ class PairBuilder {
   void classify_nodes() {
     d_.status.assign(n_, NodeStatus::inner);
     const auto prescribed = prescribed_components(slave_);
+    const auto corners = slave_corners(problem_, pair_, d_.slave_nodes);
     for (size_t m = 0; m <= n_runs_ && n_runs_ > 0; ++m) {
       const size_t i = d_.multiplier_nodes[m];
       double support = 0, covered = 0;
@@ -274,10 +328,21 @@ class PairBuilder {
         d_.status[i] = NodeStatus::barely_covered;
       } else if (auto p = prescribed.find(d_.slave_nodes[i]); p != prescribed.end() && normal_is_prescribed(p->second, nu.normalized())) {
         d_.status[i] = NodeStatus::crosspoint;
+      } else if (auto c = friction_corner(corners, i, nu); c && c->third_body) {
+        d_.status[i] = NodeStatus::crosspoint;
       } else {
         d_.status[i] = NodeStatus::contact;
+        if (friction_corner(corners, i, nu)) tangential_dropped_.insert(i);
       }
     }
+  }
+
+  // The corner (slave_corners) at slave node i with the multiplier's normal nu, if friction is involved there and
+  // the other edge turns away.
+  const Corner* friction_corner(const std::map<int, Corner>& corners, size_t i, const Eigen::Vector2d& nu) const {
+    const auto c = corners.find(d_.slave_nodes[i]);
+    if (c == corners.end() || !c->second.friction || !(nu.norm() > 0)) return nullptr;
+    return turns(Eigen::Vector2d(-nu.y(), nu.x()).normalized(), c->second.tangent) ? &c->second : nullptr;
   }
 
   // One row per contact node; every slave node's value from the rows: a multiplier node's own; inside a run the
@@ -289,6 +354,7 @@ class PairBuilder {
       if (d_.status[i] == NodeStatus::contact) {
         d_.row_of_node[i] = static_cast<int>(d_.node_of_row.size());
         d_.node_of_row.push_back(static_cast<int>(i));
+        d_.tangential_dropped.push_back(tangential_dropped_.count(i) ? 1 : 0);
       }
     d_.node_from_rows.assign(n_, {});
     for (size_t m = 0; m < n_runs_; ++m) {
@@ -405,12 +471,14 @@ class PairBuilder {
     d_.Tm = sparse_rows(tm, 2 * master_.mesh.num_nodes());
   }
 
+  const Problem& problem_;
   const ContactPair& pair_;
   const Body& slave_;
   const Body& master_;
   const double thickness_;
   PairDiscretization d_;
   std::vector<Eigen::Vector2d> S_;
+  std::set<size_t> tangential_dropped_;  // slave nodes whose friction row is dropped (slave_corners)
   size_t n_ = 0, n_runs_ = 0;
   SegmentMesh segments_;
   std::vector<double> master_length_;

@@ -57,6 +57,9 @@ struct PairDiscretization {
 
   // One row per contact node.
   std::vector<int> node_of_row;     // row -> index into slave_nodes
+  // Per row: its friction row is dropped (q = 0 there), at a corner where the slave edge meets another contact
+  // edge of its body and friction would tie three bodies in a loop (pair.cpp, slave_corners).
+  std::vector<char> tangential_dropped;
   Eigen::VectorXd D;                // D_r = integral Phi_r N_r (length x thickness): the diagonal mortar matrix
   Eigen::VectorXd area;             // integral Phi_r = sum_j M_rj: the row's share of the surface. Equal to D_r
                                     // except next to a dropped node (Phi_r then also covers the neighbour's part)

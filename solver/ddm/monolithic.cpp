@@ -15,6 +15,9 @@
 // interface Newton uses, which is what makes them a check on it.
 #include "method.hpp"
 
+#include "../linalg/friction_newton.hpp"
+#include "friction_rows.hpp"
+#include "friction_statics.hpp"
 #include "../linalg/friction_sets.hpp"
 
 #include <Eigen/CholmodSupport>
@@ -110,17 +113,12 @@ Stacked stack(const ContactSystem& system, bool shift_by_multipliers) {
   }
   s.B.resize(m, n);
   s.B.setFromTriplets(tb.begin(), tb.end());
-  // Friction rows, but not where both sides' tangential motion is prescribed (a symmetry line): the row of B is
-  // zero there and the node cannot slip (q = 0; its traction goes into the supports).
+  // Friction rows (friction_rows.hpp), but not where both sides' tangential motion is prescribed (a symmetry line):
+  // the row of B is zero there and the node cannot slip (q = 0; its traction goes into the supports).
   const Eigen::SparseMatrix<double, Eigen::RowMajor> rows_of_B = s.B;
-  for (size_t k = 0; k < pairs.size(); ++k) {
-    if (s.tangential_offset[k] < 0) continue;
-    const auto& f = pairs[k].friction;
-    for (Eigen::Index r = 0; r < pairs[k].n_rows(); ++r)
-      if (rows_of_B.row(s.tangential_offset[k] + r).norm() > 0)
-        s.friction.push_back({s.row_offset[k] + r, s.tangential_offset[k] + r, f.law == FrictionSpec::Law::coulomb,
-                              f.coefficient, f.bound});
-  }
+  s.friction = friction_rows(
+      system, [&](size_t k) { return s.row_offset[k]; }, [&](size_t k) { return s.tangential_offset[k]; },
+      [&](Eigen::Index t) { return rows_of_B.row(t).norm() > 0; });
   return s;
 }
 
@@ -146,9 +144,8 @@ Pressures split_tangential(const ContactSystem& system, const Stacked& s, const 
 
 // The saddle-point system of the sets, [K  -B^T P; R B  0] [x; y] = [b + B^T lambda0; -R g0], by sparse LU with
 // two steps of iterative refinement (the matrix mixes stiffnesses and lengths, and the unsymmetric LU loses a few
-// digits on it). Returns false (with the reason) when it is singular.
-bool solve_sets(const Stacked& s, const linalg::FrictionParametrization& p, Eigen::VectorXd& x, Eigen::VectorXd& lambda,
-                std::string& error) {
+// digits on it). Fills the iterate (lambda, h = g0 + B x, other = x); false when it is singular.
+bool solve_sets(const Stacked& s, const linalg::FrictionParametrization& p, linalg::FrictionIterate& it) {
   const Eigen::Index n = s.b.size(), na = static_cast<Eigen::Index>(p.rows.size());
   const SpMat BtP = SpMat(s.B.transpose()) * p.P;
   const Eigen::SparseMatrix<double, Eigen::RowMajor> Brows = s.B;
@@ -171,14 +168,13 @@ bool solve_sets(const Stacked& s, const linalg::FrictionParametrization& p, Eige
   kkt.makeCompressed();
   Eigen::SparseLU<SpMat> lu;
   lu.compute(kkt);
-  if (lu.info() != Eigen::Success) {
-    error = lu.lastErrorMessage();
-    return false;
-  }
+  if (lu.info() != Eigen::Success) return false;
   Eigen::VectorXd solution = lu.solve(rhs);
   for (int refine = 0; refine < 2; ++refine) solution += lu.solve(Eigen::VectorXd(rhs - kkt * solution));
-  x = solution.head(n);
-  lambda = p.P * solution.tail(na) + p.lambda0;
+  if (!solution.allFinite()) return false;
+  it.other = solution.head(n);
+  it.lambda = p.P * solution.tail(na) + p.lambda0;
+  it.h = s.g0 + s.B * it.other;
   return true;
 }
 
@@ -203,11 +199,15 @@ double zone_change(const ContactSystem& system, const Displacements& u, std::vec
 
 MethodOutcome run_exact(const ContactSystem& system, const SolverSettings& settings, RunContext& context) {
   MethodOutcome out;
+  if (std::string sliding = friction_cannot_hold(system); !sliding.empty()) {  // statics: no solver can hold it
+    out.reason = StopReason::error;
+    out.message = sliding;
+    return out;
+  }
   const Stacked s = stack(system, false);
-  const Eigen::Index n = s.b.size(), m = s.g0.size();
+  const Eigen::Index m = s.g0.size();
   const std::vector<char> mask = linalg::tangential_mask(m, s.friction);
   const Eigen::VectorXd c = s.c.cwiseQuotient(s.D);  // prediction z - c g: g / D is the nodal gap
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(n), lambda = Eigen::VectorXd::Zero(m);
   // A floating body is held only by its contacts: start with every contact node active (the saddle-point system
   // of an empty active set would be singular), and let the active set shrink to the nodes that press. Nodes in
   // contact start sticking.
@@ -215,59 +215,64 @@ MethodOutcome run_exact(const ContactSystem& system, const SolverSettings& setti
   linalg::FrictionSets sets;
   sets.active.assign(static_cast<size_t>(m), 0);
   for (Eigen::Index r = 0; r < m; ++r) sets.active[static_cast<size_t>(r)] = floating && !mask[static_cast<size_t>(r)];
-  sets.state.assign(s.friction.size(), floating ? linalg::Contact::stick : linalg::Contact::open);
-  sets.sign.assign(s.friction.size(), 0);
-  bool first = true;
+  linalg::stick_where_in_contact(sets, s.friction);
   std::vector<std::vector<char>> report_active;
   std::vector<Eigen::VectorXd> zone(system.n_bodies());
-  const int max_steps = std::max(1, settings.max_iterations);
-  for (int k = 1; k <= max_steps; ++k) {
-    if (context.cancel.cancelled()) {
-      out.reason = StopReason::cancelled;
-      out.message = "cancelled";
-      break;
-    }
-    const linalg::FrictionParametrization p = linalg::parametrize(sets, s.friction, mask);
-    std::string error;
-    if (!solve_sets(s, p, x, lambda, error)) {
-      out.reason = StopReason::error;
-      out.message = std::string("monolithic: the saddle-point system of the active set is singular (") +
-                    (floating ? "a floating body is not held by the contact nodes in contact: " : "") + error + ")";
-      return out;
-    }
-    const Eigen::VectorXd h = s.g0 + s.B * x;
-    linalg::FrictionSets next = linalg::predict_friction_sets(lambda, h, c, s.friction, mask);
-    const Displacements u = to_bodies(system, s, x);
+  bool first = true;
+  const linalg::FrictionNewtonProblem problem{s.friction, mask, c, [&](const linalg::FrictionParametrization& p, linalg::FrictionIterate& it) {
+                                                return solve_sets(s, p, it);
+                                              }};
+  linalg::FrictionNewtonSettings newton;
+  newton.max_steps = std::max(1, settings.max_iterations);
+  newton.tolerance = 1e-12;
+  const auto on_step = [&](const linalg::FrictionIterate& it, const linalg::ActiveSetStep& step) {
+    const Displacements u = to_bodies(system, s, it.other);
     const double paper = zone_change(system, u, zone, !first);
-    const Pressures z = split_rows(system, s, lambda);
-    IterationReport r = system.report(k, u, z, report_active);
-    if (!s.friction.empty()) system.report_friction(z, split_tangential(system, s, lambda), r);
+    first = false;
+    const Pressures z = split_rows(system, s, it.lambda);
+    IterationReport r = system.report(step.step, u, z, report_active);
+    if (!s.friction.empty()) system.report_friction(z, split_tangential(system, s, it.lambda), r);
     r.paper_criterion = paper;
     r.measure = Measure::complementarity;
-    r.complementarity = linalg::friction_complementarity(lambda, h, c, s.friction, mask);
-    r.active_set_changes = next.changes(sets);
+    r.complementarity = step.complementarity;
+    r.active_set_changes = step.changes;
     r.elapsed_seconds = context.elapsed();
     context.observer.on_iteration(r);
-    const bool settled = !first && (r.active_set_changes == 0 || r.complementarity <= 1e-12);
     out.history.push_back(std::move(r));
-    out.iterations = k;
-    first = false;
-    if (settled) {
+    return !context.cancel.cancelled();
+  };
+  const linalg::FrictionNewtonResult result = linalg::friction_newton(problem, std::move(sets), newton, on_step);
+  out.iterations = result.steps;
+  switch (result.stop) {
+    case linalg::FrictionStop::settled: {
       out.converged = true;
       out.reason = StopReason::converged;
       int na = 0;
-      for (Eigen::Index j = 0; j < m; ++j) na += sets.active[static_cast<size_t>(j)] && !mask[static_cast<size_t>(j)];
+      for (Eigen::Index j = 0; j < m; ++j) na += result.sets.active[static_cast<size_t>(j)] && !mask[static_cast<size_t>(j)];
       std::ostringstream os;
       os << "monolithic active set settled (" << na << " of " << s.row_offset.back() << " contact nodes in contact)";
+      if (result.damped_steps > 0) os << "; " << result.damped_steps << " steps damped by the line search";
       out.message = os.str();
       break;
     }
-    sets = std::move(next);
-    if (k == max_steps) {
+    case linalg::FrictionStop::stopped:
+      out.reason = StopReason::cancelled;
+      out.message = "cancelled";
+      break;
+    case linalg::FrictionStop::singular:
+      out.reason = StopReason::error;
+      out.message = std::string("monolithic: the saddle-point system of the ") +
+                    (s.friction.empty() ? "active set" : "stick and slip sets") + " is singular at step " +
+                    std::to_string(result.steps) +
+                    (floating ? ": a floating body is held by none of the contact nodes in contact" : "");
+      return out;
+    case linalg::FrictionStop::max_steps:
       out.reason = StopReason::max_iterations;
       out.message = "monolithic: the active set did not settle within max_iterations";
-    }
+      break;
   }
+  const Eigen::VectorXd x = result.iterate.other.size() == s.b.size() ? result.iterate.other : Eigen::VectorXd(Eigen::VectorXd::Zero(s.b.size()));
+  const Eigen::VectorXd lambda = result.iterate.lambda.size() == m ? result.iterate.lambda : Eigen::VectorXd(Eigen::VectorXd::Zero(m));
   out.u = to_bodies(system, s, x);
   out.z = split_rows(system, s, lambda);
   if (!s.friction.empty()) out.q = split_tangential(system, s, lambda);

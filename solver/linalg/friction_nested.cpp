@@ -90,28 +90,54 @@ bool sticking_sets(const FrictionLevel& level, const std::vector<char>& mask, Fr
   if (!normal.converged) return false;
   sets.active.assign(mask.size(), 0);
   for (Eigen::Index j = 0; j < level.m; ++j) sets.active[static_cast<size_t>(j)] = normal.z[j] > 0;
-  sets.state.assign(level.rows.size(), Contact::open);
-  sets.sign.assign(level.rows.size(), 0);
-  for (size_t t = 0; t < level.rows.size(); ++t)
-    if (sets.active[static_cast<size_t>(level.rows[t].normal)] || !level.rows[t].coulomb) sets.state[t] = Contact::stick;
+  stick_where_in_contact(sets, level.rows);
   return true;
 }
 
-// The Newton iteration on one level from `sets` until they repeat; false if a step's system is singular or the
-// sets do not settle within max_steps.
+// The friction Newton on one level from `sets`; false if it does not settle within max_steps.
 bool newton_on_level(const FrictionLevel& level, const Eigen::VectorXd& c, const std::vector<char>& mask,
-                     FrictionSets sets, int max_steps, FrictionStepSolve& solution, int& steps) {
-  for (steps = 1; steps <= max_steps; ++steps) {
-    solution = solve_on_friction_sets(level.F, level.g, level.eq, parametrize(sets, level.rows, mask));
-    if (!solution.ok) return false;
-    Eigen::VectorXd h = level.g + level.F * solution.lambda;
-    if (solution.alpha.size() > 0) h += level.eq.G.transpose() * solution.alpha;
-    const FrictionSets next = predict_friction_sets(solution.lambda, h, c, level.rows, mask);
-    if (next == sets) return true;
-    sets = next;
-  }
-  return false;
+                     FrictionSets sets, int max_steps, FrictionIterate& solution, int& steps) {
+  const FrictionNewtonProblem problem{level.rows, mask, c, [&](const FrictionParametrization& p, FrictionIterate& x) {
+                                        return solve_on_friction_sets(level.F, level.g, level.eq, p, x);
+                                      }};
+  FrictionNewtonSettings settings;
+  settings.max_steps = max_steps;
+  settings.tolerance = 0.0;  // the sets repeating, as the fine level's start needs them
+  const FrictionNewtonResult r = friction_newton(problem, std::move(sets), settings);
+  steps = r.steps;
+  solution = r.iterate;
+  return r.stop == FrictionStop::settled;
 }
+
+// [R F P  R G^T; G P  0] [y; alpha] = [-R (g + F lambda0); e - G lambda0], by UMFPACK; false when singular.
+bool solve_sets_system(const SparseMatrix& F, const Equalities& eq, const FrictionParametrization& p,
+                       const Eigen::VectorXd& g, Eigen::VectorXd& y) {
+  const Eigen::Index na = static_cast<Eigen::Index>(p.rows.size()), r = eq.G.rows();
+  const SparseMatrix RFP = select_rows(SparseMatrix(F * p.P), p.rows);
+  const SparseMatrix RGt = r > 0 ? select_rows(SparseMatrix(eq.G.transpose()), p.rows) : SparseMatrix(na, 0);
+  const SparseMatrix GP = r > 0 ? SparseMatrix(eq.G * p.P) : SparseMatrix(0, na);
+  std::vector<Eigen::Triplet<double>> entries;
+  auto put = [&](const SparseMatrix& A, Eigen::Index row0, Eigen::Index col0) {
+    for (int col = 0; col < A.outerSize(); ++col)
+      for (SparseMatrix::InnerIterator it(A, col); it; ++it) entries.emplace_back(row0 + it.row(), col0 + col, it.value());
+  };
+  put(RFP, 0, 0);
+  put(RGt, 0, na);
+  put(GP, na, 0);
+  SparseMatrix M(na + r, na + r);
+  M.setFromTriplets(entries.begin(), entries.end());
+  M.makeCompressed();
+  Eigen::VectorXd rhs(na + r);
+  const Eigen::VectorXd h0 = g + F * p.lambda0;
+  for (Eigen::Index i = 0; i < na; ++i) rhs[i] = -h0[p.rows[static_cast<size_t>(i)]];
+  if (r > 0) rhs.tail(r) = eq.e - eq.G * p.lambda0;
+  Eigen::UmfPackLU<SparseMatrix> lu(M);
+  if (lu.info() != Eigen::Success) return false;
+  y = lu.solve(rhs);
+  y += lu.solve(Eigen::VectorXd(rhs - M * y));  // one step of refinement: the system mixes F's scales and G's
+  return y.allFinite();
+}
+
 
 }  // namespace
 
@@ -130,44 +156,20 @@ Equalities normal_equalities(const Equalities& all, Eigen::Index m) {
   return out;
 }
 
-FrictionStepSolve solve_on_friction_sets(const SparseMatrix& F, const Eigen::VectorXd& g, const Equalities& eq,
-                                         const FrictionParametrization& p) {
+bool solve_on_friction_sets(const SparseMatrix& F, const Eigen::VectorXd& g, const Equalities& eq,
+                            const FrictionParametrization& p, FrictionIterate& x) {
   const Eigen::Index na = static_cast<Eigen::Index>(p.rows.size()), r = eq.G.rows();
-  FrictionStepSolve out;
-  if (na + r == 0) {
-    out.lambda = p.lambda0;
-    out.alpha = Eigen::VectorXd::Zero(r);
-    out.ok = true;
-    return out;
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(na + r);
+  if (na + r > 0) {
+    if (!solve_sets_system(F, eq, p, g, y)) return false;
   }
-  const SparseMatrix RFP = select_rows(SparseMatrix(F * p.P), p.rows);
-  const SparseMatrix RGt = select_rows(SparseMatrix(eq.G.transpose()), p.rows);
-  const SparseMatrix GP = r > 0 ? SparseMatrix(eq.G * p.P) : SparseMatrix(0, na);
-  std::vector<Eigen::Triplet<double>> entries;
-  auto put = [&](const SparseMatrix& A, Eigen::Index row0, Eigen::Index col0) {
-    for (int col = 0; col < A.outerSize(); ++col)
-      for (SparseMatrix::InnerIterator it(A, col); it; ++it) entries.emplace_back(row0 + it.row(), col0 + col, it.value());
-  };
-  put(RFP, 0, 0);
-  put(RGt, 0, na);
-  put(GP, na, 0);
-  SparseMatrix M(na + r, na + r);
-  M.setFromTriplets(entries.begin(), entries.end());
-  M.makeCompressed();
-  Eigen::VectorXd rhs(na + r);
-  const Eigen::VectorXd h0 = g + F * p.lambda0;
-  for (Eigen::Index i = 0; i < na; ++i) rhs[i] = -h0[p.rows[static_cast<size_t>(i)]];
-  if (r > 0) rhs.tail(r) = eq.e - eq.G * p.lambda0;
-  Eigen::UmfPackLU<SparseMatrix> lu(M);
-  if (lu.info() != Eigen::Success) return out;
-  Eigen::VectorXd y = lu.solve(rhs);
-  y += lu.solve(Eigen::VectorXd(rhs - M * y));  // one step of refinement: the system mixes F's scales and G's
-  if (!y.allFinite()) return out;
-  out.lambda = p.P * y.head(na) + p.lambda0;
-  out.alpha = y.tail(r);
-  out.ok = true;
-  return out;
+  x.lambda = p.P * y.head(na) + p.lambda0;
+  x.other = y.tail(r);
+  x.h = g + F * x.lambda;
+  if (r > 0) x.h += eq.G.transpose() * x.other;
+  return true;
 }
+
 
 Eigen::VectorXd friction_scaling(const SparseMatrix& F) {
   const Eigen::VectorXd diagonal = F.diagonal();
@@ -195,7 +197,7 @@ bool nested_friction_sets(const FrictionLevel& level, FrictionSets& sets, std::v
   FrictionSets start;
   if (!nested_friction_sets(coarse_level, start, coarse_steps, coarsest) && !sticking_sets(coarse_level, mask, start))
     return false;
-  FrictionStepSolve solution;
+  FrictionIterate solution;
   int steps = 0;
   const bool settled = newton_on_level(coarse_level, friction_scaling(Fc), mask, start, 30, solution, steps);
   if (coarse_steps) (*coarse_steps)[at] = steps;
@@ -203,7 +205,7 @@ bool nested_friction_sets(const FrictionLevel& level, FrictionSets& sets, std::v
   // The fine sets predicted from the prolonged multipliers and the fine gaps and slips they give.
   const Eigen::VectorXd lambda = coarse.P * solution.lambda;
   Eigen::VectorXd h = level.g + level.F * lambda;
-  if (solution.alpha.size() > 0) h += level.eq.G.transpose() * solution.alpha;
+  if (solution.other.size() > 0) h += level.eq.G.transpose() * solution.other;
   sets = predict_friction_sets(lambda, h, friction_scaling(level.F), level.rows, tangential_mask(level.F.rows(), level.rows));
   return true;
 }

@@ -14,6 +14,7 @@
 #pragma once
 
 #include "active_set.hpp"
+#include "friction_newton.hpp"
 #include "friction_sets.hpp"
 
 #include <vector>
@@ -21,13 +22,10 @@
 namespace contact::linalg {
 
 // One Newton step's linear system on the sets p (friction_sets.hpp): the rows of F lambda + g (+ G^T alpha) that
-// must vanish, with the equalities G lambda = e; solved by sparse LU (UMFPACK). ok = false when it is singular.
-struct FrictionStepSolve {
-  Eigen::VectorXd lambda, alpha;
-  bool ok = false;
-};
-FrictionStepSolve solve_on_friction_sets(const SparseMatrix& F, const Eigen::VectorXd& g, const Equalities& eq,
-                                         const FrictionParametrization& p);
+// must vanish, with the equalities G lambda = e; solved by sparse LU (UMFPACK). Fills x (lambda, h = g + F lambda
+// + G^T alpha, other = alpha); false when it is singular.
+bool solve_on_friction_sets(const SparseMatrix& F, const Eigen::VectorXd& g, const Equalities& eq,
+                            const FrictionParametrization& p, FrictionIterate& x);
 
 // The friction problem of one level: lambda = [z (the first m unknowns, normal rows); q], conditions per `rows`.
 struct FrictionLevel {

@@ -20,6 +20,13 @@ std::vector<char> tangential_mask(Eigen::Index size, const std::vector<FrictionR
   return mask;
 }
 
+void stick_where_in_contact(FrictionSets& sets, const std::vector<FrictionRow>& rows) {
+  sets.state.assign(rows.size(), Contact::open);
+  sets.sign.assign(rows.size(), 0);
+  for (size_t t = 0; t < rows.size(); ++t)
+    if (sets.active[static_cast<size_t>(rows[t].normal)] || !rows[t].coulomb) sets.state[t] = Contact::stick;
+}
+
 namespace {
 double bound_of(const FrictionRow& r, double normal_trial) {
   return r.coulomb ? r.mu * std::max(0.0, normal_trial) : r.bound;

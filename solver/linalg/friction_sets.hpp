@@ -1,6 +1,7 @@
 // The stick and slip sets of 2-D frictional contact and the linear system they give: the primal-dual active set
 // (semismooth Newton) of Hueber, Stadler & Wohlmuth for Coulomb and Tresca friction, in the form both the interface
-// solver (ddm/interface/friction_solver.hpp) and the monolithic reference use. Pure linear algebra.
+// solver (ddm/interface/friction_direct.hpp) and the monolithic reference use; the Newton iteration on them is
+// friction_newton.hpp. Pure linear algebra.
 //
 // Multipliers lambda = [z; q]: normal pressures z_i >= 0 and tangential multipliers q_t, each q_t paired with one
 // normal row i(t) (the same contact node). h(lambda) are the conjugate quantities: the weighted normal gaps and the
@@ -54,6 +55,11 @@ struct FrictionSets {
 // tangential unknowns.
 FrictionSets predict_friction_sets(const Eigen::VectorXd& lambda, const Eigen::VectorXd& h, const Eigen::VectorXd& c,
                                    const std::vector<FrictionRow>& rows, const std::vector<char>& is_tangential);
+
+// "Every node in contact sticks": each friction row sticks where its normal row is active (Tresca: everywhere, its
+// bound holds open or not) and is open otherwise. The tied problem under the loads is well posed (friction holds the
+// floating bodies), which makes it the start where nothing better is known and the retreat from a singular set.
+void stick_where_in_contact(FrictionSets& sets, const std::vector<FrictionRow>& rows);
 
 // lambda = P y + lambda0 on the sets; `rows` lists, for each column of P, the unknown whose h must vanish.
 struct FrictionParametrization {

@@ -1,6 +1,8 @@
 #include "friction_direct.hpp"
 
 #include "../../linalg/friction_nested.hpp"
+#include "../../linalg/friction_newton.hpp"
+#include "../friction_rows.hpp"
 
 #include <cmath>
 #include <limits>
@@ -43,8 +45,7 @@ FrictionSets first_sets(const SparseMatrix& F, const InterfaceQp& qp, const Eige
     Eigen::VectorXd h = qp.g + F * *z0;
     if (alpha0.size() == qp.equilibrium.G.rows() && alpha0.size() > 0) h += qp.equilibrium.G.transpose() * alpha0;
     FrictionSets s = linalg::predict_friction_sets(*z0, h, c, rows, mask);
-    for (size_t t = 0; t < rows.size(); ++t)
-      s.state[t] = s.active[static_cast<size_t>(rows[t].normal)] || !rows[t].coulomb ? Contact::stick : Contact::open;
+    linalg::stick_where_in_contact(s, rows);
     return s;
   }
   // Its pressing nodes are the first normal set (its own gaps, with its rigid amplitudes, confirm them).
@@ -52,69 +53,16 @@ FrictionSets first_sets(const SparseMatrix& F, const InterfaceQp& qp, const Eige
   s.active.assign(static_cast<size_t>(n), 0);
   for (Eigen::Index j = 0; j < m; ++j)
     s.active[static_cast<size_t>(j)] = solved ? lambda[j] > 0 : !qp.equilibrium.empty() || qp.g[j] < 0;
-  s.state.assign(rows.size(), Contact::open);
-  s.sign.assign(rows.size(), 0);
-  for (size_t t = 0; t < rows.size(); ++t)
-    if (s.active[static_cast<size_t>(rows[t].normal)] || !rows[t].coulomb) s.state[t] = Contact::stick;
+  linalg::stick_where_in_contact(s, rows);
   return s;
-}
-
-// Why the sets' system is singular, for the message: some floating body's load along a free translation exceeds
-// what its friction contacts carried at the last iterate (lambda), or, if none does, that nothing holds it.
-std::string friction_shortfall(const InterfaceQp& qp, const Eigen::VectorXd& lambda) {
-  const ContactSystem& system = qp.problem.system();
-  const auto& pairs = system.pairs();
-  for (const auto& f : qp.problem.floating()) {
-    const auto& body = system.body(f.body);
-    const auto& names = body.rigid_mode_names();
-    const Eigen::VectorXd load = body.external_load();
-    for (size_t mode = 0; mode < names.size(); ++mode) {
-      if (names[mode].rfind("translation in ", 0) != 0) continue;
-      const int c = names[mode].back() == 'x' ? 0 : 1;
-      double required = 0, capacity = 0;
-      for (Eigen::Index d = c; d < load.size(); d += 2) required += load[d];
-      std::string names_of_pairs;
-      for (size_t k = 0; k < pairs.size(); ++k) {
-        const auto& pair = pairs[k];
-        if (static_cast<size_t>(pair.slave_body) != f.body && static_cast<size_t>(pair.master_body) != f.body) continue;
-        if (!pair.has_friction()) continue;
-        names_of_pairs += (names_of_pairs.empty() ? "'" : ", '") + pair.name + "'";
-        for (Eigen::Index r = 0; r < pair.n_rows(); ++r) {
-          const double z = lambda.size() > qp.problem.offset(k) + r ? std::max(0.0, lambda[qp.problem.offset(k) + r]) : 0.0;
-          const double bound = pair.friction.law == FrictionSpec::Law::coulomb ? pair.friction.coefficient * z : pair.friction.bound;
-          capacity += bound * pair.area[r] * std::abs(pair.tangent[static_cast<size_t>(r)][c]);
-        }
-      }
-      if (names_of_pairs.empty() || !(std::abs(required) > capacity)) continue;
-      std::ostringstream os;
-      os.precision(4);
-      os << "friction cannot hold body '" << system.problem().bodies[f.body].name << "' against its load along "
-         << (c == 0 ? "x" : "y") << ": its contact" << (names_of_pairs.find(',') != std::string::npos ? "s " : " ")
-         << names_of_pairs << (names_of_pairs.find(',') != std::string::npos ? " carry" : " carries") << " at most "
-         << capacity << " by friction at the last iterate, the load is " << std::abs(required);
-      if (capacity > 0) os << " (" << std::abs(required) / capacity << " times)";
-      os << "; under force control it would slide without end: lower the load, raise the friction, or "
-            "prescribe the body's displacement";
-      return os.str();
-    }
-  }
-  return "the system of the stick and slip sets is singular: a floating body is held neither by normal contact nor "
-         "by friction";
 }
 
 }  // namespace
 
 std::vector<FrictionRow> friction_rows(const InterfaceProblem& problem) {
-  std::vector<FrictionRow> rows;
-  const auto& pairs = problem.system().pairs();
-  for (size_t k = 0; k < pairs.size(); ++k) {
-    const Eigen::Index t0 = problem.tangential_offset(k);
-    if (t0 < 0) continue;
-    const auto& f = pairs[k].friction;
-    for (Eigen::Index r = 0; r < pairs[k].n_rows(); ++r)
-      rows.push_back({problem.offset(k) + r, t0 + r, f.law == FrictionSpec::Law::coulomb, f.coefficient, f.bound});
-  }
-  return rows;
+  return ddm::friction_rows(
+      problem.system(), [&](size_t k) { return problem.offset(k); }, [&](size_t k) { return problem.tangential_offset(k); },
+      [](Eigen::Index) { return true; });
 }
 
 namespace {
@@ -139,119 +87,95 @@ bool first_sets_from_coarse(const SparseMatrix& F, const InterfaceQp& qp, const 
   return true;
 }
 
+// The stop of the Newton as the interface solver's answer.
+void describe_stop(const linalg::FrictionNewtonResult& r, const InterfaceQp& qp, int max_steps, double complementarity,
+                   linalg::ActiveSetResult& result) {
+  result.steps = r.steps;
+  switch (r.stop) {
+    case linalg::FrictionStop::settled: {
+      int stick = 0, slip = 0, active = 0;
+      for (auto st : r.sets.state) {
+        stick += st == Contact::stick;
+        slip += st == Contact::slip;
+      }
+      for (Eigen::Index j = 0; j < qp.problem.normal_size(); ++j) active += r.sets.active[static_cast<size_t>(j)];
+      std::ostringstream os;
+      os << "stick and slip sets settled in " << r.steps << " steps (" << active << " nodes in contact: " << stick
+         << " sticking, " << slip << " slipping)";
+      if (r.damped_steps > 0) os << "; " << r.damped_steps << " steps damped by the line search";
+      result.converged = true;
+      result.message = os.str();
+      return;
+    }
+    case linalg::FrictionStop::stopped:
+      result.cancelled = true;
+      return;
+    case linalg::FrictionStop::singular: {
+      // Statics has refused the loads that friction cannot carry before the solve (friction_statics.hpp): this is
+      // the solver failing, and the message says so.
+      std::ostringstream os;
+      os.precision(3);
+      os << "the friction Newton did not converge: at step " << r.steps
+         << " the stick and slip sets it predicted, and every set between them and the last solved one, leave a "
+            "floating body (or a group of them) held by nothing (a singular system); the complementarity residual "
+            "of the last iterate is "
+         << complementarity
+         << ". Statics does not rule these loads out, so the solver failed, not the model: try smaller load steps";
+      result.message = os.str();
+      return;
+    }
+    case linalg::FrictionStop::max_steps: {
+      std::ostringstream os;
+      os.precision(3);
+      os << "the stick and slip sets did not settle within " << max_steps
+         << " steps (complementarity residual " << complementarity << " at the last iterate)";
+      result.message = os.str();
+      return;
+    }
+  }
+}
+
 }  // namespace
 
 linalg::ActiveSetResult FrictionDirectSolver::solve(const InterfaceQp& qp, const Eigen::VectorXd* z0,
                                                     InterfaceSolveContext& context) {
-  linalg::ActiveSetResult result;
   const Eigen::Index n = qp.problem.size();
   const SparseMatrix& F = compliance_.of(qp.problem);
   const Eigen::VectorXd diagonal = F.diagonal();
   const double dmax = diagonal.cwiseAbs().maxCoeff();
   // A node whose tangential motion both sides prescribe (on a symmetry line) cannot slip: its row of F is zero and
   // its tangential traction goes into the supports; it is left out (q = 0 there).
-  std::vector<FrictionRow> rows;
-
-  for (const auto& r : friction_rows(qp.problem))
-    if (diagonal[r.tangential] > 1e-12 * dmax) rows.push_back(r);
+  const std::vector<FrictionRow> rows = ddm::friction_rows(
+      qp.problem.system(), [&](size_t k) { return qp.problem.offset(k); },
+      [&](size_t k) { return qp.problem.tangential_offset(k); },
+      [&](Eigen::Index t) { return diagonal[t] > 1e-12 * dmax; });
   const std::vector<char> mask = linalg::tangential_mask(n, rows);
-  // c_j: the inverse of the unknown's own compliance (the pressure or traction that would close its gap or slip
-  // alone); a row no body can move gets the largest scale.
   const Eigen::VectorXd c = linalg::friction_scaling(F);
   if (last_alpha_.size() != qp.equilibrium.G.rows()) last_alpha_.resize(0);
   const FrictionSets sticking = first_sets(F, qp, z0, last_alpha_, c, rows, mask, context.note);
   FrictionSets sets = sticking;
-  bool from_coarse = first_sets_from_coarse(F, qp, rows, sets, context.note);
-  result.z = Eigen::VectorXd::Zero(n);
-  bool restarted = false;
-  for (int step = 1; step <= context.max_steps; ++step) {
-    const linalg::FrictionParametrization p = linalg::parametrize(sets, rows, mask);
-    const linalg::FrictionStepSolve s = linalg::solve_on_friction_sets(F, qp.g, qp.equilibrium, p);
-    if (!s.ok && from_coarse && step == 1) {  // the coarse guess leaves a floating body unheld: start as without it
-      from_coarse = false;
-      sets = sticking;
-      --step;
-      continue;
-    }
-    if (!s.ok && !restarted && step > 1) {
-      // A floating body held by nothing on these sets, which may be a bad guess: once, every node in contact sticks.
-      restarted = true;
-      for (size_t t = 0; t < rows.size(); ++t)
-        if (sets.active[static_cast<size_t>(rows[t].normal)] || !rows[t].coulomb) sets.state[t] = Contact::stick;
-      continue;
-    }
-    if (!s.ok) {
-      result.message = friction_shortfall(qp, result.z);
-      result.steps = step;
-      return result;
-    }
-    result.z = s.lambda;
-    result.alpha = s.alpha;
-    last_alpha_ = s.alpha;
-    result.h = qp.g + F * s.lambda;
-    if (s.alpha.size() > 0) result.h += qp.equilibrium.G.transpose() * s.alpha;
-    const FrictionSets next = linalg::predict_friction_sets(result.z, result.h, c, rows, mask);
-    linalg::ActiveSetStep info;
-    info.step = step;
-    info.changes = next.changes(sets);
-    for (char a : next.active) info.active += a;
-    info.complementarity = linalg::friction_complementarity(result.z, result.h, c, rows, mask);
-    result.steps = step;
-    if (!context.on_step(result.z, result.h, info)) {
-      result.cancelled = true;
-      return result;
-    }
-    if (next == sets || info.complementarity <= 1e-13) {
-      int stick = 0, slip = 0;
-      for (auto st : sets.state) {
-        stick += st == Contact::stick;
-        slip += st == Contact::slip;
-      }
-      std::ostringstream os;
-      os << "stick and slip sets settled in " << step << " steps (" << info.active << " nodes in contact: " << stick
-         << " sticking, " << slip << " slipping)";
-      result.converged = true;
-      result.message = os.str();
-      return result;
-    }
-    sets = next;
-  }
-  result.message = "the stick and slip sets did not settle within " + std::to_string(context.max_steps) + " steps";
-  return result;
-}
+  const bool from_coarse = first_sets_from_coarse(F, qp, rows, sets, context.note);
 
-std::string friction_overload(const ContactSystem& system) {
-  const Problem& problem = system.problem();
-  const auto& pairs = system.pairs();
-  for (size_t a = 0; a < system.n_bodies(); ++a) {
-    if (system.body(a).rigid_modes().cols() < 3) continue;  // held in some direction by its own supports
-    std::vector<size_t> touching;
-    for (size_t k = 0; k < pairs.size(); ++k)
-      if (static_cast<size_t>(pairs[k].slave_body) == a || static_cast<size_t>(pairs[k].master_body) == a) touching.push_back(k);
-    if (touching.size() != 1 || !pairs[touching[0]].has_friction()) continue;
-    const auto& pair = pairs[touching[0]];
-    Eigen::Vector2d n = Eigen::Vector2d::Zero();
-    for (Eigen::Index r = 0; r < pair.n_rows(); ++r) n += pair.area[r] * pair.normal[static_cast<size_t>(r)];
-    if (!(n.norm() > 0)) continue;
-    n.normalize();
-    const Eigen::VectorXd f = system.body(a).external_load();
-    Eigen::Vector2d load = Eigen::Vector2d::Zero();
-    for (Eigen::Index d = 0; d < f.size(); ++d) load[d % 2] += f[d];
-    const double normal = std::abs(load.dot(n)), tangential = std::abs(load.x() * n.y() - load.y() * n.x());
-    const bool coulomb = pair.friction.law == FrictionSpec::Law::coulomb;
-    const double capacity = coulomb ? pair.friction.coefficient * normal : pair.friction.bound * pair.area.sum();
-    if (!(tangential > capacity * (1 + 1e-6))) continue;
-    std::ostringstream os;
-    os.precision(4);
-    os << "contact '" << pair.name << "': friction cannot hold body '" << problem.bodies[a].name
-       << "': its loads push it along the contact with " << tangential << ", "
-       << (capacity > 0 ? tangential / capacity : std::numeric_limits<double>::infinity()) << " times what friction can carry ("
-       << (coulomb ? "mu x normal load = " : "bound x contact length = ") << capacity
-       << "); under force control it would slide without end: lower the tangential load, raise the friction, or "
-          "prescribe the body's displacement";
-    return os.str();
-  }
-  return {};
+  const linalg::FrictionNewtonProblem problem{rows, mask, c, [&](const linalg::FrictionParametrization& p, linalg::FrictionIterate& x) {
+                                                return linalg::solve_on_friction_sets(F, qp.g, qp.equilibrium, p, x);
+                                              }};
+  linalg::FrictionNewtonSettings settings;
+  settings.max_steps = context.max_steps;
+  const linalg::FrictionStepCallback on_step = [&](const linalg::FrictionIterate& x, const linalg::ActiveSetStep& info) {
+    return context.on_step(x.lambda, x.h, info);
+  };
+  linalg::FrictionNewtonResult r = linalg::friction_newton(problem, sets, settings, on_step);
+  if (r.stop == linalg::FrictionStop::singular && r.iterate.lambda.size() == 0 && from_coarse)
+    r = linalg::friction_newton(problem, sticking, settings, on_step);  // the coarse guess leaves a body unheld
+
+  linalg::ActiveSetResult result;
+  result.z = r.iterate.lambda.size() == n ? r.iterate.lambda : Eigen::VectorXd(Eigen::VectorXd::Zero(n));
+  result.h = r.iterate.h;
+  result.alpha = r.iterate.other;
+  if (r.iterate.lambda.size() == n) last_alpha_ = r.iterate.other;
+  const double residual = r.iterate.lambda.size() == n ? linalg::friction_complementarity(r.iterate.lambda, r.iterate.h, c, rows, mask) : 1.0;
+  describe_stop(r, qp, context.max_steps, residual, result);
+  return result;
 }
 
 }  // namespace contact::ddm

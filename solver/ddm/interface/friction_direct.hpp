@@ -7,9 +7,10 @@
 //   [G P     0    ] [alpha] = [ e - G lambda0    ],
 // by UMFPACK (sparse LU), until the sets repeat. The normal problem is first solved without friction (the
 // frictionless direct solver's nested coarse start), then the friction problem on coarser multiplier spaces
-// (linalg/friction_nested.hpp), which makes the first stick and slip sets nearly right. Floating bodies may be
-// held by friction alone; a floating body whose loads pull it along its
-// only contact harder than friction can hold is refused before the solve, naming the pair and the ratio.
+// (linalg/friction_nested.hpp), which makes the first stick and slip sets nearly right; the Newton iteration is
+// linalg/friction_newton.hpp (globalised: damped where the full steps stop making progress). Floating bodies may
+// be held by friction alone; loads that statics shows friction cannot carry are refused before the solve
+// (ddm/friction_statics.hpp).
 #pragma once
 
 #include "../../linalg/friction_sets.hpp"
@@ -30,10 +31,5 @@ class FrictionDirectSolver final : public InterfaceSolver {
 // The friction rows of the interface problem (one per contact node of each friction pair, paired with its normal
 // row).
 std::vector<linalg::FrictionRow> friction_rows(const InterfaceProblem& problem);
-
-// Why friction cannot hold a floating body, if the loads already show it: the body's only contact is a friction
-// pair and the loads' component along the pair's mean tangent exceeds what friction can carry (Coulomb: mu times
-// the normal component; Tresca: the bound times the slave edge's covered length). Empty if none.
-std::string friction_overload(const ContactSystem& system);
 
 }  // namespace contact::ddm

@@ -1,5 +1,6 @@
 #include "interface_newton.hpp"
 
+#include "../friction_statics.hpp"
 #include "friction_direct.hpp"
 
 
@@ -64,7 +65,7 @@ MethodOutcome InterfaceNewton::solve(const SolverSettings& settings, RunContext&
   MethodOutcome out;
   if (system_.has_histories()) problem_.refresh_loads(context.runner);  // loads not proportional to the last ones
   if (system_.has_friction())
-    if (std::string overload = friction_overload(system_); !overload.empty()) {
+    if (std::string overload = friction_cannot_hold(system_); !overload.empty()) {
       out.reason = StopReason::error;
       out.message = overload;
       return out;

@@ -1,0 +1,183 @@
+// The friction Newton (solver/linalg/friction_newton.cpp) as pure linear algebra, on random problems with coupled
+// normal and tangential compliance: its answer satisfies the Coulomb conditions, equals the Tresca QP's minimiser
+// found by an independent method (accelerated projected gradient), and it converges from starts where the
+// full-step iteration cycles.
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <random>
+
+#include "linalg/friction_nested.hpp"
+#include "linalg/friction_newton.hpp"
+
+using namespace contact::linalg;
+
+namespace {
+
+// A random frictional problem of `nodes` contact nodes: lambda = [z; q], a compliance F = A A^T / n + I coupling
+// every unknown, gaps that penetrate at about half the nodes, slips of either sign.
+struct Problem {
+  int nodes = 0;
+  SparseMatrix F;
+  Eigen::VectorXd g;
+  std::vector<FrictionRow> rows;
+  std::vector<char> mask;
+  Eigen::VectorXd c;
+};
+
+Problem random_problem(unsigned seed, int nodes, bool coulomb, double mu_or_bound, double coupling = 1.0) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const int n = 2 * nodes;
+  Eigen::MatrixXd A(n, n);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) A(i, j) = normal(rng);
+  Eigen::MatrixXd F = coupling * A * A.transpose() / n + Eigen::MatrixXd::Identity(n, n);
+  Problem p;
+  p.nodes = nodes;
+  p.F = F.sparseView();
+  p.g.resize(n);
+  for (int i = 0; i < n; ++i) p.g[i] = normal(rng) - (i < nodes ? 0.3 : 0.0);
+  for (int i = 0; i < nodes; ++i)
+    p.rows.push_back({i, nodes + i, coulomb, coulomb ? mu_or_bound : 0.0, coulomb ? 0.0 : mu_or_bound});
+  p.mask = tangential_mask(n, p.rows);
+  p.c = friction_scaling(p.F);
+  return p;
+}
+
+// The cycling search's problems: 2 to 6 nodes, the compliance's coupling between 1 and 51, mu up to 0.7 (1.7 for
+// seeds 132 and 177), all drawn from the seed.
+Problem random_cycling_problem(unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::uniform_int_distribution<int> count(2, 6);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  const int nodes = count(rng), n = 2 * nodes;
+  Eigen::MatrixXd A(n, n);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) A(i, j) = normal(rng);
+  const double coupling = 1 + 50 * uniform(rng);
+  const double mu = seed < 1000 ? 0.2 + 1.5 * uniform(rng) : 0.1 + 0.6 * uniform(rng);
+  Problem p;
+  p.nodes = nodes;
+  p.F = Eigen::MatrixXd(coupling * A * A.transpose() / n + Eigen::MatrixXd::Identity(n, n)).sparseView();
+  p.g.resize(n);
+  for (int i = 0; i < n; ++i) p.g[i] = normal(rng) - (i < nodes ? 0.3 : 0.0);
+  for (int i = 0; i < nodes; ++i) p.rows.push_back({i, nodes + i, true, mu, 0.0});
+  p.mask = tangential_mask(n, p.rows);
+  p.c = friction_scaling(p.F);
+  return p;
+}
+
+FrictionNewtonProblem newton_problem(const Problem& p) {
+  return {p.rows, p.mask, p.c, [&p](const FrictionParametrization& par, FrictionIterate& x) {
+            return solve_on_friction_sets(p.F, p.g, Equalities{}, par, x);
+          }};
+}
+
+// Every node pressing and sticking: the start far from the answer.
+FrictionSets all_sticking(const Problem& p) {
+  FrictionSets s;
+  s.active.assign(p.mask.size(), 0);
+  for (int i = 0; i < p.nodes; ++i) s.active[static_cast<size_t>(i)] = 1;
+  stick_where_in_contact(s, p.rows);
+  return s;
+}
+
+// The full-step iteration the globalisation replaces: predict, solve, until the sets repeat.
+bool full_steps_settle(const Problem& p, FrictionSets sets, int max_steps) {
+  for (int k = 0; k < max_steps; ++k) {
+    FrictionIterate x;
+    if (!solve_on_friction_sets(p.F, p.g, Equalities{}, parametrize(sets, p.rows, p.mask), x)) return false;
+    const FrictionSets next = predict_friction_sets(x.lambda, x.h, p.c, p.rows, p.mask);
+    if (next == sets) return true;
+    sets = next;
+  }
+  return false;
+}
+
+// Coulomb's conditions at x, to `tol` relative to the data.
+void expect_coulomb_conditions(const Problem& p, const FrictionIterate& x, double tol) {
+  const double scale = std::max(1.0, x.lambda.cwiseAbs().maxCoeff()) * std::max(1.0, p.g.cwiseAbs().maxCoeff());
+  for (const auto& r : p.rows) {
+    const double z = x.lambda[r.normal], hn = x.h[r.normal], q = x.lambda[r.tangential], w = x.h[r.tangential];
+    const double b = r.coulomb ? r.mu * z : r.bound;
+    EXPECT_GE(z, -tol * scale);
+    EXPECT_GE(hn, -tol * scale);
+    EXPECT_NEAR(z * hn, 0.0, tol * scale);
+    EXPECT_LE(std::abs(q), b + tol * scale);
+    if (std::abs(q) < b - tol * scale) EXPECT_NEAR(w, 0.0, tol * scale);  // sticks
+    EXPECT_LE(q * w, tol * scale);                                        // slips against its traction
+  }
+}
+
+// The Tresca problem's minimiser, min 1/2 l^T F l + g^T l over z >= 0, |q| <= bound, by accelerated projected
+// gradient (FISTA with restarts): independent of the active sets.
+Eigen::VectorXd tresca_minimiser(const Problem& p, double bound) {
+  const Eigen::MatrixXd F = Eigen::MatrixXd(p.F);
+  const double L = F.operatorNorm() * 1.01;
+  const int n = static_cast<int>(p.g.size());
+  auto project = [&](Eigen::VectorXd v) {
+    for (int i = 0; i < n; ++i) v[i] = i < p.nodes ? std::max(0.0, v[i]) : std::clamp(v[i], -bound, bound);
+    return v;
+  };
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(n), y = x;
+  double t = 1.0;
+  for (int k = 0; k < 200000; ++k) {
+    const Eigen::VectorXd next = project(y - (F * y + p.g) / L);
+    const double t_next = (1 + std::sqrt(1 + 4 * t * t)) / 2;
+    if ((next - x).dot(y - next) > 0) {  // restart where the momentum points uphill
+      y = next;
+      t = 1.0;
+    } else {
+      y = next + ((t - 1) / t_next) * (next - x);
+      t = t_next;
+    }
+    if ((next - x).norm() <= 1e-15 * std::max(1.0, next.norm())) return next;
+    x = next;
+  }
+  return x;
+}
+
+}  // namespace
+
+TEST(FrictionNewton, CoulombAnswerSatisfiesTheConditionsFromEveryStart) {
+  for (unsigned seed = 0; seed < 40; ++seed) {
+    const Problem p = random_problem(seed, 12, true, 0.2 + 0.05 * (seed % 10));
+    FrictionNewtonSettings settings;
+    settings.max_steps = 200;
+    const FrictionNewtonResult r = friction_newton(newton_problem(p), all_sticking(p), settings);
+    ASSERT_EQ(r.stop, FrictionStop::settled) << "seed " << seed << " after " << r.steps << " steps";
+    expect_coulomb_conditions(p, r.iterate, 1e-10);
+  }
+}
+
+TEST(FrictionNewton, TrescaAnswerIsTheMinimiserOfItsConvexProblem) {
+  for (unsigned seed = 0; seed < 10; ++seed) {
+    const double bound = 0.1 + 0.05 * seed;
+    const Problem p = random_problem(100 + seed, 8, false, bound);
+    const FrictionNewtonResult r = friction_newton(newton_problem(p), all_sticking(p), FrictionNewtonSettings{});
+    ASSERT_EQ(r.stop, FrictionStop::settled) << seed;
+    const Eigen::VectorXd reference = tresca_minimiser(p, bound);
+    EXPECT_LE((r.iterate.lambda - reference).cwiseAbs().maxCoeff(),
+              1e-9 * std::max(1.0, reference.cwiseAbs().maxCoeff()))
+        << seed;
+  }
+}
+
+TEST(FrictionNewton, ConvergesWhereTheFullStepsCycle) {
+  // Problems of 2 to 6 nodes with a strongly coupled compliance, drawn as in random_cycling_problem, on which the
+  // full-step iteration from "everything sticks" never settles (its sets cycle; found by searching 20,000 seeds,
+  // where it happens for about one in 3,000 with mu <= 0.7): the globalised iteration settles on each, at a
+  // point that satisfies Coulomb's conditions.
+  for (unsigned seed : {132u, 177u, 14056u, 16582u, 16740u}) {
+    const Problem p = random_cycling_problem(seed);
+    EXPECT_FALSE(full_steps_settle(p, all_sticking(p), 100)) << seed;
+    FrictionNewtonSettings settings;
+    settings.max_steps = 400;
+    const FrictionNewtonResult r = friction_newton(newton_problem(p), all_sticking(p), settings);
+    ASSERT_EQ(r.stop, FrictionStop::settled) << "seed " << seed << " after " << r.steps << " steps";
+    EXPECT_GT(r.damped_steps, 0) << seed;
+    expect_coulomb_conditions(p, r.iterate, 1e-9);
+  }
+}
