@@ -260,7 +260,12 @@ int solve_and_write(contact::Session& session, contact::Problem& problem, const 
     std::cerr << "error: " << result.message << "\n";
     return finish(1);
   }
-  if (!ndjson) print_final_step(result.steps.back());
+  if (!ndjson) {
+    // A solve that stopped short of convergence leaves an iterate, not an answer: said before its numbers.
+    if (!result.converged)
+      std::printf("not converged: the last iterate, below and in the result file (converged 0), is not an answer\n");
+    print_final_step(result.steps.back());
+  }
   try {
     write_files(output, problem, result, job_id, ndjson);
     summary["result_written"] = true;
