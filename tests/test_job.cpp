@@ -975,6 +975,80 @@ TEST(JobErrors, ControlCharactersInNamesAreRefusedAtTheirPointer) {
   expect_only_error(parse(job), "/bodies/0/boundary/1/edge", "the body has no edge 'top\\u001B'");
 }
 
+// Issue 32, item 7: a contact named "." validated, and the finished job then failed writing its result (the
+// result lost); ".." became an HDF5 group "..". Zero-width and bidirectional-control characters (U+200B-U+200F,
+// U+202A-U+202E, U+2066-U+2069, U+FEFF) let a name read as another. Both are refused in every name, at its
+// pointer, the character named by its code point and shown escaped.
+TEST(JobErrors, DotNamesAreRefusedAtTheirPointer) {
+  for (const char* dots : {".", ".."}) {
+    json job = small_job();
+    job["contacts"][0]["name"] = dots;
+    expect_only_error(parse(job), "/contacts/0/name",
+                      "contact name '" + std::string(dots) + "' is not a name: '.' and '..' mean");
+    job = small_job();
+    job["bodies"][0]["name"] = dots;
+    job["contacts"] = json::array();
+    expect_only_error(parse(job), "/bodies/0/name", "body name '" + std::string(dots) + "' must consist of letters");
+    // An explicit mesh's edge and vertex names.
+    job = small_job();
+    job["bodies"][0]["mesh"] = explicit_mesh();
+    job["bodies"][0]["mesh"]["edges"][dots] = job["bodies"][0]["mesh"]["edges"]["side"];
+    job["bodies"][0]["mesh"]["edges"].erase("side");
+    job["bodies"][0]["boundary"] = {{{"edge", "wall"}, {"displacement", {{"x", 0}, {"y", 0}}}}};
+    job["contacts"][0]["slave"] = "upper.base";
+    expect_only_error(parse(job), "/bodies/0/mesh/edges/" + std::string(dots),
+                      "edge name '" + std::string(dots) + "' must consist of letters");
+    job["bodies"][0]["mesh"] = explicit_mesh();
+    job["bodies"][0]["mesh"]["vertices"] = {{dots, 0}};
+    expect_only_error(parse(job), "/bodies/0/mesh/vertices/" + std::string(dots),
+                      "vertex name '" + std::string(dots) + "' must consist of letters");
+  }
+  // Dots inside a contact name stay allowed (the default names have them).
+  json job = small_job();
+  for (const char* fine : {"upper.bottom-lower.top", "a.b", "...", ".x"}) {
+    job["contacts"][0]["name"] = fine;
+    EXPECT_TRUE(parse(job).ok()) << fine << ": " << listing(parse(job));
+  }
+}
+
+TEST(JobErrors, InvisibleCharactersInNamesAreRefusedAndNamedByCodePoint) {
+  const std::string rlo = "\xe2\x80\xae";   // U+202E RIGHT-TO-LEFT OVERRIDE
+  const std::string zwsp = "\xe2\x80\x8b";  // U+200B ZERO WIDTH SPACE
+  const std::string lri = "\xe2\x81\xa6";   // U+2066 LEFT-TO-RIGHT ISOLATE
+  const std::string bom = "\xef\xbb\xbf";   // U+FEFF ZERO WIDTH NO-BREAK SPACE
+  json job = small_job();
+  job["name"] = "report" + rlo + "fdp.exe";
+  expect_only_error(parse(job), "/name",
+                    "name 'report\\u202Efdp.exe' contains the invisible character U+202E at byte 6: it must be "
+                    "printable text");
+  job["name"] = "seed" + zwsp;
+  expect_only_error(parse(job), "/name", "U+200B at byte 4");
+  job["name"] = bom + "seed";
+  expect_only_error(parse(job), "/name", "U+FEFF at byte 0");
+  job["name"] = "seed\xe2\x80\xaf";  // U+202F NARROW NO-BREAK SPACE: visible spacing, allowed
+  EXPECT_TRUE(parse(job).ok()) << listing(parse(job));
+
+  job = small_job();
+  job["bodies"][1]["name"] = "low" + rlo + "er";
+  job["contacts"] = json::array();
+  expect_only_error(parse(job), "/bodies/1/name",
+                    "body name 'low\\u202Eer' must consist of letters, digits, '_' and '-' only (pattern "
+                    "^[A-Za-z0-9_-]+$); it contains the invisible character U+202E at byte 3");
+  job = small_job();
+  job["contacts"][0]["name"] = "pair" + zwsp;
+  expect_only_error(parse(job), "/contacts/0/name", "contains the invisible character U+200B at byte 4");
+  job = small_job();
+  job["bodies"][0]["mesh"] = explicit_mesh();
+  job["bodies"][0]["mesh"]["vertices"] = {{"tip" + lri, 0}};
+  job["bodies"][0]["boundary"] = {{{"edge", "wall"}, {"displacement", {{"x", 0}, {"y", 0}}}}};
+  job["contacts"][0]["slave"] = "upper.base";
+  expect_only_error(parse(job), "/bodies/0/mesh/vertices/tip" + lri, "contains the invisible character U+2066");
+  job["bodies"][0]["mesh"] = explicit_mesh();
+  job["bodies"][0]["mesh"]["edges"]["cap" + bom] = job["bodies"][0]["mesh"]["edges"]["cap"];
+  job["bodies"][0]["mesh"]["edges"].erase("cap");
+  expect_only_error(parse(job), "/bodies/0/mesh/edges/cap" + bom, "contains the invisible character U+FEFF");
+}
+
 // "output": which steps' fields the result keeps (issue 23, item 3). The default follows the job: the last step
 // of an adaptive run, every load step otherwise; the normalized copy says which.
 TEST(JobOutput, StepsDefaultToLastForAdaptiveJobsAndAllOtherwiseAndBadValuesAreNamed) {
