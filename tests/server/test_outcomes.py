@@ -1,11 +1,13 @@
 #!/usr/bin/env python3
-"""contactd: a job's outcome says whether it holds an answer.
+"""contactd: a job's outcome says whether it holds an answer, and a bad job answers one error per cause.
 
 - Issue 32, item 6: a job whose solve stops without converging (max_iterations) ended SUCCEEDED. It ends FAILED,
   the reason in its message, its last iterate kept in the result file (flagged converged 0).
 - Issue 32, item 6: the roller example with the friction removed from its base contact ended SUCCEEDED after 2004
   Newton steps with a tensile contact force (-3865). It ends FAILED, and its message says that the last iterate
   pulls at a contact and is not an answer.
+- Issue 31, item 4: a job over --max-bodies got its one real error followed by 200 that repeated it, one per
+  contact naming a body. /v1/validate and a submission answer the one error.
 
 Standard library and Debian's python3-h5py; exits non-zero on any failure."""
 import os
@@ -66,6 +68,18 @@ def roller_without_base_friction():
     return job
 
 
+def row_of_blocks(count):
+    """`count` unit blocks stacked, each held at its bottom, each on the one below by a contact."""
+    bodies, contacts = [], []
+    for k in range(count):
+        bodies.append({"name": f"b{k}", "material": {"E": 1, "nu": 0.3},
+                       "mesh": {"block": {"corners": [[0, k], [1, k], [1, k + 1], [0, k + 1]], "nx": 1, "ny": 1}},
+                       "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]})
+        if k > 0:
+            contacts.append({"slave": f"b{k}.bottom", "master": f"b{k - 1}.top"})
+    return {"name": "row", "bodies": bodies, "contacts": contacts}
+
+
 with Server(args=["--workers", "1"]) as server:
     # --- max_iterations: FAILED, its last iterate kept -----------------------------------------------------
     job_id = server.submit_id(long_job(max_iterations=20, name="stops-short"))
@@ -84,5 +98,16 @@ with Server(args=["--workers", "1"]) as server:
     check("roller on a frictionless base: each pulling contact is said to be no answer",
           all(f"'{name}' (force " in message for name in pulling)
           and (not pulling or "the last iterate is not an answer: contact '" in message), (attrs, message[:400]))
+
+    # --- one error for one cause past a limit ------------------------------------------------------------------
+    r = server.request("POST", "/v1/validate", json_body=row_of_blocks(589))
+    errors = r.json().get("errors", []) if r.status == 400 else []
+    check("589 bodies: 400 with exactly one error", r.status == 400 and len(errors) == 1, (r.status, errors[:3]))
+    check("589 bodies: the error is the limit, at /bodies",
+          errors[:1] == [{"pointer": "/bodies", "message": "the job has 589 bodies; at most 512 are accepted"}],
+          errors[:3])
+    r = server.submit(row_of_blocks(589))
+    errors = r.json().get("errors", []) if r.status == 400 else []
+    check("589 bodies submitted: 400 with the same one error", r.status == 400 and len(errors) == 1, (r.status, errors[:3]))
 
 finish()
