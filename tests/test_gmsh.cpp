@@ -658,12 +658,19 @@ TEST(GmshJob, TableErrorsAreReportedAtTheirPointersOnceEach) {
   job = flat_patch_table({{"data", text}});
   job["meshes"]["bad name"] = {{"data", text}};
   expect_only_error(job::parse(job), "/meshes/bad name", "mesh name 'bad name' must consist of letters, digits");
+  // A table refused whole, or an entry refused for its name, is the cause of the bodies' unknown meshes: one
+  // error (issue 31, item 4). An empty table is said to be empty (it has no error of its own to point to).
+  job["bodies"][1]["mesh"]["gmsh"]["mesh"] = "bad name";
+  expect_only_error(job::parse(job), "/meshes/bad name", "mesh name 'bad name' must consist of letters, digits");
   job["meshes"] = json::array();
+  expect_only_error(job::parse(job), "/meshes", "meshes must be an object");
+  job["meshes"] = json::object();
   r = job::parse(job);
-  ASSERT_EQ(r.errors.size(), 3u) << job::format_errors(r.errors);
-  EXPECT_EQ(r.errors[0].pointer, "/meshes");
-  EXPECT_NE(r.errors[1].message.find("the table has no entry that could be read (see /meshes)"), std::string::npos)
-      << r.errors[1].message;
+  ASSERT_EQ(r.errors.size(), 2u) << job::format_errors(r.errors);
+  EXPECT_EQ(r.errors[0].pointer, "/bodies/0/mesh/gmsh/mesh");
+  EXPECT_NE(r.errors[0].message.find("the job has no mesh 'patch' in its \"meshes\" table; the table is empty"),
+            std::string::npos)
+      << r.errors[0].message;
   // Without bodies to use them the entries are not called unused: the missing bodies are the error.
   job = flat_patch_table({{"data", text}});
   job.erase("bodies");

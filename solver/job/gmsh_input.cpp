@@ -98,12 +98,14 @@ void GmshMeshes::read_table(const json& value, const std::string& pointer, read:
   if (!value.is_object()) {
     errors.add(pointer, "meshes must be an object {\"name\": {\"file\": ...} or {\"data\": ...}, ...}, got " +
                             read::type_name(value));
+    table_incomplete_ = true;
     return;
   }
   for (const auto& item : value.items()) {
     const std::string p = read::child(pointer, item.key());
     if (auto problem = read::name_problem(item.key(), "mesh name", limits_.max_name_length, false)) {
-      errors.add(p, *problem);  // not an entry: a body that names it is told the names there are
+      errors.add(p, *problem);  // not an entry: a body that names no entry is the same cause
+      table_incomplete_ = true;
       continue;
     }
     TableEntry& entry = table_[item.key()];
@@ -170,11 +172,13 @@ const GmshMeshes::Parsed* GmshMeshes::from_table(const std::string& name, const 
                                                  read::Errors& errors, std::string& label) {
   auto it = table_.find(name);
   if (it == table_.end()) {
+    // A table refused whole, or an entry refused for its name, may be the mesh this body names: reported there.
+    if (table_incomplete_) return nullptr;
     std::vector<std::string> names;
     for (const auto& [known, entry] : table_) names.push_back("'" + read::shown(known) + "'");
     std::string known = "its meshes are " + read::join_names(names);
     if (names.empty())
-      known = table_given_ ? "the table has no entry that could be read (see /meshes)"
+      known = table_given_ ? "the table is empty"
                            : "it has no \"meshes\" table (give {\"meshes\": {\"" + read::shown(name) +
                                  "\": {\"data\": ...}}} at the top level)";
     errors.add(pointer, "the job has no mesh '" + read::shown(name) + "' in its \"meshes\" table; " + known);

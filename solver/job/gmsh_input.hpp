@@ -88,6 +88,7 @@ class GmshMeshes {
   std::multimap<std::size_t, std::unique_ptr<Parsed>> data_;         // by the hash of the text
   std::map<std::string, TableEntry> table_;                          // the job's "meshes", by name
   bool table_given_ = false;                                         // the job has "meshes" (maybe malformed)
+  bool table_incomplete_ = false;  // "meshes" not an object, or an entry refused for its name: reported there
 };
 
 }  // namespace contact::job
