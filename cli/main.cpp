@@ -260,7 +260,12 @@ int solve_and_write(contact::Session& session, contact::Problem& problem, const 
     std::cerr << "error: " << result.message << "\n";
     return finish(1);
   }
-  if (!ndjson) print_final_step(result.steps.back());
+  if (!ndjson) {
+    // A solve that stopped short of convergence leaves an iterate, not an answer: said before its numbers.
+    if (!result.converged)
+      std::printf("not converged: the last iterate, below and in the result file (converged 0), is not an answer\n");
+    print_final_step(result.steps.back());
+  }
   try {
     write_files(output, problem, result, job_id, ndjson);
     summary["result_written"] = true;
@@ -296,11 +301,16 @@ int main(int argc, char** argv) {
   catch_stop_signals();
   contact::Session session(&argc, &argv);
   CLI::App app{
-      "contact-solve: frictionless contact of elastic bodies by domain decomposition (each body solved on its own).\n"
+      "contact-solve: contact of elastic bodies in 2D, frictionless or with friction, by domain decomposition (each\n"
+      "body solved on its own).\n"
       "Methods (job field solver.method): interface_newton (default: exact dual-mortar contact, primal-dual active\n"
       "set on the bodies' interface Schur complements), neumann (the paper's penalty Neumann DDM (16)-(17)), robin,\n"
-      "monolithic (reference). See docs/job-format.md. Under `mpirun -n N` the bodies are spread over N ranks\n"
-      "(docs/parallel.md)."};
+      "monolithic (reference).\n"
+      "Friction (a contact's \"friction\"): Coulomb {\"coefficient\": mu} (|t| <= mu p) or Tresca {\"bound\": g}\n"
+      "(|t| <= g), exact, by semismooth Newton on stick and slip (interface_newton or monolithic); incremental over\n"
+      "the load steps; the result holds each pair's tangential traction, slip and stick nodes per step.\n"
+      "See docs/job-format.md. Under `mpirun -n N` the bodies are spread over N ranks (docs/parallel.md).\n"
+      "Exit codes: 0 converged; 1 solver or I/O error; 2 invalid job; 3 stopped without converging."};
   app.set_version_flag("--version", std::string("contact-solve ") + contact::solver_version());
   std::string job_path, output, job_id, progress = "text";
   bool validate_only = false, quiet = false;

@@ -5,6 +5,7 @@
 #include "ddm/load_steps.hpp"
 #include "held_bodies.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <exception>
 #include <sstream>
@@ -57,6 +58,39 @@ void refuse_unheld_bodies(const Problem& problem, Result& result) {
     result.step_history.clear();
     return;
   }
+}
+
+// A contact only pushes: the pairs of the last step whose total normal force pulls, beyond rounding (relative to
+// the largest sum of |weight x pressure| over the step's pairs), as "'name' (force -3865)"; empty if none.
+std::string tensile_pairs(const Step& step) {
+  double scale = 0.0;
+  for (const auto& p : step.pairs)
+    if (p.weight.size() == p.pressure.size()) scale = std::max(scale, p.weight.cwiseProduct(p.pressure).cwiseAbs().sum());
+  std::ostringstream os;
+  for (const auto& p : step.pairs) {
+    if (!(p.force < -1e-6 * scale)) continue;
+    os << (os.tellp() > 0 ? ", " : "") << "'" << p.name << "' (force " << p.force << ")";
+  }
+  return os.str();
+}
+
+// A tensile contact force is never an answer. The solvers' answers hold p >= 0 at every contact node; an iterate
+// they stopped on short of convergence may not, and the message says it is no answer. A solve that claims
+// convergence on one is refused (no result): its stop test was wrong.
+void refuse_tension(Result& result) {
+  if (result.steps.empty()) return;
+  const std::string pulling = tensile_pairs(result.steps.back());
+  if (pulling.empty()) return;
+  const std::string what = "contact " + pulling + " pulls, and a contact only pushes";
+  if (!result.converged) {
+    result.message += "; the last iterate is not an answer: " + what;
+    return;
+  }
+  result.stop_reason = StopReason::error;
+  result.converged = false;
+  result.message = "the solve stopped on a state that is not an answer: " + what + " (" + result.message + ")";
+  result.steps.clear();
+  result.step_history.clear();
 }
 
 }  // namespace
@@ -135,6 +169,7 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
     result.steps = steps.take_steps();
     result.step_history = steps.take_summaries();
     if (problem.solver.method == Method::monolithic) refuse_unheld_bodies(active, result);
+    if (result.stop_reason != StopReason::error && result.stop_reason != StopReason::cancelled) refuse_tension(result);
     if (outcome.updates > 0 && !result.steps.empty()) {
       std::ostringstream os;
       os << "; remaining penetration " << max_penetration(result.steps.back());

@@ -37,6 +37,32 @@ struct Recorder : Observer {
 
 }  // namespace
 
+// Issue 32, item 6: the roller example with its base contact frictionless has no equilibrium once the plate is
+// pushed sideways; its solve stopped at max_iterations on an iterate whose base contact pulled (force -3865), and
+// the server called that SUCCEEDED. The solve says it did not converge, and a pulling contact in its last
+// iterate is named as no answer (a contact only pushes).
+TEST(Outcome, AnIterateThatPullsAtAContactIsSaidToBeNoAnswer) {
+  std::ifstream in(std::string(CONTACT_SOURCE_DIR) + "/api/examples/roller_friction.json");
+  nlohmann::json job = nlohmann::json::parse(in);
+  job["contacts"][0].erase("friction");
+  auto parsed = job::parse(job);
+  ASSERT_TRUE(parsed.ok()) << job::format_errors(parsed.errors);
+  Recorder recorder;
+  CancelToken cancel;
+  const Result result = solve(*parsed.problem, recorder, cancel);
+  EXPECT_FALSE(result.converged) << result.message;
+  EXPECT_NE(result.stop_reason, StopReason::converged) << result.message;
+  if (result.steps.empty()) {  // refused as an error (e.g. nothing holds the bodies): no iterate to judge
+    EXPECT_EQ(result.stop_reason, StopReason::error) << result.message;
+    return;
+  }
+  for (const auto& pair : result.steps.back().pairs)
+    if (pair.force < 0)
+      EXPECT_NE(result.message.find("the last iterate is not an answer: contact '" + pair.name + "'"),
+                std::string::npos)
+          << pair.name << " pulls with " << pair.force << ": " << result.message;
+}
+
 TEST(Observer, ReceivesEveryIterationInOrderWithTheDocumentedFields) {
   for (const char* method : {"neumann", "monolithic"}) {
     const Problem p = seed(method);

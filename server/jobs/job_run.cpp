@@ -142,7 +142,9 @@ JobRecord JobRun::outcome_of(const contact::Result& result, CancelReason reason)
       break;
     case contact::StopReason::max_iterations:
     case contact::StopReason::stagnation:
-      outcome.state = JobState::succeeded;
+      // Not an answer: the last iterate is kept in the result file (flagged converged 0), the job fails.
+      outcome.state = JobState::failed;
+      outcome.message = "the solve did not converge (" + outcome.stop_reason + "): " + result.message;
       break;
     case contact::StopReason::error:
       outcome.state = JobState::failed;

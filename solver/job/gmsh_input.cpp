@@ -65,7 +65,7 @@ std::unique_ptr<GmshMeshes::Parsed> GmshMeshes::parse(const std::string& text) c
   return p;
 }
 
-const GmshMeshes::Parsed& GmshMeshes::parse_file(const std::string& path) {
+GmshMeshes::Parsed& GmshMeshes::parse_file(const std::string& path) {
   auto it = files_.find(path);
   if (it == files_.end()) {
     std::string read_error;
@@ -83,7 +83,7 @@ const GmshMeshes::Parsed& GmshMeshes::parse_file(const std::string& path) {
   return *it->second;
 }
 
-const GmshMeshes::Parsed& GmshMeshes::parse_data(const std::string& text) {
+GmshMeshes::Parsed& GmshMeshes::parse_data(const std::string& text) {
   const std::size_t hash = std::hash<std::string>{}(text);
   const auto [first, last] = data_.equal_range(hash);
   for (auto it = first; it != last; ++it)
@@ -98,12 +98,14 @@ void GmshMeshes::read_table(const json& value, const std::string& pointer, read:
   if (!value.is_object()) {
     errors.add(pointer, "meshes must be an object {\"name\": {\"file\": ...} or {\"data\": ...}, ...}, got " +
                             read::type_name(value));
+    table_incomplete_ = true;
     return;
   }
   for (const auto& item : value.items()) {
     const std::string p = read::child(pointer, item.key());
     if (auto problem = read::name_problem(item.key(), "mesh name", limits_.max_name_length, false)) {
-      errors.add(p, *problem);  // not an entry: a body that names it is told the names there are
+      errors.add(p, *problem);  // not an entry: a body that names no entry is the same cause
+      table_incomplete_ = true;
       continue;
     }
     TableEntry& entry = table_[item.key()];
@@ -130,17 +132,21 @@ void GmshMeshes::check_table_used(read::Errors& errors) const {
                                 "{\"mesh\": \"" + read::shown(name) + "\", \"surface\": ...}}); remove it or use it");
 }
 
+bool GmshMeshes::usable(Parsed& parsed, const std::string& pointer, const std::string& message, read::Errors& errors) {
+  if (parsed.error.empty()) return true;
+  if (!parsed.reported) errors.add(pointer, message);
+  parsed.reported = true;
+  return false;
+}
+
 const GmshMeshes::Parsed* GmshMeshes::resolve(const Source& source, const std::string& pointer, read::Errors& errors,
                                               std::string& label) {
   const std::string& text = *source.text;
   if (!source.file) {
-    const Parsed* parsed = &parse_data(text);
-    if (!parsed->error.empty()) {
-      errors.add(pointer, "the mesh data (MSH text): " + parsed->error);
-      return nullptr;
-    }
+    Parsed& parsed = parse_data(text);
+    if (!usable(parsed, pointer, "the mesh data (MSH text): " + parsed.error, errors)) return nullptr;
     label = "data";
-    return parsed;
+    return &parsed;
   }
   if (!limits_.mesh_directory) {
     errors.add(pointer, "a gmsh mesh cannot be read from a file here: the server reads no files for a job; send the "
@@ -153,25 +159,26 @@ const GmshMeshes::Parsed* GmshMeshes::resolve(const Source& source, const std::s
   }
   const fs::path given(text);
   const fs::path path = (given.is_absolute() ? given : fs::path(*limits_.mesh_directory) / given).lexically_normal();
-  const Parsed* parsed = &parse_file(path.string());
+  Parsed& parsed = parse_file(path.string());
   label = "'" + read::shown(text) + "'";
-  if (!parsed->error.empty()) {
-    const std::string resolved = path.string() != text ? " (" + read::shown(path.string()) + ")" : "";
-    errors.add(pointer, "the mesh file " + label + resolved + (parsed->unreadable ? " " : ": ") + parsed->error);
+  const std::string resolved = path.string() != text ? " (" + read::shown(path.string()) + ")" : "";
+  if (!usable(parsed, pointer, "the mesh file " + label + resolved + (parsed.unreadable ? " " : ": ") + parsed.error,
+              errors))
     return nullptr;
-  }
-  return parsed;
+  return &parsed;
 }
 
 const GmshMeshes::Parsed* GmshMeshes::from_table(const std::string& name, const std::string& pointer,
                                                  read::Errors& errors, std::string& label) {
   auto it = table_.find(name);
   if (it == table_.end()) {
+    // A table refused whole, or an entry refused for its name, may be the mesh this body names: reported there.
+    if (table_incomplete_) return nullptr;
     std::vector<std::string> names;
     for (const auto& [known, entry] : table_) names.push_back("'" + read::shown(known) + "'");
     std::string known = "its meshes are " + read::join_names(names);
     if (names.empty())
-      known = table_given_ ? "the table has no entry that could be read (see /meshes)"
+      known = table_given_ ? "the table is empty"
                            : "it has no \"meshes\" table (give {\"meshes\": {\"" + read::shown(name) +
                                  "\": {\"data\": ...}}} at the top level)";
     errors.add(pointer, "the job has no mesh '" + read::shown(name) + "' in its \"meshes\" table; " + known);

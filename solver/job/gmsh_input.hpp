@@ -51,11 +51,15 @@ class GmshMeshes {
   struct Parsed {
     std::string error;  // empty if parsed
     bool unreadable = false;  // the error is the file's (cannot be opened, too large), not its text's
+    bool reported = false;    // the error was reported, at the first body that gave this file or text
     mesh::gmsh::File file;
     const std::string* data = nullptr;  // the job's data string it was parsed from, in the job (none for a file)
   };
-  const Parsed& parse_file(const std::string& path);
-  const Parsed& parse_data(const std::string& text);  // text: a string of the job, kept by reference
+  Parsed& parse_file(const std::string& path);
+  Parsed& parse_data(const std::string& text);  // text: a string of the job, kept by reference
+  // Reports a parse's error at `pointer` the first time only (one error for one cause, however many bodies give
+  // the same file or text); false if it has one.
+  static bool usable(Parsed& parsed, const std::string& pointer, const std::string& message, read::Errors& errors);
   std::unique_ptr<Parsed> parse(const std::string& text) const;
 
   // The MSH text a body's mesh comes from, parsed; nullptr after reporting why not (at `pointer`, the file or
@@ -84,6 +88,7 @@ class GmshMeshes {
   std::multimap<std::size_t, std::unique_ptr<Parsed>> data_;         // by the hash of the text
   std::map<std::string, TableEntry> table_;                          // the job's "meshes", by name
   bool table_given_ = false;                                         // the job has "meshes" (maybe malformed)
+  bool table_incomplete_ = false;  // "meshes" not an object, or an entry refused for its name: reported there
 };
 
 }  // namespace contact::job

@@ -122,6 +122,7 @@ class JobReader {
   void read_penalty(const json& value, const std::string& pointer, json& out);
   void read_parallel(const Fields& top);
   void read_loading(const Fields& top);
+  void read_loading_steps(const json& value, const std::string& pointer);
   void read_output(const Fields& top);
 
   // read_bodies.cpp: bodies, materials, boundary conditions; the checks on the built bodies
@@ -169,6 +170,7 @@ class JobReader {
     std::string edge;
   };
   std::optional<EdgeRef> resolve(const json& value, const std::string& pointer, const std::string& what);
+  bool bodies_all_named() const;
   void read_contacts(const Fields& top);
   void read_gap(const Fields& contact, GapSpec& gap, json& out);
 
@@ -186,6 +188,11 @@ class JobReader {
   bool method_given_ = false, enforcement_given_ = false;
   std::string method_pointer_, enforcement_pointer_ = "/solver", interface_solver_pointer_;
   std::vector<std::string> friction_pointers_;  // per contact pair of problem_.contacts (empty: frictionless)
+  // One error for one cause: what a part refused whole (over a limit, of the wrong type) or read only in part
+  // leaves unknown, so the checks that depend on it are not run (docs/job-format.md, "Validation and errors").
+  bool bodies_listed_ = false;     // the bodies' list was read (not refused whole); names may still be missing
+  bool contacts_complete_ = true;  // every contact pair was read and resolved: the bodies' contacts are known
+  bool loading_read_ = true;       // the load steps were read without error: their number is known
   std::vector<BodyInput> inputs_;
   GmshMeshes gmsh_;
 };

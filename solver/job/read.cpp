@@ -69,18 +69,44 @@ std::pair<unsigned, size_t> control_at(const std::string& text, size_t k) {
   return {0, 0};
 }
 
-// The text with each control character written \u00XX, so that a message shows it rather than obeys it.
+// The code point of the invisible character at byte `k` of UTF-8 text (the zero-width and direction marks
+// U+200B-U+200F, the bidirectional embeddings and overrides U+202A-U+202E, the isolates U+2066-U+2069, the
+// zero-width no-break space U+FEFF) and its length in bytes (3), or length 0 when there is none there. They
+// show as nothing, or reorder the text around them: a name holding one reads as another name.
+std::pair<unsigned, size_t> invisible_at(const std::string& text, size_t k) {
+  if (k + 2 >= text.size()) return {0, 0};
+  const auto b0 = static_cast<unsigned char>(text[k]), b1 = static_cast<unsigned char>(text[k + 1]),
+             b2 = static_cast<unsigned char>(text[k + 2]);
+  if ((b0 & 0xF0) != 0xE0 || (b1 & 0xC0) != 0x80 || (b2 & 0xC0) != 0x80) return {0, 0};
+  const unsigned code = ((b0 & 0x0Fu) << 12) | ((b1 & 0x3Fu) << 6) | (b2 & 0x3Fu);
+  const bool invisible = (code >= 0x200B && code <= 0x200F) || (code >= 0x202A && code <= 0x202E) ||
+                         (code >= 0x2066 && code <= 0x2069) || code == 0xFEFF;
+  return invisible ? std::pair<unsigned, size_t>{code, 3} : std::pair<unsigned, size_t>{0, 0};
+}
+
+// A control or an invisible character at byte `k`: its code point and length, or length 0.
+std::pair<unsigned, size_t> unprintable_at(const std::string& text, size_t k) {
+  const auto control = control_at(text, k);
+  return control.second > 0 ? control : invisible_at(text, k);
+}
+
+std::string code_point(unsigned code, const char* format) {
+  char buffer[12];
+  std::snprintf(buffer, sizeof buffer, format, code);
+  return buffer;
+}
+
+// The text with each control or invisible character written \uXXXX, so that a message shows it rather than
+// obeys it (an escape sequence driving the terminal, an override reordering the message).
 std::string escape_controls(const std::string& text) {
   std::string out;
   for (size_t k = 0; k < text.size(); ++k) {
-    const auto [code, length] = control_at(text, k);
+    const auto [code, length] = unprintable_at(text, k);
     if (length == 0) {
       out += text[k];
       continue;
     }
-    char buffer[8];
-    std::snprintf(buffer, sizeof buffer, "\\u%04X", code);
-    out += buffer;
+    out += code_point(code, "\\u%04X");
     k += length - 1;
   }
   return out;
@@ -92,15 +118,27 @@ std::string shown(const std::string& text, size_t max) {
   return escape_controls(utf8_prefix(text, max)) + "... (" + std::to_string(text.size()) + " bytes)";
 }
 
-std::optional<std::string> control_character_problem(const std::string& s, const std::string& what) {
+namespace {
+const char* const kUnprintableRule =
+    "no control characters (U+0000 to U+001F, U+007F to U+009F), and no zero-width or bidirectional-control "
+    "characters (U+200B to U+200F, U+202A to U+202E, U+2066 to U+2069, U+FEFF), which hide or reorder text";
+
+// "the control character U+001B at byte 4" or "the invisible character U+202E at byte 1": the first character
+// of `s` that is not printable text, or nullopt.
+std::optional<std::string> first_unprintable(const std::string& s) {
   for (size_t k = 0; k < s.size(); ++k) {
-    const auto [code, length] = control_at(s, k);
+    const auto [code, length] = unprintable_at(s, k);
     if (length == 0) continue;
-    char buffer[8];
-    std::snprintf(buffer, sizeof buffer, "U+%04X", code);
-    return what + " '" + shown(s) + "' contains the control character " + buffer + " at byte " + std::to_string(k) +
-           ": it must be printable text (no control characters U+0000 to U+001F or U+007F to U+009F)";
+    const char* kind = control_at(s, k).second > 0 ? "the control character " : "the invisible character ";
+    return kind + code_point(code, "U+%04X") + " at byte " + std::to_string(k);
   }
+  return std::nullopt;
+}
+}  // namespace
+
+std::optional<std::string> control_character_problem(const std::string& s, const std::string& what) {
+  if (auto found = first_unprintable(s))
+    return what + " '" + shown(s) + "' contains " + *found + ": it must be printable text (" + kUnprintableRule + ")";
   return std::nullopt;
 }
 
@@ -275,11 +313,21 @@ bool is_identifier(const std::string& s, bool dot = false) {
 }  // namespace
 
 std::optional<std::string> name_problem(const std::string& s, const std::string& what, size_t max_length, bool dot) {
-  const char* allowed = dot ? "letters, digits, '_', '-' and '.' only (pattern ^[A-Za-z0-9_.-]+$)"
+  const char* allowed = dot ? "letters, digits, '_', '-' and '.' only, and not '.' or '..' (pattern "
+                              "^(?!\\.{1,2}$)[A-Za-z0-9_.-]+$)"
                             : "letters, digits, '_' and '-' only (pattern ^[A-Za-z0-9_-]+$)";
   if (s.size() > max_length)
     return what + " '" + read::shown(s) + "' is too long: at most " + std::to_string(max_length) + " characters";
-  if (!is_identifier(s, dot)) return what + " '" + read::shown(s) + "' must consist of " + allowed;
+  if (!is_identifier(s, dot)) {
+    // A control or invisible character is named by its code point: it cannot be seen in the name quoted.
+    const auto found = first_unprintable(s);
+    return what + " '" + read::shown(s) + "' must consist of " + allowed +
+           (found ? "; it contains " + *found + ", which is not printable text (" + kUnprintableRule + ")" : "");
+  }
+  // "." and "..": a path's components, not names (the result file would take them for its own groups).
+  if (s == "." || s == "..")
+    return what + " '" + s + "' is not a name: '.' and '..' mean this and the parent group in the result file; a "
+                             "name must consist of " + allowed;
   return std::nullopt;
 }
 

@@ -37,7 +37,9 @@ std::string shown(const std::string& text, size_t max = 64);
 
 // Why `s` (the `what` of the job, e.g. "name") is not printable text: the first control character it holds
 // (U+0000-U+001F, U+007F-U+009F: a NUL cuts the name short in the result file, an escape sequence drives the
-// terminal that prints it), or nullopt.
+// terminal that prints it) or invisible character (zero-width U+200B-U+200F and U+FEFF, bidirectional controls
+// U+202A-U+202E and U+2066-U+2069: they make a name in the job list or a download's file name read as another),
+// or nullopt. The one rule for free text; names (name_problem) are stricter.
 std::optional<std::string> control_character_problem(const std::string& s, const std::string& what);
 
 // The errors found so far, in the order found. Each message and pointer is cut to kMaxErrorText bytes, and only
@@ -79,8 +81,10 @@ std::optional<Eigen::Vector2d> pair(const json& value, const std::string& pointe
                                     Errors& errors);
 
 // Values of the job's own kinds, read and reported the same way. Names that other parts of the job refer to
-// (bodies, edges, vertices, contacts) consist of letters, digits, '_' and '-' (and '.' when `dot`), at least one.
-// Why `s` is not a name of at most `max_length` characters of the allowed set (the pattern quoted), or nullopt.
+// (bodies, edges, vertices, contacts) consist of letters, digits, '_' and '-' (and '.' when `dot`), at least one;
+// with dots, "." and ".." are not names (the result file's groups are named after them).
+// Why `s` is not a name of at most `max_length` characters of the allowed set (the pattern quoted; a control or
+// invisible character named by its code point), or nullopt. The one check of every name.
 std::optional<std::string> name_problem(const std::string& s, const std::string& what, size_t max_length, bool dot);
 // Reads a name that other parts of the job refer to ("body.edge"), so it must be an identifier.
 std::optional<std::string> identifier(const json& value, const std::string& pointer, const std::string& what,

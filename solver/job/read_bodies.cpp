@@ -30,6 +30,7 @@ void JobReader::read_bodies(const Fields& top) {
                                std::to_string(limits_.max_bodies) + " are accepted");
     return;
   }
+  bodies_listed_ = true;
   json& out_list = normalized_["bodies"];
   std::map<std::string, std::string> first_pointer_of_name;
   for (size_t i = 0; i < list->size(); ++i) {
@@ -346,6 +347,9 @@ std::string contact_names(const Problem& problem, size_t i) {
 // interface problem with its equilibrium (interface_newton, monolithic); the fixed-point schemes solve every
 // body alone with Neumann data on its contact zone, which a floating body cannot take.
 void JobReader::check_floating_bodies() {
+  // A contact pair refused or left out (a limit, a bad reference, a bad gap) may be the one that holds a body:
+  // whether a body floats is then not known, and its error would only repeat the contacts'.
+  if (!contacts_complete_) return;
   const Method method = problem_.solver.method;
   for (size_t i = 0; i < inputs_.size(); ++i) {
     const BodyInput& in = inputs_[i];

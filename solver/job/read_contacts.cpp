@@ -1,6 +1,7 @@
 // The job's contact pairs: their "body.edge" references resolved to the bodies read (phase 5), and their gaps.
 #include "job_reader.hpp"
 
+#include <algorithm>
 #include <map>
 #include <optional>
 #include <string>
@@ -8,7 +9,13 @@
 
 namespace contact::job::detail {
 
-// "body.edge" -> indices; reports what is wrong at `pointer`.
+bool JobReader::bodies_all_named() const {
+  return std::all_of(inputs_.begin(), inputs_.end(), [](const BodyInput& in) { return in.has_name; });
+}
+
+// "body.edge" -> indices; reports what is wrong at `pointer`. A body that is not found is reported only when
+// every body's name was read: a job whose bodies were refused whole (over the limit) or whose body names are in
+// error has that error already, and every pair naming those bodies would only repeat it.
 std::optional<JobReader::EdgeRef> JobReader::resolve(const json& value, const std::string& pointer,
                                                     const std::string& what) {
   auto s = read::string(value, pointer, what, errors_);
@@ -32,7 +39,8 @@ std::optional<JobReader::EdgeRef> JobReader::resolve(const json& value, const st
       return EdgeRef{static_cast<int>(b), edge};
     }
   }
-  errors_.add(pointer, "there is no body named '" + read::shown(body) + "'; the bodies are " + join_names(names));
+  if (bodies_listed_ && bodies_all_named())
+    errors_.add(pointer, "there is no body named '" + read::shown(body) + "'; the bodies are " + join_names(names));
   return std::nullopt;
 }
 
@@ -45,9 +53,11 @@ void JobReader::read_contacts(const Fields& top) {
   }
   if (!list->is_array()) {
     errors_.add("/contacts", "contacts must be an array, got " + read::type_name(*list));
+    contacts_complete_ = false;
     return;
   }
   if (list->size() > static_cast<size_t>(limits_.max_contacts)) {  // refused before any pair is read
+    contacts_complete_ = false;
     errors_.add("/contacts", "the job has " + std::to_string(list->size()) + " contact pairs; at most " +
                                  std::to_string(limits_.max_contacts) + " are accepted");
     return;
@@ -58,7 +68,10 @@ void JobReader::read_contacts(const Fields& top) {
     const std::string cp = child("/contacts", k);
     json& out = element(out_list, k);
     Fields f((*list)[k], cp, "a contact", {"name", "slave", "master", "gap", "friction"}, errors_);
-    if (!f.ok()) continue;
+    if (!f.ok()) {
+      contacts_complete_ = false;
+      continue;
+    }
     const size_t before = errors_.size();
     ContactPair pair;
     std::optional<EdgeRef> slave, master;
@@ -105,6 +118,8 @@ void JobReader::read_contacts(const Fields& top) {
     if (errors_.size() == before) {
       problem_.contacts.push_back(pair);
       friction_pointers_.push_back(pair.friction.active() ? f.at("friction") : std::string());
+    } else {
+      contacts_complete_ = false;
     }
   }
 }

@@ -57,7 +57,7 @@ void JobReader::check_friction_and_histories() {
       if (!h.empty() && problem_.adaptivity.enabled)
         errors_.add(child(in.condition_pointers[j], "history"),
                     "a load history needs load steps, which adaptivity does not take (it refines for one load)");
-      else if (!h.empty() && h.size() != steps)
+      else if (!h.empty() && h.size() != steps && loading_read_)  // else the number of steps is not known
         errors_.add(child(in.condition_pointers[j], "history"),
                     "history has " + std::to_string(h.size()) + " load factors but the job has " +
                         std::to_string(steps) + " load step" + (steps == 1 ? "" : "s") +

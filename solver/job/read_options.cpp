@@ -229,7 +229,7 @@ void JobReader::read_adaptive_bodies(const json& value, const std::string& point
       if (inputs_[k].has_name && inputs_[k].body.name == name) found = static_cast<int>(k);
       if (inputs_[k].has_name) known.push_back(inputs_[k].body.name);
     }
-    if (found < 0)
+    if (found < 0 && bodies_listed_ && bodies_all_named())  // else the bodies' own error is the cause
       errors_.add(ip, "unknown body '" + read::shown(name) + "'; the bodies are " + join_names(known));
     else if (std::find(a.bodies.begin(), a.bodies.end(), found) == a.bodies.end())
       a.bodies.push_back(found);
@@ -360,7 +360,13 @@ void JobReader::read_loading(const Fields& top) {
     return;
   }
   const std::string pointer = top.at("loading");
-  Fields f(*v, pointer, "loading", {"steps", "factors"}, errors_);
+  const size_t before = errors_.size();
+  read_loading_steps(*v, pointer);
+  loading_read_ = errors_.size() == before;
+}
+
+void JobReader::read_loading_steps(const json& value, const std::string& pointer) {
+  Fields f(value, pointer, "loading", {"steps", "factors"}, errors_);
   if (!f.ok()) return;
   if (f.has("steps") == f.has("factors")) {
     errors_.add(pointer, "give either steps (a number of equal load steps) or factors (the load factor of each step)");

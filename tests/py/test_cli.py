@@ -9,6 +9,8 @@ import sys
 import tempfile
 import time
 
+import h5py
+
 SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
 BIN = os.environ.get("CONTACT_BINARY_DIR", os.path.join(SRC, "build"))
 CLI = os.path.join(BIN, "contact-solve")
@@ -94,6 +96,37 @@ with tempfile.TemporaryDirectory() as tmp:
     # --validate only checks.
     r = run(EXAMPLE, "--validate")
     check("--validate exits 0", r.returncode == 0 and "valid" in r.stdout, r.stdout + r.stderr)
+
+    # A solve that stops without converging (issue 32, item 6): the roller example with its base contact
+    # frictionless has no equilibrium once the plate is pushed sideways (nothing holds the roller and the plate
+    # against sliding along the base); its friction Newton ran to max_iterations and its last iterate pulled at
+    # the base contact. Exit 3 (README: stopped without converging), the stop line and the final lines say it is
+    # not an answer, and the file is flagged converged 0.
+    with open(os.path.join(EXAMPLES, "roller_friction.json")) as f:
+        roller = json.load(f)
+    del roller["contacts"][0]["friction"]
+    roller_path = os.path.join(tmp, "roller_frictionless_base.json")
+    with open(roller_path, "w") as f:
+        json.dump(roller, f)
+    roller_out = os.path.join(tmp, "roller_frictionless_base.hdf")
+    r = run(roller_path, "-o", roller_out)
+    stop = next((l for l in r.stdout.splitlines() if l.startswith("stop: ")), "")
+    # (A solver that finds out that nothing holds the bodies would refuse the job instead: exit 1, no result.)
+    check("not converged: never exit 0", r.returncode in (1, 3), f"{r.returncode} {stop} {r.stderr}")
+    if r.returncode == 3:
+        check("not converged: the stop line names the reason", stop.startswith("stop: max_iterations after "), stop)
+        pulls = re.findall(r"^pair (\S+): exact contact, force (-[0-9.e+]+)", r.stdout, re.M)
+        check("not converged: a pulling contact is said to be no answer",
+              all(f"'{name}' (force " in stop for name, _ in pulls) and (not pulls or (
+                  "the last iterate is not an answer: contact '" in stop and "pulls, and a contact only pushes" in stop)),
+              (pulls, stop))
+        check("not converged: said before the final numbers",
+              "not converged: the last iterate, below and in the result file (converged 0), is not an answer"
+              in r.stdout, r.stdout[-800:])
+        with h5py.File(roller_out, "r") as f:
+            check("not converged: the file says converged 0 and max_iterations",
+                  int(f.attrs["converged"]) == 0 and str(f.attrs["stop_reason"]) == "max_iterations",
+                  dict(f.attrs))
 
     # A bad job: exit code 2, every error with its JSON pointer, nothing written.
     with open(EXAMPLE) as f:

@@ -126,6 +126,19 @@ rejected_at("a body name with a dot", lambda d: d["bodies"][0].update(name="up.p
             ["bodies", 0, "name"], "pattern")
 rejected_at("a job name with a NUL (issue 22)", lambda d: d.update(name="seed\x00layers"), ["name"], "pattern")
 rejected_at("a job name with an escape sequence", lambda d: d.update(name="red \x1b[31m"), ["name"], "pattern")
+# Issue 32, item 7: "." and ".." as a contact name (the pair's group in the result file), invisible characters
+# (zero-width, bidirectional controls) in the job's name and in names: refused by both, at the name.
+rejected_at("a contact named '.'", lambda d: d["contacts"][0].update(name="."), ["contacts", 0, "name"], "pattern")
+rejected_at("a contact named '..'", lambda d: d["contacts"][0].update(name=".."), ["contacts", 0, "name"], "pattern")
+check("accepts a contact name with dots inside",
+      not errors_of(mutated(lambda d: d["contacts"][0].update(name="upper.bottom-lower.top"))))
+for char in ("\u200b", "\u200f", "\u202a", "\u202e", "\u2066", "\u2069", "\ufeff"):
+    rejected_at(f"a job name with U+{ord(char):04X}", lambda d, c=char: d.update(name=f"seed{c}layers"), ["name"],
+                "pattern")
+rejected_at("a body name with a right-to-left override", lambda d: d["bodies"][0].update(name="up\u202eper"),
+            ["bodies", 0, "name"], "pattern")
+check("accepts a job name with printable non-ASCII text",
+      not errors_of(mutated(lambda d: d.update(name="Grenzfl\u00e4che \u202f2"))))
 rejected_at("a malformed contact reference", lambda d: d["contacts"][0].update(slave="upper"),
             ["contacts", 0, "slave"], "pattern")
 rejected_at("an unknown adaptivity indicator", lambda d: d.update(adaptivity={"indicator": "residual"}),

@@ -1,0 +1,113 @@
+#!/usr/bin/env python3
+"""contactd: a job's outcome says whether it holds an answer, and a bad job answers one error per cause.
+
+- Issue 32, item 6: a job whose solve stops without converging (max_iterations) ended SUCCEEDED. It ends FAILED,
+  the reason in its message, its last iterate kept in the result file (flagged converged 0).
+- Issue 32, item 6: the roller example with the friction removed from its base contact ended SUCCEEDED after 2004
+  Newton steps with a tensile contact force (-3865). It ends FAILED, and its message says that the last iterate
+  pulls at a contact and is not an answer.
+- Issue 31, item 4: a job over --max-bodies got its one real error followed by 200 that repeated it, one per
+  contact naming a body. /v1/validate and a submission answer the one error.
+
+Standard library and Debian's python3-h5py; exits non-zero on any failure."""
+import os
+import sys
+import tempfile
+
+import h5py
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))  # tests/
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import check, finish  # noqa: E402
+from harness import Server, example, long_job, read_all_events  # noqa: E402
+
+
+def result_attributes(server, job_id):
+    """The root attributes of the job's result file, downloaded, and the last step's force per pair."""
+    r = server.get(f"/v1/jobs/{job_id}/result")
+    if r.status != 200:
+        return None
+    with tempfile.NamedTemporaryFile(suffix=".hdf") as f:
+        f.write(r.body)
+        f.flush()
+        with h5py.File(f.name, "r") as h:
+            steps = h["history/steps"]
+            names = [n.decode() if isinstance(n, bytes) else str(n) for n in steps.attrs["pair_names"]]
+            forces = dict(zip(names, steps["force"][-1])) if len(steps["force"]) else {}
+            return {"converged": h.attrs["converged"], "stop_reason": h.attrs["stop_reason"], "forces": forces}
+
+
+def ends_failed_not_converged(server, job_id, what, reason):
+    """The checks every job that stopped without converging passes: FAILED with the solver's stop reason, the
+    reason in the message and in `error`, the end event saying the same, the last iterate downloadable and
+    flagged not converged."""
+    final = server.wait_done(job_id, timeout=300)
+    check(f"{what}: FAILED, not SUCCEEDED", final.get("state") == "FAILED" and final.get("converged") is False, final)
+    check(f"{what}: stop_reason {reason}", final.get("stop_reason") == reason, final)
+    message = final.get("message", "")
+    check(f"{what}: the message says the solve did not converge",
+          message.startswith(f"the solve did not converge ({reason}): "), message[:300])
+    error = final.get("error") or {}
+    check(f"{what}: error names the reason", error.get("reason") == reason and error.get("message") == message, error)
+    end = read_all_events(server, job_id)[-1]
+    check(f"{what}: the end event says FAILED", end.get("type") == "end" and end.get("state") == "FAILED"
+          and end.get("converged") is False, end)
+    check(f"{what}: the last iterate is kept", final.get("result_available") is True, final)
+    attrs = result_attributes(server, job_id)
+    check(f"{what}: the result file says converged 0", attrs is not None and int(attrs["converged"]) == 0
+          and str(attrs["stop_reason"]) == reason, attrs)
+    return final
+
+
+def roller_without_base_friction():
+    """api/examples/roller_friction.json with its base contact frictionless: nothing holds the roller and the plate
+    together against sliding sideways along the base (issue 32, item 6)."""
+    job = example("roller_friction.json")
+    job["name"] = "roller-frictionless-base"
+    del job["contacts"][0]["friction"]
+    return job
+
+
+def row_of_blocks(count):
+    """`count` unit blocks stacked, each held at its bottom, each on the one below by a contact."""
+    bodies, contacts = [], []
+    for k in range(count):
+        bodies.append({"name": f"b{k}", "material": {"E": 1, "nu": 0.3},
+                       "mesh": {"block": {"corners": [[0, k], [1, k], [1, k + 1], [0, k + 1]], "nx": 1, "ny": 1}},
+                       "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]})
+        if k > 0:
+            contacts.append({"slave": f"b{k}.bottom", "master": f"b{k - 1}.top"})
+    return {"name": "row", "bodies": bodies, "contacts": contacts}
+
+
+with Server(args=["--workers", "1"]) as server:
+    # --- max_iterations: FAILED, its last iterate kept -----------------------------------------------------
+    job_id = server.submit_id(long_job(max_iterations=20, name="stops-short"))
+    final = ends_failed_not_converged(server, job_id, "a job stopped at max_iterations", "max_iterations")
+    check("its iterations are all there", final.get("iterations") == 20, final)
+
+    # --- the roller on a frictionless base: never SUCCEEDED, never a pulling contact as an answer ------------
+    job_id = server.submit_id(roller_without_base_friction())
+    final = server.wait_done(job_id, timeout=300)
+    check("roller on a frictionless base: not SUCCEEDED", final.get("state") == "FAILED", final)
+    message = final.get("message", "")
+    if final.get("stop_reason") in ("max_iterations", "stagnation"):
+        ends_failed_not_converged(server, job_id, "roller on a frictionless base", final["stop_reason"])
+    attrs = result_attributes(server, job_id) if final.get("result_available") else None
+    pulling = [name for name, force in (attrs or {}).get("forces", {}).items() if force < 0]
+    check("roller on a frictionless base: each pulling contact is said to be no answer",
+          all(f"'{name}' (force " in message for name in pulling)
+          and (not pulling or "the last iterate is not an answer: contact '" in message), (attrs, message[:400]))
+
+    # --- one error for one cause past a limit ------------------------------------------------------------------
+    r = server.request("POST", "/v1/validate", json_body=row_of_blocks(589))
+    errors = r.json().get("errors", []) if r.status == 400 else []
+    check("589 bodies: 400 with exactly one error", r.status == 400 and len(errors) == 1, (r.status, errors[:3]))
+    check("589 bodies: the error is the limit, at /bodies",
+          errors[:1] == [{"pointer": "/bodies", "message": "the job has 589 bodies; at most 512 are accepted"}],
+          errors[:3])
+    r = server.submit(row_of_blocks(589))
+    errors = r.json().get("errors", []) if r.status == 400 else []
+    check("589 bodies submitted: 400 with the same one error", r.status == 400 and len(errors) == 1, (r.status, errors[:3]))
+
+finish()
