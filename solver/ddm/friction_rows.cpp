@@ -22,4 +22,14 @@ std::vector<linalg::FrictionRow> friction_rows(const ContactSystem& system,
   return rows;
 }
 
+std::vector<char> tangential_unknowns(const ContactSystem& system, Eigen::Index size,
+                                      const std::function<Eigen::Index(size_t)>& tangential_offset) {
+  std::vector<char> mask(static_cast<size_t>(size), 0);
+  const auto& pairs = system.pairs();
+  for (size_t k = 0; k < pairs.size(); ++k)
+    if (const Eigen::Index t0 = tangential_offset(k); t0 >= 0)
+      for (Eigen::Index r = 0; r < pairs[k].n_rows(); ++r) mask[static_cast<size_t>(t0 + r)] = 1;
+  return mask;
+}
+
 }  // namespace contact::ddm

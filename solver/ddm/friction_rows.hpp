@@ -22,4 +22,9 @@ std::vector<linalg::FrictionRow> friction_rows(const ContactSystem& system,
                                                const std::function<Eigen::Index(size_t)>& tangential_offset,
                                                const std::function<bool(Eigen::Index)>& movable);
 
+// Every tangential unknown of the friction pairs (size: the solver's multipliers), those without a friction row
+// included: the Newton fixes those at q = 0 rather than taking them for normal rows.
+std::vector<char> tangential_unknowns(const ContactSystem& system, Eigen::Index size,
+                                      const std::function<Eigen::Index(size_t)>& tangential_offset);
+
 }  // namespace contact::ddm

@@ -206,7 +206,7 @@ MethodOutcome run_exact(const ContactSystem& system, const SolverSettings& setti
   }
   const Stacked s = stack(system, false);
   const Eigen::Index m = s.g0.size();
-  const std::vector<char> mask = linalg::tangential_mask(m, s.friction);
+  const std::vector<char> mask = tangential_unknowns(system, m, [&](size_t k) { return s.tangential_offset[k]; });
   const Eigen::VectorXd c = s.c.cwiseQuotient(s.D);  // prediction z - c g: g / D is the nodal gap
   // A floating body is held only by its contacts: start with every contact node active (the saddle-point system
   // of an empty active set would be singular), and let the active set shrink to the nodes that press. Nodes in

@@ -190,8 +190,8 @@ bool nested_friction_sets(const FrictionLevel& level, FrictionSets& sets, std::v
   // G P (no rows without floating bodies, but always as many columns as unknowns).
   const Equalities eqc{level.eq.G.cols() == level.F.rows() ? SparseMatrix(level.eq.G * coarse.P) : SparseMatrix(0, coarse.n),
                        level.eq.G.cols() == level.F.rows() ? level.eq.e : Eigen::VectorXd(0)};
-  const FrictionLevel coarse_level{Fc, gc, eqc, coarse.rows, coarse.m, coarse.line, coarse.position};
   const std::vector<char> mask = tangential_mask(coarse.n, coarse.rows);
+  const FrictionLevel coarse_level{Fc, gc, eqc, coarse.rows, mask, coarse.m, coarse.line, coarse.position};
   const size_t at = coarse_steps ? coarse_steps->size() : 0;
   if (coarse_steps) coarse_steps->push_back(0);
   FrictionSets start;
@@ -206,7 +206,7 @@ bool nested_friction_sets(const FrictionLevel& level, FrictionSets& sets, std::v
   const Eigen::VectorXd lambda = coarse.P * solution.lambda;
   Eigen::VectorXd h = level.g + level.F * lambda;
   if (solution.other.size() > 0) h += level.eq.G.transpose() * solution.other;
-  sets = predict_friction_sets(lambda, h, friction_scaling(level.F), level.rows, tangential_mask(level.F.rows(), level.rows));
+  sets = predict_friction_sets(lambda, h, friction_scaling(level.F), level.rows, level.mask);
   return true;
 }
 

@@ -70,12 +70,12 @@ namespace {
 // The first sets from coarse friction solves (linalg/friction_nested.hpp) over the sticking start: false (and the
 // sets unchanged) when there is no coarser level or a coarse problem could not be solved.
 bool first_sets_from_coarse(const SparseMatrix& F, const InterfaceQp& qp, const std::vector<FrictionRow>& rows,
-                            FrictionSets& sets, std::string& note) {
+                            const std::vector<char>& mask, FrictionSets& sets, std::string& note) {
   const Eigen::Index m = qp.problem.normal_size();
   if (static_cast<Eigen::Index>(qp.line.size()) < m || qp.position.size() < m) return false;
   const std::vector<int> line(qp.line.begin(), qp.line.begin() + m);  // the normal rows' (tangential: on none)
   const Eigen::VectorXd position = qp.position.head(m);
-  const linalg::FrictionLevel level{F, qp.g, qp.equilibrium, rows, m, line, position};
+  const linalg::FrictionLevel level{F, qp.g, qp.equilibrium, rows, mask, m, line, position};
   std::vector<int> coarse_steps;
   FrictionSets nested;
   if (!linalg::nested_friction_sets(level, nested, &coarse_steps)) return false;
@@ -111,8 +111,8 @@ void describe_stop(const linalg::FrictionNewtonResult& r, const InterfaceQp& qp,
       result.cancelled = true;
       return;
     case linalg::FrictionStop::singular: {
-      // Statics has refused the loads that friction cannot carry before the solve (friction_statics.hpp): this is
-      // the solver failing, and the message says so.
+      // Statics has refused the loads that friction cannot carry along flat joints before the solve
+      // (friction_statics.hpp); what is left is the solver failing or a motion that check cannot judge.
       std::ostringstream os;
       os.precision(3);
       os << "the friction Newton did not converge: at step " << r.steps
@@ -120,7 +120,10 @@ void describe_stop(const linalg::FrictionNewtonResult& r, const InterfaceQp& qp,
             "floating body (or a group of them) held by nothing (a singular system); the complementarity residual "
             "of the last iterate is "
          << complementarity
-         << ". Statics does not rule these loads out, so the solver failed, not the model: try smaller load steps";
+         << ". The statics check before the solve found no set of bodies that friction cannot hold along a flat "
+            "joint, so either the solver failed (try smaller load steps) or the loads move a body that check cannot "
+            "judge (a curved contact, bodies held only by frictionless contacts): check that every floating body is "
+            "held";
       result.message = os.str();
       return;
     }
@@ -149,12 +152,13 @@ linalg::ActiveSetResult FrictionDirectSolver::solve(const InterfaceQp& qp, const
       qp.problem.system(), [&](size_t k) { return qp.problem.offset(k); },
       [&](size_t k) { return qp.problem.tangential_offset(k); },
       [&](Eigen::Index t) { return diagonal[t] > 1e-12 * dmax; });
-  const std::vector<char> mask = linalg::tangential_mask(n, rows);
+  const std::vector<char> mask =
+      ddm::tangential_unknowns(qp.problem.system(), n, [&](size_t k) { return qp.problem.tangential_offset(k); });
   const Eigen::VectorXd c = linalg::friction_scaling(F);
   if (last_alpha_.size() != qp.equilibrium.G.rows()) last_alpha_.resize(0);
   const FrictionSets sticking = first_sets(F, qp, z0, last_alpha_, c, rows, mask, context.note);
   FrictionSets sets = sticking;
-  const bool from_coarse = first_sets_from_coarse(F, qp, rows, sets, context.note);
+  const bool from_coarse = first_sets_from_coarse(F, qp, rows, mask, sets, context.note);
 
   const linalg::FrictionNewtonProblem problem{rows, mask, c, [&](const linalg::FrictionParametrization& p, linalg::FrictionIterate& x) {
                                                 return linalg::solve_on_friction_sets(F, qp.g, qp.equilibrium, p, x);

@@ -1,0 +1,168 @@
+// Frictional masonry (scripts/make_brick_wall.py --friction): walls without dowels, held sideways by friction alone,
+// precompressed and then sheared by a load path (`history`). Checked by statics (the base carries exactly the
+// applied loads; a shear above mu V cannot be held by a bed joint, which the solve says at once), by the independent
+// monolithic reference (the same discrete solution), and by the classical inclined plane, whose sliding threshold
+// (tan a + mu) / (1 - mu tan a) is known in closed form.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+#include "contact/job.hpp"
+#include "contact/solve.hpp"
+#include "support.hpp"
+
+using namespace contact;
+using contact::testing::run;
+using nlohmann::json;
+
+namespace {
+
+// A wall from the project's generator with the given options (e.g. "--head-joints --friction 0.6 --shear 0.3").
+json wall(int rows, int bricks, const std::string& options) {
+  const std::string path = std::string(CONTACT_BINARY_DIR) + "/test_masonry_" + std::to_string(rows) + "x" +
+                           std::to_string(bricks) + "_" + std::to_string(std::hash<std::string>{}(options)) + ".json";
+  const std::string command = "/usr/bin/python3 " + std::string(CONTACT_SOURCE_DIR) +
+                              "/scripts/make_brick_wall.py --rows " + std::to_string(rows) + " --bricks " +
+                              std::to_string(bricks) + " " + options + " -o " + path + " > /dev/null 2>&1";
+  EXPECT_EQ(std::system(command.c_str()), 0) << command;
+  std::ifstream in(path);
+  json job = json::parse(in);
+  std::remove(path.c_str());
+  return job;
+}
+
+// The loads the job applies in load step k (the generator's: the top pressure and the point shears, each scaled by
+// its history), summed: the resultant every support together must carry.
+Eigen::Vector2d applied_load(const json& job, size_t step) {
+  Eigen::Vector2d total = Eigen::Vector2d::Zero();
+  for (const auto& body : job["bodies"]) {
+    const auto& corners = body["mesh"]["block"]["corners"];
+    const double length = corners[1][0].get<double>() - corners[0][0].get<double>();
+    for (const auto& c : body["boundary"]) {
+      const double factor = c.contains("history") ? c["history"][step].get<double>() : 1.0;
+      if (c.contains("traction")) total.y() -= factor * c["traction"]["normal"].get<double>() * length;
+      if (c.contains("force"))
+        total += factor * Eigen::Vector2d(c["force"][0].get<double>(), c["force"][1].get<double>());
+    }
+  }
+  return total;
+}
+
+Eigen::Vector2d support_reactions(const Step& step) {
+  Eigen::Vector2d total = Eigen::Vector2d::Zero();
+  for (const auto& b : step.bodies) total += b.reaction_total;
+  return total;
+}
+
+double relative_difference(const Result& a, const Result& b) {
+  double worst = 0.0;
+  for (size_t s = 0; s < a.steps.size(); ++s) {
+    for (size_t i = 0; i < a.steps[s].bodies.size(); ++i) {
+      const auto& u = a.steps[s].bodies[i].displacement;
+      const auto& v = b.steps[s].bodies[i].displacement;
+      worst = std::max(worst, (u - v).cwiseAbs().maxCoeff() / std::max(v.cwiseAbs().maxCoeff(), 1e-300));
+    }
+    for (size_t k = 0; k < a.steps[s].pairs.size(); ++k) {
+      const auto& p = a.steps[s].pairs[k];
+      const auto& q = b.steps[s].pairs[k];
+      const double scale = std::max(q.pressure.cwiseAbs().maxCoeff(), 1e-300);
+      worst = std::max(worst, (p.pressure - q.pressure).cwiseAbs().maxCoeff() / scale);
+      if (p.tangential_traction.size() == q.tangential_traction.size() && p.tangential_traction.size() > 0)
+        worst = std::max(worst, (p.tangential_traction - q.tangential_traction).cwiseAbs().maxCoeff() / scale);
+    }
+  }
+  return worst;
+}
+
+json monolithic(json job) {
+  job["solver"] = {{"method", "monolithic"}};
+  return job;
+}
+
+}  // namespace
+
+TEST(Masonry, FrictionalWallsHoldEveryStepWithTheBaseCarryingExactlyTheLoads) {
+  // mu = 0.6, H/V = 0.3: bed joints only; head joints with free ends; head joints against abutments; frictionless
+  // head joints beside frictional bed joints. No dowels: friction alone holds every brick sideways.
+  for (const std::string options :
+       {"--friction 0.6 --shear 0.3", "--head-joints --friction 0.6 --shear 0.3",
+        "--abutments --friction 0.6 --shear 0.3", "--head-joints --friction 0.6 --head-friction 0 --shear 0.3"}) {
+    const json job = wall(8, 8, options);
+    const Result r = run(job);
+    ASSERT_TRUE(r.converged) << options << ": " << r.message;
+    ASSERT_EQ(r.steps.size(), 2u) << options;
+    for (size_t k = 0; k < 2; ++k) {
+      const Eigen::Vector2d load = applied_load(job, k);
+      const Eigen::Vector2d reaction = support_reactions(r.steps[k]);
+      EXPECT_NEAR(reaction.x(), -load.x(), 1e-8 * load.norm()) << options << " step " << k;
+      EXPECT_NEAR(reaction.y(), -load.y(), 1e-8 * load.norm()) << options << " step " << k;
+    }
+    EXPECT_GT(std::abs(applied_load(job, 1).x()), 0.29 * std::abs(applied_load(job, 1).y())) << options;
+  }
+}
+
+TEST(Masonry, TheInterfaceSolverEqualsTheMonolithicReferenceOnFrictionalWalls) {
+  for (const std::string options :
+       {"--head-joints --friction 0.6 --shear 0.3", "--abutments --friction 0.6 --shear 0.3",
+        "--head-joints --friction 0.6 --head-friction 0 --shear 0.3"}) {
+    const json job = wall(4, 4, options);
+    const Result direct = run(job);
+    const Result reference = run(monolithic(job));
+    ASSERT_TRUE(direct.converged) << options << ": " << direct.message;
+    ASSERT_TRUE(reference.converged) << options << ": " << reference.message;
+    EXPECT_LT(relative_difference(direct, reference), 1e-8) << options;
+  }
+}
+
+TEST(Masonry, AShearAboveTheFrictionCoefficientStopsAtOnceNamingTheSlidingCourseAndKeepsTheStepThatHeld) {
+  // H/V = 0.65 > mu = 0.6: the joint under the top course cannot carry its shear, 0.65 / 0.6 = 1.083 times what
+  // friction can; the top course (9 bricks in a running bond of 8 x 8) is named. Both solvers say it before solving.
+  const json job = wall(8, 8, "--head-joints --friction 0.6 --shear 0.65");
+  for (const json& j : {job, monolithic(job)}) {
+    const Result r = run(j);
+    EXPECT_EQ(r.stop_reason, StopReason::error);
+    EXPECT_NE(r.message.find("load step 2 of 2: friction cannot hold 9 bodies 'b7_0'"), std::string::npos) << r.message;
+    EXPECT_NE(r.message.find("(+x)"), std::string::npos) << r.message;
+    EXPECT_NE(r.message.find("1.083 times what friction can carry"), std::string::npos) << r.message;
+    ASSERT_EQ(r.steps.size(), 1u) << "the precompression step held and is kept";
+    EXPECT_NEAR(r.steps[0].load_factor, 1.0, 0.0);
+  }
+}
+
+TEST(Statics, TheInclinedPlaneHoldsBelowTheClassicalThresholdAndIsRefusedAboveIt) {
+  // A block on a plane of slope tan a = 0.1, mu = 0.3, pressed by its weight G and pushed up the slope by a
+  // horizontal F: it slides when F cos a - G sin a > mu (F sin a + G cos a), i.e. F / G > (tan a + mu) /
+  // (1 - mu tan a) = 0.4 / 0.97.
+  const double t = 0.1, mu = 0.3, G = 100.0, threshold = (t + mu) / (1 - mu * t);
+  auto job = [&](double F) {
+    json j = json::parse(R"({
+      "name": "inclined_plane", "version": 1, "model": {"plane": "strain"},
+      "bodies": [
+        {"name": "plane", "material": {"E": 1000, "nu": 0.3},
+         "mesh": {"block": {"corners": [[-2, -1.2], [2, -0.8], [2, 0.2], [-2, -0.2]], "nx": 16, "ny": 4}},
+         "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]},
+        {"name": "block", "material": {"E": 1000, "nu": 0.3},
+         "mesh": {"block": {"corners": [[-0.5, -0.05], [0.5, 0.05], [0.5, 0.55], [-0.5, 0.45]], "nx": 6, "ny": 3}},
+         "boundary": []}
+      ],
+      "contacts": [{"slave": "block.bottom", "master": "plane.top", "friction": {"coefficient": 0.3}}]
+    })");
+    j["bodies"][1]["boundary"] = json::array({{{"edge", "top"}, {"force", {F, -G}}}});
+    return j;
+  };
+  for (const bool mono : {false, true}) {
+    const json below = job(threshold * G * (1 - 1e-4)), above = job(threshold * G * (1 + 1e-4));
+    const Result held = run(mono ? monolithic(below) : below);
+    ASSERT_TRUE(held.converged) << held.message;
+    const Eigen::Vector2d reaction = support_reactions(held.steps.back());
+    EXPECT_NEAR(reaction.x(), -threshold * G * (1 - 1e-4), 1e-8 * G);
+    EXPECT_NEAR(reaction.y(), G, 1e-8 * G);
+    const Result slides = run(mono ? monolithic(above) : above);
+    EXPECT_EQ(slides.stop_reason, StopReason::error);
+    EXPECT_NE(slides.message.find("friction cannot hold body 'block'"), std::string::npos) << slides.message;
+    EXPECT_NE(slides.message.find("1.000 times"), std::string::npos) << slides.message;
+  }
+}
