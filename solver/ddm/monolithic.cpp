@@ -221,7 +221,8 @@ MethodOutcome run_exact(const ContactSystem& system, const SolverSettings& setti
   bool first = true;
   const linalg::FrictionNewtonProblem problem{s.friction, mask, c, [&](const linalg::FrictionParametrization& p, linalg::FrictionIterate& it) {
                                                 return solve_sets(s, p, it);
-                                              }};
+                                              },
+                                              [&] { return context.cancel.cancelled(); }};
   linalg::FrictionNewtonSettings newton;
   newton.max_steps = std::max(1, settings.max_iterations);
   newton.tolerance = 1e-12;

@@ -101,6 +101,10 @@ class Newton {
  private:
   double merit(const FrictionIterate& x) const { return friction_merit(x.lambda, x.h, p_.c, p_.rows, p_.mask); }
   bool solve(const FrictionSets& sets, FrictionIterate& out) {
+    if (p_.cancelled && p_.cancelled()) {
+      cancelled_ = true;
+      return false;
+    }
     ++result_.steps;
     return p_.solve(parametrize(sets, p_.rows, p_.mask), out);
   }
@@ -119,18 +123,19 @@ class Newton {
   double best_merit_ = std::numeric_limits<double>::infinity();
   int steps_since_best_ = 0;
   bool tied_retreat_ = false;
+  bool cancelled_ = false;
 };
 
 bool Newton::solve_towards(FrictionSets& target, FrictionIterate& out) {
   if (solve(target, out)) return true;
-  if (!have_x_) return false;
+  if (!have_x_ || cancelled_) return false;
   // The most changes (surest first) whose set is solvable, by bisection between the current sets (solvable) and
   // the target (singular).
   const std::vector<Change> changes = changes_between(result_.sets, target, x_, p_);
   size_t lo = 0, hi = changes.size();
   FrictionSets best;
   FrictionIterate best_out;
-  while (hi - lo > 1 && result_.steps < s_.max_steps) {
+  while (hi - lo > 1 && result_.steps < s_.max_steps && !cancelled_) {
     const size_t mid = lo + (hi - lo) / 2;
     FrictionSets partial = apply_changes(result_.sets, target, changes, mid, p_.rows);
     FrictionIterate candidate;
@@ -147,7 +152,7 @@ bool Newton::solve_towards(FrictionSets& target, FrictionIterate& out) {
     out = std::move(best_out);
     return true;
   }
-  if (tied_retreat_ || result_.steps >= s_.max_steps) return false;
+  if (tied_retreat_ || cancelled_ || result_.steps >= s_.max_steps) return false;
   // Not even one change is solvable: once, the target's contact with every node in it sticking.
   tied_retreat_ = true;
   FrictionSets tied = target;
@@ -191,7 +196,9 @@ FrictionNewtonResult Newton::run(FrictionSets sets) {
   while (result_.steps < s_.max_steps) {
     FrictionIterate n;
     if (!solve_towards(sets, n)) {
-      result_.stop = result_.steps >= s_.max_steps ? FrictionStop::max_steps : FrictionStop::singular;
+      result_.stop = cancelled_                      ? FrictionStop::stopped
+                     : result_.steps >= s_.max_steps ? FrictionStop::max_steps
+                                                     : FrictionStop::singular;
       if (have_x_) result_.iterate = x_;
       return result_;
     }

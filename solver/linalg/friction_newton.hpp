@@ -41,6 +41,8 @@ struct FrictionNewtonProblem {
   const std::vector<char>& mask;  // tangential unknowns (tangential_mask)
   const Eigen::VectorXd& c;
   std::function<bool(const FrictionParametrization& p, FrictionIterate& out)> solve;
+  // Polled before every linear solve (the halvings included); true stops the iteration (`stopped`). Optional.
+  std::function<bool()> cancelled = {};
 };
 
 struct FrictionNewtonSettings {

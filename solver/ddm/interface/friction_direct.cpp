@@ -162,7 +162,10 @@ linalg::ActiveSetResult FrictionDirectSolver::solve(const InterfaceQp& qp, const
 
   const linalg::FrictionNewtonProblem problem{rows, mask, c, [&](const linalg::FrictionParametrization& p, linalg::FrictionIterate& x) {
                                                 return linalg::solve_on_friction_sets(F, qp.g, qp.equilibrium, p, x);
-                                              }};
+                                              },
+                                              // One process: the token between solves; several: only at the steps'
+                                              // reports, where interface Newton reads it the same on every rank.
+                                              [&] { return !context.runner.distributed() && context.cancel.cancelled(); }};
   linalg::FrictionNewtonSettings settings;
   settings.max_steps = context.max_steps;
   const linalg::FrictionStepCallback on_step = [&](const linalg::FrictionIterate& x, const linalg::ActiveSetStep& info) {
