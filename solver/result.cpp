@@ -37,6 +37,7 @@ StepSummary summarize(const Step& step) {
   s.index = step.index;
   s.iteration = step.iteration;
   s.load_factor = step.load_factor;
+  s.converged = step.converged;
   for (const auto& b : step.bodies) {
     s.body_names.push_back(b.name);
     s.elements.push_back(b.mesh.num_cells());

@@ -129,7 +129,21 @@ TEST(Masonry, AShearAboveTheFrictionCoefficientStopsAtOnceNamingTheSlidingCourse
     EXPECT_NE(r.message.find("1.083 times what friction can carry"), std::string::npos) << r.message;
     ASSERT_EQ(r.steps.size(), 1u) << "the precompression step held and is kept";
     EXPECT_NEAR(r.steps[0].load_factor, 1.0, 0.0);
+    EXPECT_TRUE(r.steps[0].converged);
   }
+}
+
+TEST(Masonry, AStepThatDidNotConvergeIsKeptOnlyAsTheLastAndFlagged) {
+  // Three Newton steps per load step are enough for the precompression of this wall (it takes three), too few for
+  // the shear (four): the run stops there, the first step flagged converged, the second not.
+  json job = wall(4, 4, "--head-joints --friction 0.6 --shear 0.3");
+  job["solver"]["max_iterations"] = 3;
+  const Result r = run(job);
+  EXPECT_FALSE(r.converged);
+  ASSERT_EQ(r.steps.size(), 2u) << r.message;
+  EXPECT_TRUE(r.steps[0].converged) << r.message;
+  EXPECT_FALSE(r.steps[1].converged);
+  EXPECT_EQ(summarize(r.steps[1]).converged, false);
 }
 
 TEST(Statics, TheInclinedPlaneHoldsBelowTheClassicalThresholdAndIsRefusedAboveIt) {

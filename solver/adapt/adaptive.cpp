@@ -214,7 +214,9 @@ ddm::MethodOutcome converge_then_refine(Problem& working, ddm::ContactSystem& sy
     const ddm::MethodOutcome& o = solve_step(system, working, context, method, solves, refined_last, warm);
     if (o.u.empty()) return solves.take();
     if (context.cancel.cancelled()) {  // stopped inside the solve: keep what it reached, skip the estimate
-      steps.push_back(make_step(system, o.u, o.z, total.iterations, step, {}));
+      Step reached = make_step(system, o.u, o.z, total.iterations, step, {});
+      reached.converged = false;
+      steps.push_back(std::move(reached));
       total.reason = StopReason::cancelled;
       total.converged = false;
       return solves.take();
@@ -222,7 +224,9 @@ ddm::MethodOutcome converge_then_refine(Problem& working, ddm::ContactSystem& sy
     const ddm::Displacements loads = o.z.empty() ? system.contact_loads(o.u) : system.loads_from_pressures(o.z);
     const auto eta = estimate(working, system, o.u, loads, context.runner, &context.cancel);
     for (const auto& e : eta) total.indicator_seconds += e.seconds;
-    steps.push_back(make_step(system, o.u, o.z, total.iterations, step, eta));
+    Step solved = make_step(system, o.u, o.z, total.iterations, step, eta);
+    solved.converged = o.converged;
+    steps.push_back(std::move(solved));
     const StepMeasures now = measure(steps.back(), eta);
     AdaptiveStepReport report =
         step_report(step, working, total, now, step > 0 ? &previous : nullptr, eta, context.elapsed());

@@ -22,6 +22,7 @@ MethodOutcome run_load_steps(ContactSystem& system, const SolverSettings& settin
                                                 total.q.empty() ? nullptr : &total.q);
     step.index = static_cast<int>(k);
     step.load_factor = factors[k];
+    step.converged = total.converged;
     steps.push_back(std::move(step));
     if (!total.converged) return steps_so_far.take();
     system.accept_step(total.u);  // friction: the next step's slip is measured from here

@@ -125,6 +125,9 @@ void read_history(hid_t file, ResultFile& r) {
     s.step = h5::read_vector<int>(g, "step");
     s.iteration = h5::read_vector<int>(g, "iteration");
     s.load_factor = h5::read_vector<double>(g, "load_factor");
+    if (h5::has_link(g, "converged")) {  // (older files: absent)
+      for (auto c : h5::read_vector<std::int8_t>(g, "converged")) s.converged.push_back(c);
+    }
     s.elements = read_matrix<int>(g, "elements", nb);
     s.dofs = read_matrix<int>(g, "dofs", nb);
     s.force = read_matrix<double>(g, "force", np);
@@ -224,6 +227,7 @@ void read_steps(hid_t file, ResultFile& r) {
     s.index = h5::has_attribute(g, "step") ? h5::read_attribute<std::int32_t>(g, "step") : k;  // its history row
     s.iteration = h5::read_attribute<std::int32_t>(g, "iteration");
     s.load_factor = h5::read_attribute<double>(g, "load_factor");
+    s.converged = !h5::has_attribute(g, "converged") || h5::read_attribute<std::int8_t>(g, "converged") != 0;
     Handle bodies = h5::open_group(g, "bodies");
     for (const auto& name : h5::read_strings_attribute(g, "body_names")) s.bodies.push_back(read_body(bodies, name));
     Handle contacts = h5::open_group(g, "contacts");

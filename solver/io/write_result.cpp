@@ -220,6 +220,7 @@ void write_step_history(hid_t history, const std::vector<StepSummary>& rows) {
   const auto nb = static_cast<Eigen::Index>(names.size());
   const auto np = static_cast<Eigen::Index>(pairs.size());
   std::vector<std::int32_t> step, iteration;
+  std::vector<std::int8_t> converged;
   std::vector<double> load_factor;
   Eigen::MatrixXi elements(n, nb), dofs(n, nb);
   Eigen::MatrixXd force(n, np), contact_begin(n, np), contact_end(n, np), tangential_force(n, np);
@@ -232,6 +233,7 @@ void write_step_history(hid_t history, const std::vector<StepSummary>& rows) {
     step.push_back(static_cast<std::int32_t>(k));
     iteration.push_back(s.iteration);
     load_factor.push_back(s.load_factor);
+    converged.push_back(s.converged ? 1 : 0);
     for (Eigen::Index b = 0; b < nb; ++b) {
       elements(k, b) = s.elements[static_cast<size_t>(b)];
       dofs(k, b) = 2 * s.nodes[static_cast<size_t>(b)];
@@ -248,6 +250,7 @@ void write_step_history(hid_t history, const std::vector<StepSummary>& rows) {
   h5::write_vector(g, "step", step);
   h5::write_vector(g, "iteration", iteration);
   h5::write_vector(g, "load_factor", load_factor);
+  h5::write_vector(g, "converged", converged);
   write_matrix(g, "elements", elements);
   write_matrix(g, "dofs", dofs);
   write_matrix(g, "force", force);
@@ -401,6 +404,7 @@ void write_steps(hid_t file, const Result& result, std::size_t history_rows) {
     h5::write_attribute<std::int32_t>(g, "step", static_cast<std::int32_t>(history_rows - result.steps.size() + k));
     h5::write_attribute<std::int32_t>(g, "iteration", s.iteration);
     h5::write_attribute<double>(g, "load_factor", s.load_factor);
+    h5::write_attribute<std::int8_t>(g, "converged", s.converged ? 1 : 0);
     h5::write_attribute(g, "body_names", body_names_of(s));
     h5::write_attribute(g, "pair_names", pair_names_of(s));
     Handle bodies = h5::create_group(g, "bodies");

@@ -138,6 +138,9 @@ struct Step {
   int index = 0;
   int iteration = 0;  // the DDM iteration at which this step's mesh was final
   double load_factor = 1.0;  // the load factor of this step (Problem::loading)
+  // Whether this step's solve converged. A step that did not is kept only as the last one of a run that stopped on
+  // it (its iterate, flagged), never as an answer: the steps before it all converged.
+  bool converged = true;
   std::vector<BodyField> bodies;
   std::vector<PairField> pairs;
 };
@@ -148,6 +151,7 @@ struct StepSummary {
   int index = 0;
   int iteration = 0;
   double load_factor = 1.0;
+  bool converged = true;
   std::vector<std::string> body_names;
   std::vector<int> elements, nodes;  // per body
   std::vector<std::string> pair_names;

@@ -73,6 +73,7 @@ struct StepHistory {
   std::vector<std::string> body_names, pair_names;
   std::vector<int> step, iteration;
   std::vector<double> load_factor;
+  std::vector<int> converged;  // 1 or 0 per step (older files: absent, every step converged)
   Eigen::MatrixXi elements, dofs;
   Eigen::MatrixXd force, contact_begin, contact_end;  // S x P
   Eigen::MatrixXd tangential_force;                   // S x P (0 for frictionless pairs; empty in older files)
