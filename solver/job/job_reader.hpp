@@ -184,7 +184,7 @@ class JobReader {
   Errors errors_;
   Problem problem_;
   bool method_given_ = false, enforcement_given_ = false;
-  std::string method_pointer_, enforcement_pointer_ = "/solver", interface_solver_pointer_;
+  std::string method_pointer_, enforcement_pointer_ = "/solver";
   std::vector<std::string> friction_pointers_;  // per contact pair of problem_.contacts (empty: frictionless)
   std::vector<BodyInput> inputs_;
   GmshMeshes gmsh_;
