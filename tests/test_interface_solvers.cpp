@@ -263,3 +263,23 @@ TEST(InterfaceSolvers, WithFrictionTheAutomaticChoiceFollowsTheSameSizeRule) {
   EXPECT_EQ(r.interface_solver, "iterative");
   EXPECT_GT(r.interface_iterations, 0);
 }
+
+TEST(InterfaceSolvers, WithFrictionACancelAtTheFirstOuterIterationStopsTheIterativeSolverThere) {
+  // The report of every outer iteration on the slip bounds is where the solve asks the token (besides every
+  // product with F): a cancel set while the first one is reported ends the solve before a second.
+  const Problem problem =
+      contact::testing::parse_or_fail(with_solver(with_friction(wall(8, 8, 4, false), {{"coefficient", 0.6}}), "iterative"));
+  CancelToken cancel;
+  struct CancelAtFirst : Observer {
+    CancelToken* token = nullptr;
+    int reports = 0;
+    void on_iteration(const IterationReport&) override {
+      ++reports;
+      token->cancel();
+    }
+  } observer;
+  observer.token = &cancel;
+  const Result r = solve(problem, observer, cancel);
+  EXPECT_EQ(r.stop_reason, StopReason::cancelled) << r.message;
+  EXPECT_EQ(observer.reports, 1);
+}
