@@ -26,7 +26,7 @@ using linalg::FrictionRow;
 constexpr double infinity = std::numeric_limits<double>::infinity();
 
 // The friction problem as the direct solver sees it: its rows (without those no body can move tangentially), the
-// tangential mask and the scaling c = 1 / diag(F) (linalg::friction_scaling's rule, from F's replicated diagonal).
+// tangential mask and the scaling c = 1 / diag(F) (from F's replicated diagonal; capped, below).
 struct FrictionData {
   std::vector<FrictionRow> rows;
   std::vector<char> mask;
@@ -44,9 +44,18 @@ FrictionData friction_data(const InterfaceProblem& problem, const Eigen::VectorX
       d.rows.push_back(r);
       d.coulomb = d.coulomb || r.coulomb;
     }
-  d.mask = linalg::tangential_mask(problem.size(), d.rows);
+  // The mask covers every tangential row, those left out too: friction_box fixes them at 0, and the complementarity
+  // and the sets' prediction skip them (as normal rows they would count their slip, with c = 1 / (1e-12 max F_jj),
+  // as a violated gap: a complementarity of 1e5 and more on hertz.json's symmetry node).
+  d.mask.assign(static_cast<size_t>(problem.size()), 0);
+  for (Eigen::Index j = problem.normal_size(); j < problem.size(); ++j) d.mask[static_cast<size_t>(j)] = 1;
+  // c = 1 / F_jj, but at most 1 / (1e-6 max F_jj): a row barely moved (a node next to a symmetry line, whose
+  // tangential compliance is 1e-10 of the others on hertz_force.json) multiplies its slip, which the iterative
+  // solve leaves at the products' rounding (1e-13 where the gaps are 1e-2), by 1e13 into a complementarity of 1
+  // that no inner precision removes. The direct solver's c is the uncapped one; where no row is that stiff (the
+  // examples and walls of the tests) the two are equal.
   d.c.resize(diagonal.size());
-  for (Eigen::Index j = 0; j < d.c.size(); ++j) d.c[j] = 1.0 / std::max(diagonal[j], 1e-12 * dmax + 1e-300);
+  for (Eigen::Index j = 0; j < d.c.size(); ++j) d.c[j] = 1.0 / std::max(diagonal[j], 1e-6 * dmax + 1e-300);
   return d;
 }
 
@@ -118,7 +127,8 @@ linalg::ActiveSetStep outer_step(int outer, const FrictionData& d, const ActiveS
 // anyway), never below ten times the tolerance: a warm-started solve near the answer meets the projected
 // gradient's rounding floor there (measured on roller_friction: ~1e-11 of the free response's penetration), and
 // asking for less would stall SMALBE. Stops when the bounds moved by less than 1e3 x the tolerance and the Coulomb
-// complementarity is below that too: both reduced quantities, so every process takes the same decision.
+// complementarity is below that too, or the bounds have settled (below): reduced quantities only, so every process
+// takes the same decision.
 void coulomb_outer(Smalbe& smalbe, const FrictionData& d, const Eigen::VectorXd* z0, Smalbe::Solve how,
                    double tolerance, InterfaceSolveContext& context, ActiveSetResult& out) {
   const Eigen::Index n = smalbe.diagonal().size();
@@ -128,8 +138,12 @@ void coulomb_outer(Smalbe& smalbe, const FrictionData& d, const Eigen::VectorXd*
   how.report = false;
   linalg::FrictionSets previous;
   double change = 1.0;
+  int settled = 0;
+  how.tolerance = std::max(10 * tolerance, 1e-6);
   for (int outer = 1; outer <= std::max(1, context.max_steps); ++outer) {
-    how.tolerance = std::clamp(0.01 * change, 10 * tolerance, std::max(10 * tolerance, 1e-6));
+    // Never looser than the last: a solve that its start already satisfies leaves the bounds where they were, and
+    // a tolerance from that zero change would loosen the next one again.
+    how.tolerance = std::clamp(0.01 * change, 10 * tolerance, how.tolerance);
     smalbe.solve(friction_box(n, d, b), outer == 1 ? z0 : nullptr, how, out);
     if (out.cancelled) return;
     if (!out.converged && outer == 1 && b.allFinite()) {  // the warm start's bounds do not hold a body: tied
@@ -148,9 +162,20 @@ void coulomb_outer(Smalbe& smalbe, const FrictionData& d, const Eigen::VectorXd*
       out.message = "cancelled";
       return;
     }
-    if (change <= outer_tolerance && info.complementarity <= outer_tolerance) {
+    // Settled: the bounds stopped moving in two outer iterations at the finest inner tolerance. The complementarity
+    // is then as small as the inner precision lets it be; above the tolerance only where a row's c = 1 / F_jj
+    // magnifies the slip's rounding (see friction_data), which the message reports.
+    settled = change <= outer_tolerance && how.tolerance <= 10 * tolerance ? settled + 1 : 0;
+    if (change <= outer_tolerance && (info.complementarity <= outer_tolerance || settled >= 2)) {
       out.converged = true;
       out.message = settled_message(d, out, outer, smalbe);
+      if (info.complementarity > outer_tolerance) {
+        std::ostringstream os;
+        os.precision(3);
+        os << "; the bounds settled with the complementarity at " << info.complementarity
+           << " (the slips' rounding on rows of tiny tangential compliance)";
+        out.message += os.str();
+      }
       return;
     }
     b = next;
