@@ -2,6 +2,8 @@
 // (projected MPRGP in SMALBE) give the discrete solution of the monolithic reference, an independent algebra, on
 // every example and on brick walls of many floating bodies; MPRGP alone solves bound-constrained QPs like the
 // active-set QP method; the iterative solver's iterations do not grow with the number of bodies (the FETI property).
+// With friction the iterative solver (MPRGP on the box, Coulomb's outer iteration) gives the direct friction
+// solver's discrete solution (semismooth Newton, an independent method) under Coulomb and Tresca.
 #include "contact/result_file.hpp"
 #include "linalg/active_set.hpp"
 #include "linalg/mprgp.hpp"
