@@ -52,8 +52,8 @@ FrictionData friction_data(const InterfaceProblem& problem, const Eigen::VectorX
   // c = 1 / F_jj, but at most 1 / (1e-6 max F_jj): a row barely moved (a node next to a symmetry line, whose
   // tangential compliance is 1e-10 of the others on hertz_force.json) multiplies its slip, which the iterative
   // solve leaves at the products' rounding (1e-13 where the gaps are 1e-2), by 1e13 into a complementarity of 1
-  // that no inner precision removes. The direct solver's c is the uncapped one; where no row is that stiff (the
-  // examples and walls of the tests) the two are equal.
+  // that no inner precision removes. The direct solver's c is the uncapped one; where no row is that stiff the two
+  // are equal.
   d.c.resize(diagonal.size());
   for (Eigen::Index j = 0; j < d.c.size(); ++j) d.c[j] = 1.0 / std::max(diagonal[j], 1e-6 * dmax + 1e-300);
   return d;
