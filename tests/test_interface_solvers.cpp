@@ -2,6 +2,8 @@
 // (projected MPRGP in SMALBE) give the discrete solution of the monolithic reference, an independent algebra, on
 // every example and on brick walls of many floating bodies; MPRGP alone solves bound-constrained QPs like the
 // active-set QP method; the iterative solver's iterations do not grow with the number of bodies (the FETI property).
+// With friction the iterative solver (MPRGP on the box, Coulomb's outer iteration) gives the direct friction
+// solver's discrete solution (semismooth Newton, an independent method) under Coulomb and Tresca.
 #include "contact/result_file.hpp"
 #include "linalg/active_set.hpp"
 #include "linalg/mprgp.hpp"
@@ -60,6 +62,49 @@ json wall(int rows, int bricks, int cells, bool abutments) {
   json job = json::parse(in);
   std::remove(path.c_str());
   return job;
+}
+
+// The largest relative difference of the last step's displacements, pressures and tangential tractions (each
+// relative to its own largest value in `b`).
+double friction_difference(const Result& a, const Result& b) {
+  const Step& sa = a.steps.back();
+  const Step& sb = b.steps.back();
+  double u_scale = 0, p_scale = 0, worst = 0;
+  for (const auto& body : sb.bodies) u_scale = std::max(u_scale, max_abs(body.displacement));
+  for (const auto& pair : sb.pairs) p_scale = std::max({p_scale, max_abs(pair.pressure), max_abs(pair.tangential_traction)});
+  for (size_t i = 0; i < sa.bodies.size(); ++i)
+    worst = std::max(worst, max_abs(sa.bodies[i].displacement - sb.bodies[i].displacement) / u_scale);
+  for (size_t k = 0; k < sa.pairs.size(); ++k) {
+    worst = std::max(worst, max_abs(sa.pairs[k].pressure - sb.pairs[k].pressure) / p_scale);
+    worst = std::max(worst, max_abs(sa.pairs[k].tangential_traction - sb.pairs[k].tangential_traction) / p_scale);
+  }
+  return worst;
+}
+
+// Every contact of `job` with `friction` (Coulomb {"coefficient": mu} or Tresca {"bound": g}).
+json with_friction(json job, const json& friction) {
+  for (auto& c : job["contacts"]) c["friction"] = friction;
+  return job;
+}
+
+// The iterative solver with a tight tolerance against the direct friction solver (semismooth Newton, exact on its
+// sets): the same discrete solution, reached to `rel`; the iterative answer's own complementarity is reported by
+// its last iteration.
+void expect_iterative_equals_direct(const json& job, double rel, const std::string& what) {
+  const Result direct = run(with_solver(job, "direct"));
+  ASSERT_TRUE(direct.converged) << what << " direct: " << direct.message;
+  json tight = with_solver(job, "iterative");
+  tight["solver"]["interface"]["tolerance"] = 1e-13;
+  const Result iterative = run(tight);
+  ASSERT_TRUE(iterative.converged) << what << " iterative: " << iterative.message;
+  EXPECT_EQ(iterative.interface_solver, "iterative");
+  ASSERT_EQ(iterative.steps.size(), direct.steps.size()) << what;
+  const double difference = friction_difference(iterative, direct);
+  EXPECT_LE(difference, rel) << what;
+  ASSERT_FALSE(iterative.history.empty());
+  EXPECT_LE(iterative.history.back().complementarity, 1e-9) << what;
+  std::printf("[ friction ] %s: iterative = direct to %.2e (%ld MPRGP iterations, %d outer)\n", what.c_str(),
+              difference, iterative.interface_iterations, iterative.iterations);
 }
 
 }  // namespace
@@ -183,4 +228,60 @@ TEST(InterfaceSolvers, AnUnheldFloatingBodyIsNamedByTheIterativeSolverToo) {
   EXPECT_EQ(r.stop_reason, StopReason::error) << r.message;
   EXPECT_NE(r.message.find("body 'cap' floats (translation in y, rotation free) and no contact holds it"),
             std::string::npos) << r.message;
+}
+
+TEST(InterfaceSolvers, WithFrictionTheIterativeSolverEqualsTheDirectOneOnTheFrictionExamples) {
+  // roller_friction: Coulomb mu = 0.2 over three load steps (the push grows): friction alone holds the floating
+  // roller and plate; the same job under Tresca with a bound that lets the contact zones' edges slip.
+  const json roller = example("roller_friction.json");
+  expect_iterative_equals_direct(roller, 1e-8, "roller_friction Coulomb");
+  expect_iterative_equals_direct(with_friction(roller, {{"bound", 3000.0}}), 1e-8, "roller_friction Tresca");
+}
+
+TEST(InterfaceSolvers, WithFrictionTheIterativeSolverEqualsTheDirectOneOnAFrictionalBrickWall) {
+  // The dowelled wall with friction in every bed joint (Coulomb mu = 0.6 as asked, and a low mu = 0.05 where
+  // more nodes slip), and Tresca with a bound of a fifth of the top pressure.
+  const json job = wall(8, 8, 4, false);
+  expect_iterative_equals_direct(with_friction(job, {{"coefficient", 0.6}}), 1e-8, "wall 8x8 Coulomb 0.6");
+  expect_iterative_equals_direct(with_friction(job, {{"coefficient", 0.05}}), 1e-8, "wall 8x8 Coulomb 0.05");
+  double pressure = 0;
+  for (const auto& body : job["bodies"])
+    for (const auto& c : body["boundary"])
+      if (c.contains("traction")) pressure = std::abs(c["traction"]["normal"].get<double>());
+  ASSERT_GT(pressure, 0);
+  expect_iterative_equals_direct(with_friction(job, {{"bound", 0.2 * pressure}}), 1e-8, "wall 8x8 Tresca");
+}
+
+TEST(InterfaceSolvers, WithFrictionTheAutomaticChoiceFollowsTheSameSizeRule) {
+  // The rule counts floating-body rows and contact rows, not friction: few bodies take the direct solver, the
+  // 16 x 16 wall (264 dowelled bricks, 528 floating-body rows) the iterative one, with friction as without.
+  json few = example("roller_friction.json");
+  few["solver"] = {{"method", "interface_newton"}};
+  EXPECT_EQ(run(few).interface_solver, "direct");
+  json many = with_friction(wall(16, 16, 2, false), {{"coefficient", 0.6}});
+  many["solver"] = {{"method", "interface_newton"}};
+  const Result r = run(many);
+  ASSERT_TRUE(r.converged) << r.message;
+  EXPECT_EQ(r.interface_solver, "iterative");
+  EXPECT_GT(r.interface_iterations, 0);
+}
+
+TEST(InterfaceSolvers, WithFrictionACancelAtTheFirstOuterIterationStopsTheIterativeSolverThere) {
+  // The report of every outer iteration on the slip bounds is where the solve asks the token (besides every
+  // product with F): a cancel set while the first one is reported ends the solve before a second.
+  const Problem problem =
+      contact::testing::parse_or_fail(with_solver(with_friction(wall(8, 8, 4, false), {{"coefficient", 0.6}}), "iterative"));
+  CancelToken cancel;
+  struct CancelAtFirst : Observer {
+    CancelToken* token = nullptr;
+    int reports = 0;
+    void on_iteration(const IterationReport&) override {
+      ++reports;
+      token->cancel();
+    }
+  } observer;
+  observer.token = &cancel;
+  const Result r = solve(problem, observer, cancel);
+  EXPECT_EQ(r.stop_reason, StopReason::cancelled) << r.message;
+  EXPECT_EQ(observer.reports, 1);
 }

@@ -186,7 +186,7 @@ class JobReader {
   Errors errors_;
   Problem problem_;
   bool method_given_ = false, enforcement_given_ = false;
-  std::string method_pointer_, enforcement_pointer_ = "/solver", interface_solver_pointer_;
+  std::string method_pointer_, enforcement_pointer_ = "/solver";
   std::vector<std::string> friction_pointers_;  // per contact pair of problem_.contacts (empty: frictionless)
   // One error for one cause: what a part refused whole (over a limit, of the wrong type) or read only in part
   // leaves unknown, so the checks that depend on it are not run (docs/job-format.md, "Validation and errors").

@@ -85,12 +85,6 @@ void JobReader::check_friction_and_histories() {
                       "tractions only; solve the frictional job on a fixed (e.g. previously refined) mesh");
       return;
     }
-    if (s.interface.solver == InterfaceSolverKind::iterative) {
-      errors_.add(at, "friction is solved by the direct interface solver; the iterative one (at " +
-                          interface_solver_pointer_ + ") takes frictionless contact only: choose \"direct\" or "
-                          "\"auto\" (which picks direct for friction)");
-      return;
-    }
   }
 }
 

@@ -285,8 +285,7 @@ void JobReader::read_interface_solver(const json& value, const std::string& poin
   if (!f.ok()) return;
   auto& in = problem_.solver.interface;
   if (const json* v = f.find("solver"))
-    if (interface_solver_pointer_ = f.at("solver");
-        auto x = choice(*v, f.at("solver"), "solver", {"auto", "direct", "iterative"}, errors_))
+    if (auto x = choice(*v, f.at("solver"), "solver", {"auto", "direct", "iterative"}, errors_))
       in.solver = *x == "direct"      ? InterfaceSolverKind::direct
                   : *x == "iterative" ? InterfaceSolverKind::iterative
                                       : InterfaceSolverKind::automatic;

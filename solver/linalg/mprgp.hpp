@@ -1,17 +1,19 @@
 // MPRGP: modified proportioning with reduced gradient projections (Dostal & Schoeberl 2005; Dostal, "Optimal
 // Quadratic Programming Algorithms", 2009, algorithm 5.8), for the bound-constrained QP
 //
-//   min f(x) = 1/2 x^T A x - b^T x   subject to   x >= l,        A symmetric positive definite,
+//   min f(x) = 1/2 x^T A x - b^T x   subject to   l <= x <= u,        A symmetric positive definite,
 //
-// given only products with A (and, optionally, a preconditioner). With the free set F = {i : x_i > l_i}, the
-// gradient g = A x - b splits into the free gradient phi (g on F, 0 elsewhere) and the chopped gradient beta
-// (min(g_i, 0) off F): their sum, the projected gradient, vanishes exactly at the solution. Each iteration is one
-// of three steps:
+// given only products with A (and, optionally, a preconditioner); u is optional (+inf where absent, and l may be
+// -inf: a free unknown; l = u fixes it). With the free set F = {i : l_i < x_i < u_i}, the gradient g = A x - b
+// splits into the free gradient phi (g on F, 0 elsewhere) and the chopped gradient beta (min(g_i, 0) where x_i is
+// at its lower bound, max(g_i, 0) at its upper bound: the part that points into the box, 0 for a fixed unknown):
+// their sum, the projected gradient, vanishes exactly at the solution (Dostal 2009, section 5.8 for the box, the
+// case of friction's tangential multipliers -b <= q <= b). Each iteration is one of three steps:
 //   - conjugate gradients in the face F while x stays feasible and the chopped gradient is small against the
 //     reduced free gradient (the iterate is "proportional": ||beta||^2 <= Gamma^2 phi~^T phi);
 //   - an expansion step when the CG step would leave the feasible set: the longest feasible step along the CG
-//     direction, then a projected gradient step of fixed length alpha_bar in (0, 2 / ||A||], which adds
-//     constraints to the face several at a time;
+//     direction, then a projected gradient step of fixed length alpha_bar in (0, 2 / ||A||] (projected onto the
+//     box), which adds constraints to the face several at a time;
 //   - a proportioning step along beta when the chopped gradient dominates, which releases constraints.
 // The rate of convergence depends on the spectrum of A only (Dostal's bound), so on a family of problems with a
 // bounded condition number the iterations stay bounded: the property FETI relies on.
@@ -33,6 +35,7 @@ struct BoundQp {
   // y = M r (an approximation of A^-1); empty: no preconditioner. Returns true to stop (cancelled).
   std::function<bool(const Eigen::VectorXd& r, Eigen::VectorXd& y)> precondition;
   Eigen::VectorXd b, lower;
+  Eigen::VectorXd upper;  // empty: no upper bounds (+inf); entries may be +inf
 };
 
 struct MprgpSettings {
@@ -49,13 +52,14 @@ struct MprgpResult {
   bool converged = false, cancelled = false;
 };
 
-// Starts from x0 (projected onto x >= l) and stops when `done(x, g, ||g^P||)` says so (converged), after
+// Starts from x0 (projected onto the box) and stops when `done(x, g, ||g^P||)` says so (converged), after
 // max_iterations, or when a product asks to stop.
 MprgpResult solve_mprgp(const BoundQp& qp, const Eigen::VectorXd& x0, const MprgpSettings& settings,
                         const std::function<bool(const Eigen::VectorXd& x, const Eigen::VectorXd& g, double norm_gp)>& done);
 
-// The projected gradient g^P of x (free gradient plus chopped gradient).
-Eigen::VectorXd projected_gradient(const Eigen::VectorXd& x, const Eigen::VectorXd& g, const Eigen::VectorXd& lower);
+// The projected gradient g^P of x (free gradient plus chopped gradient); `upper` empty: no upper bounds.
+Eigen::VectorXd projected_gradient(const Eigen::VectorXd& x, const Eigen::VectorXd& g, const Eigen::VectorXd& lower,
+                                   const Eigen::VectorXd& upper = Eigen::VectorXd());
 
 // An estimate of ||A|| (the largest eigenvalue) by `iterations` steps of the power method from a fixed start.
 double estimate_norm(const std::function<bool(const Eigen::VectorXd&, Eigen::VectorXd&)>& apply, Eigen::Index n,

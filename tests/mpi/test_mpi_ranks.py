@@ -95,7 +95,7 @@ with tempfile.TemporaryDirectory() as tmp:
 
     # The interface solvers on ranks: each equals the monolithic reference (one process) to 1e-8, on 1, 2 and 3
     # ranks, on the examples with floating bodies and on walls whose bricks float (dowelled: two rigid motions
-    # each; abutments: all three) up to 16 x 16.
+    # each; abutments: all three) up to 16 x 16, and with friction (roller_friction, a frictional wall).
     cases = []
     for n, flags, label in ((8, [], "wall 8x8 dowelled"), (16, [], "wall 16x16 dowelled"),
                             (8, ["--abutments"], "wall 8x8 abutments"), (16, ["--abutments"], "wall 16x16 abutments")):
@@ -103,8 +103,18 @@ with tempfile.TemporaryDirectory() as tmp:
         subprocess.run(["/usr/bin/python3", os.path.join(SRC, "scripts", "make_brick_wall.py"), "--rows", str(n),
                         "--bricks", str(n), "--cells", "2", *flags, "-o", path], check=True, capture_output=True)
         cases.append((label, path))
-    for name in ("stack3_floating", "hertz_force", "punch_force", "flat_patch_nonmatching"):
+    for name in ("stack3_floating", "hertz_force", "punch_force", "flat_patch_nonmatching", "roller_friction"):
         cases.append((name, os.path.join(EXAMPLES, name + ".json")))
+    # Friction on ranks: the 8 x 8 wall with Coulomb friction (mu 0.6) in every bed joint; the iterative solver's
+    # outer iteration on the slip bounds decides from reduced quantities only, so every rank stops together.
+    with open(cases[0][1]) as f:
+        frictional = json.load(f)
+    for c in frictional["contacts"]:
+        c["friction"] = {"coefficient": 0.6}
+    frictional_path = os.path.join(tmp, "wall_8x8_friction.json")
+    with open(frictional_path, "w") as f:
+        json.dump(frictional, f)
+    cases.append(("wall 8x8 dowelled, Coulomb friction", frictional_path))
     for label, source in cases:
         with open(source) as f:
             job = json.load(f)

@@ -2,6 +2,7 @@
 // reference implementation): the dual problem in the nodal pressures,
 //
 //   min 1/2 z^T H z + g^T z   over z >= 0 with G z = e          (H = F + diag(penalty), interface_solver.hpp)
+//   (with friction: over the box of the normal and tangential multipliers, below)
 //
 // 1. Homogenise the equalities: z = z_hat + z_I with z_I = G^T (G G^T)^-1 e (coarse_space.hpp), so G z_hat = 0
 //    and the bounds become z_hat >= -z_I.
@@ -19,6 +20,13 @@
 // Each product with A is one product with F, which every process computes for its own bodies and one
 // MPI_Allreduce sums; P and Q cost one solve with the sparse G G^T, replicated. Stops when the projected gradient
 // and the equality violation are both below the tolerance relative to the problem's own scales.
+// The engine (SMALBE, MPRGP's calls, the rigid amplitudes) is smalbe.hpp.
+//
+// Friction (interface problem built with tangential rows, interface_options(..., friction = true)): the unknowns
+// are [z; q], the box z >= 0, -b <= q <= b (MPRGP with upper bounds), shifted by -z_I like the normal bounds.
+// Tresca (b = g) is one solve; Coulomb (b = mu z) an outer fixed point on b, each step a Tresca solve from the last
+// answer (feti_friction.cpp). Rows no body can move tangentially are fixed at q = 0, as friction_direct does. The
+// answer is the direct friction solver's discrete solution (same layout: normal rows, then tangential ones).
 #pragma once
 
 #include "interface_solver.hpp"
@@ -32,6 +40,7 @@ class FetiSolver final : public InterfaceSolver {
   linalg::ActiveSetResult solve(const InterfaceQp& qp, const Eigen::VectorXd* z0, InterfaceSolveContext& context) override;
 
  private:
+  linalg::ActiveSetResult solve_friction(const InterfaceQp& qp, const Eigen::VectorXd* z0, InterfaceSolveContext& context);
   InterfaceSolverSettings settings_;
 };
 

@@ -4,8 +4,6 @@
 #include "friction_direct.hpp"
 #include "sparse_direct.hpp"
 
-#include <stdexcept>
-
 namespace contact::ddm {
 
 namespace {
@@ -24,7 +22,6 @@ InterfaceSolverKind choose_interface_solver(const InterfaceSolverSettings& setti
   // its answer does not depend on them (the direct solver runs replicated on every rank; docs/parallel.md).
   (void)runner;
   if (settings.solver != InterfaceSolverKind::automatic) return settings.solver;
-  if (system.has_friction()) return InterfaceSolverKind::direct;  // the one that takes friction
   Eigen::Index rows = 0, floating_rows = 0;
   for (const auto& pair : system.pairs()) rows += pair.n_rows();
   for (size_t a = 0; a < system.n_bodies(); ++a) floating_rows += system.body(a).rigid_modes().cols();
@@ -35,7 +32,7 @@ InterfaceSolverKind choose_interface_solver(const InterfaceSolverSettings& setti
 InterfaceProblem::Options interface_options(InterfaceSolverKind kind, const InterfaceSolverSettings& settings,
                                             bool friction) {
   InterfaceProblem::Options options;
-  options.friction = friction && kind == InterfaceSolverKind::direct;
+  options.friction = friction;  // both solvers take the tangential rows
   if (kind == InterfaceSolverKind::iterative) {
     options.preconditioner = settings.preconditioner;
     options.replicate_blocks = false;  // each process applies its own bodies' blocks
@@ -45,11 +42,7 @@ InterfaceProblem::Options interface_options(InterfaceSolverKind kind, const Inte
 
 std::unique_ptr<InterfaceSolver> make_interface_solver(InterfaceSolverKind kind, const InterfaceSolverSettings& settings,
                                                        bool friction) {
-  if (kind == InterfaceSolverKind::iterative) {
-    // The job reader refuses friction with the iterative solver; a program that builds a Problem itself is told too.
-    if (friction) throw std::invalid_argument("the iterative interface solver takes frictionless contact only: choose direct for friction");
-    return std::make_unique<FetiSolver>(settings);
-  }
+  if (kind == InterfaceSolverKind::iterative) return std::make_unique<FetiSolver>(settings);  // with or without friction
   if (friction) return std::make_unique<FrictionDirectSolver>();
   return std::make_unique<SparseDirectSolver>();
 }

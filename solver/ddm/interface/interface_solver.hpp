@@ -9,9 +9,10 @@
 //             step; first active set from nested coarse solves. Exact in finitely many steps; one process holds
 //             every block.
 //   friction  (friction_direct.hpp): the direct solver's setting with friction pairs: semismooth Newton on the
-//             stick and slip sets of the normal and tangential multipliers (the only solver that takes friction).
+//             stick and slip sets of the normal and tangential multipliers.
 //   iterative (feti.hpp): FETI-style projected MPRGP inside SMALBE, applying F block by block where the blocks
-//             live (MPI ranks: each its own bodies), with the coarse space of the floating bodies.
+//             live (MPI ranks: each its own bodies), with the coarse space of the floating bodies; with friction
+//             MPRGP on the box z >= 0, |q| <= b (Tresca; Coulomb by an outer iteration on b = mu z).
 // make_interface_solver picks one from the settings and the size of the problem; a new solver is a new class here.
 #pragma once
 
@@ -69,14 +70,15 @@ class InterfaceSolver {
 
 // The solver to use for `system` under `settings`: the one asked for, or, automatically, the iterative solver
 // where the direct one's dense Schur complement on the floating bodies' rows (r x r) or its sparse factor would be
-// large, the direct one otherwise (by size alone: the same on any number of processes).
+// large, the direct one otherwise (by size alone: the same on any number of processes; with or without friction).
 InterfaceSolverKind choose_interface_solver(const InterfaceSolverSettings& settings, const ContactSystem& system,
                                             const parallel::TaskRunner& runner);
 // How the interface problem must be built for that solver (blocks replicated or not, preconditioner, tangential
 // rows for friction).
 InterfaceProblem::Options interface_options(InterfaceSolverKind kind, const InterfaceSolverSettings& settings,
                                             bool friction = false);
-// With friction: the direct solver with stick and slip sets (friction_direct.hpp); automatic picks it.
+// With friction: direct is the semismooth Newton on stick and slip sets (friction_direct.hpp), iterative FETI on
+// the box of the normal and tangential multipliers (feti.hpp).
 std::unique_ptr<InterfaceSolver> make_interface_solver(InterfaceSolverKind kind, const InterfaceSolverSettings& settings,
                                                        bool friction = false);
 

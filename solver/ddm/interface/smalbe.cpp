@@ -1,0 +1,251 @@
+#include "smalbe.hpp"
+
+#include "../../common/scoped_timer.hpp"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace contact::ddm {
+
+using linalg::ActiveSetResult;
+
+Smalbe::Smalbe(const InterfaceQp& qp, const InterfaceSolverSettings& settings, InterfaceSolveContext& context)
+    : qp_(qp), s_(settings), ctx_(context), coarse_(qp.problem, qp.equilibrium), m_(qp.problem.size()) {}
+
+bool Smalbe::prepare(ActiveSetResult& out) {
+  if (!coarse_.ok()) {
+    out.unrestrained = coarse_.unheld();
+    out.message = "the contact nodes cannot hold every floating body";
+    return false;
+  }
+  if (!ready_) setup();
+  return true;
+}
+
+bool Smalbe::apply_H(const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+  bool stop = false;
+  {
+    ScopedTimer timer(seconds_F_);  // the per-iteration costs docs/parallel.md's model is built from
+    stop = qp_.problem.apply(x, y, ctx_.runner);
+  }
+  if (qp_.penalty.size() == m_) y += qp_.penalty.cwiseProduct(x);
+  // One process: the token directly; several: only the agreed answer of the sum, the same on every process.
+  if (!ctx_.runner.distributed()) stop = stop || ctx_.cancel.cancelled();
+  return stop;
+}
+
+bool Smalbe::apply_A(const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+  Eigen::VectorXd Px, HPx;
+  {
+    ScopedTimer timer(seconds_coarse_);
+    Px = coarse_.project(x);
+  }
+  const bool stop = apply_H(Px, HPx);
+  ScopedTimer timer(seconds_coarse_);
+  y = coarse_.project(HPx) + rho_ * (x - Px);
+  return stop;
+}
+
+bool Smalbe::precondition(const Eigen::VectorXd& r, Eigen::VectorXd& y) {
+  const Eigen::VectorXd Pr = coarse_.project(r);
+  Eigen::VectorXd Mr;
+  bool stop = qp_.problem.apply_preconditioner(Pr, Mr, ctx_.runner);
+  if (!ctx_.runner.distributed()) stop = stop || ctx_.cancel.cancelled();
+  y = coarse_.project(Mr) + (r - Pr) / rho_;
+  return stop;
+}
+
+void Smalbe::setup() {
+  ready_ = true;
+  z_I_ = coarse_.particular();
+  Eigen::VectorXd Hz;
+  apply_H(z_I_, Hz);
+  Pc_ = coarse_.project(Hz + qp_.g);
+  // ||A|| = max(||P H P||, rho) with rho = ||P H P||: Dostal's choice, which keeps A's condition that of P H P.
+  const double norm_PHP = linalg::estimate_norm(
+      [&](const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+        const Eigen::VectorXd Px = coarse_.project(x);
+        Eigen::VectorXd HPx;
+        const bool stop = apply_H(Px, HPx);
+        y = coarse_.project(HPx);
+        return stop;
+      },
+      m_);
+  rho_ = norm_PHP > 0 ? norm_PHP : 1.0;
+  norm_A_ = norm_PHP_ = rho_;
+  diagonal_ = qp_.problem.diagonal();
+  if (qp_.penalty.size() == m_) diagonal_ += qp_.penalty;
+  nu_ = Eigen::VectorXd::Zero(m_);
+  bound_.apply = [this](const Eigen::VectorXd& x, Eigen::VectorXd& y) { return apply_A(x, y); };
+  if (s_.preconditioner != InterfacePreconditioner::none)
+    bound_.precondition = [this](const Eigen::VectorXd& r, Eigen::VectorXd& y) { return precondition(r, y); };
+}
+
+// The pressures (and tangential multipliers), rigid amplitudes and gaps of the current iterate, as the direct
+// solver would report them. A row is at its bound exactly where MPRGP holds it there (x on the shifted bound), so
+// the rows that enter the rigid amplitudes' least squares (the free ones: a closed gap or a sticking node) do
+// not depend on the rounding of x + z_I.
+bool Smalbe::finish(const Eigen::VectorXd& x, const Bounds& bounds, ActiveSetResult& out) {
+  std::vector<char> active(static_cast<size_t>(m_));
+  out.z = x + z_I_;
+  const bool upper = bounds.upper.size() == m_;
+  for (Eigen::Index j = 0; j < m_; ++j) {
+    const bool at_lower = x[j] <= bound_.lower[j], at_upper = upper && x[j] >= bound_.upper[j];
+    if (at_lower) out.z[j] = bounds.lower[j];
+    if (at_upper) out.z[j] = bounds.upper[j];
+    active[static_cast<size_t>(j)] = !at_lower && !at_upper;
+  }
+  Eigen::VectorXd Hz;
+  const bool stop = apply_H(out.z, Hz);
+  out.h = qp_.g + Hz;
+  out.alpha = Eigen::VectorXd::Zero(coarse_.rows());
+  if (!coarse_.empty()) {
+    out.alpha = coarse_.multipliers(out.h, active);
+    if (out.alpha.size() != coarse_.rows()) {
+      out.unrestrained = coarse_.unheld_by(active);
+      if (out.unrestrained.empty())
+        for (Eigen::Index i = 0; i < coarse_.rows(); ++i) out.unrestrained.push_back(i);
+      out.alpha = Eigen::VectorXd::Zero(coarse_.rows());
+    }
+    out.h += coarse_.G().transpose() * out.alpha;
+  }
+  return stop;
+}
+
+bool Smalbe::report(int step, const Solve& how, ActiveSetResult& out) {
+  linalg::ActiveSetStep r;
+  r.step = step;
+  const Eigen::Index normal = qp_.problem.normal_size();
+  std::vector<char> active(static_cast<size_t>(normal));
+  Eigen::VectorXd C(normal);
+  for (Eigen::Index j = 0; j < normal; ++j) {
+    active[static_cast<size_t>(j)] = out.z[j] > 0;
+    r.active += active[static_cast<size_t>(j)];
+    if (!previous_active_.empty()) r.changes += active[static_cast<size_t>(j)] != previous_active_[static_cast<size_t>(j)];
+    C[j] = out.z[j] - std::max(0.0, out.z[j] - out.h[j] / diagonal_[j]);
+  }
+  if (previous_active_.empty()) r.changes = r.active;
+  previous_active_ = std::move(active);
+  r.complementarity = how.measure ? how.measure(out.z, out.h) : C.norm() / std::max(out.z.norm(), 1e-300);
+  out.steps = step;
+  return ctx_.on_step(out.z, out.h, r);
+}
+
+// The equality violation has stopped falling over the last outer iterations while the multipliers grow: no
+// admissible pressures balance some floating body (its loads pull it off its contacts, or along them harder than
+// friction holds).
+bool Smalbe::stagnating(const std::vector<double>& violation) const {
+  const size_t k = violation.size();
+  return k >= 8 && violation[k - 1] > 0.5 * violation[k - 4] && rho_ >= 1e6 * norm_PHP_;
+}
+
+// The rows of the floating bodies whose equilibrium G_b z = e_b is violated by more than a thousandth of the
+// largest violation: the bodies that their contacts do not hold.
+std::vector<Eigen::Index> Smalbe::unbalanced_rows(const Eigen::VectorXd& z) const {
+  const Eigen::VectorXd residual = coarse_.G() * z - coarse_.e();
+  const double largest = residual.cwiseAbs().maxCoeff();
+  std::vector<Eigen::Index> out;
+  for (const auto& f : qp_.problem.floating())
+    if (residual.segment(f.offset, f.count).cwiseAbs().maxCoeff() > 1e-3 * largest)
+      for (Eigen::Index i = 0; i < f.count; ++i) out.push_back(f.offset + i);
+  return out;
+}
+
+// The gradient's scale: the free response's penetration (where the contact acts), not its open gaps, which can be
+// orders of magnitude larger on a curved surface and would make the tolerance meaningless. With friction the
+// normal rows' alone too: the free slips of the tangential rows (after the normal ones) are as large as the open
+// gaps on a curved surface, where they would loosen the tolerance by as much (hertz_force: 1e-8 instead of 1e-12).
+void Smalbe::scales(double& scale_g) const {
+  const double penetration = Pc_.head(qp_.problem.normal_size()).cwiseMin(0.0).norm();
+  scale_g = penetration > 0 ? penetration : std::max(Pc_.norm(), 1e-300);
+}
+
+void Smalbe::solve(const Bounds& bounds, const Eigen::VectorXd* z0, const Solve& how, ActiveSetResult& out) {
+  if (!ready_) setup();
+  out.converged = false;
+  out.unrestrained.clear();
+  bound_.lower = bounds.lower - z_I_;
+  bound_.upper = bounds.upper.size() == m_ ? Eigen::VectorXd(bounds.upper - z_I_) : Eigen::VectorXd();
+  double scale_g = 1.0;
+  scales(scale_g);
+  const double eta = 0.1 * scale_g;
+  // rho from ||P H P|| again: raised where the previous solve's multipliers crawled, at its cap it would take the
+  // equality violation's rounding floor near a warm start for a body nothing holds (stagnating()).
+  rho_ = norm_A_ = norm_PHP_;
+  double M = norm_A_;
+  const Eigen::VectorXd* start = z0 && z0->size() == m_ ? z0 : last_z_.size() == m_ ? &last_z_ : nullptr;
+  Eigen::VectorXd x = start ? Eigen::VectorXd(*start - z_I_) : Eigen::VectorXd::Zero(m_);
+  double previous_L = -std::numeric_limits<double>::infinity();
+  std::vector<double> violation;
+  linalg::MprgpSettings inner;
+  const int max_outer = std::max(1, ctx_.max_steps);
+  for (int outer = 1; outer <= max_outer; ++outer) {
+    inner.alpha_bar = 1.9 / (1.05 * norm_A_);  // the power method underestimates ||A|| a little
+    bound_.b = -(Pc_ + nu_);
+    inner.max_iterations = std::max<long>(1, s_.max_iterations - out.inner_iterations);
+    bool global = false;
+    const auto done = [&](const Eigen::VectorXd& xi, const Eigen::VectorXd&, double norm_gp) {
+      const double feasibility = coarse_.range_part(xi).norm();
+      const double z_scale = std::max((xi + z_I_).norm(), 1e-300);
+      if (norm_gp <= how.tolerance * scale_g && feasibility <= how.tolerance * z_scale) return global = true;
+      return norm_gp <= std::max(std::min(M * feasibility, eta), 0.1 * how.tolerance * scale_g);
+    };
+    last_inner_ = linalg::solve_mprgp(bound_, x, inner, done);
+    const linalg::MprgpResult& r = last_inner_;
+    out.inner_iterations += r.iterations;
+    x = r.x;
+    out.steps = outer;
+    const bool stop = finish(x, bounds, out) || r.cancelled;
+    if (stop || (how.report && !report(outer, how, out))) {
+      out.cancelled = true;
+      out.message = "cancelled";
+      return;
+    }
+    last_z_ = out.z;
+    if (global) {
+      out.converged = out.unrestrained.empty();
+      std::ostringstream os;
+      os << "FETI (projected MPRGP, SMALBE) converged: " << out.inner_iterations << " MPRGP iterations in " << outer
+         << " outer iterations (" << r.cg_steps << " CG, " << r.expansion_steps << " expansion, "
+         << r.proportioning_steps << " proportioning steps in the last; F products " << seconds_F_
+         << " s, coarse projections " << seconds_coarse_ << " s)";
+      out.message = out.converged ? os.str() : "the contact nodes in contact do not hold every floating body";
+      return;
+    }
+    if (out.inner_iterations >= s_.max_iterations || !r.converged) break;
+    if (!update_multipliers(x, r, outer, M, previous_L, violation)) {
+      if (out.unrestrained.empty()) out.unrestrained = unbalanced_rows(out.z);
+      out.message = "the contact nodes in contact do not hold every floating body";
+      return;
+    }
+  }
+  std::ostringstream os;
+  os << "FETI did not converge within " << out.inner_iterations << " MPRGP iterations and " << out.steps
+     << " outer iterations (interface.max_iterations " << s_.max_iterations << ")";
+  out.message = os.str();
+}
+
+// SMALBE's update after an inner solve: the multipliers, and M halved when the Lagrangian did not grow by
+// rho/2 ||Q x||^2. False when the equality violation stagnates (a floating body nothing holds).
+bool Smalbe::update_multipliers(const Eigen::VectorXd& x, const linalg::MprgpResult& r, int outer, double& M,
+                                double& previous_L, std::vector<double>& violation) {
+  const Eigen::VectorXd Qx = coarse_.range_part(x);
+  const double L = 0.5 * x.dot(r.gradient - bound_.b);
+  nu_ += rho_ * Qx;
+  if (outer > 1 && L < previous_L + 0.5 * rho_ * Qx.squaredNorm()) M /= 2;
+  previous_L = L;
+  violation.push_back(Qx.norm());
+  if (stagnating(violation)) return false;
+  // On a face much smaller than the contact surface (a cylinder on a block) rho Q acts there only through the
+  // face's share of the rigid modes' gaps, and the multiplier updates crawl: raise rho (A's spectrum on ker G is
+  // unchanged; the expansion step shortens with ||A||) while the violation falls by less than 10x.
+  const size_t k = violation.size();
+  if (k >= 2 && violation[k - 1] > 0.1 * violation[k - 2] && rho_ < 1e6 * norm_PHP_) {
+    rho_ *= 10;
+    norm_A_ = std::max(norm_PHP_, rho_);
+  }
+  return true;
+}
+
+}  // namespace contact::ddm
