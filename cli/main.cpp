@@ -87,14 +87,36 @@ class ProgressPrinter final : public contact::Observer {
     else
       std::printf("  paper %.3e  residual %.3e", r.paper_criterion, r.fixed_point_residual);
     if (r.gamma > 0) std::printf("  gamma %.3g", r.gamma);
-    for (const auto& p : r.pairs)
-      std::printf("  | %s: force %.6g  p_max %.6g  active %d (%+d)", p.name.c_str(), p.force, p.max_pressure,
-                  p.active_nodes, p.changed_nodes);
+    print_pairs(r.pairs);
     std::printf("  %.2fs", r.elapsed_seconds);
     if (!r.note.empty()) std::printf("  [%s]", r.note.c_str());
     std::printf("\n");
     std::fflush(stdout);
   }
+
+  // Every pair while they are few; past kPairsShown one summary, so that a line stays short on a wall of hundreds
+  // of pairs (the result file and --ndjson have every pair).
+  static void print_pairs(const std::vector<contact::PairReport>& pairs) {
+    if (pairs.size() <= kPairsShown) {
+      for (const auto& p : pairs)
+        std::printf("  | %s: force %.6g  p_max %.6g  active %d (%+d)", p.name.c_str(), p.force, p.max_pressure,
+                    p.active_nodes, p.changed_nodes);
+      return;
+    }
+    double force = 0;
+    int active = 0, changed = 0, changing_pairs = 0;
+    const contact::PairReport* peak = &pairs.front();
+    for (const auto& p : pairs) {
+      force += p.force;
+      active += p.active_nodes;
+      changed += std::abs(p.changed_nodes);
+      changing_pairs += p.changed_nodes != 0;
+      if (p.max_pressure > peak->max_pressure) peak = &p;
+    }
+    std::printf("  | %zu pairs: force %.6g  active %d (%d changed in %d pairs)  p_max %.6g at %s", pairs.size(), force,
+                active, changed, changing_pairs, peak->max_pressure, peak->name.c_str());
+  }
+  static constexpr size_t kPairsShown = 6;
 
   // One line per adaptive step: cells and unknowns per body (and the cells refined after the step), the global
   // estimate, force and peak pressure with their relative changes over the step (what the stop test compares),
@@ -153,7 +175,9 @@ std::string read_file(const std::string& path) {
 // The summary lines of the last step: per pair its force, resultant, peak pressure and penetration (and friction),
 // per supported body its reactions (per displacement condition, the components it prescribes, and the total).
 void print_final_step(const contact::Step& step) {
-  for (const auto& p : step.pairs) {
+  constexpr size_t kPairLines = 24;  // a wall's hundreds of pairs are in the result file
+  for (size_t k = 0; k < step.pairs.size() && k < kPairLines; ++k) {
+    const auto& p = step.pairs[k];
     double p_max = 0, penetration = 0;
     for (Eigen::Index j = 0; j < p.pressure.size(); ++j) {
       p_max = std::max(p_max, p.pressure[j]);
@@ -174,6 +198,8 @@ void print_final_step(const contact::Step& step) {
                   in_contact);
     }
   }
+  if (step.pairs.size() > kPairLines)
+    std::printf("... and %zu more pairs (every pair is in the result file)\n", step.pairs.size() - kPairLines);
   for (const auto& b : step.bodies) {
     if (b.support_reactions.empty()) continue;
     std::printf("body %s: reactions total (%.8g, %.8g)", b.name.c_str(), b.reaction_total.x(), b.reaction_total.y());
