@@ -16,7 +16,7 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_walls import QUICK, SRC, run, seed_job  # noqa: E402  (one runner and one yardstick for the wall benches)
+from bench_walls import QUICK, SRC, print_result, run, seed_job  # noqa: E402  (one runner and one yardstick for the wall benches)
 
 
 def generated(n, options, solver, tmp):
@@ -49,11 +49,8 @@ def main():
                     job, bodies = generated(n, options, solver, tmp)
                     r, error = run(job, 1, tmp)
                     rows[(n, kind, solver)] = r
-                    if r is None:
-                        print(f"{n:>4}x{n:<2} {bodies:>6} {kind:>12} {solver:>9} {error[:160]}", flush=True)
-                        continue
-                    print(f"{n:>4}x{n:<2} {bodies:>6} {kind:>12} {solver:>9} {r['wall']:>8.2f} {r['rss']:>8.0f} "
-                          f"{r['steps']:>5} {r['iterations']:>9}", flush=True)
+                    print_result(f"{n:>4}x{n:<2} {bodies:>6} {kind:>12} {solver:>9}", r, error,
+                                 "{wall:>8.2f} {rss:>8.0f} {steps:>5} {iterations:>9}")
         print("\nratios (same run):")
         for solver in ("direct", "iterative"):
             a, b = rows.get((22, "frictional", solver)), rows.get((16, "frictional", solver))

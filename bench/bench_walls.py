@@ -44,6 +44,11 @@ def run(job, ranks, tmp):
     return dict(wall=wall, rss=rss, iterations=iterations, steps=steps), ""
 
 
+def print_result(label, r, error, columns):
+    """One row of a table: the label, then `columns` (a format of run()'s fields) or the error."""
+    print(f"{label} {error[:160]}" if r is None else f"{label} " + columns.format(**r), flush=True)
+
+
 def wall_job(n, solver, tmp):
     path = os.path.join(tmp, f"wall{n}.json")
     if not os.path.exists(path):
@@ -88,11 +93,8 @@ def main():
                 for ranks in ranks_list:
                     r, error = run(job, ranks, tmp)
                     rows[(n, solver, ranks)] = r
-                    if r is None:
-                        print(f"{n:>4}x{n:<2} {bodies:>6} {solver:>9} {ranks:>5} {error}", flush=True)
-                        continue
-                    print(f"{n:>4}x{n:<2} {bodies:>6} {solver:>9} {ranks:>5} {r['wall']:>8.2f} {r['rss']:>12.0f} "
-                          f"{r['iterations']:>9} {r['steps']:>5}", flush=True)
+                    print_result(f"{n:>4}x{n:<2} {bodies:>6} {solver:>9} {ranks:>5}", r, error,
+                                 "{wall:>8.2f} {rss:>12.0f} {iterations:>9} {steps:>5}")
         print("\nratios (same run):")
         for solver in ("direct", "iterative"):
             a, b = rows.get((22, solver, 1)), rows.get((16, solver, 1))

@@ -235,18 +235,7 @@ FrictionNewtonResult Newton::run(FrictionSets sets) {
 
 double friction_merit(const Eigen::VectorXd& lambda, const Eigen::VectorXd& h, const Eigen::VectorXd& c,
                       const std::vector<FrictionRow>& rows, const std::vector<char>& mask) {
-  double sum = 0.0;
-  for (Eigen::Index j = 0; j < lambda.size(); ++j)
-    if (!mask[static_cast<size_t>(j)]) {
-      const double C = lambda[j] - std::max(0.0, lambda[j] - c[j] * h[j]);
-      sum += C * C;
-    }
-  for (const auto& r : rows) {
-    const double b = trial_bound(r, lambda, h, c);
-    const double C = lambda[r.tangential] - std::clamp(lambda[r.tangential] - c[r.tangential] * h[r.tangential], -b, b);
-    sum += C * C;
-  }
-  return sum;
+  return complementarity_squared(lambda, h, c, rows, mask, CoulombBound::trial);
 }
 
 FrictionNewtonResult friction_newton(const FrictionNewtonProblem& problem, FrictionSets start,

@@ -1,8 +1,9 @@
 #include "friction_sets.hpp"
-#include "../common/assert.hpp"
 
 #include <algorithm>
 #include <cmath>
+
+#include "../common/assert.hpp"
 
 namespace contact::linalg {
 
@@ -91,8 +92,9 @@ FrictionParametrization parametrize(const FrictionSets& sets, const std::vector<
   return out;
 }
 
-double friction_complementarity(const Eigen::VectorXd& lambda, const Eigen::VectorXd& h, const Eigen::VectorXd& c,
-                                const std::vector<FrictionRow>& rows, const std::vector<char>& is_tangential) {
+double complementarity_squared(const Eigen::VectorXd& lambda, const Eigen::VectorXd& h, const Eigen::VectorXd& c,
+                               const std::vector<FrictionRow>& rows, const std::vector<char>& is_tangential,
+                               CoulombBound bound) {
   double sum = 0.0;
   for (Eigen::Index j = 0; j < lambda.size(); ++j)
     if (!is_tangential[static_cast<size_t>(j)]) {
@@ -100,12 +102,19 @@ double friction_complementarity(const Eigen::VectorXd& lambda, const Eigen::Vect
       sum += C * C;
     }
   for (const auto& r : rows) {
-    const double bounded = !r.coulomb || lambda[r.normal] > 0 ? bound_of(r, lambda[r.normal]) : 0.0;
+    const double z = bound == CoulombBound::trial ? lambda[r.normal] - c[r.normal] * h[r.normal] : lambda[r.normal];
+    const double b = !r.coulomb || z > 0 ? bound_of(r, z) : 0.0;
     const double trial = lambda[r.tangential] - c[r.tangential] * h[r.tangential];
-    const double C = lambda[r.tangential] - std::clamp(trial, -bounded, bounded);
+    const double C = lambda[r.tangential] - std::clamp(trial, -b, b);
     sum += C * C;
   }
-  return std::sqrt(sum) / std::max(lambda.norm(), 1e-300);
+  return sum;
+}
+
+double friction_complementarity(const Eigen::VectorXd& lambda, const Eigen::VectorXd& h, const Eigen::VectorXd& c,
+                                const std::vector<FrictionRow>& rows, const std::vector<char>& is_tangential) {
+  return std::sqrt(complementarity_squared(lambda, h, c, rows, is_tangential, CoulombBound::current)) /
+         std::max(lambda.norm(), 1e-300);
 }
 
 }  // namespace contact::linalg

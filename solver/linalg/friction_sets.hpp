@@ -70,6 +70,15 @@ struct FrictionParametrization {
 FrictionParametrization parametrize(const FrictionSets& sets, const std::vector<FrictionRow>& rows,
                                     const std::vector<char>& is_tangential);
 
+// Which Coulomb bound the complementarity function C takes: mu z at the current normal multiplier (the residual the
+// solvers report) or mu max(0, z - c h_n) at the normal trial (what a set's slip rows impose: the Newton's merit).
+enum class CoulombBound { current, trial };
+
+// ||C(lambda)||^2 with the normal part z - max(0, z - c h) and the tangential part q - proj_[-b,b](q - c w).
+double complementarity_squared(const Eigen::VectorXd& lambda, const Eigen::VectorXd& h, const Eigen::VectorXd& c,
+                               const std::vector<FrictionRow>& rows, const std::vector<char>& is_tangential,
+                               CoulombBound bound);
+
 // ||C(lambda)|| / max(||lambda||, tiny): normal C_i = z_i - max(0, z_i - c_i h_i), tangential
 // C_t = q_t - proj_[-b,b](q_t - c_t w_t) with b from the current z.
 double friction_complementarity(const Eigen::VectorXd& lambda, const Eigen::VectorXd& h, const Eigen::VectorXd& c,
