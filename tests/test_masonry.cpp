@@ -117,6 +117,42 @@ TEST(Masonry, TheInterfaceSolverEqualsTheMonolithicReferenceOnFrictionalWalls) {
   }
 }
 
+TEST(Masonry, TheIterativeSolverEqualsTheDirectOneOnWallsWithHeadJoints) {
+  for (const std::string options :
+       {"--head-joints --friction 0.6 --shear 0.3", "--abutments --friction 0.6 --shear 0.3",
+        "--head-joints --friction 0.6 --head-friction 0 --shear 0.3"}) {
+    json job = wall(4, 4, options);
+    job["solver"]["interface"] = {{"solver", "direct"}};
+    const Result direct = run(job);
+    job["solver"]["interface"] = {{"solver", "iterative"}, {"tolerance", 1e-13}};
+    const Result iterative = run(job);
+    ASSERT_TRUE(direct.converged) << options << ": " << direct.message;
+    ASSERT_TRUE(iterative.converged) << options << ": " << iterative.message;
+    EXPECT_EQ(iterative.interface_solver, "iterative");
+    EXPECT_LT(relative_difference(iterative, direct), 1e-8) << options;
+  }
+}
+
+TEST(Masonry, A16x16WallHoldsAndA22x22OneRefusesAShearAboveMu) {
+  // The statics at scale, with the solver `auto` picks (the iterative one past 256 floating-body rows). (The 22 x 22
+  // wall at H/V = 0.3 holds too, in about 10 s: bench/bench_friction_walls.py.)
+  for (const int n : {16}) {
+    const json job = wall(n, n, "--head-joints --friction 0.6 --shear 0.3");
+    const Result r = run(job);
+    ASSERT_TRUE(r.converged) << n << ": " << r.message;
+    ASSERT_EQ(r.steps.size(), 2u);
+    for (size_t k = 0; k < 2; ++k) {
+      const Eigen::Vector2d load = applied_load(job, k), reaction = support_reactions(r.steps[k]);
+      EXPECT_NEAR(reaction.x(), -load.x(), 1e-8 * load.norm()) << n << " step " << k;
+      EXPECT_NEAR(reaction.y(), -load.y(), 1e-8 * load.norm()) << n << " step " << k;
+    }
+  }
+  const Result r = run(wall(22, 22, "--head-joints --friction 0.6 --shear 0.65"));
+  EXPECT_EQ(r.stop_reason, StopReason::error);
+  EXPECT_NE(r.message.find("1.083 times what friction can carry"), std::string::npos) << r.message;
+  EXPECT_EQ(r.steps.size(), 1u);
+}
+
 TEST(Masonry, AShearAboveTheFrictionCoefficientStopsAtOnceNamingTheSlidingCourseAndKeepsTheStepThatHeld) {
   // H/V = 0.65 > mu = 0.6: the joint under the top course cannot carry its shear, 0.65 / 0.6 = 1.083 times what
   // friction can; the top course (9 bricks in a running bond of 8 x 8) is named. Both solvers say it before solving.
