@@ -4,16 +4,16 @@
 // -b <= q <= b started from the last answer (and the last equality multipliers), b <- mu z, until the bounds
 // stop moving and the friction complementarity of the Coulomb problem itself is below the tolerance
 // (docs/algorithm.md, "Friction in the iterative solver", for why this outer iteration and what it costs).
-#include "feti.hpp"
-
-#include "../../linalg/friction_sets.hpp"
-#include "friction_direct.hpp"
-#include "smalbe.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
+
+#include "../../linalg/friction_sets.hpp"
+#include "../friction_rows.hpp"
+#include "feti.hpp"
+#include "friction_direct.hpp"
+#include "smalbe.hpp"
 
 namespace contact::ddm {
 
@@ -37,18 +37,16 @@ struct FrictionData {
 FrictionData friction_data(const InterfaceProblem& problem, const Eigen::VectorXd& diagonal) {
   FrictionData d;
   const double dmax = diagonal.size() ? diagonal.cwiseAbs().maxCoeff() : 0.0;
-  // A node whose tangential motion both sides prescribe (on a symmetry line) cannot slip: its row of F is zero and
-  // its tangential traction goes into the supports; it is left out (q = 0 there), as friction_direct does.
-  for (const auto& r : friction_rows(problem))
-    if (diagonal[r.tangential] > 1e-12 * dmax) {
-      d.rows.push_back(r);
-      d.coulomb = d.coulomb || r.coulomb;
-    }
-  // The mask covers every tangential row, those left out too: friction_box fixes them at 0, and the complementarity
-  // and the sets' prediction skip them (as normal rows they would count their slip, with c = 1 / (1e-12 max F_jj),
-  // as a violated gap: a complementarity of 1e5 and more on hertz.json's symmetry node).
-  d.mask.assign(static_cast<size_t>(problem.size()), 0);
-  for (Eigen::Index j = problem.normal_size(); j < problem.size(); ++j) d.mask[static_cast<size_t>(j)] = 1;
+  // The rows of every frictional solver (friction_rows.hpp): none where no body moves the node tangentially (a
+  // symmetry line: q = 0 there, as in friction_direct). The mask covers every tangential row, those left out too:
+  // friction_box fixes them at 0, and the complementarity and the sets' prediction skip them.
+  d.rows = ddm::friction_rows(
+      problem.system(), [&](size_t k) { return problem.offset(k); },
+      [&](size_t k) { return problem.tangential_offset(k); },
+      [&](Eigen::Index t) { return diagonal[t] > 1e-12 * dmax; });
+  for (const auto& r : d.rows) d.coulomb = d.coulomb || r.coulomb;
+  d.mask = ddm::tangential_unknowns(problem.system(), problem.size(),
+                                    [&](size_t k) { return problem.tangential_offset(k); });
   // c = 1 / F_jj, but at most 1 / (1e-6 max F_jj): a row barely moved (a node next to a symmetry line, whose
   // tangential compliance is 1e-10 of the others on hertz_force.json) multiplies its slip, which the iterative
   // solve leaves at the products' rounding (1e-13 where the gaps are 1e-2), by 1e13 into a complementarity of 1
@@ -93,8 +91,8 @@ std::string settled_message(const FrictionData& d, const ActiveSetResult& out, i
     slip += st == Contact::slip;
   }
   std::ostringstream os;
-  os << "FETI (projected MPRGP on the box, SMALBE) with " << (d.coulomb ? "Coulomb" : "Tresca") << " friction converged: "
-     << out.inner_iterations << " MPRGP iterations";
+  os << "FETI (projected MPRGP on the box, SMALBE) with " << (d.coulomb ? "Coulomb" : "Tresca")
+     << " friction converged: " << out.inner_iterations << " MPRGP iterations";
   if (d.coulomb) os << " in " << outer << " outer iterations on the slip bounds";
   os << " (" << active << " nodes in contact: " << stick << " sticking, " << slip << " slipping; F products "
      << smalbe.seconds_F() << " s, coarse projections " << smalbe.seconds_coarse() << " s)";

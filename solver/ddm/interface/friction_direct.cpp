@@ -59,12 +59,6 @@ FrictionSets first_sets(const SparseMatrix& F, const InterfaceQp& qp, const Eige
 
 }  // namespace
 
-std::vector<FrictionRow> friction_rows(const InterfaceProblem& problem) {
-  return ddm::friction_rows(
-      problem.system(), [&](size_t k) { return problem.offset(k); }, [&](size_t k) { return problem.tangential_offset(k); },
-      [](Eigen::Index) { return true; });
-}
-
 namespace {
 
 // The first sets from coarse friction solves (linalg/friction_nested.hpp) over the sticking start: false (and the

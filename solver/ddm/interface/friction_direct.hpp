@@ -28,8 +28,4 @@ class FrictionDirectSolver final : public InterfaceSolver {
   Eigen::VectorXd last_alpha_;  // the floating bodies' rigid amplitudes of the last solve (with its warm start)
 };
 
-// The friction rows of the interface problem (one per contact node of each friction pair, paired with its normal
-// row).
-std::vector<linalg::FrictionRow> friction_rows(const InterfaceProblem& problem);
-
 }  // namespace contact::ddm
