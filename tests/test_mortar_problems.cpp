@@ -107,6 +107,41 @@ TEST(MortarHertz, CylinderArcOnGradedNonMatchingBlockMatchesTheFormulaWithDefaul
   }
 }
 
+TEST(MortarShrinkFit, AnInterferenceGivesLamesUniformPressureOnMatchingArcs) {
+  // api/examples/shrink_fit.json: a quarter of a solid shaft (radius a = 500) in a ring (a .. b = 1000), same steel,
+  // radial interference delta = 0.6667 as gap.constant < 0, plane strain. Lame: p = E' delta / (2 a) (1 - a^2/b^2)
+  // with E' = E / (1 - nu^2), uniform along the bore; the shaft's symmetry edge y = 0 carries p a per unit
+  // thickness. The same fit written as geometry (the ring's bore of radius a - delta overlapping the shaft, gap
+  // left to the geometry) gives Lame's pressure for that bore.
+  const double E = 2e5, nu = 0.3, b = 1000.0, delta = 0.6667;
+  auto lame = [&](double a) { return E / (1 - nu * nu) * delta / (2 * a) * (1 - a * a / (b * b)); };
+  for (const bool overlapping : {false, true}) {
+    json job = example("shrink_fit.json");
+    double a = 500.0;
+    if (overlapping) {
+      const double bore = 500.0 - delta;
+      auto& ring = job["bodies"][1]["mesh"]["block"];
+      ring["corners"] = json::array({json::array({bore, 0}), json::array({1000, 0}), json::array({0, 1000}), json::array({0, bore})});
+      ring["edges"]["left"] = {{"arc", {{"center", {0, 0}}, {"radius", bore}}}};
+      for (auto& c : job["contacts"]) c.erase("gap");
+      a = 500.0 - delta / 2;  // the fit's radius
+    }
+    const Result r = run(job);
+    ASSERT_TRUE(r.converged) << r.message;
+    const double p = lame(a);
+    int nodes = 0;
+    for (const PairField& pair : r.steps.back().pairs)
+      for (Eigen::Index i = 0; i < pair.pressure.size(); ++i) {
+        if (pair.status[i] != 0) continue;
+        ++nodes;
+        EXPECT_NEAR(pair.pressure[i], p, 0.005 * p) << pair.name << " node " << i << (overlapping ? " (overlap)" : "");
+      }
+    EXPECT_GE(nodes, 32);
+    for (const BodyField& body : r.steps.back().bodies)
+      if (body.name == "shaft") EXPECT_NEAR(body.reaction_total.y(), p * a, 0.005 * p * a);
+  }
+}
+
 TEST(MortarAdaptive, ThePapersProblemWithEveryDefaultAndBothBodiesAdaptingIsSmoothAndAccurate) {
   // seed_layers_adaptive without its solver object and with the default strategy (converge, then refine) and
   // every body adapting: exact contact on meshes that become non-matching everywhere.
