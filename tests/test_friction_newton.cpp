@@ -181,3 +181,40 @@ TEST(FrictionNewton, ConvergesWhereTheFullStepsCycle) {
     expect_coulomb_conditions(p, r.iterate, 1e-9);
   }
 }
+
+TEST(FrictionSetsSystem, AConsistentSingularSystemIsSolvedWithTheLeastRigidMotionAnInconsistentOneIsRefused) {
+  // Two floating bodies, one rigid mode each (rows of G), three multipliers: the first is free (the sets' unknown),
+  // the other two act on body 2 only and are prescribed by the sets (slip at a Tresca bound: lambda0). Body 2's row
+  // of G P is zero, so the sets' system is singular: body 2's motion is fixed by no free multiplier. If the loads on
+  // body 2 (e_2) balance the prescribed tractions (G_2 lambda0 = e_2: a brick whose joints slip at the same force
+  // above and below) every motion is an equilibrium and the answer is the one without it (alpha_2 = 0); if they do
+  // not, no equilibrium exists and the solve says so.
+  Eigen::MatrixXd Fd(3, 3);
+  Fd << 2.0, 0.3, 0.1, 0.3, 1.5, 0.2, 0.1, 0.2, 1.0;
+  const SparseMatrix F = Fd.sparseView();
+  const Eigen::VectorXd g = Eigen::Vector3d(-0.4, 0.1, 0.2);
+  Eigen::MatrixXd Gd(2, 3);
+  Gd << 1.0, 0.0, 0.0, 0.0, 1.0, -1.0;
+  FrictionParametrization p;
+  p.rows = {0};
+  p.P = SparseMatrix(3, 1);
+  p.P.insert(0, 0) = 1.0;
+  p.lambda0 = Eigen::Vector3d(0.0, 0.7, 0.7);  // the two prescribed tractions cancel on body 2
+  for (const double load : {0.0, 0.05}) {
+    Equalities eq;
+    eq.G = Gd.sparseView();
+    eq.e = Eigen::Vector2d(0.5, load);
+    FrictionIterate x;
+    const bool solved = solve_on_friction_sets(F, g, eq, p, x);
+    if (load != 0.0) {
+      EXPECT_FALSE(solved) << "body 2's load is not balanced: no equilibrium";
+      continue;
+    }
+    ASSERT_TRUE(solved);
+    // Both bodies in equilibrium, to the regularisation's 1e-10 (the solve accepts at most 1e-9 relative).
+    EXPECT_NEAR((eq.G * x.lambda - eq.e).norm(), 0.0, 1e-9 * eq.e.norm());
+    EXPECT_NEAR(x.lambda[0], 0.5, 1e-9);  // body 1's: G_1 lambda = lambda_0 = e_1
+    EXPECT_NEAR(x.h[0], 0.0, 1e-10);                           // the free row's gap closed
+    EXPECT_NEAR(std::abs(x.other[1]), 0.0, 1e-8);               // body 2 not moved
+  }
+}

@@ -52,7 +52,7 @@ std::unique_ptr<fem::BodySolver> ContactSystem::make_body(size_t a, bool local, 
   if (cancel) cancelled = [cancel] { return cancel->cancelled(); };
   auto b = std::make_unique<fem::BodySolver>(problem_.bodies[a], problem_.model, factorization_ != Factorization::none,
                                              interface_dofs(a), may_float(a), local, std::move(cancelled));
-  b->set_load_step(load_step_, load_factor_);
+  b->set_load_between(load_step_, previous_factor_, load_factor_, step_fraction_);
   return b;
 }
 

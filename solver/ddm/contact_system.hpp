@@ -58,12 +58,18 @@ class ContactSystem {
   // The load factor of every body (load steps): scales the bodies' loads and prescribed values; set_load_step also
   // gives the conditions with their own history their factor of that step.
   void set_load_factor(double factor) { set_load_step(0, factor); }
-  void set_load_step(size_t step, double factor) {
+  void set_load_step(size_t step, double factor) { set_load_between(step, 0.0, factor, 1.0); }
+  // A point t of the way through step `step` from the previous step's loads (fem::BodySolver::set_load_between).
+  void set_load_between(size_t step, double previous_factor, double factor, double t) {
     load_step_ = step;
+    previous_factor_ = previous_factor;
     load_factor_ = factor;
-    for (auto& b : bodies_) b->set_load_step(step, factor);
+    step_fraction_ = t;
+    for (auto& b : bodies_) b->set_load_between(step, previous_factor, factor, t);
+    const double from = step == 0 ? 0.0 : previous_factor;
+    current_factor_ = t == 1.0 ? factor : from + t * (factor - from);  // as each body has it
   }
-  double load_factor() const { return load_factor_; }
+  double load_factor() const { return current_factor_; }  // the loading's factor now (within a cut step: between)
   // Some condition has its own load history: the loads of a step are then not a multiple of another step's.
   bool has_histories() const;
   bool has_friction() const { return problem_.has_friction(); }
@@ -146,7 +152,7 @@ class ContactSystem {
   std::string error_;
   bool cancelled_ = false;
   double setup_seconds_ = 0.0, factorization_seconds_ = 0.0;
-  double load_factor_ = 1.0;
+  double load_factor_ = 1.0, previous_factor_ = 0.0, step_fraction_ = 1.0, current_factor_ = 1.0;
   size_t load_step_ = 0;
 };
 

@@ -12,6 +12,7 @@ MethodOutcome run_enforced(ContactSystem& system, const SolverSettings& settings
       (settings.method == Method::neumann || settings.method == Method::robin)) {
     MethodOutcome out;
     out.reason = StopReason::error;
+    out.refused = true;  // a setting, not the loads: no increment is solved
     out.message = std::string("method ") + (settings.method == Method::neumann ? "neumann" : "robin") +
                   " iterates on the penalty problem: enforcement exact is not available with it (use penalty, or "
                   "augmented_lagrangian for exact contact in the limit; or method interface_newton)";

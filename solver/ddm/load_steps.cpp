@@ -1,7 +1,27 @@
 #include "load_steps.hpp"
 
+#include <algorithm>
 
 namespace contact::ddm {
+
+namespace {
+
+// A frictional step that does not converge is cut: its increment is halved (at most kMaxCuts times, down to 1/32 of
+// the step) and the sub-steps are solved and accepted in turn from the last state that held. Why: friction is
+// path dependent and the semismooth Newton's start is the previous state; near the limit of what friction holds
+// (bricks at the heel of a sheared wall whose bed joints slip above and below) a whole step's increment can leave
+// the Newton in sets that hold no answer, while halves of it, each from an answer, converge. The sub-steps follow
+// the load path more closely; they are not output steps (the step's result is its last sub-step's).
+constexpr int kMaxCuts = 5;
+
+bool may_cut(const ContactSystem& system, const MethodOutcome& outcome, const RunContext& context) {
+  // Not: frictionless steps (path independent: a cut solves the same problem), a statics refusal (the loads of the
+  // step's end are refused whatever the path) or a cancel.
+  return system.has_friction() && !outcome.converged && !outcome.refused &&
+         outcome.reason != StopReason::cancelled && !context.cancel.cancelled();
+}
+
+}  // namespace
 
 MethodOutcome run_load_steps(ContactSystem& system, const SolverSettings& settings, const std::vector<double>& factors,
                              RunContext& context, ContactMethod& method, StepLog& steps) {
@@ -9,19 +29,39 @@ MethodOutcome run_load_steps(ContactSystem& system, const SolverSettings& settin
   MethodOutcome& total = steps_so_far.total();
   Displacements warm;
   for (size_t k = 0; k < factors.size(); ++k) {
-    system.set_load_step(k, factors[k]);
-    steps_so_far.run(context, warm.empty() ? nullptr : &warm, InnerMarks{},
-                     [&](RunContext& inner) { return run_enforced(system, settings, inner, method); });
-    const std::string prefix = factors.size() == 1 ? std::string()
-                                                   : "load step " + std::to_string(k + 1) + " of " +
-                                                         std::to_string(factors.size()) + ": ";
-    total.message = prefix + total.message;
+    const double previous = k == 0 ? 0.0 : factors[k - 1];
+    double done = 0.0, increment = 1.0;
+    int cuts = 0, sub_steps = 0;
+    while (true) {
+      const double t = std::min(1.0, done + increment);
+      system.set_load_between(k, previous, factors[k], t);
+      steps_so_far.run(context, warm.empty() ? nullptr : &warm, InnerMarks{},
+                       [&](RunContext& inner) { return run_enforced(system, settings, inner, method); });
+      if (total.converged && t < 1.0) {  // a sub-step held: its state is the next one's start
+        system.accept_step(total.u);
+        warm = total.u;
+        done = t;
+        ++sub_steps;
+        continue;
+      }
+      if (total.converged || cuts == kMaxCuts || !may_cut(system, total, context)) break;
+      increment *= 0.5;
+      ++cuts;
+    }
+    std::string prefix = factors.size() == 1 ? std::string()
+                                             : "load step " + std::to_string(k + 1) + " of " +
+                                                   std::to_string(factors.size());
+    if (cuts > 0)
+      prefix += std::string(prefix.empty() ? "" : " ") + "(cut " + std::to_string(cuts) + " times: " +
+                std::to_string(sub_steps + (total.converged ? 1 : 0)) + " sub-steps held, the last at " +
+                std::to_string(static_cast<int>(100 * (total.converged ? 1.0 : done) + 0.5)) + " % of the step)";
+    if (!prefix.empty()) total.message = prefix + ": " + total.message;
     if (total.u.empty()) return steps_so_far.take();
     Step step = total.z.empty() ? system.fields(total.u, total.iterations)
                                 : system.fields(total.u, total.z, total.iterations, &total.rigid_amplitudes,
                                                 total.q.empty() ? nullptr : &total.q);
     step.index = static_cast<int>(k);
-    step.load_factor = factors[k];
+    step.load_factor = system.load_factor();  // factors[k], or where a cut step failed the fraction tried
     step.converged = total.converged;
     steps.push_back(std::move(step));
     if (!total.converged) return steps_so_far.take();

@@ -30,6 +30,9 @@ struct MethodOutcome {
   bool converged = false;
   StopReason reason = StopReason::error;
   std::string message;
+  // Refused before any solve (statics: friction cannot hold the loads, ddm/friction_statics.hpp; or the settings):
+  // a smaller increment of the same step would be refused too (load_steps.cpp cuts only the other failures).
+  bool refused = false;
   int iterations = 0;
   int updates = 0;  // augmented-Lagrangian updates (0 for the penalty or exact problem alone)
   double gamma = 0.0;

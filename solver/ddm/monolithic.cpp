@@ -201,6 +201,7 @@ MethodOutcome run_exact(const ContactSystem& system, const SolverSettings& setti
   MethodOutcome out;
   if (std::string sliding = friction_cannot_hold(system); !sliding.empty()) {  // statics: no solver can hold it
     out.reason = StopReason::error;
+    out.refused = true;
     out.message = sliding;
     return out;
   }

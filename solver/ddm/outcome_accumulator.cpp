@@ -40,6 +40,7 @@ void OutcomeAccumulator::append(MethodOutcome inner, const InnerMarks& marks) {
   total_.q = std::move(inner.q);
   total_.rigid_amplitudes = std::move(inner.rigid_amplitudes);
   total_.converged = inner.converged;
+  total_.refused = inner.refused;
   total_.reason = inner.reason;
   total_.message = std::move(inner.message);
 }

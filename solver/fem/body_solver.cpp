@@ -171,11 +171,18 @@ void BodySolver::setup_history_groups() {
   }
 }
 
-void BodySolver::set_load_step(size_t step, double factor) {
-  load_factor_ = factor;
+void BodySolver::set_load_between(size_t step, double previous_factor, double factor, double t) {
+  if (step == 0) previous_factor = 0.0;
+  load_factor_ = t == 1.0 ? factor : previous_factor + t * (factor - previous_factor);
   for (auto& group : groups_) {
     const auto& h = group.condition->history;
-    group.factor = h.empty() ? factor : h[std::min(step, h.size() - 1)];
+    if (h.empty()) {
+      group.factor = load_factor_;
+      continue;
+    }
+    const double end = h[std::min(step, h.size() - 1)];
+    const double start = step == 0 ? 0.0 : h[std::min(step - 1, h.size() - 1)];
+    group.factor = t == 1.0 ? end : start + t * (end - start);
   }
 }
 

@@ -109,6 +109,17 @@ bool newton_on_level(const FrictionLevel& level, const Eigen::VectorXd& c, const
   return r.stop == FrictionStop::settled;
 }
 
+// M y = rhs by UMFPACK with a step of refinement (the system mixes F's scales and G's); false when M is singular or
+// so nearly that the refined solution does not solve it (relative residual above 1e-8).
+bool solve_refined(const SparseMatrix& M, const Eigen::VectorXd& rhs, Eigen::VectorXd& y) {
+  Eigen::UmfPackLU<SparseMatrix> lu(M);
+  if (lu.info() != Eigen::Success) return false;
+  y = lu.solve(rhs);
+  if (!y.allFinite()) return false;
+  y += lu.solve(Eigen::VectorXd(rhs - M * y));
+  return y.allFinite() && (M * y - rhs).norm() <= 1e-8 * std::max(rhs.norm(), 1e-300);
+}
+
 // [R F P  R G^T; G P  0] [y; alpha] = [-R (g + F lambda0); e - G lambda0], by UMFPACK; false when singular.
 bool solve_sets_system(const SparseMatrix& F, const Equalities& eq, const FrictionParametrization& p,
                        const Eigen::VectorXd& g, Eigen::VectorXd& y) {
@@ -131,11 +142,28 @@ bool solve_sets_system(const SparseMatrix& F, const Equalities& eq, const Fricti
   const Eigen::VectorXd h0 = g + F * p.lambda0;
   for (Eigen::Index i = 0; i < na; ++i) rhs[i] = -h0[p.rows[static_cast<size_t>(i)]];
   if (r > 0) rhs.tail(r) = eq.e - eq.G * p.lambda0;
-  Eigen::UmfPackLU<SparseMatrix> lu(M);
-  if (lu.info() != Eigen::Success) return false;
-  y = lu.solve(rhs);
-  y += lu.solve(Eigen::VectorXd(rhs - M * y));  // one step of refinement: the system mixes F's scales and G's
-  return y.allFinite();
+  if (solve_refined(M, rhs, y)) return true;
+  if (r == 0) return false;
+  // Singular: a floating body (or a group) whose rigid motion no free multiplier fixes, the rows of G P dependent.
+  // Where the loads on it balance with the tractions its sets prescribe (a brick whose bed joints above and below
+  // both slip at mu times the same normal force: its slip is indeterminate, every value an equilibrium), the
+  // system is consistent and the solution with the least rigid motion along the free directions is as good an
+  // answer as any: regularised, -eps I in the equilibrium block, and taken only if the equalities still hold (the
+  // regularisation did not have to push), otherwise the sets are singular indeed (the body would slide away).
+  double gp2 = 0, f = 0;
+  for (Eigen::Index i = 0; i < GP.rows(); ++i) gp2 = std::max(gp2, GP.row(i).squaredNorm());
+  for (Eigen::Index i = 0; i < na; ++i) f = std::max(f, std::abs(RFP.coeff(i, i)));
+  if (!(gp2 > 0) || !(f > 0)) return false;
+  const double eps = 1e-10 * gp2 / f;
+  for (Eigen::Index i = 0; i < r; ++i) entries.emplace_back(na + i, na + i, -eps);
+  SparseMatrix Me(na + r, na + r);
+  Me.setFromTriplets(entries.begin(), entries.end());
+  // Not refined on the true system: that would move the free direction by rounding over eps (the rigid motion the
+  // regularisation keeps least); the held bodies' equalities are off by eps alpha, which the test below bounds.
+  if (!solve_refined(Me, rhs, y)) return false;
+  const Eigen::VectorXd residual = M * y - rhs;
+  return residual.tail(r).norm() <= 1e-9 * std::max(rhs.tail(r).norm(), 1e-300) &&
+         residual.head(na).norm() <= 1e-9 * std::max(rhs.head(na).norm(), 1e-300);
 }
 
 

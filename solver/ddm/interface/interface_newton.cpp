@@ -67,6 +67,7 @@ MethodOutcome InterfaceNewton::solve(const SolverSettings& settings, RunContext&
   if (system_.has_friction())
     if (std::string overload = friction_cannot_hold(system_); !overload.empty()) {
       out.reason = StopReason::error;
+      out.refused = true;
       out.message = overload;
       return out;
     }
