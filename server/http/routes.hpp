@@ -84,7 +84,8 @@ struct RouteContext {
                       BodyBudget::Slot& slot) const;
   // The job the path names, or null with 404 (or 400 for a malformed id) set.
   std::shared_ptr<Job> find_job(const Request& req, Response& res) const;
-  nlohmann::json job_resource(const JobRecord& record, int queue_position) const;
+  // The job as JSON; `listed`: as the job list carries it (its progress a bounded digest, progress_digest).
+  nlohmann::json job_resource(const JobRecord& record, int queue_position, bool listed = false) const;
 };
 
 void register_job_routes(Router& router, RouteContext& context);

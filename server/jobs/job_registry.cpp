@@ -156,7 +156,7 @@ bool JobRegistry::commit(const std::shared_ptr<Job>& job, const Change& change, 
 void JobRegistry::update_progress(Job& job, int iterations, nlohmann::json summary) {
   std::lock_guard<std::mutex> lock(mutex_);
   job.record.iterations = iterations;
-  job.record.progress = std::move(summary);
+  job.record.progress = std::make_shared<const nlohmann::json>(std::move(summary));
 }
 
 JobRecord JobRegistry::count_outcome(Job& job) {

@@ -226,9 +226,21 @@ void handle_list(RouteContext& ctx, const Request& req, Response& res) {
     }
     after = cursor;
   }
-  const auto page = ctx.queue.list(state, static_cast<std::size_t>(page_size), after);
+  auto page = ctx.queue.list(state, static_cast<std::size_t>(page_size), after);
+  // Bounded by bytes as well as by count: past kListBytes the page ends early (at least one job), and the token
+  // continues after its last job.
+  constexpr std::size_t kListBytes = 1 << 20;
   nlohmann::json jobs = nlohmann::json::array();
-  for (const auto& record : page.jobs) jobs.push_back(ctx.job_resource(record, 0));
+  std::size_t bytes = 0;
+  for (std::size_t i = 0; i < page.jobs.size(); ++i) {
+    nlohmann::json job = ctx.job_resource(page.jobs[i], 0, true);
+    bytes += job.dump().size();
+    jobs.push_back(std::move(job));
+    if (bytes > kListBytes && i + 1 < page.jobs.size()) {
+      page.next = JobQueue::Cursor{page.jobs[i].created_us, page.jobs[i].id};
+      break;
+    }
+  }
   send_json(res, 200, {{"jobs", jobs}, {"next_page_token", page.next ? encode_cursor(*page.next) : std::string()}});
 }
 

@@ -6,10 +6,11 @@
 
 #include "common/time.hpp"
 #include "http/problem_document.hpp"
+#include "jobs/events.hpp"
 
 namespace contactd {
 
-nlohmann::json RouteContext::job_resource(const JobRecord& r, int queue_position) const {
+nlohmann::json RouteContext::job_resource(const JobRecord& r, int queue_position, bool listed) const {
   const std::int64_t now = now_unix_us();
   auto time_or_null = [](std::int64_t us) { return us > 0 ? nlohmann::json(iso8601_us(us)) : nlohmann::json(nullptr); };
   const std::int64_t queued_until = r.started_us > 0 ? r.started_us : (r.finished_us > 0 ? r.finished_us : now);
@@ -35,7 +36,7 @@ nlohmann::json RouteContext::job_resource(const JobRecord& r, int queue_position
                       {"attempts", r.attempts},
                       {"interruptions", r.interruptions},
                       {"iterations", r.iterations},
-                      {"progress", r.progress},
+                      {"progress", !r.progress ? nlohmann::json(nullptr) : listed ? progress_digest(*r.progress) : *r.progress},
                       {"timings", timings},
                       {"result_available", r.result_available},
                       {"events_dropped", r.events_dropped},

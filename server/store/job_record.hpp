@@ -4,6 +4,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <memory>
+
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -37,7 +39,9 @@ struct JobRecord {
   bool result_available = false;  // result.hdf and result.xmf exist
   std::int64_t result_bytes = 0;  // the size of result.hdf as written (checked before it is served)
   std::int64_t events_dropped = 0;  // iteration events not recorded: the job's event log reached its cap
-  nlohmann::json progress;        // the latest iteration in short (null before the first)
+  // The latest iteration in short (null before the first); shared, so copying a record (a listing, a snapshot)
+  // does not copy it: a 500-body wall's is 0.6 MB.
+  std::shared_ptr<const nlohmann::json> progress;
 };
 
 nlohmann::json to_state_json(const JobRecord& record);
