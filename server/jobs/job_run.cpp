@@ -167,18 +167,28 @@ JobRecord JobRun::outcome_of(const contact::Result& result, CancelReason reason)
 void JobRun::write_result_files(const contact::Result& result, JobRecord& outcome) {
   JobStore& store = context_.store;
   if (mpi_) {
-    outcome.result_available = mpi_->result_written && result.stop_reason != contact::StopReason::error;
+    outcome.result_available = mpi_->result_written;  // with the steps that held, also when a later one failed
     if (!outcome.result_available) store.remove_result(id_);
     for (const auto& step : mpi_->steps) job_->events.append("step", step);
     return;
   }
-  if (!problem_ || result.steps.empty() || result.stop_reason == contact::StopReason::error) return;
+  // Every step that held is kept, also when a later one failed (an error stop: the statics refused a load step,
+  // the friction Newton did not converge); the file's steps say which converged, the job's message which step
+  // failed and why. Nothing is written when no step was solved.
+  if (!problem_ || result.steps.empty()) return;
   try {
     contact::io::WriteInfo info;
     info.job_id = id_;
     contact::io::write_result(store.result_path(id_), *problem_, result, info);
     contact::io::write_xdmf(store.xmf_path(id_), "result.hdf", result);
     outcome.result_available = true;
+    if (result.stop_reason == contact::StopReason::error) {
+      std::size_t held = 0;
+      for (const auto& step : result.steps) held += step.converged;
+      outcome.message += held == 0 ? std::string("; no load step held (the result file has the last iterate, converged 0)")
+                                   : "; the result file keeps the " + std::to_string(held) + " load step" +
+                                         (held == 1 ? "" : "s") + " that held";
+    }
   } catch (const std::exception& e) {
     log_line("job " + id_ + ": cannot write the result file: " + e.what());
     store.remove_result(id_);  // also frees the space a full disk needs for the state change below

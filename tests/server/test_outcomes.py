@@ -10,7 +10,9 @@
   contact naming a body. /v1/validate and a submission answer the one error.
 
 Standard library and Debian's python3-h5py; exits non-zero on any failure."""
+import json
 import os
+import subprocess
 import sys
 import tempfile
 
@@ -19,7 +21,7 @@ import h5py
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))  # tests/
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from checks import check, finish  # noqa: E402
-from harness import Server, example, long_job, read_all_events  # noqa: E402
+from harness import SRC, Server, example, long_job, read_all_events  # noqa: E402
 
 
 def result_attributes(server, job_id):
@@ -98,6 +100,33 @@ with Server(args=["--workers", "1"]) as server:
     check("roller on a frictionless base: each pulling contact is said to be no answer",
           all(f"'{name}' (force " in message for name in pulling)
           and (not pulling or "the last iterate is not an answer: contact '" in message), (attrs, message[:400]))
+
+    # --- a load step refused: the steps that held are kept (issue 31, item 1) -------------------------------------
+    # An 8 x 8 frictional wall (mu 0.6) sheared to H/V = 0.65 in step 2: statics refuses it (no bed joint carries
+    # 0.65 V); the precompression of step 1 held and is downloadable.
+    wall = subprocess.run(["/usr/bin/python3", os.path.join(SRC, "scripts", "make_brick_wall.py"), "--rows", "4",
+                           "--bricks", "4", "--head-joints", "--friction", "0.6", "--shear", "0.65", "-o", "-"],
+                          capture_output=True, text=True)
+    job = json.loads(wall.stdout) if wall.returncode == 0 else {}
+    check("the generator wrote the wall", wall.returncode == 0, wall.stderr)
+    job_id = server.submit_id(job)
+    final = server.wait_done(job_id, timeout=300)
+    message = final.get("message") or ""
+    check("a refused load step: FAILED with the step and the cause", final.get("state") == "FAILED"
+          and message.startswith("load step 2 of 2: friction cannot hold") and "1.083 times" in message, message[:300])
+    check("its message says the step that held is kept", message.endswith("; the result file keeps the 1 load step that held"),
+          message[-200:])
+    check("the result is downloadable", final.get("result_available") is True, final)
+    r = server.get(f"/v1/jobs/{job_id}/result")
+    if r.status == 200:
+        with tempfile.NamedTemporaryFile(suffix=".hdf") as f:
+            f.write(r.body)
+            f.flush()
+            with h5py.File(f.name, "r") as h:
+                converged = list(h["history/steps/converged"][()])
+                check("the file holds step 1, converged", converged == [1] and "steps/0" in h, converged)
+    else:
+        check("the result downloads", False, r.status)
 
     # --- one error for one cause past a limit ------------------------------------------------------------------
     r = server.request("POST", "/v1/validate", json_body=row_of_blocks(589))
