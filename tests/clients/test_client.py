@@ -431,6 +431,23 @@ def test_cli(server, tmp):
     check("cli --events-out saves every event", [e["seq"] for e in saved] == list(range(1, len(saved) + 1))
           and saved and saved[-1]["type"] == "end", len(saved))
 
+    # A FAILED job with load steps that held (issue 31): a 4 x 4 frictional wall sheared past mu in step 2 is
+    # refused there; the client still downloads its result, which keeps step 1, and exits with the job's error.
+    wall = subprocess.run(["/usr/bin/python3", os.path.join(SRC, "scripts", "make_brick_wall.py"), "--rows", "4",
+                           "--bricks", "4", "--head-joints", "--friction", "0.6", "--shear", "0.65", "-o", "-"],
+                          capture_output=True, text=True)
+    failed_hdf = os.path.join(tmp, "refused.hdf")
+    r = run("submit", "-", "--wait", "-q", "-o", failed_hdf, url=url, stdin=wall.stdout)
+    check("cli: a FAILED job exits non-zero naming the refused step",
+          r.returncode != 0 and "ended FAILED" in r.stderr and "load step 2 of 2: friction cannot hold" in r.stderr,
+          r.stderr[-400:])
+    held = []
+    if os.path.exists(failed_hdf):
+        import h5py
+        with h5py.File(failed_hdf, "r") as f:
+            held = list(f["history/steps/converged"][()])
+    check("cli: the FAILED job's result is downloaded with the step that held", held == [1], (held, r.stderr[-300:]))
+
     r = run("submit", "-", url=url, stdin=json.dumps(flat_patch(name="from-stdin")))
     check("cli submit - reads standard input", r.returncode == 0 and UUID_RE.match(r.stdout.strip()), r)
     stdin_id = r.stdout.strip()
