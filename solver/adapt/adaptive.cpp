@@ -75,6 +75,10 @@ RefineOutcome mark_and_refine(Problem& problem, const std::vector<IndicatorResul
   const std::vector<ContactZone> zones = s.marking == MarkingRule::contact ? contact_zones(step) : std::vector<ContactZone>{};
   RefineOutcome out;
   const size_t n = problem.bodies.size();
+  // The job's total: each body may grow by what the others leave (counted as 2 x nodes, as mark() does).
+  long total = 0;
+  for (const auto& body : problem.bodies) total += 2L * body.mesh.num_nodes();
+  bool total_hit = false;
   out.changed.assign(n, 0);
   out.refined.assign(n, 0);
   out.refinements.resize(n);
@@ -84,8 +88,11 @@ RefineOutcome mark_and_refine(Problem& problem, const std::vector<IndicatorResul
     const ContactMarking rules = contact_marking(mesh, zones, s.grading);
     Eigen::VectorXd weighted = eta[a].eta;
     for (Eigen::Index c = 0; c < weighted.size(); ++c) weighted[c] *= rules.factor[static_cast<size_t>(c)];
-    const Marking m = mark(mesh, weighted, s.delta, s.max_level, s.max_dofs, rules.graded);
-    if (m.dof_limit_hit) add_note(out.note, "body '" + problem.bodies[a].name + "': max_dofs reached, refinement cut back");
+    const long own = 2L * mesh.num_nodes();
+    const long allowed = s.max_total_dofs > 0 ? std::min(s.max_dofs, own + std::max(0L, s.max_total_dofs - total)) : s.max_dofs;
+    const Marking m = mark(mesh, weighted, s.delta, s.max_level, allowed, rules.graded);
+    if (m.dof_limit_hit && allowed < s.max_dofs) total_hit = true;
+    else if (m.dof_limit_hit) add_note(out.note, "body '" + problem.bodies[a].name + "': max_dofs reached, refinement cut back");
     if (m.level_limit_hit) add_note(out.note, "body '" + problem.bodies[a].name + "': cells at max_level not refined");
     if (m.graded_out > 0)
       add_note(out.note, "body '" + problem.bodies[a].name + "': " + std::to_string(m.graded_out) +
@@ -94,9 +101,15 @@ RefineOutcome mark_and_refine(Problem& problem, const std::vector<IndicatorResul
     add_note(out.note, eta[a].note);
     if (m.cells.empty()) continue;
     out.refinements[a] = mesh::refine(mesh, m.cells, s.max_level);
+    total += 2L * mesh.num_nodes() - own;
     out.refined[a] = out.refinements[a].refined_cells;
     out.changed[a] = out.refined[a] > 0;
     out.any = out.any || out.changed[a];
+  }
+  if (total_hit) {
+    add_note(out.note, "the job's limit of " + std::to_string(s.max_total_dofs) +
+                           " unknowns over all bodies (--max-dofs) reached, refinement cut back");
+    out.blocked = true;
   }
   return out;
 }

@@ -165,6 +165,7 @@ void JobReader::read_adaptivity(const json& value, const std::string& pointer) {
   if (!f.ok()) return;
   AdaptivitySettings& a = problem_.adaptivity;
   a.enabled = true;
+  a.max_total_dofs = limits_.max_dofs;
   json& out = normalized_["adaptivity"];
   if (const json* i = f.find("indicator"))
     if (auto x = choice(*i, f.at("indicator"), "indicator", {"fem_bem", "zz"}, errors_))

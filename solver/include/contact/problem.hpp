@@ -196,6 +196,10 @@ struct AdaptivitySettings {
   std::vector<int> bodies;  // indices of the adaptive bodies; empty = all
   int max_level = 8;        // refinement levels above the initial mesh
   long max_dofs = 400000;   // per body; refinement that would exceed it is cut back (and reported)
+  // Over all bodies: the job reader sets it to the limit on unknowns the job was admitted under (job::Limits,
+  // --max-dofs of contact-solve and contactd), so refinement never takes a job past what it could be submitted
+  // with (0: no total limit, a Problem built in code).
+  long max_total_dofs = 0;
   AdaptStrategy strategy = AdaptStrategy::converge_then_refine;
   int max_steps = 20;       // refinement steps (converge_then_refine)
   // converge_then_refine stops once a step changed the total contact force, the peak contact pressure and the
