@@ -16,25 +16,6 @@ const char* solver_version() { return CONTACT_VERSION; }
 
 namespace {
 
-const char* enforcement_name(Enforcement e) {
-  switch (e) {
-    case Enforcement::exact: return "exact";
-    case Enforcement::penalty: return "penalty";
-    case Enforcement::augmented_lagrangian: return "augmented_lagrangian";
-  }
-  return "exact";
-}
-
-const char* method_name(Method m) {
-  switch (m) {
-    case Method::neumann: return "neumann";
-    case Method::monolithic: return "monolithic";
-    case Method::interface_newton: return "interface_newton";
-    case Method::robin: return "robin";
-  }
-  return "neumann";
-}
-
 // Largest overlap max(0, -g) over the slave nodes of every pair.
 double max_penetration(const Step& step) {
   double m = 0;
@@ -110,8 +91,8 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
 Result solve(const Problem& problem, Observer& observer, const CancelToken& cancel, parallel::TaskRunner& runner) {
   const auto start = std::chrono::steady_clock::now();
   Result result;
-  result.method = method_name(problem.solver.method);
-  result.enforcement = enforcement_name(problem.solver.enforcement);
+  result.method = to_string(problem.solver.method);
+  result.enforcement = to_string(problem.solver.enforcement);
   try {
     if (runner.distributed() && problem.solver.method == Method::monolithic) {
       result.stop_reason = StopReason::error;

@@ -13,7 +13,7 @@ MethodOutcome run_enforced(ContactSystem& system, const SolverSettings& settings
     MethodOutcome out;
     out.reason = StopReason::error;
     out.refused = true;  // a setting, not the loads: no increment is solved
-    out.message = std::string("method ") + (settings.method == Method::neumann ? "neumann" : "robin") +
+    out.message = std::string("method ") + to_string(settings.method) +
                   " iterates on the penalty problem: enforcement exact is not available with it (use penalty, or "
                   "augmented_lagrangian for exact contact in the limit; or method interface_newton)";
     return out;

@@ -155,10 +155,6 @@ Eigen::MatrixX2d node_normals(const mortar::PairDiscretization& pair, const Eige
   return normal;
 }
 
-const char* enforcement_name(Enforcement e) {
-  return e == Enforcement::exact ? "exact" : e == Enforcement::penalty ? "penalty" : "augmented_lagrangian";
-}
-
 }  // namespace
 
 void ContactSystem::stresses_and_reactions(const Displacements& u, const Displacements& loads,
@@ -222,7 +218,7 @@ PairField ContactSystem::pair_field(size_t k, const Displacements& u, const Eige
   f.master_body = problem_.bodies[static_cast<size_t>(spec.master_body)].name;
   f.slave_edge = spec.slave_edge;
   f.master_edge = spec.master_edge;
-  f.enforcement = enforcement_name(problem_.solver.enforcement);
+  f.enforcement = to_string(problem_.solver.enforcement);
   f.theta = problem_.solver.enforcement == Enforcement::exact ? 0.0 : pair.theta;
   const auto& mesh = problem_.bodies[static_cast<size_t>(spec.slave_body)].mesh;
   const Eigen::Index n = static_cast<Eigen::Index>(pair.slave_nodes.size());

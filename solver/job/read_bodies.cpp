@@ -382,7 +382,7 @@ void JobReader::check_floating_bodies() {
     } else if (method == Method::neumann || method == Method::robin) {
       errors_.add(method_pointer_.empty() ? child(in.pointer, "boundary") : method_pointer_,
                   "body '" + in.body.name + "' floats (" + free + ": only its contacts hold it), and method \"" +
-                      (method == Method::neumann ? "neumann" : "robin") +
+                      to_string(method) +
                       "\" solves every body on its own with contact tractions as loads, which a floating body "
                       "cannot take; use method \"interface_newton\" (the default) or \"monolithic\", or restrain "
                       "the body");

@@ -69,14 +69,14 @@ void JobReader::check_friction_and_histories() {
     const std::string& at = friction_pointers_[k];
     if (s.method == Method::neumann || s.method == Method::robin) {
       errors_.add(at, std::string("friction is solved on the interface problem (semismooth Newton on stick and slip): "
-                                  "method \"") + (s.method == Method::neumann ? "neumann" : "robin") +
+                                  "method \"") + to_string(s.method) +
                           "\" cannot take it; use method \"interface_newton\" (the default) or \"monolithic\"" +
                           (method_pointer_.empty() ? "" : " at " + method_pointer_));
       return;
     }
     if (s.enforcement != Enforcement::exact) {
       errors_.add(at, "friction needs exact contact (enforcement \"exact\", the default of interface_newton), not \"" +
-                          std::string(s.enforcement == Enforcement::penalty ? "penalty" : "augmented_lagrangian") +
+                          std::string(to_string(s.enforcement)) +
                           "\" at " + enforcement_pointer_);
       return;
     }

@@ -57,10 +57,7 @@ void JobReader::read_solver_fields(const json& value, const std::string& pointer
 void JobReader::read_method(const json& value, const std::string& pointer) {
   method_pointer_ = pointer;
   if (auto x = choice(value, pointer, "method", {"neumann", "monolithic", "interface_newton", "robin"}, errors_)) {
-    problem_.solver.method = *x == "monolithic"         ? Method::monolithic
-                             : *x == "interface_newton" ? Method::interface_newton
-                             : *x == "robin"            ? Method::robin
-                                                        : Method::neumann;
+    problem_.solver.method = *method_named(*x);
     method_given_ = true;
   }
 }
@@ -90,9 +87,7 @@ void JobReader::read_gamma(const json& value, const std::string& pointer) {
 void JobReader::read_enforcement(const json& value, const std::string& pointer) {
   enforcement_pointer_ = pointer;
   if (auto x = choice(value, pointer, "enforcement", {"exact", "penalty", "augmented_lagrangian"}, errors_)) {
-    problem_.solver.enforcement = *x == "augmented_lagrangian" ? Enforcement::augmented_lagrangian
-                                  : *x == "penalty"            ? Enforcement::penalty
-                                                               : Enforcement::exact;
+    problem_.solver.enforcement = *enforcement_named(*x);
     enforcement_given_ = true;
   }
 }
@@ -130,9 +125,6 @@ void JobReader::resolve_method_defaults() {
   SolverSettings& s = problem_.solver;
   json& out = sub_object(normalized_, "solver");
   const bool paper_strategy = problem_.adaptivity.enabled && problem_.adaptivity.strategy == AdaptStrategy::paper;
-  auto name = [](Method m) {
-    return m == Method::neumann ? "neumann" : m == Method::robin ? "robin" : m == Method::monolithic ? "monolithic" : "interface_newton";
-  };
   if (!method_given_) s.method = paper_strategy ? Method::neumann : Method::interface_newton;
   const bool fixed_point = s.method == Method::neumann || s.method == Method::robin;
   if (!enforcement_given_) s.enforcement = fixed_point || paper_strategy ? Enforcement::penalty : Enforcement::exact;
@@ -140,21 +132,19 @@ void JobReader::resolve_method_defaults() {
     errors_.add(method_pointer_.empty() ? "/adaptivity/strategy" : method_pointer_,
                 std::string("the adaptive strategy \"paper\" interleaves single Neumann iterations (paper (16)-(17)) "
                             "with refinement: it needs method \"neumann\", not \"") +
-                    name(s.method) + "\" (or use strategy \"converge_then_refine\", which works with every method)");
+                    to_string(s.method) + "\" (or use strategy \"converge_then_refine\", which works with every method)");
   else if (paper_strategy && s.enforcement != Enforcement::penalty)
     errors_.add(enforcement_pointer_,
                 "the adaptive strategy \"paper\" runs the paper's penalty iteration: enforcement must be \"penalty\" "
                 "(use strategy \"converge_then_refine\" for exact or augmented-Lagrangian contact)");
   else if (fixed_point && s.enforcement == Enforcement::exact)
     errors_.add(enforcement_pointer_,
-                std::string("method \"") + name(s.method) +
+                std::string("method \"") + to_string(s.method) +
                     "\" iterates on the penalty problem: enforcement \"exact\" is not available with it (use "
                     "\"penalty\", or \"augmented_lagrangian\" for exact contact in the limit, or method "
                     "\"interface_newton\")");
-  set_default(out, "method", name(s.method));
-  set_default(out, "enforcement", s.enforcement == Enforcement::exact     ? "exact"
-                                  : s.enforcement == Enforcement::penalty ? "penalty"
-                                                                          : "augmented_lagrangian");
+  set_default(out, "method", to_string(s.method));
+  set_default(out, "enforcement", to_string(s.enforcement));
 }
 
 void JobReader::read_adaptivity(const json& value, const std::string& pointer) {

@@ -122,6 +122,13 @@ enum class Acceleration { none, anderson };
 // limit (for the penalty-based fixed-point schemes neumann and robin).
 enum class Enforcement { exact, penalty, augmented_lagrangian };
 
+// The job format's names of the methods and enforcements, one table each (problem.cpp): the job reader takes them,
+// the result and the progress report give them back.
+const char* to_string(Method m);
+const char* to_string(Enforcement e);
+std::optional<Method> method_named(const std::string& name);
+std::optional<Enforcement> enforcement_named(const std::string& name);
+
 // Robin weight psi (force per length^3, like 1/theta): a constant over every contact zone, or 1/theta on the
 // current active set and 0 elsewhere ("active_set").
 struct RobinSettings {

@@ -1,0 +1,43 @@
+#include "contact/problem.hpp"
+
+#include <array>
+#include <utility>
+
+namespace contact {
+
+namespace {
+
+constexpr std::array<std::pair<Method, const char*>, 4> kMethods = {{{Method::neumann, "neumann"},
+                                                                    {Method::monolithic, "monolithic"},
+                                                                    {Method::interface_newton, "interface_newton"},
+                                                                    {Method::robin, "robin"}}};
+constexpr std::array<std::pair<Enforcement, const char*>, 3> kEnforcements = {
+    {{Enforcement::exact, "exact"}, {Enforcement::penalty, "penalty"}, {Enforcement::augmented_lagrangian, "augmented_lagrangian"}}};
+
+}  // namespace
+
+const char* to_string(Method m) {
+  for (const auto& [value, name] : kMethods)
+    if (value == m) return name;
+  return "interface_newton";
+}
+
+const char* to_string(Enforcement e) {
+  for (const auto& [value, name] : kEnforcements)
+    if (value == e) return name;
+  return "exact";
+}
+
+std::optional<Method> method_named(const std::string& name) {
+  for (const auto& [value, text] : kMethods)
+    if (name == text) return value;
+  return std::nullopt;
+}
+
+std::optional<Enforcement> enforcement_named(const std::string& name) {
+  for (const auto& [value, text] : kEnforcements)
+    if (name == text) return value;
+  return std::nullopt;
+}
+
+}  // namespace contact
