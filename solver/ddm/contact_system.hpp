@@ -66,10 +66,11 @@ class ContactSystem {
     load_factor_ = factor;
     step_fraction_ = t;
     for (auto& b : bodies_) b->set_load_between(step, previous_factor, factor, t);
-    const double from = step == 0 ? 0.0 : previous_factor;
-    current_factor_ = t == 1.0 ? factor : from + t * (factor - from);  // as each body has it
   }
-  double load_factor() const { return current_factor_; }  // the loading's factor now (within a cut step: between)
+  // The loading's factor now (within a cut step: between the steps'), as each body has it.
+  double load_factor() const {
+    return step_fraction_ == 1.0 ? load_factor_ : previous_factor_ + step_fraction_ * (load_factor_ - previous_factor_);
+  }
   // Some condition has its own load history: the loads of a step are then not a multiple of another step's.
   bool has_histories() const;
   bool has_friction() const { return problem_.has_friction(); }
@@ -152,7 +153,7 @@ class ContactSystem {
   std::string error_;
   bool cancelled_ = false;
   double setup_seconds_ = 0.0, factorization_seconds_ = 0.0;
-  double load_factor_ = 1.0, previous_factor_ = 0.0, step_fraction_ = 1.0, current_factor_ = 1.0;
+  double load_factor_ = 1.0, previous_factor_ = 0.0, step_fraction_ = 1.0;
   size_t load_step_ = 0;
 };
 

@@ -172,7 +172,6 @@ void BodySolver::setup_history_groups() {
 }
 
 void BodySolver::set_load_between(size_t step, double previous_factor, double factor, double t) {
-  if (step == 0) previous_factor = 0.0;
   load_factor_ = t == 1.0 ? factor : previous_factor + t * (factor - previous_factor);
   for (auto& group : groups_) {
     const auto& h = group.condition->history;

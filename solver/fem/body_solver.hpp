@@ -84,8 +84,8 @@ class BodySolver {
   // (BoundaryCondition::history) its factor of step `step`, the others the loading's `factor`.
   void set_load_factor(double factor) { set_load_step(0, factor); }
   void set_load_step(size_t step, double factor) { set_load_between(step, 0.0, factor, 1.0); }
-  // A point t in [0, 1] of the way from the end of step `step - 1` (loaded by previous_factor and each history's
-  // value there; nothing before step 0) to the end of step `step`: every factor interpolated linearly (the
+  // A point t in [0, 1] of the way from the end of step `step - 1` (loaded by previous_factor, 0 before step 0, and
+  // each history's value there, 0 before step 0) to the end of step `step`: every factor interpolated linearly (the
   // sub-steps of a load step that is cut, ddm/load_steps.cpp).
   void set_load_between(size_t step, double previous_factor, double factor, double t);
   bool has_histories() const { return !groups_.empty(); }
