@@ -76,15 +76,32 @@ std::vector<Eigen::Index> CoarseSpace::unheld_by(const std::vector<char>& column
   return dependent_rows(problem_, GA * GAt);
 }
 
-Eigen::VectorXd CoarseSpace::multipliers(const Eigen::VectorXd& r, const std::vector<char>& columns) const {
+Eigen::VectorXd CoarseSpace::multipliers(const Eigen::VectorXd& r, const std::vector<char>& columns,
+                                         bool indeterminate) const {
   if (empty()) return Eigen::VectorXd();
   const SparseMatrix GA = columns_of(columns);
   const SparseMatrix GAt = GA.transpose();
   const SparseMatrix GAGAt = GA * GAt;
-  if (!dependent_rows(problem_, GAGAt).empty()) return Eigen::VectorXd();
-  Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> llt(GAGAt);
-  if (llt.info() != Eigen::Success) return Eigen::VectorXd();
-  return llt.solve(-(GA * r));
+  const Eigen::VectorXd rhs = -(GA * r);
+  // Singular with each body's block regular: a group of bodies held by nothing as a whole (two bricks joined by a
+  // head joint on a slipping course); CHOLMOD says so by failing, quietly.
+  const auto solve = [&](const SparseMatrix& A, Eigen::VectorXd& alpha) {
+    Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> llt;
+    llt.cholmod().print = 0;
+    llt.compute(A);
+    if (llt.info() != Eigen::Success) return false;
+    alpha = llt.solve(rhs);
+    return alpha.allFinite();
+  };
+  Eigen::VectorXd alpha;
+  const bool dependent = !dependent_rows(problem_, GAGAt).empty();
+  if (!dependent && solve(GAGAt, alpha)) return alpha;
+  if (!indeterminate) return Eigen::VectorXd();
+  const double eps = 1e-10 * std::max(GAGAt.diagonal().cwiseAbs().maxCoeff(), 1e-300);
+  SparseMatrix shift(GAGAt.rows(), GAGAt.cols());
+  shift.setIdentity();
+  if (solve(SparseMatrix(GAGAt + eps * shift), alpha)) return alpha;
+  return Eigen::VectorXd();
 }
 
 }  // namespace contact::ddm

@@ -35,8 +35,12 @@ class CoarseSpace {
   Eigen::VectorXd range_part(const Eigen::VectorXd& x) const;     // Q x
   Eigen::VectorXd particular() const;                             // z_I
   // The least-squares multipliers alpha of G^T alpha = -r on the columns `columns` (the active contact nodes):
-  // (G_A G_A^T)^-1 G_A (-r_A). Empty when G_A G_A^T is singular (the active set leaves a body unheld).
-  Eigen::VectorXd multipliers(const Eigen::VectorXd& r, const std::vector<char>& columns) const;
+  // (G_A G_A^T)^-1 G_A (-r_A). Empty when G_A G_A^T is singular (the active set leaves a body unheld), unless
+  // `indeterminate` allows it: then the least-squares solution with the least |alpha| along the motions no column
+  // holds (G_A G_A^T + eps I, eps = 1e-10 of its largest diagonal entry), the choice the direct solver makes for
+  // a brick whose joints all slip (linalg/friction_nested.cpp, solve_sets_system).
+  Eigen::VectorXd multipliers(const Eigen::VectorXd& r, const std::vector<char>& columns,
+                              bool indeterminate = false) const;
   // The rows of the floating bodies that the columns `columns` alone cannot hold (their block of G_A G_A^T is
   // singular): the bodies an active set leaves unheld.
   std::vector<Eigen::Index> unheld_by(const std::vector<char>& columns) const;

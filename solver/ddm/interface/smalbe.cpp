@@ -101,7 +101,11 @@ bool Smalbe::finish(const Eigen::VectorXd& x, const Bounds& bounds, ActiveSetRes
   out.h = qp_.g + Hz;
   out.alpha = Eigen::VectorXd::Zero(coarse_.rows());
   if (!coarse_.empty()) {
-    out.alpha = coarse_.multipliers(out.h, active);
+    // With friction a floating body whose contact nodes all sit on their bounds (a brick whose bed joints both
+    // slip) has an indeterminate rigid motion along the slip when its loads balance (SMALBE's equalities, checked
+    // apart): the least rigid motion is taken, and a body that would slide away is still named, by the stagnating
+    // equality violation.
+    out.alpha = coarse_.multipliers(out.h, active, upper);
     if (out.alpha.size() != coarse_.rows()) {
       out.unrestrained = coarse_.unheld_by(active);
       if (out.unrestrained.empty())
