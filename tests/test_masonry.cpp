@@ -123,6 +123,15 @@ TEST(Masonry, FreeEndedWallsHoldAShearOfHalfTheirLoad) {
       EXPECT_NEAR(reaction.x(), -load.x(), 1e-8 * load.norm()) << options << " step " << k;
       EXPECT_NEAR(reaction.y(), -load.y(), 1e-8 * load.norm()) << options << " step " << k;
     }
+    // With head joints the direct solver's Newton does not settle the whole step and the iterative solver takes it
+    // over (interface_newton.cpp), converged (not merely settled bounds).
+    if (options.find("--head-joints") != std::string::npos) {
+      bool took_over = false;
+      for (const auto& report : r.history)
+        took_over = took_over || report.note.find("iterative (the direct solver's friction Newton did not settle)") != std::string::npos;
+      EXPECT_TRUE(took_over) << "the direct solver settled by itself: the case no longer tests the take-over";
+      EXPECT_EQ(r.message.find("settled with the complementarity"), std::string::npos) << r.message;
+    }
     // Coulomb at every node of the last step: |t| <= mu p, to 1e-8 of the largest pressure (the iterative solver's
     // precision, where it took a step over).
     double p_max = 0.0;
@@ -232,6 +241,9 @@ TEST(Masonry, WhereABricksSlipIsIndeterminateTheIterativeSolverTakesTheLeastRigi
   ASSERT_TRUE(direct.converged) << direct.message;
   ASSERT_TRUE(iterative.converged) << iterative.message;
   ASSERT_EQ(iterative.steps.size(), 4u) << iterative.message;  // no step cut
+  EXPECT_EQ(iterative.message.find("settled with the complementarity"), std::string::npos) << iterative.message;
+  for (const auto& report : direct.history)  // the direct answer is the Newton's own: an independent check
+    EXPECT_EQ(report.note.find("did not settle"), std::string::npos) << report.note;
   // Each field against its largest value in the step (a pair at the heel opens: its own scale is zero).
   for (size_t k = 0; k < direct.steps.size(); ++k) {
     double p_max = 0, dp = 0, dq = 0, u_max = 0, du = 0;
@@ -251,37 +263,6 @@ TEST(Masonry, WhereABricksSlipIsIndeterminateTheIterativeSolverTakesTheLeastRigi
     EXPECT_LT(dq, 1e-8 * p_max) << "step " << k;
     EXPECT_LT(du, 1e-8 * u_max) << "step " << k;
   }
-  // Low friction under the precompression alone: the end bricks slip outwards on both bed joints. The direct
-  // solver's Newton does not settle here (its sets cycle) and the iterative solver takes the step over; the
-  // iterative one alone holds every brick too. Both: the base carries the load, Coulomb's bound holds at every
-  // node, and their answers agree.
-  std::vector<Result> low;
-  for (const std::string solver : {"direct", "iterative"}) {
-    json job_low = wall(8, 8, "--friction 0.05 --shear 0");
-    job_low["solver"]["interface"] = {{"solver", solver}};
-    const Result r = run(job_low);
-    ASSERT_TRUE(r.converged) << solver << ": " << r.message;
-    ASSERT_EQ(r.steps.size(), 2u) << solver;
-    for (size_t k = 0; k < 2; ++k) {
-      EXPECT_TRUE(r.steps[k].converged);
-      const Eigen::Vector2d load = applied_load(job_low, k), reaction = support_reactions(r.steps[k]);
-      EXPECT_NEAR(reaction.x(), -load.x(), 1e-8 * load.norm()) << solver << " step " << k;
-      EXPECT_NEAR(reaction.y(), -load.y(), 1e-8 * load.norm()) << solver << " step " << k;
-    }
-    int slipping = 0;
-    for (const auto& pair : r.steps[1].pairs)
-      for (Eigen::Index i = 0; i < pair.pressure.size(); ++i) {
-        EXPECT_LE(std::abs(pair.tangential_traction[i]), 0.05 * pair.pressure[i] + 1e-9) << pair.name << " node " << i;
-        slipping += pair.pressure[i] > 0 && std::abs(pair.tangential_traction[i]) >= 0.05 * pair.pressure[i] * (1 - 1e-6);
-      }
-    EXPECT_GT(slipping, 0) << solver << ": no node at its bound: the case no longer tests an indeterminate slip";
-    low.push_back(r);
-  }
-  bool took_over = false;
-  for (const auto& report : low[0].history)
-    took_over = took_over || report.note.find("iterative (the direct solver's friction Newton did not settle)") != std::string::npos;
-  EXPECT_TRUE(took_over) << "the direct solver settled by itself: the case no longer tests the take-over";
-  EXPECT_LT(relative_difference(low[0], low[1]), 1e-8);
 }
 
 TEST(Masonry, A16x16WallHoldsAndA22x22OneRefusesAShearAboveMu) {
