@@ -325,6 +325,45 @@ TEST(Masonry, AStepThatDidNotConvergeIsCutAndIfThatFailsKeptOnlyAsTheLastAndFlag
   EXPECT_EQ(summarize(r.steps[1]).converged, false);
 }
 
+TEST(Masonry, FromRestWithClosedJointsTheAnswerIsProportionalToTheLoadSoAFailedFirstStepIsNotCut) {
+  // The precompression of a wall whose joints are closed with no gap, from rest: Coulomb's incremental problem is
+  // positively homogeneous, so half the load gives half the answer (displacements and tractions), which is why a
+  // failed first step is not cut (each cut would be the same problem scaled).
+  json job = wall(4, 4, "--head-joints --friction 0.6 --shear 0");
+  job["loading"] = {{"factors", {1.0}}};
+  for (auto& body : job["bodies"])
+    for (auto& c : body["boundary"]) c.erase("history");
+  const Result whole = run(job);
+  job["loading"] = {{"factors", {0.5}}};
+  const Result half = run(job);
+  ASSERT_TRUE(whole.converged) << whole.message;
+  ASSERT_TRUE(half.converged) << half.message;
+  double u_max = 0, du = 0, p_max = 0, dp = 0;
+  for (size_t i = 0; i < whole.steps[0].bodies.size(); ++i) {
+    const auto& u = whole.steps[0].bodies[i].displacement;
+    u_max = std::max(u_max, u.cwiseAbs().maxCoeff());
+    du = std::max(du, (2.0 * half.steps[0].bodies[i].displacement - u).cwiseAbs().maxCoeff());
+  }
+  for (size_t j = 0; j < whole.steps[0].pairs.size(); ++j) {
+    const auto& a = whole.steps[0].pairs[j];
+    const auto& b = half.steps[0].pairs[j];
+    p_max = std::max(p_max, a.pressure.cwiseAbs().maxCoeff());
+    dp = std::max(dp, (2.0 * b.pressure - a.pressure).cwiseAbs().maxCoeff());
+    dp = std::max(dp, (2.0 * b.tangential_traction - a.tangential_traction).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LT(du, 1e-10 * u_max);
+  EXPECT_LT(dp, 1e-10 * p_max);
+  // One Newton step is too few for it (it takes three): the step fails once, uncut.
+  json failing = wall(4, 4, "--head-joints --friction 0.6 --shear 0.3");
+  failing["solver"]["max_iterations"] = 1;
+  const Result r = run(failing);
+  EXPECT_FALSE(r.converged);
+  EXPECT_NE(r.message.find("load step 1 of 2 (not cut: from rest with every joint closed"), std::string::npos)
+      << r.message;
+  ASSERT_EQ(r.steps.size(), 1u) << r.message;
+  EXPECT_FALSE(r.steps[0].converged);
+}
+
 TEST(Statics, TheInclinedPlaneHoldsBelowTheClassicalThresholdAndIsRefusedAboveIt) {
   // A block on a plane of slope tan a = 0.1, mu = 0.3, pressed by its weight G and pushed up the slope by a
   // horizontal F: it slides when F cos a - G sin a > mu (F sin a + G cos a), i.e. F / G > (tan a + mu) /
