@@ -15,7 +15,7 @@ namespace {
 class UzawaMultipliers {
  public:
   explicit UzawaMultipliers(const ContactSystem& system)
-      : pairs_(system.pairs()), offset_(pairs_.size() + 1, 0), history_(5) {
+      : pairs_(system.pairs()), offset_(pairs_.size() + 1, 0) {
     for (size_t k = 0; k < pairs_.size(); ++k) offset_[k + 1] = offset_[k] + pairs_[k].n_rows();
     sqrt_w_.resize(offset_.back());
     for (size_t k = 0; k < pairs_.size(); ++k) sqrt_w_.segment(offset_[k], pairs_[k].n_rows()) = pairs_[k].area.cwiseSqrt();
@@ -40,18 +40,7 @@ class UzawaMultipliers {
 
   // lambda <- the Anderson-mixed image, projected onto lambda >= 0, and given to the system's pairs.
   void update(ContactSystem& system, const Eigen::VectorXd& image, const Eigen::VectorXd& residual) {
-    if (residual.norm() > 10 * best_) {
-      history_.clear();
-      previous_lambda_.resize(0);
-    }
-    best_ = std::min(best_, residual.norm());
-    if (previous_lambda_.size()) history_.push(residual - previous_residual_, image - previous_image_);
-    previous_lambda_ = lambda_;
-    previous_residual_ = residual;
-    previous_image_ = image;
-    Eigen::VectorXd next = image;
-    history_.mix(residual, [&](double c, const Eigen::VectorXd& d_image) { next -= c * d_image; });
-    lambda_ = next.cwiseMax(0.0);
+    lambda_ = mixing_.next(image, residual);
     for (size_t k = 0; k < pairs_.size(); ++k) system.set_multipliers(k, lambda_.segment(offset_[k], pairs_[k].n_rows()));
   }
 
@@ -59,9 +48,7 @@ class UzawaMultipliers {
   const std::vector<mortar::PairDiscretization>& pairs_;
   std::vector<Eigen::Index> offset_;  // per pair, into lambda
   Eigen::VectorXd sqrt_w_, lambda_;
-  linalg::AndersonHistory<Eigen::VectorXd> history_;  // multiplier fixed point: image differences
-  Eigen::VectorXd previous_lambda_, previous_residual_, previous_image_;
-  double best_ = std::numeric_limits<double>::infinity();
+  linalg::NonnegativeAnderson mixing_{5};  // the multiplier fixed point
 };
 
 }  // namespace

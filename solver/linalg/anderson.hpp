@@ -10,8 +10,10 @@
 #include <Eigen/Core>
 #include <Eigen/QR>
 
+#include <algorithm>
 #include <cmath>
 #include <deque>
+#include <limits>
 #include <utility>
 
 namespace contact::linalg {
@@ -62,6 +64,44 @@ class AndersonHistory {
   size_t depth_;
   std::deque<Eigen::VectorXd> dr_;
   std::deque<Step> steps_;
+};
+
+// Anderson mixing of a fixed point x = g(x) constrained to x >= 0 (contact multipliers, slip bounds): the caller
+// passes each image g(x_k) with its residual (g(x_k) - x_k, weighted as it likes); next() returns the image mixed
+// with the history's image differences and cut at 0 (the image itself while there is no history). The history
+// restarts when a residual is more than ten times the best one so far (a mixed step that made things worse, or a
+// change the extrapolation did not see). Used by the augmented-Lagrangian multipliers and the iterative solver's
+// Coulomb slip bounds (ddm/interface/feti_friction.cpp).
+class NonnegativeAnderson {
+ public:
+  explicit NonnegativeAnderson(size_t depth = 5) : history_(depth) {}
+
+  Eigen::VectorXd next(const Eigen::VectorXd& image, const Eigen::VectorXd& residual) {
+    const double norm = residual.norm();
+    if (norm > 10 * best_ || last_residual_.size() != residual.size()) {
+      history_.clear();
+    } else {
+      history_.push(residual - last_residual_, image - last_image_);
+    }
+    best_ = std::min(best_, norm);
+    last_residual_ = residual;
+    last_image_ = image;
+    Eigen::VectorXd out = image;
+    history_.mix(residual, [&](double c, const Eigen::VectorXd& d_image) { out -= c * d_image; });
+    return out.cwiseMax(0.0);
+  }
+  // Whether the last next() combined any history (false: it returned the image).
+  bool mixed() const { return !history_.empty(); }
+  void reset() {
+    history_.clear();
+    last_residual_.resize(0);
+    best_ = std::numeric_limits<double>::infinity();
+  }
+
+ private:
+  AndersonHistory<Eigen::VectorXd> history_;
+  Eigen::VectorXd last_residual_, last_image_;
+  double best_ = std::numeric_limits<double>::infinity();
 };
 
 }  // namespace contact::linalg

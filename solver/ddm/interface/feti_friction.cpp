@@ -119,42 +119,6 @@ linalg::ActiveSetStep outer_step(int outer, const FrictionData& d, const ActiveS
   return info;
 }
 
-// Anderson mixing of the Coulomb bounds (linalg/anderson.hpp): the fixed point b = mu z(b). Where the stick and
-// slip sets no longer change, z(b) is affine in b and the mixing converges like a Krylov method on it, where the
-// plain update contracts by a constant factor (about 0.5 per outer iteration on a sheared brick wall). The mixed
-// bounds are cut at 0; the history restarts when the residual grows past ten times the best one (a set change
-// the extrapolation did not see).
-class BoundMixing {
- public:
-  // Writes the next bounds to `b` (the last bounds `before`, their image `image`); false: take the plain update.
-  bool next(const Eigen::VectorXd& before, const Eigen::VectorXd& image, Eigen::VectorXd& b) {
-    const Eigen::VectorXd r = image - before;
-    const double norm = r.norm();
-    if (last_r_.size() == r.size() && norm <= 10 * best_)
-      history_.push(r - last_r_, image - last_image_);
-    else
-      history_.clear();
-    best_ = std::min(best_, norm);
-    last_r_ = r;
-    last_image_ = image;
-    if (history_.empty()) return false;
-    b = image;
-    history_.mix(r, [&](double c, const Eigen::VectorXd& dimage) { b -= c * dimage; });
-    b = b.cwiseMax(0.0);
-    return true;
-  }
-  void reset() {
-    history_.clear();
-    last_r_.resize(0);
-    best_ = infinity;
-  }
-
- private:
-  linalg::AndersonHistory<Eigen::VectorXd> history_{5};
-  Eigen::VectorXd last_r_, last_image_;
-  double best_ = infinity;
-};
-
 // Coulomb: the outer fixed point b <- mu z on Tresca problems. The first bounds are mu z0 (the previous load
 // step's or update's answer) or, without one (or if a floating body is not held on them), +inf: the tied problem,
 // well posed whatever holds the floating bodies. Each Tresca solve starts from the last answer and equality
@@ -175,7 +139,10 @@ void coulomb_outer(Smalbe& smalbe, const FrictionData& d, const Eigen::VectorXd*
   double change = 1.0;
   int settled = 0;
   how.tolerance = std::max(10 * tolerance, 1e-6);
-  BoundMixing mixing;
+  // The bounds Anderson-mixed (linalg/anderson.hpp): where the stick and slip sets no longer change, z(b) is affine
+  // in b and the mixing converges like a Krylov method on it, where the plain update contracts by a constant factor
+  // (about 0.5 per outer iteration on a sheared brick wall).
+  linalg::NonnegativeAnderson mixing(5);
   Eigen::VectorXd plain;  // the last plain update mu z, the fallback of mixed bounds
   bool mixed = false;
   for (int outer = 1; outer <= std::max(1, context.max_steps); ++outer) {
@@ -236,8 +203,13 @@ void coulomb_outer(Smalbe& smalbe, const FrictionData& d, const Eigen::VectorXd*
       return;
     }
     plain = next;
-    mixed = b.allFinite() && mixing.next(b, next, b);
-    if (!mixed) b = next;
+    mixed = false;
+    if (b.allFinite()) {  // not from the tied first pass (infinite bounds)
+      b = mixing.next(next, next - b);
+      mixed = mixing.mixed();
+    } else {
+      b = next;
+    }
   }
   std::ostringstream os;
   os << "FETI with Coulomb friction: the slip bounds did not settle within " << context.max_steps
