@@ -66,10 +66,11 @@ const char* enforcement_name(contact::Enforcement e) {
 // fixed-point schemes both stopping measures; then per pair force, max pressure and active nodes.
 class ProgressPrinter final : public contact::Observer {
  public:
-  ProgressPrinter(bool quiet, bool ndjson) : quiet_(quiet), ndjson_(ndjson) {}
+  ProgressPrinter(bool quiet, bool ndjson, contact::io::ProgressSelection selection)
+      : quiet_(quiet), ndjson_(ndjson), selection_(std::move(selection)) {}
   void on_iteration(const contact::IterationReport& r) override {
     if (ndjson_) {
-      nlohmann::json line = contact::io::iteration_json(r);
+      nlohmann::json line = contact::io::bounded_progress(contact::io::iteration_json(r), selection_);
       line["type"] = "iteration";
       std::printf("%s\n", line.dump().c_str());
       std::fflush(stdout);
@@ -87,34 +88,44 @@ class ProgressPrinter final : public contact::Observer {
     else
       std::printf("  paper %.3e  residual %.3e", r.paper_criterion, r.fixed_point_residual);
     if (r.gamma > 0) std::printf("  gamma %.3g", r.gamma);
-    print_pairs(r.pairs);
+    print_pairs(contact::io::bounded_progress(contact::io::iteration_json(r, false), selection_));
     std::printf("  %.2fs", r.elapsed_seconds);
     if (!r.note.empty()) std::printf("  [%s]", r.note.c_str());
     std::printf("\n");
     std::fflush(stdout);
   }
 
-  // Every pair while they are few; past kPairsShown one summary, so that a line stays short on a wall of hundreds
-  // of pairs (the result file and --ndjson have every pair).
-  static void print_pairs(const std::vector<contact::PairReport>& pairs) {
-    if (pairs.size() <= kPairsShown) {
-      for (const auto& p : pairs)
-        std::printf("  | %s: force %.6g  p_max %.6g  active %d (%+d)", p.name.c_str(), p.force, p.max_pressure,
-                    p.active_nodes, p.changed_nodes);
+  // Every pair while they are few (kPairsShown) and none is selected; otherwise the totals (with friction the
+  // stick and slip counts), the pair of highest pressure, and the first kPairsShown of the pairs the job or
+  // --progress-pairs selects, so that a line stays short on a wall of hundreds of pairs (the result file has
+  // every pair).
+  void print_pairs(const nlohmann::json& progress) const {
+    const auto& pairs = progress["pairs"];
+    auto print_pair = [](const nlohmann::json& p) {
+      std::printf("  | %s: force %.6g  p_max %.6g  active %d (%+d)", p.value("name", "").c_str(),
+                  p.value("force", 0.0), p.value("max_pressure", 0.0), p.value("active_nodes", 0),
+                  p.value("changed_nodes", 0));
+      if (p.contains("stick_nodes"))
+        std::printf("  stick %d slip %d", p.value("stick_nodes", 0), p.value("slip_nodes", 0));
+    };
+    const auto& s = progress["pairs_summary"];
+    if (selection_.all || (selection_.patterns.empty() && s.value("count", 0) <= static_cast<int>(kPairsShown))) {
+      for (const auto& p : pairs) print_pair(p);
       return;
     }
-    double force = 0;
-    int active = 0, changed = 0, changing_pairs = 0;
-    const contact::PairReport* peak = &pairs.front();
-    for (const auto& p : pairs) {
-      force += p.force;
-      active += p.active_nodes;
-      changed += std::abs(p.changed_nodes);
-      changing_pairs += p.changed_nodes != 0;
-      if (p.max_pressure > peak->max_pressure) peak = &p;
-    }
-    std::printf("  | %zu pairs: force %.6g  active %d (%d changed in %d pairs)  p_max %.6g at %s", pairs.size(), force,
-                active, changed, changing_pairs, peak->max_pressure, peak->name.c_str());
+    std::printf("  | %d pairs: force %.6g  active %.0f (%.0f changed in %d pairs)", s.value("count", 0),
+                s.value("force", 0.0), s.value("active_nodes", 0.0), s.value("changed_nodes", 0.0),
+                s.value("pairs_changed", 0));
+    if (s.value("friction_pairs", 0) > 0)
+      std::printf("  stick %.0f slip %.0f", s.value("stick_nodes", 0.0), s.value("slip_nodes", 0.0));
+    std::printf("  p_max %.6g at %s", s.value("max_pressure", 0.0), s.value("max_pressure_pair", "").c_str());
+    std::size_t shown = 0, selected = 0;
+    for (const auto& p : pairs)
+      if (contact::io::matches_any(p.value("name", ""), selection_.patterns) && ++selected <= kPairsShown) {
+        print_pair(p);
+        ++shown;
+      }
+    if (selected > shown) std::printf("  | and %zu more selected pairs (--progress ndjson lists them)", selected - shown);
   }
   static constexpr size_t kPairsShown = 6;
 
@@ -155,6 +166,7 @@ class ProgressPrinter final : public contact::Observer {
 
  private:
   bool quiet_, ndjson_;
+  contact::io::ProgressSelection selection_;
 };
 
 // Ranks other than 0 report nothing.
@@ -245,7 +257,7 @@ bool counts_active_set_steps(const contact::Problem& problem) {
 // Everything after the job is parsed: solve on this process's share, report and write on rank 0. Returns the
 // exit code (rank 0's decides for all).
 int solve_and_write(contact::Session& session, contact::Problem& problem, const std::string& output,
-                    const std::string& job_id, bool quiet, bool ndjson) {
+                    const std::string& job_id, bool quiet, bool ndjson, contact::io::ProgressSelection selection) {
   const bool root = session.root();
   contact::CancelToken cancel;
   if (session.size() == 1) {
@@ -253,7 +265,7 @@ int solve_and_write(contact::Session& session, contact::Problem& problem, const 
     if (g_stop_request) cancel.cancel();  // asked before the token existed
   }
   if (root && !ndjson) print_header(session, problem);
-  ProgressPrinter printer(quiet, ndjson);
+  ProgressPrinter printer(quiet, ndjson, std::move(selection));
   Silent silent;
   const contact::Result result =
       session.solve(problem, root ? static_cast<contact::Observer&>(printer) : silent, &g_stop_request, &cancel);
@@ -355,6 +367,11 @@ int main(int argc, char** argv) {
                  "\"result\" object, as contactd reads them (docs/parallel.md)")
       ->check(CLI::IsMember({"text", "ndjson"}));
   app.add_option("--job-id", job_id, "job id recorded in the result file (contactd sets it)");
+  std::string progress_pairs;
+  app.add_option("--progress-pairs", progress_pairs,
+                 "the pairs whose detail each progress line lists: names or patterns (* ?) separated by commas, or "
+                 "'all' (overrides the job's output.progress_pairs; default: every pair while there are few, else "
+                 "the totals and the pairs that stand out)");
   bool no_mesh_files = false;
   app.add_flag("--no-mesh-files", no_mesh_files,
                "refuse Gmsh meshes given by file, as contactd does (it passes this flag): only \"data\"");
@@ -390,7 +407,17 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (output.empty()) output = std::filesystem::path(job_path).stem().string() + ".hdf";
-  const int code = session.broadcast(solve_and_write(session, problem, output, job_id, quiet, ndjson));
+  contact::io::ProgressSelection selection{problem.output.progress_pairs, false};
+  if (progress_pairs == "all") {
+    selection = {{}, true};
+  } else if (!progress_pairs.empty()) {
+    selection.patterns.clear();
+    std::stringstream list(progress_pairs);
+    for (std::string pattern; std::getline(list, pattern, ',');)
+      if (!pattern.empty()) selection.patterns.push_back(pattern);
+  }
+  const int code =
+      session.broadcast(solve_and_write(session, problem, output, job_id, quiet, ndjson, std::move(selection)));
   if (contact::background_work_running()) {
     // A cancel left a factorisation running (contact/solve.hpp); the result is written: exit now, not seconds later.
     std::cout.flush();

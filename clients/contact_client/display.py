@@ -110,8 +110,12 @@ class Progress:
             msg = f": {word(e['message'], 500)}" if e.get("message") else ""
             self._line(f"state {word(e.get('state'))}{msg}")
         elif t == "step":
-            bodies = ", ".join(f"{word(b.get('name'))} {num(b.get('elements'), 'd')} cells"
-                               for b in dicts(e.get("bodies")))
+            listed = dicts(e.get("bodies"))
+            total = obj(e.get("bodies_summary"))
+            if total and (not listed or len(listed) > LISTED):
+                bodies = f"{num(total.get('count'), 'd')} bodies, {num(total.get('elements'), 'd')} cells"
+            else:
+                bodies = ", ".join(f"{word(b.get('name'))} {num(b.get('elements'), 'd')} cells" for b in listed)
             self._line(f"step {num(e.get('step'), 'd')} at iteration {num(e.get('iteration'), 'd')}: {bodies}")
         elif t == "end":
             if self.bar is not None:
@@ -150,15 +154,64 @@ def _tangential(p):
     return f" t_force {num(p['tangential_force'], '.5g')}" if "tangential_force" in p else ""
 
 
+# Past this many pairs or bodies, a line shows their totals (the event's pairs_summary and bodies_summary) and
+# the pairs the job selects (output.progress_pairs), not each one.
+LISTED = 6
+
+
+def _summarised(e, key):
+    """True when the line should show the totals of `key` ("pairs" or "bodies") rather than each item: the event
+    lists only some of them, or more than LISTED."""
+    summary = obj(e.get(f"{key}_summary"))
+    count = summary.get("count") if isinstance(summary.get("count"), int) else len(dicts(e.get(key)))
+    return bool(summary) and (e.get(f"{key}_listed") not in (None, "all") or count > LISTED)
+
+
+def _pairs_total(e):
+    """ "946 pairs: force 232.3 active 2882 (0 changed in 0 pairs) stick 2882 slip 0 p_max 3.94 at b0_21..." """
+    s = obj(e.get("pairs_summary"))
+    text = (f"{num(s.get('count'), 'd')} pairs: force {num(s.get('force', 0), '.5g')} "
+            f"active {num(s.get('active_nodes', 0), '.0f')} ({num(s.get('changed_nodes', 0), '.0f')} changed in "
+            f"{num(s.get('pairs_changed', 0), 'd')} pairs)")
+    if s.get("friction_pairs"):
+        text += (f" stick {num(s.get('stick_nodes', 0), '.0f')} slip {num(s.get('slip_nodes', 0), '.0f')}"
+                 f" t_force {num(s.get('tangential_force', 0), '.5g')}")
+    text += f" p_max {num(s.get('max_pressure', 0), '.5g')} at {word(s.get('max_pressure_pair'))}"
+    if s.get("most_changed_nodes"):
+        text += f" most changed {word(s.get('most_changed_pair'))} ({num(s.get('most_changed_nodes'), '.0f')})"
+    return text
+
+
+def _selected_pairs(e):
+    """The pairs an event lists beyond the two its summary names (those the job selects), at most LISTED."""
+    s = obj(e.get("pairs_summary"))
+    named = {s.get("max_pressure_pair"), s.get("most_changed_pair")}
+    return [p for p in dicts(e.get("pairs")) if p.get("name") not in named][:LISTED]
+
+
+def _bodies_total(e):
+    s = obj(e.get("bodies_summary"))
+    return (f"dofs {num(s.get('dofs', 0), '.0f')} in {num(s.get('count'), 'd')} bodies"
+            f"{'' if not s.get('elements_refined') else ', ' + num(s['elements_refined'], '.0f') + ' cells refined'}")
+
+
 def format_iteration(e):
     """ "iter 12  paper 1.23e-03  residual 2.22e-02  dofs upper 528 lower 528  | pair: force 140.9 p_max 166.4"
     (active-set methods: "step 3  active 245 (2 changed)  compl 1.20e-03 ..."; a friction pair adds its
-    tangential force: "| pair: force 6.18 p_max 20.3 t_force -0.985") """
+    tangential force: "| pair: force 6.18 p_max 20.3 t_force -0.985"). Past LISTED pairs or bodies, or when the
+    event lists only some, their totals instead ("| 946 pairs: force ... p_max ... at <pair>", "dofs 29832 in 496
+    bodies") and the pairs the job selects."""
     parts = [f"{_label(e)} {num(e.get('iteration', 0), '5d'):>5}"] + _measure_parts(e)
     bodies = dicts(e.get("bodies"))
-    if bodies:
+    if _summarised(e, "bodies"):
+        parts.append(_bodies_total(e))
+    elif bodies:
         parts.append("dofs " + " ".join(f"{word(b.get('name'))} {num(b.get('dofs'), 'd')}" for b in bodies))
-    for p in dicts(e.get("pairs")):
+    pairs = dicts(e.get("pairs"))
+    if _summarised(e, "pairs"):
+        parts.append("| " + _pairs_total(e))
+        pairs = _selected_pairs(e)
+    for p in pairs:
         parts.append(f"| {word(p.get('name'))}: force {num(p.get('force', 0), '.5g')} "
                      f"p_max {num(p.get('max_pressure', 0), '.5g')}{_tangential(p)}")
     if e.get("elapsed_seconds") is not None:
@@ -173,17 +226,27 @@ def compact_iterations(e, elapsed=True):
     """The terminal's live line, in forms from the fullest to the shortest (the first that fits is drawn):
     "iter 12  paper 1.23e-03  res 2.22e-02  active 15  force 140.9  p_max 166.4  dofs 528/528  0.05s", or for
     the active-set methods "step 2  active 245 (3 changed)  compl 1.20e-03  force ..." (several pairs or bodies:
-    values joined by '/', in the order of the job; with friction pairs "t_force", '-' for a frictionless pair).
+    values joined by '/', in the order of the job; with friction pairs "t_force", '-' for a frictionless pair;
+    past LISTED pairs or bodies their totals: "force 232.3 (946 pairs)  p_max 3.94  dofs 29832 (496 bodies)").
     elapsed=False leaves out the solver's elapsed time."""
     pairs, bodies = dicts(e.get("pairs")), dicts(e.get("bodies"))
     head = [f"{_label(e)} {num(e.get('iteration', 0), 'd')}"] + _measure_parts(e, wide=False)
     extra = []  # left out from the end first when the line is too long
-    if pairs:
+    if _summarised(e, "pairs"):
+        s = obj(e.get("pairs_summary"))
+        extra.append(f"force {num(s.get('force', 0), '.5g')} ({num(s.get('count'), 'd')} pairs)")
+        extra.append(f"p_max {num(s.get('max_pressure', 0), '.5g')}")
+        if s.get("friction_pairs"):
+            extra.append(f"stick/slip {num(s.get('stick_nodes', 0), '.0f')}/{num(s.get('slip_nodes', 0), '.0f')}")
+    elif pairs:
         extra.append("force " + "/".join(num(p.get("force", 0), ".5g") for p in pairs))
         extra.append("p_max " + "/".join(num(p.get("max_pressure", 0), ".5g") for p in pairs))
         if any("tangential_force" in p for p in pairs):
             extra.append("t_force " + "/".join(num(p.get("tangential_force"), ".5g", "-") for p in pairs))
-    if bodies:
+    if _summarised(e, "bodies"):
+        s = obj(e.get("bodies_summary"))
+        extra.append(f"dofs {num(s.get('dofs', 0), '.0f')} ({num(s.get('count'), 'd')} bodies)")
+    elif bodies:
         extra.append("dofs " + "/".join(num(b.get("dofs"), "d") for b in bodies))
     seconds = [f"{num(e['elapsed_seconds'], '.1f')}s"] if elapsed and e.get("elapsed_seconds") is not None else []
     forms = ["  ".join(head + extra + seconds), " ".join(head + extra + seconds)]

@@ -33,6 +33,12 @@ const ProblemType kProblemTypes[] = {
     {"no-result", "The job has no result file",
      "The job finished without a solution to store (it failed before the first iteration, or was cancelled "
      "before it started)."},
+    {"no-progress", "The job has no per-pair progress",
+     "GET /v1/jobs/{id}/pairs serves the last iteration's detail of the pairs named; the job has none (it has not "
+     "run an iteration yet, or it ended without one). A finished job's result file has every pair."},
+    {"no-such-pair", "No pair matches",
+     "None of the job's contact pairs matches the names or patterns given in `names`; the job's pairs are in its "
+     "iteration events (pairs_summary counts them) and in GET /v1/jobs/{id}/pairs?names=*."},
     {"corrupt-job", "The job's stored files are damaged",
      "The server found the job's files in its data directory damaged (state.json unreadable, a result file that is "
      "not the HDF5 file it wrote, a file replaced by a symbolic link). Nothing is served from them and nothing is "

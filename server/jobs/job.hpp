@@ -7,9 +7,12 @@
 
 #include "contact/result.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <memory>
 #include <mutex>
 #include <string>
 
@@ -37,6 +40,18 @@ struct Job {
   std::int64_t disk_bytes = 0;       // what its directory holds once finished (retention)
   bool cancelling_queued = false;    // a cancel is storing this QUEUED job as CANCELLED
 
+  // The last iteration's detail of every pair (profiles included) while the job runs: {"iteration", "pairs"}.
+  // The events list only the pairs the job selects (contact/progress_json.hpp); GET /v1/jobs/{id}/pairs serves
+  // any pair from here, and from pairs.json (the same, stored when the job ends) afterwards.
+  void set_pair_detail(std::shared_ptr<const nlohmann::json> detail) {
+    std::lock_guard<std::mutex> lock(detail_mutex_);
+    pair_detail_ = std::move(detail);
+  }
+  std::shared_ptr<const nlohmann::json> pair_detail() const {
+    std::lock_guard<std::mutex> lock(detail_mutex_);
+    return pair_detail_;
+  }
+
   // Called with the WorkerPool's mutex held.
   bool request_cancel(CancelReason reason) {
     int expected = static_cast<int>(CancelReason::none);
@@ -46,6 +61,10 @@ struct Job {
     return first;
   }
   std::chrono::steady_clock::time_point cancel_requested_at{};  // when the first reason was set
+
+ private:
+  mutable std::mutex detail_mutex_;
+  std::shared_ptr<const nlohmann::json> pair_detail_;
 };
 
 }  // namespace contactd

@@ -68,6 +68,7 @@ void JobRun::execute() {
   JobRecord outcome = outcome_of(result, reason);
   // The result file: written before the job is marked done, so that `end` means "downloadable now".
   write_result_files(result, outcome);
+  keep_pair_detail();
   for (const auto& step : result.step_history) job_->events.append("step", step_event(step));
   finish(std::move(outcome));
 }
@@ -83,7 +84,8 @@ contact::Result JobRun::solve() {
   try {
     problem_ = parse_again(result);
     if (!problem_) return result;
-    ProgressObserver observer(*job_, context_.registry, context_.metrics);
+    ProgressObserver observer(*job_, context_.registry, context_.metrics,
+                              contact::io::ProgressSelection{problem_->output.progress_pairs, false});
     if (problem_->ranks > 1) return solve_on_ranks(observer);
     return contact::solve(*problem_, observer, job_->cancel);
   } catch (const std::bad_alloc&) {
@@ -198,6 +200,19 @@ void JobRun::write_result_files(const contact::Result& result, JobRecord& outcom
   }
 }
 
+// The last iteration's detail of every pair goes from memory to pairs.json, so that GET /v1/jobs/{id}/pairs
+// still answers after the job (and after a restart). Not a reason to fail the job: without it the route says so.
+void JobRun::keep_pair_detail() {
+  const auto detail = job_->pair_detail();
+  if (!detail) return;
+  try {
+    context_.store.save_pairs(id_, detail->dump());
+  } catch (const std::exception& e) {
+    log_line("job " + id_ + ": cannot store the pairs' detail: " + e.what());
+  }
+  job_->set_pair_detail(nullptr);
+}
+
 void JobRun::finish(JobRecord outcome) {
   outcome.finished_us = now_unix_us();
   outcome.events_dropped = job_->events.dropped();
@@ -233,6 +248,7 @@ void JobRun::finish(JobRecord outcome) {
 }
 
 void JobRun::requeue_after_shutdown() {
+  job_->set_pair_detail(nullptr);
   context_.store.remove_result(id_);
   const std::string message = "interrupted by a shutdown; it runs again when the server restarts";
   if (!context_.registry.commit(

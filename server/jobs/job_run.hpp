@@ -61,6 +61,7 @@ class JobRun {
   contact::Result solve_on_ranks(ProgressObserver& observer);
   JobRecord outcome_of(const contact::Result& result, CancelReason reason) const;
   void write_result_files(const contact::Result& result, JobRecord& outcome);
+  void keep_pair_detail();
   void finish(JobRecord outcome);
   void requeue_after_shutdown();
   // commit() until it succeeds or the workers stop; false if stopped.

@@ -249,7 +249,7 @@ MpiOutcome run_mpi_job(const MpiSettings& settings, int ranks, const std::string
     args.push_back(a);
   }
   for (const std::string& a : {settings.solver, job_file, std::string("-o"), result_path, std::string("--progress"),
-                               std::string("ndjson"), std::string("--job-id"), job_id, std::string("--max-dofs"),
+                               std::string("ndjson"), std::string("--progress-pairs"), std::string("all"), std::string("--job-id"), job_id, std::string("--max-dofs"),
                                std::to_string(max_dofs), std::string("--no-mesh-files")})
     args.push_back(a);
   return MpiRun(settings, on_iteration, cancel).run(std::move(args));

@@ -1,16 +1,23 @@
 #include "jobs/progress_observer.hpp"
 
-#include "jobs/events.hpp"
+#include <memory>
+#include <utility>
 
 namespace contactd {
 
 void ProgressObserver::on_iteration(const contact::IterationReport& report) {
-  on_iteration_json(iteration_event(report));
+  on_iteration_json(contact::io::iteration_json(report, true));
 }
 
-void ProgressObserver::on_iteration_json(const nlohmann::json& event) {
+void ProgressObserver::on_iteration_json(nlohmann::json full) {
+  full.erase("type");  // an MPI run's line names its type; the event log adds it
+  nlohmann::json event = contact::io::bounded_progress(full, selection_);
+  const int iteration = event.value("iteration", 0);
+  if (auto pairs = full.find("pairs"); pairs != full.end() && pairs->is_array())
+    job_.set_pair_detail(std::make_shared<const nlohmann::json>(
+        nlohmann::json{{"iteration", iteration}, {"pairs", std::move(*pairs)}}));
   job_.events.append("iteration", event);
-  nlohmann::json summary = event;  // the summary is the event without the pressure profiles
+  nlohmann::json summary = std::move(event);  // the summary is the event without the profiles
   if (summary.contains("pairs") && summary["pairs"].is_array())
     for (auto& pair : summary["pairs"])
       if (pair.is_object()) {
@@ -19,7 +26,7 @@ void ProgressObserver::on_iteration_json(const nlohmann::json& event) {
         pair.erase("tangential_tractions");
         pair.erase("stick");
       }
-  registry_.update_progress(job_, event.value("iteration", 0), std::move(summary));
+  registry_.update_progress(job_, iteration, std::move(summary));
   metrics_.iteration_done();
 }
 

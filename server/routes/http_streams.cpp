@@ -9,6 +9,8 @@
 #include "http/range.hpp"
 #include "jobs/events.hpp"
 
+#include "contact/progress_json.hpp"
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -33,6 +35,64 @@ struct Stream {
 };
 
 bool pump_stream(RouteContext& ctx, Stream& stream, httplib::DataSink& sink);
+
+// GET /v1/jobs/{id}/pairs?names=a,b*: the last iteration's detail (force, pressure and, with friction, tangential
+// traction profiles) of the pairs named, whatever the job's progress_pairs: live while the job runs, from
+// pairs.json once it has ended. At most kMaxPairsSelected pairs per answer ("matched" counts them all).
+void handle_pairs(RouteContext& ctx, const Request& req, Response& res) {
+  const auto job = ctx.find_job(req, res);
+  if (!job) return;
+  std::vector<std::string> patterns;
+  const std::string names = req.has_param("names") ? req.get_param_value("names") : std::string();
+  if (names.size() > 2000) {
+    send_problem(res, 400, "invalid-request", "names has " + std::to_string(names.size()) +
+                                                  " characters: at most 2000", req.path);
+    return;
+  }
+  std::size_t from = 0;
+  for (std::size_t comma; from <= names.size(); from = comma + 1) {
+    comma = std::min(names.find(',', from), names.size());
+    if (comma > from) patterns.push_back(names.substr(from, comma - from));
+  }
+  if (patterns.empty() || patterns.size() > 16) {
+    send_problem(res, 400, "invalid-request",
+                 "names must list 1 to 16 pair names or patterns (* ?) separated by commas, e.g. "
+                 "?names=b0_0.top-b1_0.bottom,b3_*",
+                 req.path);
+    return;
+  }
+  std::shared_ptr<const nlohmann::json> detail = job->pair_detail();
+  const char* source = "live";
+  if (!detail) {
+    source = "final";
+    if (auto text = ctx.store.read_pairs(job->record.id)) {
+      auto parsed = nlohmann::json::parse(*text, nullptr, false);
+      if (parsed.is_object()) detail = std::make_shared<const nlohmann::json>(std::move(parsed));
+    }
+  }
+  const JobRecord record = ctx.queue.snapshot(*job);
+  if (!detail) {
+    send_problem(res, 404, "no-progress",
+                 "job " + record.id + " (" + to_string(record.state) + ") has no iteration yet" +
+                     (is_terminal(record.state) ? "; its result file, if any, has every pair" : ""),
+                 req.path, {{"state", to_string(record.state)}});
+    return;
+  }
+  nlohmann::json pairs = nlohmann::json::array();
+  std::size_t matched = 0;
+  if (auto all = detail->find("pairs"); all != detail->end() && all->is_array())
+    for (const auto& pair : *all) {
+      if (!pair.is_object() || !contact::io::matches_any(pair.value("name", std::string()), patterns)) continue;
+      if (++matched <= contact::io::kMaxPairsSelected) pairs.push_back(pair);
+    }
+  if (matched == 0) {
+    send_problem(res, 404, "no-such-pair", "no pair of job " + record.id + " matches '" + clip(names, 200) + "'",
+                 req.path);
+    return;
+  }
+  send_json(res, 200, {{"iteration", detail->value("iteration", 0)}, {"source", source},
+                       {"state", to_string(record.state)}, {"matched", matched}, {"pairs", std::move(pairs)}});
+}
 
 void handle_result(RouteContext& ctx, const Request& req, Response& res, bool sidecar) {
   const auto job = ctx.find_job(req, res);
@@ -206,6 +266,7 @@ bool pump_stream(RouteContext& ctx, Stream& stream, httplib::DataSink& sink) {
 void register_stream_routes(Router& router, RouteContext& ctx) {
   const std::string job = R"(/v1/jobs/([^/]+))";
   router.get(job + "/events", [&ctx](const Request& req, Response& res) { handle_events(ctx, req, res); });
+  router.get(job + "/pairs", [&ctx](const Request& req, Response& res) { handle_pairs(ctx, req, res); });
   router.get(job + "/result", [&ctx](const Request& req, Response& res) { handle_result(ctx, req, res, false); });
   router.get(job + R"(/result\.xmf)", [&ctx](const Request& req, Response& res) { handle_result(ctx, req, res, true); });
 }

@@ -156,9 +156,24 @@ bool JobStore::restore_reserve() {
 std::string JobStore::read_job(const std::string& id) const { return contact::read_whole_file(job_path(id)); }
 
 void JobStore::remove_result(const std::string& id) {
-  for (const std::string& path : {result_path(id), xmf_path(id)}) {
+  for (const std::string& path : {result_path(id), xmf_path(id), pairs_path(id)}) {
     ::unlink(path.c_str());  // a link is removed, never what it points to
     ::unlink((path + ".tmp").c_str());
+  }
+}
+
+void JobStore::save_pairs(const std::string& id, const std::string& text) {
+  contact::write_file_atomically(pairs_path(id), text, /*durable=*/false);
+}
+
+std::optional<std::string> JobStore::read_pairs(const std::string& id) const {
+  const std::string path = pairs_path(id);
+  struct stat st {};
+  if (::lstat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return std::nullopt;
+  try {
+    return contact::read_whole_file(path);
+  } catch (const std::exception&) {
+    return std::nullopt;
   }
 }
 

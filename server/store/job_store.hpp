@@ -6,6 +6,7 @@
 //   <data>/jobs/<id>/state.json     JobRecord (to_state_json), rewritten on every state change
 //   <data>/jobs/<id>/events.ndjson  the progress events, append-only (EventLog)
 //   <data>/jobs/<id>/result.hdf     the HDF5 result, and result.xmf its XDMF sidecar
+//   <data>/jobs/<id>/pairs.json     the last iteration's detail of every pair (GET /v1/jobs/{id}/pairs)
 // Every rewrite goes to "<file>.tmp", is fsync'ed and renamed over the file. Ids are checked with is_job_id()
 // before they become paths; no file is opened through a symbolic link. Thread safety: the methods touch only the
 // files of the job they are given, so calls for different jobs may run concurrently; the JobQueue serialises the
@@ -39,6 +40,7 @@ class JobStore {
   std::string events_path(const std::string& id) const { return job_dir(id) + "/events.ndjson"; }
   std::string result_path(const std::string& id) const { return job_dir(id) + "/result.hdf"; }
   std::string xmf_path(const std::string& id) const { return job_dir(id) + "/result.xmf"; }
+  std::string pairs_path(const std::string& id) const { return job_dir(id) + "/pairs.json"; }
 
   // A new job's directory with job.json, state.json (and idempotency.key). Throws (the directory is removed).
   void create(const JobRecord& record, const std::string& body);
@@ -50,8 +52,13 @@ class JobStore {
   // job.json as submitted. Throws FileError.
   std::string read_job(const std::string& id) const;
 
-  // Removes result.hdf and result.xmf (and their temporary files) of a job about to run again.
+  // Removes result.hdf, result.xmf and pairs.json (and their temporary files) of a job about to run again.
   void remove_result(const std::string& id);
+
+  // pairs.json: written atomically (not fsync'ed: it only serves GET /v1/jobs/{id}/pairs); read as its text, or
+  // nullopt when there is none (or it is not a regular file). Throws FileError on a failed write.
+  void save_pairs(const std::string& id, const std::string& text);
+  std::optional<std::string> read_pairs(const std::string& id) const;
 
   // What is wrong with a finished job's result file, or nullopt: a symbolic link, not the size recorded, or not
   // starting with the HDF5 signature.

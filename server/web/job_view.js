@@ -8,6 +8,8 @@ import {followEvents} from "./stream.js";
 const $ = (id) => document.getElementById(id);
 const TERMINAL = new Set(["SUCCEEDED", "FAILED", "CANCELLED"]);
 const MAX_LOG = 300;
+const MAX_PAIR_PLOTS = 24;     // pressure panels at most (the events' pairs and the ones picked)
+const PICK_INTERVAL_MS = 1000; // the picked pairs are fetched again at most this often while the job runs
 
 export class JobView {
   // onChange(): the job list should be refreshed (a state changed, the job was deleted).
@@ -17,6 +19,13 @@ export class JobView {
     this.controller = null;
     this.convergence = new ConvergencePlot($("convergence"), $("convergence-title"));
     this.pairs = new Map();
+    this.picked = "";        // the names or patterns shown on request (GET v1/jobs/{id}/pairs)
+    this.pickPending = false;
+    this.pickLast = 0;
+    $("pairs-form").addEventListener("submit", (ev) => {
+      ev.preventDefault();
+      this.pick($("pairs-names").value.trim());
+    });
     $("cancel").addEventListener("click", () => this.cancel());
     $("delete").addEventListener("click", () => this.remove());
     for (const [id, file] of [["result-link", "result"], ["xmf-link", "result.xmf"]]) {
@@ -63,6 +72,9 @@ export class JobView {
     this.pairs.clear();
     $("pressure").replaceChildren();
     $("pressure").dataset.iteration = "0";
+    $("pairs-summary").textContent = "";
+    $("pairs-message").textContent = "";
+    this.picked = "";
     this.id = null;
   }
 
@@ -154,7 +166,10 @@ export class JobView {
         this.onChange();
         break;
       case "step": {
-        const bodies = (e.bodies || []).map((b) => `${b.name} ${b.elements} cells`).join(", ");
+        const s = e.bodies_summary;
+        const bodies = Array.isArray(e.bodies) && e.bodies.length <= 6
+          ? e.bodies.map((b) => `${b.name} ${b.elements} cells`).join(", ")
+          : s ? `${s.count} bodies, ${s.elements} cells` : "";
         this.log(`step ${e.step} at iteration ${e.iteration}: ${bodies}`);
         break;
       }
@@ -174,22 +189,76 @@ export class JobView {
     if (this.state !== "RUNNING") this.setState("RUNNING");
     this.convergence.add(e);
     $("job-iteration").textContent = `iteration ${e.iteration}`;
-    for (const pair of Array.isArray(e.pairs) ? e.pairs : []) {
-      let plot = this.pairs.get(pair.name);
-      if (!plot) {
-        const el = document.createElement("div");
-        el.className = "pair";
-        $("pressure").append(el);
-        plot = new PressurePlot(el, String(pair.name));
-        this.pairs.set(pair.name, plot);
-      }
-      plot.add(e.iteration, pair);
-    }
+    this.summary(e);
+    for (const pair of Array.isArray(e.pairs) ? e.pairs : []) this.addPair(e.iteration, pair);
     $("pressure").dataset.iteration = String(e.iteration);
-    this.meshTable(Array.isArray(e.bodies) ? e.bodies : []);
+    this.meshTable(Array.isArray(e.bodies) ? e.bodies : [], e.bodies_summary);
+    if (this.picked) this.pick(this.picked, false);
   }
 
-  meshTable(bodies) {
+  // A pair's panel, made on its first data; past MAX_PAIR_PLOTS no new panel (false).
+  addPair(iteration, pair) {
+    let plot = this.pairs.get(pair.name);
+    if (!plot) {
+      if (this.pairs.size >= MAX_PAIR_PLOTS) return false;
+      const el = document.createElement("div");
+      el.className = "pair";
+      $("pressure").append(el);
+      plot = new PressurePlot(el, String(pair.name));
+      this.pairs.set(pair.name, plot);
+    }
+    plot.add(iteration, pair);
+    return true;
+  }
+
+  // The totals over every pair (the events' pairs_summary), whatever the number of pairs.
+  summary(e) {
+    const s = e.pairs_summary;
+    if (!s || typeof s !== "object") return;
+    const n = (v, digits = 5) => (typeof v === "number" ? Number(v.toPrecision(digits)).toString() : "?");
+    let text = `${n(s.count)} pairs: force ${n(s.force)}, ${n(s.active_nodes)} contact nodes ` +
+               `(${n(s.changed_nodes)} changed in ${n(s.pairs_changed)} pairs)`;
+    if (s.friction_pairs) text += `, stick ${n(s.stick_nodes)} / slip ${n(s.slip_nodes)} nodes, ` +
+                                  `tangential force ${n(s.tangential_force)}`;
+    if (s.max_pressure_pair) text += `; highest pressure ${n(s.max_pressure)} at ${s.max_pressure_pair}`;
+    if (s.most_changed_pair) text += `; most change at ${s.most_changed_pair} (${n(s.most_changed_nodes)} nodes)`;
+    if (e.pairs_listed === "selected") text += ". Panels: the pairs that stand out or are selected.";
+    $("pairs-summary").textContent = text;
+  }
+
+  // Shows the pairs `names` (comma-separated names or patterns) from GET v1/jobs/{id}/pairs; again at each
+  // iteration while the job runs (`asked`: the user's request, which reports its outcome), at most every
+  // PICK_INTERVAL_MS and one request at a time.
+  async pick(names, asked = true) {
+    if (!names) return;
+    const now = Date.now();
+    if (!asked && (this.pickPending || now - this.pickLast < PICK_INTERVAL_MS)) return;
+    const id = this.id;
+    this.picked = names;
+    this.pickPending = true;
+    this.pickLast = now;
+    try {
+      const answer = await api(`v1/jobs/${id}/pairs?names=${encodeURIComponent(names)}`);
+      if (id !== this.id) return;
+      let shown = 0;
+      for (const pair of Array.isArray(answer.pairs) ? answer.pairs : []) shown += this.addPair(answer.iteration, pair) ? 1 : 0;
+      if (asked) {
+        const more = answer.matched > shown ? ` (${answer.matched} matched; ${shown} shown)` : "";
+        $("pairs-message").textContent = `iteration ${answer.iteration}: ${shown} pair${shown === 1 ? "" : "s"}${more}`;
+      }
+    } catch (e) {
+      if (id === this.id && asked) $("pairs-message").textContent = e.message;
+      if (id === this.id) this.picked = asked ? "" : this.picked;
+    } finally {
+      this.pickPending = false;
+    }
+  }
+
+  meshTable(bodies, summary) {
+    if (!bodies.length && summary && typeof summary === "object") {
+      bodies = [{name: `${summary.count} bodies (totals)`, elements: summary.elements, dofs: summary.dofs,
+                 elements_refined: summary.elements_refined}];
+    }
     const rows = bodies.map((b) => {
       const tr = document.createElement("tr");
       for (const v of [b.name, b.elements, b.dofs, b.elements_refined]) {

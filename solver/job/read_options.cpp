@@ -2,6 +2,8 @@
 // "adaptivity", "loading", "parallel" and "output" (its default depends on adaptivity).
 #include "job_reader.hpp"
 
+#include "contact/progress_json.hpp"
+
 #include <algorithm>
 #include <string>
 #include <vector>
@@ -392,19 +394,62 @@ void JobReader::read_loading_steps(const json& value, const std::string& pointer
   problem_.loading.factors = std::move(factors);
 }
 
-// {"steps": "last" | "all"}: which steps' fields the result keeps. The default depends on the job (after
-// adaptivity was read): an adaptive run's steps are ever finer meshes on the way to the answer, each about as large
-// as the last, so only the last is kept; load steps are answers to different loads, kept all.
+// {"steps": "last" | "all", "progress_pairs": [glob, ...]}. steps: which steps' fields the result keeps. The
+// default depends on the job (after adaptivity was read): an adaptive run's steps are ever finer meshes on the way
+// to the answer, each about as large as the last, so only the last is kept; load steps are answers to different
+// loads, kept all. progress_pairs: the pairs whose detail the progress lists (contact/progress_json.hpp), each
+// pattern matching at least one pair (after the contacts were read).
 void JobReader::read_output(const Fields& top) {
   json& out = sub_object(normalized_, "output");
   problem_.output.steps = problem_.adaptivity.enabled ? StepOutput::last : StepOutput::all;
   if (const json* v = top.find("output")) {
-    Fields f(*v, top.at("output"), "output", {"steps"}, errors_);
+    Fields f(*v, top.at("output"), "output", {"steps", "progress_pairs"}, errors_);
     if (const json* s = f.find("steps"))
       if (auto c = choice(*s, f.at("steps"), "steps", {"last", "all"}, errors_))
         problem_.output.steps = *c == "last" ? StepOutput::last : StepOutput::all;
+    if (const json* p = f.find("progress_pairs")) read_progress_pairs(*p, f.at("progress_pairs"));
   }
   set_default(out, "steps", problem_.output.steps == StepOutput::last ? "last" : "all");
+}
+
+void JobReader::read_progress_pairs(const json& value, const std::string& pointer) {
+  constexpr size_t kMaxPatterns = 16, kMaxPatternLength = 200;
+  if (!value.is_array()) {
+    errors_.add(pointer, "progress_pairs must be an array of pair names or patterns (* and ? as in a shell), got " +
+                             read::type_name(value));
+    return;
+  }
+  if (value.size() > kMaxPatterns) {
+    errors_.add(pointer, "progress_pairs has " + std::to_string(value.size()) + " patterns: at most " +
+                             std::to_string(kMaxPatterns) + " (one pattern such as \"b3_*\" selects many pairs)");
+    return;
+  }
+  std::vector<std::string> names;
+  for (const auto& c : problem_.contacts) names.push_back(c.name);
+  for (size_t k = 0; k < value.size(); ++k) {
+    const std::string at = child(pointer, k);
+    const auto pattern = read::string(value[k], at, "a progress_pairs pattern", errors_);
+    if (!pattern) continue;
+    if (pattern->empty() || pattern->size() > kMaxPatternLength) {
+      errors_.add(at, "a progress_pairs pattern must have 1 to " + std::to_string(kMaxPatternLength) +
+                          " characters, not " + std::to_string(pattern->size()));
+      continue;
+    }
+    if (auto problem = read::control_character_problem(*pattern, "the pattern")) {
+      errors_.add(at, *problem);
+      continue;
+    }
+    bool found = false;
+    for (const auto& name : names) found = found || io::matches_any(name, {*pattern});
+    if (!found && !names.empty()) {
+      std::string listed;
+      for (size_t n = 0; n < names.size() && n < 8; ++n) listed += (n ? ", " : "") + names[n];
+      if (names.size() > 8) listed += ", ... (" + std::to_string(names.size()) + " pairs)";
+      errors_.add(at, "'" + read::shown(*pattern) + "' matches no contact pair; the pairs are " + listed);
+      continue;
+    }
+    problem_.output.progress_pairs.push_back(*pattern);
+  }
 }
 
 }  // namespace contact::job::detail

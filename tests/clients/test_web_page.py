@@ -17,6 +17,7 @@ Exits 77 (CTest: skipped) with a message saying why only when chromium cannot be
 import json
 import os
 import shutil
+import subprocess
 import sys
 import tempfile
 import time
@@ -230,6 +231,7 @@ def test_without_token(server, b, downloads):
             check("example: the link serves the HDF5 file", r.read(8) == b"\x89HDF\r\n\x1a\n")
 
     test_friction(server, b)
+    test_wall(server, b)
 
     # 4. An invalid job: every error with its pointer, no job created.
     bad = example("flat_patch.json")
@@ -315,6 +317,51 @@ def test_friction(server, b):
     labels = b.driver.execute_script("return window.pressureCanvasTexts || null;")
     check("friction: the tangential axis is labelled", labels is not None and "tangential traction" in labels,
           labels and sorted(set(labels))[:20])
+
+
+def test_wall(server, b):
+    """3c. A 22 x 22 frictional wall (946 pairs): the page shows the totals over every pair, a bounded number of
+    panels (the pairs that stand out), the bodies' totals, and any pair picked by pattern."""
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "wall.json")
+        subprocess.run(["/usr/bin/python3", os.path.join(SRC, "scripts", "make_brick_wall.py"), "--rows", "22",
+                        "--bricks", "22", "--friction", "0.6", "--shear", "0.3", "-o", path], check=True,
+                       capture_output=True)
+        with open(path) as f:
+            job = json.load(f)
+    job_id = server.submit_id(job)
+    check("wall: solved", server.wait_done(job_id, 300).get("state") == "SUCCEEDED")
+    b.driver.execute_script(f"window.location.hash = 'job={job_id}';")
+    check("wall: the page loads the job", b.wait(lambda: b.text("job-state") == "SUCCEEDED", 30),
+          b.text("job-state"))
+    iterations = [e for e in read_all_events(server, job_id, ndjson=True) if e.get("type") == "iteration"]
+    last = iterations[-1]
+    listed = {p["name"] for e in iterations for p in e["pairs"]}
+    summary = b.wait(lambda: b.text("pairs-summary") if "946 pairs" in b.text("pairs-summary") else None, 30)
+    check("wall: the totals over the 946 pairs, with stick and slip",
+          bool(summary) and "stick" in summary and last["pairs_summary"]["max_pressure_pair"] in summary, summary)
+    panels = len(b.driver.find_elements(By.CSS_SELECTOR, "#pressure .pair"))
+    check("wall: a panel per pair the events listed, not 946", panels == len(listed) and panels <= 2 * len(iterations),
+          (panels, listed))
+    check("wall: the mesh table gives the bodies' totals", any("496 bodies" in r[0] for r in b.rows("mesh")),
+          b.rows("mesh")[:3])
+    field = b.el("pairs-names")
+    field.clear()
+    field.send_keys("b21_1.*,b21_2.*")
+    b.el("pairs-show").click()
+    picked = [n for n in (c.get("name") or f"{c['slave']}-{c['master']}" for c in job["contacts"])
+              if n.startswith(("b21_1.", "b21_2."))]
+    shown = b.wait(lambda: len(b.driver.find_elements(By.CSS_SELECTOR, "#pressure .pair")) >= panels + len(picked), 20)
+    check("wall: 'Show pairs' adds a panel per pair the pattern matches", bool(shown),
+          (len(b.driver.find_elements(By.CSS_SELECTOR, "#pressure .pair")), panels, len(picked)))
+    check("wall: and says what it showed", f"{len(picked)} pairs" in b.text("pairs-message"), b.text("pairs-message"))
+    texts = b.text("pressure")
+    check("wall: the picked pairs are drawn by name", all(n in texts for n in picked), picked)
+    field.clear()
+    field.send_keys("no_such_pair")
+    b.el("pairs-show").click()
+    check("wall: a pattern matching nothing says so", b.wait(lambda: "no pair" in b.text("pairs-message"), 10),
+          b.text("pairs-message"))
 
 
 def test_with_token(b, downloads):

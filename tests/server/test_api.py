@@ -298,7 +298,7 @@ with Server() as server, tempfile.TemporaryDirectory() as tmp:
 
     # The data directory holds what docs/server.md says.
     files = sorted(os.listdir(os.path.join(server.data_dir, "jobs", job_id)))
-    check("data dir layout", files == ["events.ndjson", "job.json", "result.hdf", "result.xmf", "state.json"], files)
+    check("data dir layout", files == ["events.ndjson", "job.json", "pairs.json", "result.hdf", "result.xmf", "state.json"], files)
     with open(os.path.join(server.data_dir, "jobs", job_id, "job.json"), "rb") as f:
         check("job.json is the body as submitted", f.read() == json.dumps(job).encode())
     with open(os.path.join(server.data_dir, "jobs", job_id, "events.ndjson")) as f:

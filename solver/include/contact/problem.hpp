@@ -226,6 +226,9 @@ struct LoadingSpec {
 enum class StepOutput { all, last };
 struct OutputSettings {
   StepOutput steps = StepOutput::all;
+  // The pairs whose detail the progress lists (shell globs on pair names; contact/progress_json.hpp). Empty: every
+  // pair while they are few, past that a summary and the pairs that stand out.
+  std::vector<std::string> progress_pairs;
 };
 
 struct Problem {
