@@ -12,8 +12,11 @@ As a command (clients/contact_client.py, or python3 -m contact_client with clien
     contact_client.py download ID -o seed.hdf [--xmf]
     contact_client.py validate my_job.json
     contact_client.py plot seed.hdf -o seed.png [--events events.ndjson] [--xlim LO HI | --xlim full]
-                                              [--along arc|x]   # friction pairs: also the tangential
-                                              # traction, the stick zone shaded
+                                              [--along auto|arc|x|angle] [--pairs PATTERN,...]
+                                              [--max-pairs N] [--overview | --no-overview] [--warp F]
+                                              # friction pairs: also the tangential traction, the slip and
+                                              # the stick zone per step; many bodies: an overview of all
+                                              # bodies and joints; stepped jobs: the load path
 
     --url (CONTACT_URL, default http://127.0.0.1:8080), --token (CONTACT_TOKEN), --timeout (seconds).
     Exit codes: 0 ok; 1 server, connection or job error (an answer that is not the API's included);
@@ -29,16 +32,18 @@ As a module:
     r = read_result("seed.hdf")                 # numpy arrays
     x, p = r["steps"][-1]["contacts"]["upper.bottom-lower.top"]["x"], ...["pressure"]
 
-Modules: errors (the exceptions), client (HTTP and the API), sse (event streams), results (reading files),
-plot (the figure), display (what the commands print), cli (the commands).
+Modules: errors (the exceptions), client (HTTP and the API), sse (event streams), results (reading files, all
+or in part), plot (the figure; its parts in plot_profiles, plot_pairs, plot_paths, plot_mesh, plot_wall and
+plot_select), display (what the commands print), cli (the commands).
 """
 from .cli import build_parser, main
 from .client import DEFAULT_TIMEOUT, DEFAULT_URL, STREAM_READ_TIMEOUT, Client
 from .display import Progress, compact_iterations, format_iteration
 from .errors import (EXIT_ERROR, EXIT_JOB, EXIT_OK, EXIT_USAGE, ApiError, BadAnswer, BadInput, ClientError,
                      ConnectionFailed, RequestTimeout)
-from .plot import load_curve, plot_result
-from .results import read_events, read_result
+from .plot import load_curve, load_path, plot_result
+from .results import ResultFile, read_events, read_result
 
 __all__ = ["Client", "ClientError", "ConnectionFailed", "RequestTimeout", "ApiError", "BadInput", "BadAnswer",
-           "read_result", "read_events", "plot_result", "load_curve", "DEFAULT_URL", "DEFAULT_TIMEOUT", "main"]
+           "read_result", "read_events", "ResultFile", "plot_result", "load_curve", "load_path", "DEFAULT_URL",
+           "DEFAULT_TIMEOUT", "main"]

@@ -9,8 +9,8 @@ import traceback
 from .client import DEFAULT_TIMEOUT, DEFAULT_URL, Client
 from .display import Progress, dicts, num, print_job, word
 from .errors import EXIT_ERROR, EXIT_JOB, EXIT_OK, EXIT_USAGE, BadInput, ClientError, one_line
-from .plot import plot_result
-from .results import read_events, read_result
+from .plot import MAX_PAIRS, plot_result
+from .results import read_events
 
 
 def _cmd_submit(c, a):
@@ -155,29 +155,50 @@ def _cmd_plot(c, a):
         raise ClientError(f"plot needs {exc.name}, which {sys.executable} cannot import (Debian's "
                           "/usr/bin/python3 with apt-get install python3-h5py python3-numpy python3-matplotlib)"
                           ) from None
-    try:
-        result = read_result(a.file)
-    except (OSError, KeyError, ValueError) as exc:
-        raise BadInput(f"cannot read {a.file}: {one_line(exc)}") from None
+    if a.max_pairs < 1:
+        raise BadInput(f"--max-pairs {a.max_pairs}: give 1 or more")
     events = None
     if a.events:
         try:
             events = read_events(a.events)
         except (OSError, ValueError) as exc:
             raise BadInput(f"cannot read events from {a.events}: {one_line(exc)}") from None
-    drawn = plot_result(result, a.output, events=events, warp=a.warp, title=a.title, xlim=_xlim(a.xlim),
-                        along=a.along)
-    warp = drawn["warp"]
-    print(f"wrote {a.output} (1000 x 800 px; " + (f"mesh displaced x {warp:g})" if warp else "undeformed mesh)"))
-    coordinate = "arc length" if a.along == "arc" else "x"
+    try:
+        # Only what the figure draws is read (a wall of hundreds of bodies holds tens of thousands of datasets).
+        drawn = plot_result(a.file, a.output, events=events, warp=a.warp, title=a.title, xlim=_xlim(a.xlim),
+                            along=a.along, pairs=a.pairs, max_pairs=a.max_pairs, overview=a.overview)
+    except (OSError, KeyError) as exc:
+        raise BadInput(f"cannot read {a.file}: {one_line(exc)}") from None
+    _print_plot(a.output, drawn)
+    return EXIT_OK
+
+
+COORDINATE_WORDS = {"arc": "arc length", "x": "x", "angle": "angle"}
+
+
+def _print_plot(png, drawn):
+    """What plot drew: the size and the magnification, the pairs chosen, each pair's range and contact (and
+    friction), the joints' states of the overview, the load path."""
+    warp, (width, height) = drawn["warp"], drawn["size"]
+    print(f"wrote {png} ({width} x {height} px; " + (f"mesh displaced x {warp:g})" if warp else "undeformed mesh)"))
+    if drawn["warp_note"]:
+        print(f"  magnification lowered: {drawn['warp_note']}")
+    if drawn["pairs_note"]:
+        print(f"  {drawn['pairs_note']}")
     for pair, (lo, hi) in drawn["pressure_xlim"].items():
         zone = drawn["contact_zone"].get(pair)
-        print(f"  {pair}: pressure drawn from {coordinate} {lo:g} to {hi:g}, "
+        print(f"  {pair}: pressure drawn from {COORDINATE_WORDS[drawn['along'][pair]]} {lo:g} to {hi:g}, "
               + (f"contact from {zone[0]:g} to {zone[1]:g}" if zone else "no contact"))
         if pair in drawn["friction"]:
             print(f"  {pair}: {drawn['friction'][pair]}, tangential force {drawn['tangential_force'][pair]:.6g}, "
                   + _stick_text(drawn["stick_zones"][pair]))
-    return EXIT_OK
+    if drawn["overview"]:
+        nodes = drawn["overview"]["nodes"]
+        print(f"  overview: {drawn['overview']['bodies']} bodies, {drawn['overview']['pairs']} pairs; slave nodes "
+              + ", ".join(f"{n} {state}" for state, n in nodes.items() if n))
+    path = drawn["load_path"]
+    if path is not None and "x_label" in path:
+        print(f"  load history: {len(path['x'])} steps against the {path['x_label']}")
 
 
 def _stick_text(zones):
@@ -261,23 +282,38 @@ def build_parser():
 
     s = sub.add_parser("plot", parents=[common],
                        help="plot a result: pressure along each pair (with friction also the tangential "
-                            "traction and the stick zone), deformed mesh by von Mises stress, the force-load curve "
-                            "of a load-stepped job")
+                            "traction, the slip and the stick zone per step), deformed mesh by von Mises stress or "
+                            "for many bodies an overview with every joint's state, the load path of a stepped job")
     s.add_argument("file", metavar="FILE.hdf")
     s.add_argument("-o", "--output", required=True, metavar="PNG")
     s.add_argument("--events", metavar="FILE",
                    help="the job's saved events (--events-out, or NDJSON/SSE from curl): one curve per iteration")
     s.add_argument("--warp", type=float, default=None,
                    help="draw the mesh displaced by this factor times the displacement (default: the factor that "
-                        "makes the largest displacement 4%% of the mesh; 0: undeformed)")
+                        "makes the largest displacement 4%% of the mesh, lowered as far as needed, down to 1 or 0, "
+                        "so that no closed contact is drawn open by more than a pixel; 0: undeformed)")
     s.add_argument("--xlim", nargs="+", metavar=("LO", "HI"),
                    help="--xlim LO HI: the pressure panels' horizontal range; --xlim full: the whole slave edge "
                         "(default: the contact zone, the nodes with "
                         "pressure > 0, plus 15%% of its width and at least 3 nodes on each side; the mesh is "
                         "drawn whole and zoomed on that stretch)")
-    s.add_argument("--along", choices=["arc", "x"], default="arc",
-                   help="the pressure panels' horizontal coordinate: arc (default) the arc length along the "
-                        "slave edge from its first node, as on the web page; x the nodes' x")
+    s.add_argument("--along", choices=["auto", "arc", "x", "angle"], default="auto",
+                   help="the pressure panels' horizontal coordinate: arc, the arc length along the slave edge "
+                        "from its first node, as on the web page; x, the nodes' x; angle, degrees about the centre "
+                        "of a circular slave edge; auto (default): angle where the slave edge is circular and the "
+                        "contact turns through more than 30 degrees (a ring, a shrink fit), else arc")
+    s.add_argument("--pairs", metavar="PATTERN[,PATTERN]", action="append",
+                   help="draw the panels of these pairs: names or shell patterns (* ?) of pairs, or of their "
+                        "slave or master bodies ('b0_*', base); repeatable (default: every pair, or beyond "
+                        "--max-pairs the ones with the largest contact force)")
+    s.add_argument("--max-pairs", type=int, default=MAX_PAIRS, metavar="N",
+                   help=f"at most N pair panels ({MAX_PAIRS}); beyond, those with the largest contact force")
+    group = s.add_mutually_exclusive_group()
+    group.add_argument("--overview", dest="overview", action="store_true", default=None,
+                       help="draw all bodies by stress and every joint by state (open, stick, slip) instead of "
+                            "the mesh row (the default beyond 8 bodies)")
+    group.add_argument("--no-overview", dest="overview", action="store_false",
+                       help="draw the mesh row whatever the number of bodies")
     s.add_argument("--title")
     s.set_defaults(func=_cmd_plot)
     return p
