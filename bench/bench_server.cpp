@@ -239,6 +239,59 @@ int main(int argc, char** argv) {
     server.stop();
   }
 
+  // --- 4. a small job's latency while long jobs hold every general worker ---------------------------------------
+  // Two long jobs on two general workers; flat patches submitted one after another: with the small-job lane they
+  // run at once, without it (--small-job-workers 0) each waits for a long job to end (here: 3 s each).
+  {
+    std::vector<double> p50(2);
+    for (int lane = 1; lane >= 0; --lane) {
+      Contactd server;
+      if (!server.start({"--workers", "2", "--small-job-workers", std::to_string(lane)})) {
+        std::printf("could not start contactd\n");
+        server.stop();
+        return 0;
+      }
+      httplib::Client client("127.0.0.1", server.port);
+      nlohmann::json blocker = job_from("seed_layers.json");  // 33k unknowns: a general worker's job
+      blocker["solver"]["criterion"] = "residual";
+      blocker["solver"]["tolerance"] = 1e-300;
+      blocker["solver"]["max_iterations"] = 100000;
+      blocker["solver"]["gamma"] = 0.002;
+      for (auto& b : blocker["bodies"]) b["mesh"]["block"]["ny"] = 256;
+      std::vector<std::string> blockers = {submit(client, blocker), submit(client, blocker)};
+      std::this_thread::sleep_for(std::chrono::milliseconds(500));
+      std::vector<double> latency_ms;
+      const nlohmann::json small = job_from("flat_patch.json");
+      const int rounds = lane ? 10 : 2;
+      for (int k = 0; k < rounds; ++k) {
+        const auto t0 = Clock::now();
+        const std::string id = submit(client, small);
+        if (id.empty()) continue;
+        if (!lane) {  // the long jobs end after 3 s so that the flat patch gets a worker at all
+          std::this_thread::sleep_for(std::chrono::seconds(3));
+          for (const auto& b : blockers) client.Post(("/v1/jobs/" + b + "/cancel").c_str(), "", "application/json");
+        }
+        stream(server.port, id, [](const std::string&, double) {});
+        latency_ms.push_back(std::chrono::duration<double>(Clock::now() - t0).count() * 1e3);
+        if (!lane) blockers = {submit(client, blocker), submit(client, blocker)};
+        if (!lane) std::this_thread::sleep_for(std::chrono::milliseconds(500));
+      }
+      for (const auto& b : blockers) client.Post(("/v1/jobs/" + b + "/cancel").c_str(), "", "application/json");
+      p50[lane] = percentile(latency_ms, 0.5);
+      const std::string what = std::string("small job submit -> end, two long jobs running, ") +
+                               (lane ? "small-job lane" : "no lane");
+      print_row(what.c_str(), "ms", percentile(latency_ms, 0.5), percentile(latency_ms, 0.9),
+                percentile(latency_ms, 1.0),
+                std::to_string(latency_ms.size()) + " flat_patch jobs" +
+                    (lane ? "" : " (each waits until a long job is cancelled after 3 s)"));
+      server.stop();
+    }
+    char ratio[64];
+    std::snprintf(ratio, sizeof ratio, "%.0fx", p50[0] / std::max(1e-9, p50[1]));
+    std::printf("| %-52s | %-4s | %9s | %9s | %9s | %s\n", "  no lane / lane (median)", "", ratio, "", "",
+                "same run");
+  }
+
   // --- 2. event latency with many subscribers ---------------------------------------------------------------
   {
     Contactd server;

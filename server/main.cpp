@@ -61,6 +61,17 @@ void add_job_limit_flags(CLI::App& app, Config& c) {
       ->envname("CONTACTD_WORKERS")
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();
+  app.add_option("--small-job-workers", c.queue.small_workers,
+                 "more workers that take only small jobs, so that a job of seconds never waits behind long ones")
+      ->envname("CONTACTD_SMALL_JOB_WORKERS")
+      ->check(CLI::Range(0, 64))
+      ->capture_default_str();
+  app.add_option("--small-job-dofs", c.queue.small_job_dofs,
+                 "a job is small with at most this many unknowns times load steps (one process, no adaptivity, at "
+                 "most 16 bodies)")
+      ->envname("CONTACTD_SMALL_JOB_DOFS")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   app.add_option("--max-queued", c.queue.max_queued, "queued jobs beyond which submissions get 503")
       ->envname("CONTACTD_MAX_QUEUED")
       ->check(CLI::Range(1, 1000000))
@@ -77,6 +88,16 @@ void add_job_limit_flags(CLI::App& app, Config& c) {
                  "most contact pairs a job may have (the command line takes 65536)")
       ->envname("CONTACTD_MAX_CONTACTS")
       ->check(CLI::Range(1, 4000000))
+      ->capture_default_str();
+  app.add_option("--max-load-steps", c.queue.max_load_steps, "most load steps a job may have")
+      ->envname("CONTACTD_MAX_LOAD_STEPS")
+      ->check(CLI::Range(1, 1000000))
+      ->capture_default_str();
+  app.add_option("--max-result-bytes", c.queue.max_result_bytes,
+                 "largest result a job may write, estimated before it runs from its meshes' nodes and the steps it "
+                 "keeps (the solver holds the kept steps in memory until it writes them)")
+      ->envname("CONTACTD_MAX_RESULT_BYTES")
+      ->check(CLI::Range(1e6, 1e15))
       ->capture_default_str();
 }
 
@@ -338,8 +359,9 @@ int serve(const Config& config, const sigset_t& signals) {
     throw;
   }
   server.set_ready();
-  std::printf("contactd %s listening on http://%s:%d (data dir %s, %d workers%s)\n", contact::solver_version(),
-              config.http.host.c_str(), port, config.data_dir.c_str(), config.queue.workers,
+  std::printf("contactd %s listening on http://%s:%d (data dir %s, %d workers + %d for small jobs%s)\n",
+              contact::solver_version(), config.http.host.c_str(), port, config.data_dir.c_str(),
+              config.queue.workers, config.queue.small_workers,
               config.http.token.empty() ? "" : ", bearer token required");
   std::fflush(stdout);
   capture_stdout();

@@ -22,7 +22,7 @@ JobQueue::JobQueue(JobStore& store, Metrics& metrics, BodyBudget& budget, QueueS
       store_(store),
       metrics_(metrics),
       registry_(store, settings_.max_event_log_bytes),
-      pool_(registry_, settings_.workers, settings_.time_limit_seconds,
+      pool_(registry_, settings_.workers, settings_.small_workers, settings_.time_limit_seconds,
             [this](const std::shared_ptr<Job>& job) { JobRun(run_context_, job).execute(); }),
       janitor_(registry_, pool_, store, settings_),
       run_context_{registry_,
@@ -78,6 +78,7 @@ JobQueue::Submission JobQueue::submit(const std::string& body, contact::job::Par
       break;
   }
   const std::shared_ptr<Job> job = admission.job;
+  job->record.small = small_job(settings_, *parsed.problem);  // not yet visible: nobody reads it concurrently
   const JobRecord record = job->record;  // nobody changes it before it is stored (persist lock held)
   try {
     store_.create(record, body);

@@ -103,7 +103,8 @@ class JobQueue {
   }
 
   JobCounts counts() const { return registry_.counts(); }
-  int workers() const { return settings_.workers; }
+  int workers() const { return settings_.workers + settings_.small_workers; }  // threads: both lanes
+  int small_workers() const { return settings_.small_workers; }
   int workers_busy() const { return pool_.busy(); }
   int workers_alive() const { return pool_.alive(); }
   bool stopping() const { return pool_.stopping(); }

@@ -1,12 +1,26 @@
 #include "jobs/queue_settings.hpp"
 
+#include <algorithm>
+
 namespace contactd {
+
+bool small_job(const QueueSettings& settings, const contact::Problem& problem) {
+  if (settings.small_workers <= 0 || problem.ranks > 1 || problem.adaptivity.enabled || problem.bodies.size() > 16)
+    return false;
+  double dofs = 0;
+  for (const auto& b : problem.bodies) dofs += 2.0 * b.mesh.num_nodes();
+  return dofs * static_cast<double>(std::max<std::size_t>(1, problem.loading.factors.size())) <=
+         static_cast<double>(settings.small_job_dofs);
+}
 
 contact::job::ParseResult validate_job(const QueueSettings& settings, const std::string& body) {
   contact::job::Limits limits;
   limits.max_dofs = settings.max_dofs;
   limits.max_bodies = settings.max_bodies;
   limits.max_contacts = settings.max_contacts;
+  limits.max_load_steps = settings.max_load_steps;
+  limits.max_result_bytes = settings.max_result_bytes;
+  limits.result_bytes_hint = "contactd --max-result-bytes";
   limits.max_ranks = settings.mpi.launcher.empty() ? 1 : settings.mpi.max_ranks;
   limits.ranks_hint = settings.mpi.launcher.empty()
                           ? "this server solves every job in its own process: it was started without --mpi-launcher"

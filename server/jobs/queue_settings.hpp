@@ -13,10 +13,16 @@ namespace contactd {
 
 struct QueueSettings {
   int workers = 1;                     // jobs solved at once
+  // The small-job lane: this many more workers that take only small jobs (small_job), so that a job of seconds
+  // never waits behind long ones; and the size below which a job is small: unknowns x load steps.
+  int small_workers = 1;
+  long small_job_dofs = 20'000;
   std::size_t max_queued = 100;        // QUEUED jobs beyond which submissions are refused (503)
   long max_dofs = 2'000'000;           // job::Limits::max_dofs
   int max_bodies = 512;                // job::Limits::max_bodies: a server's share of the machine, a setting
   int max_contacts = 2048;             // job::Limits::max_contacts
+  int max_load_steps = 1000;           // job::Limits::max_load_steps
+  double max_result_bytes = 2e9;       // job::Limits::max_result_bytes: the estimated result (and kept steps)
   double time_limit_seconds = 3600.0;  // per run; 0 = none
   int max_attempts = 3;                // runs cut short by the server dying, after which a job ends FAILED
   std::uint64_t max_event_log_bytes = 256u << 20;  // per job; iteration events beyond are not recorded
@@ -26,6 +32,10 @@ struct QueueSettings {
   double janitor_interval_seconds = 10.0;          // how often retention runs
   MpiSettings mpi;                                 // jobs with parallel.ranks > 1 (mpi_job.hpp)
 };
+
+// A job the small-job lane may take: one process, no adaptivity (it grows), at most 16 bodies and at most
+// small_job_dofs unknowns times load steps.
+bool small_job(const QueueSettings& settings, const contact::Problem& problem);
 
 // Parses and validates a job body within the settings' limits (the ranks a job may ask for depend on
 // whether MPI jobs are possible).

@@ -3,12 +3,20 @@
 #include "common/log.hpp"
 #include "common/time.hpp"
 
+#include "contact/solve.hpp"
+
+#include <malloc.h>
+
 #include <algorithm>
 
 namespace contactd {
 
-WorkerPool::WorkerPool(JobRegistry& registry, int workers, double time_limit_seconds, Run run)
-    : registry_(registry), workers_(workers), time_limit_seconds_(time_limit_seconds), run_(std::move(run)) {}
+WorkerPool::WorkerPool(JobRegistry& registry, int workers, int small_workers, double time_limit_seconds, Run run)
+    : registry_(registry),
+      workers_(workers),
+      small_workers_(small_workers),
+      time_limit_seconds_(time_limit_seconds),
+      run_(std::move(run)) {}
 
 WorkerPool::~WorkerPool() {
   for (auto& t : threads_)
@@ -19,9 +27,10 @@ void WorkerPool::start() {
   std::lock_guard<std::mutex> lock(mutex_);
   if (started_) return;
   started_ = true;
-  for (int i = 0; i < workers_; ++i) {
+  for (int i = 0; i < workers_ + small_workers_; ++i) {
     ++workers_alive_;
-    threads_.emplace_back([this] { worker_loop(); });
+    const bool small_lane = i >= workers_;
+    threads_.emplace_back([this, small_lane] { worker_loop(small_lane); });
   }
 }
 
@@ -51,7 +60,7 @@ void WorkerPool::enqueue(const std::shared_ptr<Job>& job) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!registry_.is_queued(*job) || stopping_) return;
   queue_.push_back(job);
-  work_.notify_one();
+  work_.notify_all();  // the lanes take different jobs: wake both
 }
 
 JobRegistry::CancelStep WorkerPool::cancel(const std::string& id, std::shared_ptr<Job>& job) {
@@ -78,7 +87,7 @@ void WorkerPool::restore_after_failed_cancel(const std::shared_ptr<Job>& job) {
     return other->record.created_us > job->record.created_us;
   });
   queue_.insert(later, job);
-  work_.notify_one();
+  work_.notify_all();  // the lanes take different jobs: wake both
 }
 
 JobRecord WorkerPool::snapshot(const Job& job, int& queue_position) const {
@@ -106,15 +115,19 @@ void WorkerPool::for_each_running(const std::function<void(Job&)>& visit) const 
   for (const auto& job : running_) visit(*job);
 }
 
-void WorkerPool::worker_loop() {
-  while (const std::shared_ptr<Job> job = take()) {
-    if (!store_running(job)) continue;
+void WorkerPool::worker_loop(bool small_lane) {
+  while (const std::shared_ptr<Job> job = take(small_lane)) {
+    if (!store_running(job, small_lane)) continue;
     try {
       run_(job);
     } catch (const std::exception& e) {  // a run handles the solver's failures; this is a bug or no memory
       log_line("job " + job->record.id + ": unexpected error: " + e.what());
     }
-    release(job);
+    // The run's meshes, fields and factorisations are freed: give the memory back to the system now rather than
+    // keep it in the allocator's arenas until the next validation trims them (a job of 1000 load steps left the
+    // server 2.3 GB larger after it ended).
+    ::malloc_trim(0);
+    release(job, small_lane);
   }
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -123,15 +136,28 @@ void WorkerPool::worker_loop() {
   idle_.notify_all();
 }
 
-std::shared_ptr<Job> WorkerPool::take() {
+bool WorkerPool::general_lane_full() const {
+  return general_running_ + contact::abandoned_background_work() >= workers_;
+}
+
+std::shared_ptr<Job> WorkerPool::take(bool small_lane) {
   std::unique_lock<std::mutex> lock(mutex_);
+  // JobRecord::small is set before a job is queued and never changed: read without the registry's lock.
+  const auto mine = [small_lane](const std::shared_ptr<Job>& job) { return !small_lane || job->record.small; };
   while (true) {
-    work_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
+    // Abandoned factorisations end on their own threads, unannounced: a general worker looks again every 100 ms.
+    work_.wait_for(lock, std::chrono::milliseconds(100), [&] {
+      return stopping_ || (std::any_of(queue_.begin(), queue_.end(), mine) && (small_lane || !general_lane_full()));
+    });
     if (stopping_) return nullptr;
-    std::shared_ptr<Job> job = queue_.front();
-    queue_.pop_front();
+    if (!small_lane && general_lane_full()) continue;
+    const auto it = std::find_if(queue_.begin(), queue_.end(), mine);
+    if (it == queue_.end()) continue;
+    std::shared_ptr<Job> job = *it;
+    queue_.erase(it);
     if (!registry_.is_queued(*job)) continue;  // cancelled while waiting
     running_.push_back(job);  // from now on a cancel finds it among the running (its state says QUEUED)
+    general_running_ += small_lane ? 0 : 1;
     return job;
   }
 }
@@ -139,7 +165,7 @@ std::shared_ptr<Job> WorkerPool::take() {
 // RUNNING is on disk before the API says so (not fsync'ed: whether a crash leaves QUEUED or RUNNING on disk, the
 // job is queued again at start-up). False when the store cannot take the change (a full disk): the job waits at
 // the front of the queue, and the worker a second.
-bool WorkerPool::store_running(const std::shared_ptr<Job>& job) {
+bool WorkerPool::store_running(const std::shared_ptr<Job>& job, bool small_lane) {
   const std::int64_t started = now_unix_us();
   const bool stored = registry_.commit(
       job,
@@ -155,6 +181,7 @@ bool WorkerPool::store_running(const std::shared_ptr<Job>& job) {
   std::unique_lock<std::mutex> lock(mutex_);
   if (!stored) {
     running_.erase(std::remove(running_.begin(), running_.end(), job), running_.end());
+    general_running_ -= small_lane ? 0 : 1;
     if (registry_.is_queued(*job)) queue_.push_front(job);
     stop_.wait_for(lock, std::chrono::seconds(1), [this] { return stopping_.load(); });
     return false;
@@ -166,12 +193,14 @@ bool WorkerPool::store_running(const std::shared_ptr<Job>& job) {
   return true;
 }
 
-void WorkerPool::release(const std::shared_ptr<Job>& job) {
+void WorkerPool::release(const std::shared_ptr<Job>& job, bool small_lane) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     running_.erase(std::remove(running_.begin(), running_.end(), job), running_.end());
+    general_running_ -= small_lane ? 0 : 1;
   }
   idle_.notify_all();
+  work_.notify_all();  // a general worker may have waited for room
 }
 
 }  // namespace contactd

@@ -2,6 +2,13 @@
 // RUNNING (not fsync'ed: whether a crash leaves QUEUED or RUNNING on disk, the job is queued again at start-up),
 // gives it its time limit and hands it to `run` (a JobRun), until the pool stops.
 //
+// Two lanes. The general workers take the jobs in the order they came; before a general worker starts a job it
+// waits while the factorisations that cancels left running (contact::abandoned_background_work) and the general
+// jobs running fill the general workers: each such factorisation holds a core and its memory until it ends, and
+// a loop of submit-and-cancel ran more factorisations at once than there are workers (6.2 GB with 2). The
+// small-job workers take only jobs marked small at submission (JobRecord::small), the first in the queue, so a
+// job of seconds does not wait behind long ones (it waited 94 s behind two frictional walls on two workers).
+//
 // Thread safety: every public member may be called from any thread. One mutex guards the queue, the jobs the
 // workers hold (taken or running) and their deadlines and cancel requests; the registry's mutex may be taken
 // while it is held (a job's state is read under both), never the other way round. It is never held while a
@@ -27,8 +34,9 @@ class WorkerPool {
  public:
   using Run = std::function<void(const std::shared_ptr<Job>&)>;
 
-  // `workers` threads; a run is stopped by its time limit after `time_limit_seconds` (0: none).
-  WorkerPool(JobRegistry& registry, int workers, double time_limit_seconds, Run run);
+  // `workers` general threads and `small_workers` for small jobs; a run is stopped by its time limit after
+  // `time_limit_seconds` (0: none).
+  WorkerPool(JobRegistry& registry, int workers, int small_workers, double time_limit_seconds, Run run);
   ~WorkerPool();  // threads shutdown() gave up on are left to the exiting process
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
@@ -57,13 +65,15 @@ class WorkerPool {
   void for_each_running(const std::function<void(Job&)>& visit) const;
 
  private:
-  void worker_loop();
-  std::shared_ptr<Job> take();  // null once stopping
-  bool store_running(const std::shared_ptr<Job>& job);
-  void release(const std::shared_ptr<Job>& job);
+  void worker_loop(bool small_lane);
+  std::shared_ptr<Job> take(bool small_lane);  // null once stopping
+  // With the lock held: the general lane has no room while abandoned factorisations and its running jobs fill it.
+  bool general_lane_full() const;
+  bool store_running(const std::shared_ptr<Job>& job, bool small_lane);
+  void release(const std::shared_ptr<Job>& job, bool small_lane);
 
   JobRegistry& registry_;
-  const int workers_;
+  const int workers_, small_workers_;
   const double time_limit_seconds_;
   const Run run_;
 
@@ -73,6 +83,7 @@ class WorkerPool {
   mutable std::condition_variable stop_;  // stopping
   std::deque<std::shared_ptr<Job>> queue_;
   std::vector<std::shared_ptr<Job>> running_;  // taken by a worker (stored RUNNING, or being stored)
+  int general_running_ = 0;                    // of running_, those a general worker took
   std::vector<std::thread> threads_;
   std::atomic<int> workers_alive_{0};
   bool started_ = false;

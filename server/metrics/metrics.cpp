@@ -34,6 +34,10 @@ std::string Metrics::render(const Gauges& g) const {
   gauge("contactd_queue_length", "Jobs waiting for a worker.", g.jobs.queue_length);
   gauge("contactd_workers", "Worker threads.", g.workers);
   gauge("contactd_workers_busy", "Worker threads running a job.", g.workers_busy);
+  gauge("contactd_abandoned_factorisations",
+        "Factorisations a cancel left running (each holds a core and memory until it ends; no job starts on a "
+        "general worker while they and the running jobs fill the workers).",
+        g.abandoned_work);
   gauge("contactd_jobs_damaged", "Jobs whose files in the data directory are damaged (listed by /readyz).",
         g.damaged_jobs);
   gauge("contactd_jobs_stuck", "Running jobs that did not stop when told to (listed by /readyz).", g.stuck_jobs);

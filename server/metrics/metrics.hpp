@@ -29,7 +29,7 @@ class Metrics {
   // What is sampled from the queue, the store and the transport when rendering.
   struct Gauges {
     JobCounts jobs;
-    int workers = 0, workers_busy = 0;
+    int workers = 0, workers_busy = 0, abandoned_work = 0;
     std::int64_t damaged_jobs = 0, stuck_jobs = 0;
     std::int64_t jobs_expired_total = 0, events_dropped_total = 0;
     bool disk_reserve_used = false;

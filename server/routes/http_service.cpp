@@ -8,6 +8,8 @@
 #include "http/problem_document.hpp"
 #include "jobs/events.hpp"
 
+#include "contact/solve.hpp"
+
 namespace contactd {
 
 nlohmann::json RouteContext::job_resource(const JobRecord& r, int queue_position, bool listed) const {
@@ -33,6 +35,7 @@ nlohmann::json RouteContext::job_resource(const JobRecord& r, int queue_position
                       {"created", iso8601_us(r.created_us)},
                       {"started", time_or_null(r.started_us)},
                       {"finished", time_or_null(r.finished_us)},
+                      {"lane", r.small ? "small" : "general"},
                       {"attempts", r.attempts},
                       {"interruptions", r.interruptions},
                       {"iterations", r.iterations},
@@ -88,6 +91,8 @@ void handle_readyz(RouteContext& ctx, const Request&, Response& res) {
                          {"data_dir_writable", writable},
                          {"disk_reserve_used", reserve_used},
                          {"workers", ctx.queue.workers()},
+                         {"small_job_workers", ctx.queue.small_workers()},
+                         {"abandoned_factorisations", contact::abandoned_background_work()},
                          {"workers_alive", alive},
                          {"problems", problems},
                          {"damaged_jobs", damaged},
@@ -103,6 +108,7 @@ void handle_metrics(RouteContext& ctx, const Request&, Response& res) {
   gauges.jobs = ctx.queue.counts();
   gauges.workers = ctx.queue.workers();
   gauges.workers_busy = ctx.queue.workers_busy();
+  gauges.abandoned_work = contact::abandoned_background_work();
   const QueueHealth health = ctx.queue.health();
   gauges.damaged_jobs = static_cast<std::int64_t>(health.damaged.size());
   gauges.stuck_jobs = static_cast<std::int64_t>(health.stuck.size());

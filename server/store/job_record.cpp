@@ -43,6 +43,7 @@ nlohmann::json to_state_json(const JobRecord& r) {
                       {"interruptions", r.interruptions},
                       {"idempotency_key", r.idempotency_key},
                       {"body_bytes", r.body_bytes},
+                      {"small", r.small},
                       {"stop_reason", r.stop_reason},
                       {"message", r.message},
                       {"iterations", r.iterations},
@@ -72,6 +73,7 @@ JobRecord from_state_json(const nlohmann::json& j) {
   r.interruptions = j.value("interruptions", 0);
   r.idempotency_key = j.value("idempotency_key", "");
   r.body_bytes = j.value("body_bytes", std::int64_t{0});
+  r.small = j.value("small", false);
   r.stop_reason = j.value("stop_reason", "");
   r.message = j.value("message", "");
   r.iterations = j.value("iterations", 0);

@@ -30,6 +30,8 @@ struct JobRecord {
   int interruptions = 0;        // runs cut short by the server dying (found RUNNING at start-up)
   std::string idempotency_key;  // "" when none was given
   std::int64_t body_bytes = 0;
+  // Small enough for the small-job lane (queue_settings.hpp, small_job); set at submission, never changed after.
+  bool small = false;
   // The outcome, set when the job is done.
   std::string stop_reason;  // converged, max_iterations, stagnation, cancelled, error, time_limit
   std::string message;

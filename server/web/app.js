@@ -2,13 +2,14 @@
 // and the selected job (job_view.js). The selection is in the address (#job=<id>), so a job's page can be
 // bookmarked and shared (the token is not in it).
 
-import {ApiError, api, getToken, headers, setToken} from "./api.js";
+import {ApiError, api, errorFrom, getToken, headers, setToken} from "./api.js";
 import {JobView} from "./job_view.js";
 
 const $ = (id) => document.getElementById(id);
 const LIST_PERIOD_MS = 2000;
 
 let listTimer = null;
+let listTag = "";  // the ETag of the list drawn: sent back, the server answers 304 while nothing changed
 const view = new JobView({onChange: () => refreshList()});
 
 function banner(text) {
@@ -49,12 +50,27 @@ function select(id) {
 async function refreshList() {
   clearTimeout(listTimer);
   try {
-    const page = await api("v1/jobs?page_size=50");
+    const response = await fetch("v1/jobs?page_size=50", {
+      headers: headers(listTag ? {"Accept": "application/json", "If-None-Match": listTag} : {"Accept": "application/json"}),
+      cache: "no-store"});
+    if (response.status === 304) {
+      banner("");
+      for (const tr of $("jobs").children) {
+        tr.classList.toggle("selected", tr.dataset.id === view.id);
+        if (tr.lastElementChild) tr.lastElementChild.textContent = age(tr.dataset.created);
+      }
+      if (!document.hidden) listTimer = setTimeout(refreshList, LIST_PERIOD_MS);
+      return;
+    }
+    if (!response.ok) throw await errorFrom(response);
+    const page = await response.json();
+    listTag = response.headers.get("ETag") || "";
     banner("");
     const rows = (Array.isArray(page.jobs) ? page.jobs : []).map((j) => {
       const tr = document.createElement("tr");
       tr.dataset.id = j.id;
       tr.dataset.state = j.state;
+      tr.dataset.created = j.created || "";
       tr.title = j.id;
       const cells = [j.name, j.state, j.iterations, age(j.created)];
       cells.forEach((v, i) => {
@@ -74,8 +90,9 @@ async function refreshList() {
       banner(getToken() ? "The server refused the token: check it and press Use."
                         : "This server requires a bearer token: enter it at the top and press Use.");
     } else {
-      banner(e.message);
+      banner(e instanceof TypeError ? "cannot reach the server (is contactd running?)" : e.message);
     }
+    listTag = "";
   }
   if (!document.hidden) listTimer = setTimeout(refreshList, LIST_PERIOD_MS);
 }

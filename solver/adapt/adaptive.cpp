@@ -69,9 +69,19 @@ void add_note(std::string& notes, const std::string& note) {
   notes += note;
 }
 
-// Marks and refines the adaptive bodies; `step` is the current mesh state (its contact zones for the grading).
-RefineOutcome mark_and_refine(Problem& problem, const std::vector<IndicatorResult>& eta, const Step& step) {
+// Marks and refines the adaptive bodies; `step` is the current mesh state (its contact zones for the grading);
+// `kept_nodes`: the nodes of the steps the result keeps besides the next mesh (StepLog::committed_nodes).
+RefineOutcome mark_and_refine(Problem& problem, const std::vector<IndicatorResult>& eta, const Step& step,
+                              double kept_nodes) {
   const auto& s = problem.adaptivity;
+  // The total the next mesh may have: the job's limit on unknowns, and what the result's budget leaves.
+  long max_total = s.max_total_dofs;
+  bool result_bound = false;
+  if (s.max_kept_nodes > 0) {
+    const long left = static_cast<long>(std::max(0.0, 2.0 * (s.max_kept_nodes - kept_nodes)));
+    result_bound = max_total <= 0 || left < max_total;
+    if (result_bound) max_total = left;
+  }
   const std::vector<ContactZone> zones = s.marking == MarkingRule::contact ? contact_zones(step) : std::vector<ContactZone>{};
   RefineOutcome out;
   const size_t n = problem.bodies.size();
@@ -89,7 +99,8 @@ RefineOutcome mark_and_refine(Problem& problem, const std::vector<IndicatorResul
     Eigen::VectorXd weighted = eta[a].eta;
     for (Eigen::Index c = 0; c < weighted.size(); ++c) weighted[c] *= rules.factor[static_cast<size_t>(c)];
     const long own = 2L * mesh.num_nodes();
-    const long allowed = s.max_total_dofs > 0 ? std::min(s.max_dofs, own + std::max(0L, s.max_total_dofs - total)) : s.max_dofs;
+    const long allowed = max_total > 0 || result_bound ? std::min(s.max_dofs, own + std::max(0L, max_total - total))
+                                                       : s.max_dofs;
     const Marking m = mark(mesh, weighted, s.delta, s.max_level, allowed, rules.graded);
     if (m.dof_limit_hit && allowed < s.max_dofs) total_hit = true;
     else if (m.dof_limit_hit) add_note(out.note, "body '" + problem.bodies[a].name + "': max_dofs reached, refinement cut back");
@@ -106,7 +117,11 @@ RefineOutcome mark_and_refine(Problem& problem, const std::vector<IndicatorResul
     out.changed[a] = out.refined[a] > 0;
     out.any = out.any || out.changed[a];
   }
-  if (total_hit) {
+  if (total_hit && result_bound) {
+    add_note(out.note, "the result's limit on its size (the steps kept, --max-result-bytes) reached, refinement "
+                       "cut back");
+    out.blocked = true;
+  } else if (total_hit) {
     add_note(out.note, "the job's limit of " + std::to_string(s.max_total_dofs) +
                            " unknowns over all bodies (--max-dofs) reached, refinement cut back");
     out.blocked = true;
@@ -260,7 +275,7 @@ ddm::MethodOutcome converge_then_refine(Problem& working, ddm::ContactSystem& sy
     if (const std::string stop = stalled(report, s.stop_tolerance); !stop.empty()) return finish(stop);
     if (step >= s.max_steps)
       return finish("adaptive: max_steps = " + std::to_string(s.max_steps) + " refinement steps done; " + o.message);
-    RefineOutcome r = mark_and_refine(working, eta, steps.back());
+    RefineOutcome r = mark_and_refine(working, eta, steps.back(), steps.committed_nodes());
     if (!r.any) {
       std::ostringstream os;
       os << "adaptive: " << (r.blocked ? "nothing marked can be refined" : "no cell marked") << " after " << step
@@ -381,7 +396,10 @@ ddm::MethodOutcome paper_interleaving(Problem& working, ddm::ContactSystem& syst
     rep.gamma = out.gamma;
     // Record the mesh state (before it is refined), then refine.
     Step st = make_step(system, update.u_new, {}, k, step, eta);
-    const RefineOutcome r = mark_and_refine(working, eta, st);
+    double mesh_nodes = 0;  // st is kept (pushed below) if the meshes are refined
+    for (const auto& body : st.bodies) mesh_nodes += static_cast<double>(body.mesh.num_nodes());
+    const RefineOutcome r =
+        mark_and_refine(working, eta, st, steps.committed_nodes() + (steps.keeps_all() ? mesh_nodes : 0.0));
     for (size_t a = 0; a < rep.bodies.size(); ++a) rep.bodies[a].elements_refined = r.refined[a];
     rep.note = r.note;
     rep.elapsed_seconds = context.elapsed();
@@ -393,8 +411,9 @@ ddm::MethodOutcome paper_interleaving(Problem& working, ddm::ContactSystem& syst
       steps.push_back(std::move(st));
       out.converged = true;
       out.reason = StopReason::converged;
-      out.message = "adaptive (paper): the DDM criterion holds and no cell is marked (" + std::to_string(step) +
-                    " refinements)";
+      out.message = "adaptive (paper): the DDM criterion holds and " +
+                    std::string(r.blocked ? "nothing marked can be refined" : "no cell is marked") + " (" +
+                    std::to_string(step) + " refinements" + (r.blocked && !r.note.empty() ? "; " + r.note : "") + ")";
       break;
     }
     if (r.any) {

@@ -10,6 +10,7 @@ struct Registry {
   std::mutex mutex;
   std::condition_variable idle;
   int running = 0;
+  int abandoned = 0;  // of `running`, those whose caller left (a cancel)
 };
 
 Registry& registry() {
@@ -26,13 +27,19 @@ void background_started() {
   ++registry().running;
 }
 
-void background_finished() {
+void background_finished(bool abandoned) {
   Registry& r = registry();
   {
     std::lock_guard<std::mutex> lock(r.mutex);
     --r.running;
+    if (abandoned) --r.abandoned;
   }
   r.idle.notify_all();
+}
+
+void background_abandoned() {
+  std::lock_guard<std::mutex> lock(registry().mutex);
+  ++registry().abandoned;
 }
 
 }  // namespace detail
@@ -40,6 +47,11 @@ void background_finished() {
 bool background_work_running() {
   std::lock_guard<std::mutex> lock(registry().mutex);
   return registry().running > 0;
+}
+
+int abandoned_background_work() {
+  std::lock_guard<std::mutex> lock(registry().mutex);
+  return registry().abandoned;
 }
 
 bool wait_for_background_work(double seconds) {

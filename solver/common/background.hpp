@@ -21,7 +21,8 @@ namespace contact {
 
 namespace detail {
 void background_started();
-void background_finished();
+void background_finished(bool abandoned = false);
+void background_abandoned();  // the caller left; background_finished(true) follows
 }  // namespace detail
 
 // Runs work() and returns its result; with a `cancelled` test, runs it on its own thread and returns nullptr as
@@ -63,7 +64,7 @@ std::unique_ptr<T> run_unless_cancelled(std::function<std::unique_ptr<T>()> work
       }
       lock.unlock();
       result.reset();  // an abandoned result is freed before the work counts as finished
-      detail::background_finished();
+      detail::background_finished(/*abandoned=*/true);
     }).detach();
   } catch (...) {  // no thread could be started
     detail::background_finished();
@@ -73,6 +74,7 @@ std::unique_ptr<T> run_unless_cancelled(std::function<std::unique_ptr<T>()> work
   while (!state->done_cv.wait_for(lock, poll, [&] { return state->done; }))
     if (cancelled()) {
       state->abandoned = true;
+      detail::background_abandoned();
       return nullptr;
     }
   if (state->error) std::rethrow_exception(state->error);

@@ -20,6 +20,11 @@ class StepLog {
   const Step& back() const { return steps_.back(); }
   bool empty() const { return steps_.empty(); }
 
+  // The mesh nodes of the steps whose fields stay kept when another step is pushed (every step's with
+  // StepOutput::all, none with last): what a next step adds to the result on top of them.
+  double committed_nodes() const { return keep_ == StepOutput::all ? nodes_ : 0.0; }
+  bool keeps_all() const { return keep_ == StepOutput::all; }
+
   std::vector<Step> take_steps() { return std::move(steps_); }
   std::vector<StepSummary> take_summaries() { return std::move(summaries_); }
 
@@ -27,6 +32,7 @@ class StepLog {
   StepOutput keep_;
   std::vector<Step> steps_;
   std::vector<StepSummary> summaries_;
+  double nodes_ = 0;  // over steps_
 };
 
 }  // namespace contact::ddm

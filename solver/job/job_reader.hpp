@@ -124,6 +124,7 @@ class JobReader {
   void read_loading(const Fields& top);
   void read_loading_steps(const json& value, const std::string& pointer);
   void read_output(const Fields& top);
+  void check_result_size();
   void read_progress_pairs(const json& value, const std::string& pointer);
 
   // read_bodies.cpp: bodies, materials, boundary conditions; the checks on the built bodies

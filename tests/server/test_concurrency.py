@@ -86,7 +86,7 @@ with Server(args=["--workers", "2", "--max-queued", "8"]) as server:
     check("metrics count them", server.metric("contactd_jobs_submitted_total") == len(accepted) + 1)
 
 # --- a full queue answers 503 with Retry-After ------------------------------------------------------------------
-with Server(args=["--workers", "1", "--max-queued", "2"]) as server:
+with Server(args=["--workers", "1", "--small-job-workers", "0", "--max-queued", "2"]) as server:  # no lane: the flat patches queue
     running = server.submit_id(long_job())
     server.wait_for(running, lambda j: j["state"] == "RUNNING", timeout=30)
     queued = [server.submit(flat_patch()) for _ in range(2)]

@@ -61,6 +61,17 @@ with Server(args=["--workers", "1"]) as server:
     size_full, size_digest = len(json.dumps(progress)), len(json.dumps(digest))
     check("the digest is small", size_digest < 2000 and size_digest <= size_full, (size_digest, size_full))
 
+    # A poller that sends the ETag back gets 304 and no body while nothing changed (the web page polls every 2 s).
+    first = server.get("/v1/jobs?page_size=50")
+    tag = first.headers.get("etag", "")
+    again = server.get("/v1/jobs?page_size=50", headers={"If-None-Match": tag})
+    check("an unchanged list: 304 without a body", tag and again.status == 304 and again.body == b"", again)
+    new_id = server.submit_id(example("flat_patch.json"))
+    server.wait_done(new_id)
+    changed = server.get("/v1/jobs?page_size=50", headers={"If-None-Match": tag})
+    check("a changed list: 200 with the new job and a new ETag", changed.status == 200
+          and changed.json()["jobs"][0]["id"] == new_id and changed.headers.get("etag") not in ("", tag), changed.status)
+
     small = listed[patch_id]["progress"]
     check("a small job is listed with its pairs and bodies as they are",
           small == server.job(patch_id)["progress"] and len(small.get("pairs", [])) == 1, small)

@@ -14,7 +14,7 @@ from harness import HOST, Server, Stream, flat_patch, long_job, read_all_events 
 from checks import check, finish  # noqa: E402
 
 
-with Server(args=["--workers", "1", "--max-streams", "24"]) as server:
+with Server(args=["--workers", "1", "--small-job-workers", "0", "--max-streams", "24"]) as server:  # flat patches queue
     # --- cancel during a run ----------------------------------------------------------------------------------
     job_id = server.submit_id(long_job(name="to-cancel"))
     stream = Stream(server, job_id)

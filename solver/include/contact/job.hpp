@@ -31,6 +31,11 @@ struct Limits {
   int max_updates = 1'000;             // solver.augmented_lagrangian.max_updates
   int max_adaptive_steps = 100;        // adaptivity.max_steps
   int max_load_steps = 1000;           // loading.steps, or the number of loading.factors
+  // The result file (and the kept steps the solver holds in memory until it writes them), as estimated before
+  // the job runs (io::estimated_result_bytes: nodes x kept steps); 0: no limit (the command line), contactd's
+  // --max-result-bytes otherwise.
+  double max_result_bytes = 0;
+  std::string result_bytes_hint;       // the setting named when a job is over max_result_bytes
   int max_ranks = 4096;                // parallel.ranks (contactd: its --max-ranks, 1 without an MPI launcher)
   std::string ranks_hint;              // appended to the message when parallel.ranks is over max_ranks
   std::size_t max_name_length = 64;    // body, edge and contact names (identifiers)

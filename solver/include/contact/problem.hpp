@@ -207,6 +207,10 @@ struct AdaptivitySettings {
   // --max-dofs of contact-solve and contactd), so refinement never takes a job past what it could be submitted
   // with (0: no total limit, a Problem built in code).
   long max_total_dofs = 0;
+  // The result's budget in mesh nodes summed over the steps it keeps (the job reader sets it from the limit on
+  // the result's size, job::Limits::max_result_bytes; 0: none): a mesh that would take the kept steps past it is
+  // not made (refinement is cut back, as by max_total_dofs).
+  double max_kept_nodes = 0;
   AdaptStrategy strategy = AdaptStrategy::converge_then_refine;
   int max_steps = 20;       // refinement steps (converge_then_refine)
   // converge_then_refine stops once a step changed the total contact force, the peak contact pressure and the

@@ -26,6 +26,9 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
 // waits for them (wait_for_background_work with a bound) or, if it must exit at once, ends with std::_Exit after
 // flushing its output: exiting normally while one runs may crash in the libraries' exit handlers.
 bool background_work_running();
+// How many of them run now: each holds a core and its memory until it ends (contactd counts them against its
+// workers before it starts another job).
+int abandoned_background_work();
 // Waits until no such work runs or `seconds` passed; true when none runs.
 bool wait_for_background_work(double seconds);
 

@@ -1,0 +1,131 @@
+#!/usr/bin/env python3
+"""contactd admits a job by what it will cost and never lets a small job starve (issue 32, items 1, 4 and 5).
+
+1. The result's size is estimated before a job runs (its meshes' nodes x the steps it keeps): two 100 x 100 blocks
+   over 1000 load steps (it wrote 5.15 GB and left the server 2.3 GB larger) are refused at /loading, naming
+   --max-result-bytes and what to change; the same job keeping its last step only is accepted; the estimate is
+   within 25 % of the file the command line writes for a job of 10 steps.
+2. A small job (unknowns x load steps at most --small-job-dofs) runs on the small-job lane at once while two long
+   jobs hold the one general worker and the queue (it waited 94 s behind two frictional walls).
+3. Factorisations a cancel leaves running count against the workers: after a large job is cancelled during its
+   set-up, the next job starts only once they have ended (a loop of submit-and-cancel ran more factorisations at
+   once than there are workers).
+
+Standard library only; exits non-zero on any failure."""
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+from datetime import datetime
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))  # tests/
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import check, finish, section  # noqa: E402
+from harness import CONTACT_SOLVE, Server, example, flat_patch, long_job  # noqa: E402
+
+
+def blocks(n, steps=None, output=None, name="blocks"):
+    job = example("flat_patch.json")
+    job["name"] = name
+    for body in job["bodies"]:
+        body["mesh"]["block"]["nx"] = n
+        body["mesh"]["block"]["ny"] = n
+    if steps:
+        job["loading"] = {"steps": steps}
+    if output:
+        job["output"] = output
+    return job
+
+
+def seconds(iso):
+    return datetime.fromisoformat(iso.replace("Z", "+00:00")).timestamp()
+
+
+section("the result's size, estimated before the job runs")
+with Server(args=["--workers", "1"]) as server:
+    answer = server.request("POST", "/v1/validate", json_body=blocks(100, steps=1000))
+    errors = (answer.json() or {}).get("errors", [])
+    check("1000 load steps of two 100 x 100 blocks: 400 at /loading", answer.status == 400 and len(errors) == 1
+          and errors[0]["pointer"] == "/loading", errors)
+    message = errors[0]["message"] if errors else ""
+    check("naming the estimate, the limit, the setting and what to change",
+          re.search(r"about 5\.\d+ GB", message) and "2 GB accepted (contactd --max-result-bytes)" in message
+          and '"output": {"steps": "last"}' in message, message)
+    answer = server.request("POST", "/v1/validate", json_body=blocks(100, steps=1000, output={"steps": "last"}))
+    check("the same keeping its last step only: valid", answer.status == 200, answer.body[:300])
+    answer = server.submit(blocks(100, steps=1000))
+    check("a submission is refused the same way (nothing stored)", answer.status == 400
+          and server.get("/v1/jobs").json()["jobs"] == [], answer.status)
+    adaptive = server.wait_done(server.submit_id(example("seed_layers_adaptive.json")), 120)
+    free_bytes = len(server.get(f"/v1/jobs/{adaptive['id']}/result").body)
+    check("an adaptive run keeping every step refines under the default limit",
+          adaptive.get("state") == "SUCCEEDED" and "0 refinements" not in adaptive.get("message", ""), adaptive)
+
+with tempfile.TemporaryDirectory() as tmp, Server(args=["--max-result-bytes", "1e6"]) as server:
+    job = blocks(100, steps=10)
+    answer = server.request("POST", "/v1/validate", json_body=job)
+    message = ((answer.json() or {}).get("errors") or [{}])[0].get("message", "")
+    estimate = re.search(r"about ([\d.]+) MB", message)
+    path = os.path.join(tmp, "blocks.json")
+    with open(path, "w") as f:
+        json.dump(job, f)
+    run = subprocess.run([CONTACT_SOLVE, path, "-o", os.path.join(tmp, "blocks.hdf"), "-q"], capture_output=True,
+                         timeout=300)
+    written = os.path.getsize(os.path.join(tmp, "blocks.hdf")) / 1e6 if run.returncode == 0 else None
+    check("the estimate is within 25 % of the file written (10 steps of two 100 x 100 blocks)",
+          estimate and written and 0.8 <= float(estimate.group(1)) / written <= 1.25,
+          (message, written))
+    adaptive = server.wait_done(server.submit_id(example("seed_layers_adaptive.json")), 120)
+    result = server.get(f"/v1/jobs/{adaptive['id']}/result").body
+    check("the same adaptive run under a 1 MB limit refines only within it, and says so",
+          adaptive.get("state") == "SUCCEEDED" and "--max-result-bytes" in adaptive.get("message", "")
+          and 0 < len(result) <= 1.25e6 and len(result) < free_bytes, (adaptive.get("message"), len(result), free_bytes))
+
+section("the small-job lane")
+with Server(args=["--workers", "1"]) as server:
+    first, second = server.submit_id(long_job(name="long-1")), server.submit_id(long_job(name="long-2"))
+    server.wait_for(first, lambda j: j["state"] == "RUNNING", 30)
+    small = server.submit_id(flat_patch(name="small"))
+    start = time.time()
+    done = server.wait_done(small, 30)
+    waited = time.time() - start
+    states = server.job(first)["state"], server.job(second)["state"]
+    check("the long jobs go to the general lane, the flat patch to the small-job lane",
+          server.job(first)["lane"] == "general" and done.get("lane") == "small", done.get("lane"))
+    check("the small job SUCCEEDED in seconds while a long job runs and the other waits",
+          done.get("state") == "SUCCEEDED" and waited < 10 and states == ("RUNNING", "QUEUED"), (waited, states))
+    check("the small-job lane never takes a long job", server.job(second)["state"] == "QUEUED")
+    ready = server.get("/readyz").json()
+    check("/readyz counts both lanes' workers", ready.get("workers") == 2 and ready.get("small_job_workers") == 1,
+          ready)
+    for job_id in (first, second):
+        server.request("POST", f"/v1/jobs/{job_id}/cancel")
+
+section("abandoned factorisations count against the workers")
+with Server(args=["--workers", "1", "--small-job-workers", "0"]) as server:
+    big = server.submit_id(blocks(400, name="big"))
+    server.wait_for(big, lambda j: j["state"] == "RUNNING", 30)
+    time.sleep(1.0)  # into the factorisation of its two bodies (set-up of about 6 s)
+    server.request("POST", f"/v1/jobs/{big}/cancel")
+    cancelled = server.wait_done(big, 10)
+    check("the large job stops within a second of the cancel", cancelled.get("state") == "CANCELLED", cancelled)
+    after = server.submit_id(flat_patch(name="after"))
+    abandoned_until, seen = time.time(), 0.0
+    deadline = time.time() + 60
+    while time.time() < deadline:
+        count = server.metric("contactd_abandoned_factorisations") or 0.0
+        seen = max(seen, count)
+        if count == 0:
+            break
+        abandoned_until = time.time()
+        time.sleep(0.05)
+    check("the cancel left its factorisations running (the metric counts them)", seen >= 1, seen)
+    done = server.wait_done(after, 60)
+    started = seconds(done["started"]) if done.get("started") else 0.0
+    check("the next job started only once they ended", done.get("state") == "SUCCEEDED"
+          and started >= abandoned_until - 0.2, (started - abandoned_until, done.get("state")))
+
+finish()
