@@ -299,8 +299,15 @@ int solve_and_write(contact::Session& session, contact::Problem& problem, const 
     return finish(1);
   }
   if (!ndjson) {
-    // A solve that stopped short of convergence leaves an iterate, not an answer: said before its numbers.
-    if (!result.converged)
+    // A solve that stopped short of convergence leaves an iterate, not an answer: said before its numbers. A
+    // later load step that failed leaves the steps that held, the last of them below.
+    std::size_t held = 0;
+    for (const auto& step : result.steps) held += step.converged;
+    if (!result.converged && result.steps.back().converged)
+      std::printf("not converged: the result file keeps the %zu load step%s that held (converged 1); below, the "
+                  "last of them (load factor %.6g)\n",
+                  held, held == 1 ? "" : "s", result.steps.back().load_factor);
+    else if (!result.converged)
       std::printf("not converged: the last iterate, below and in the result file (converged 0), is not an answer\n");
     print_final_step(result.steps.back());
   }

@@ -279,4 +279,24 @@ with tempfile.TemporaryDirectory() as tmp:
     check_stopped(run_rebuild, out, "during step 7's assembly and factorisation",
                   "cancelled during adaptive step 7 (assembling and factorising its refined meshes")
 
+# A load step that fails keeps the steps that held (issue 31, item 1): a 4 x 4 wall with friction mu = 0.6,
+# sheared in step 2 past what friction holds (statics: 1.083 times): exit 1, the stop names step 2 and the ratio,
+# the final lines are said to be the held step's, and the file keeps that step, converged, and says the run did not.
+with tempfile.TemporaryDirectory() as tmp:
+    job = os.path.join(tmp, "wall.json")
+    subprocess.run(["/usr/bin/python3", os.path.join(SRC, "scripts", "make_brick_wall.py"), "--rows", "4", "--bricks",
+                    "4", "--friction", "0.6", "--shear", "0.65", "-o", job], check=True, capture_output=True)
+    out = os.path.join(tmp, "wall.hdf")
+    r = run(job, "-o", out, "-q")
+    check("failed step 2: exit 1, the stop names the step and the ratio", r.returncode == 1
+          and "load step 2 of 2: contact 'b3_0.bottom-b2_0.top': friction cannot hold body 'b3_0'" in r.stdout
+          and "1.083 times" in r.stdout, r.stdout[:600])
+    check("failed step 2: the lines below are the held step's",
+          "not converged: the result file keeps the 1 load step that held (converged 1)" in r.stdout, r.stdout[:600])
+    with h5py.File(out, "r") as f:
+        check("failed step 2: the file keeps step 1, converged, and the run flagged not converged",
+              list(f["history/steps/converged"][()]) == [1] and list(f["steps"].keys()) == ["0"]
+              and int(f.attrs["converged"]) == 0 and str(f.attrs["stop_reason"]) == "error",
+              (list(f["history/steps/converged"][()]), list(f["steps"].keys())))
+
 finish()
