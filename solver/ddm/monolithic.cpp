@@ -19,6 +19,7 @@
 #include "friction_rows.hpp"
 #include "friction_statics.hpp"
 #include "../linalg/friction_sets.hpp"
+#include "../linalg/refined_solve.hpp"
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/SparseLU>
@@ -142,18 +143,10 @@ Pressures split_tangential(const ContactSystem& system, const Stacked& s, const 
   return q;
 }
 
-// Solves `kkt` by sparse LU with two steps of iterative refinement (the matrix mixes stiffnesses and lengths, and
-// the unsymmetric LU loses a few digits on it); false when it is singular, and with `strict` also when it is so
-// nearly singular that the refined solution does not solve it (relative residual above 1e-8: SparseLU factorises
-// some singular matrices without a word and returns multipliers of 1e12).
+// Solves `kkt` by sparse LU with two steps of iterative refinement (linalg/refined_solve.hpp); false when it is
+// singular, and with `strict` also when it is so nearly singular that the refined solution does not solve it.
 bool solve_refined(const SpMat& kkt, const Eigen::VectorXd& rhs, bool strict, Eigen::VectorXd& solution) {
-  Eigen::SparseLU<SpMat> lu;
-  lu.compute(kkt);
-  if (lu.info() != Eigen::Success) return false;
-  solution = lu.solve(rhs);
-  for (int refine = 0; refine < 2; ++refine) solution += lu.solve(Eigen::VectorXd(rhs - kkt * solution));
-  if (!solution.allFinite()) return false;
-  return !strict || (kkt * solution - rhs).norm() <= 1e-8 * std::max(rhs.norm(), 1e-300);
+  return linalg::refined_solve<Eigen::SparseLU<SpMat>>(kkt, rhs, 2, strict, solution);
 }
 
 // The saddle-point system of the sets, [K  -B^T P; R B  0] [x; y] = [b + B^T lambda0; -R g0]. Fills the iterate

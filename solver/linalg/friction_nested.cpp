@@ -1,5 +1,7 @@
 #include "friction_nested.hpp"
 
+#include "refined_solve.hpp"
+
 #include <Eigen/UmfPackSupport>
 
 #include <algorithm>
@@ -109,15 +111,10 @@ bool newton_on_level(const FrictionLevel& level, const Eigen::VectorXd& c, const
   return r.stop == FrictionStop::settled;
 }
 
-// M y = rhs by UMFPACK with a step of refinement (the system mixes F's scales and G's); false when M is singular or
-// so nearly that the refined solution does not solve it (relative residual above 1e-8).
+// M y = rhs by UMFPACK with a step of refinement (refined_solve.hpp); false when M is singular or so nearly that
+// the refined solution does not solve it.
 bool solve_refined(const SparseMatrix& M, const Eigen::VectorXd& rhs, Eigen::VectorXd& y) {
-  Eigen::UmfPackLU<SparseMatrix> lu(M);
-  if (lu.info() != Eigen::Success) return false;
-  y = lu.solve(rhs);
-  if (!y.allFinite()) return false;
-  y += lu.solve(Eigen::VectorXd(rhs - M * y));
-  return y.allFinite() && (M * y - rhs).norm() <= 1e-8 * std::max(rhs.norm(), 1e-300);
+  return refined_solve<Eigen::UmfPackLU<SparseMatrix>>(M, rhs, 1, /*strict=*/true, y);
 }
 
 // [R F P  R G^T; G P  0] [y; alpha] = [-R (g + F lambda0); e - G lambda0], by UMFPACK; false when singular.
