@@ -46,6 +46,11 @@ void send_invalid_job(httplib::Response& res, const std::vector<contact::job::Va
                instance, {{"errors", errors}});
 }
 
+// The one answer for a job id that names no job (a malformed id is shown clipped: it never reaches the disk).
+void send_no_job(httplib::Response& res, const std::string& id, const std::string& instance) {
+  send_problem(res, 404, "", "no job with id '" + clip(id, 64) + "'", instance);
+}
+
 void send_busy(httplib::Response& res, const std::string& what, const std::string& instance) {
   res.set_header("Retry-After", "5");
   send_problem(res, 503, "busy", "the server is at its limit of " + what + "; retry later", instance);
@@ -97,7 +102,7 @@ bool RouteContext::read_json_body(const Request& req, Response& res, const Conte
 std::shared_ptr<Job> RouteContext::find_job(const Request& req, Response& res) const {
   const std::string id = req.matches.size() > 1 ? std::string(req.matches[1]) : std::string();
   if (!is_job_id(id)) {  // anything else never reaches the disk
-    send_problem(res, 404, "", "no job with id '" + clip(id, 64) + "'", req.path);
+    send_no_job(res, id, req.path);
     return nullptr;
   }
   std::shared_ptr<Job> job = queue.find(id);
@@ -105,7 +110,7 @@ std::shared_ptr<Job> RouteContext::find_job(const Request& req, Response& res) c
     if (auto problem = queue.damage(id))
       send_problem(res, 500, "corrupt-job", "job " + id + ": " + *problem, req.path);
     else
-      send_problem(res, 404, "", "no job with id '" + id + "'", req.path);
+      send_no_job(res, id, req.path);
   }
   return job;
 }
@@ -268,7 +273,7 @@ void handle_get(RouteContext& ctx, const Request& req, Response& res) {
 void handle_delete(RouteContext& ctx, const Request& req, Response& res) {
   const std::string id = req.matches.size() > 1 ? std::string(req.matches[1]) : std::string();
   if (!is_job_id(id)) {
-    send_problem(res, 404, "", "no job with id '" + clip(id, 64) + "'", req.path);
+    send_no_job(res, id, req.path);
     return;
   }
   std::string detail;
@@ -277,7 +282,7 @@ void handle_delete(RouteContext& ctx, const Request& req, Response& res) {
       res.status = 204;
       return;
     case JobQueue::RemoveOutcome::not_found:
-      send_problem(res, 404, "", "no job with id '" + id + "'", req.path);
+      send_no_job(res, id, req.path);
       return;
     case JobQueue::RemoveOutcome::not_done: {
       const auto job = ctx.queue.find(id);
@@ -306,7 +311,7 @@ void handle_cancel(RouteContext& ctx, const Request& req, Response& res) {
     if (auto problem = is_job_id(id) ? ctx.queue.damage(id) : std::nullopt)
       send_problem(res, 500, "corrupt-job", "job " + id + ": " + *problem, req.path);
     else
-      send_problem(res, 404, "", "no job with id '" + clip(id, 64) + "'", req.path);
+      send_no_job(res, id, req.path);
     return;
   }
   const auto outcome = ctx.queue.cancel(id);
@@ -324,7 +329,7 @@ void handle_cancel(RouteContext& ctx, const Request& req, Response& res) {
                    {{"state", to_string(record.state)}});
       return;
     case JobQueue::CancelOutcome::not_found:
-      send_problem(res, 404, "", "no job with id '" + id + "'", req.path);
+      send_no_job(res, id, req.path);
       return;
     case JobQueue::CancelOutcome::store_error:
       send_problem(res, 500, "store-error", "the cancellation could not be stored; the job is still queued", req.path);
