@@ -145,10 +145,15 @@ std::shared_ptr<Job> WorkerPool::take(bool small_lane) {
   // JobRecord::small is set before a job is queued and never changed: read without the registry's lock.
   const auto mine = [small_lane](const std::shared_ptr<Job>& job) { return !small_lane || job->record.small; };
   while (true) {
-    // Abandoned factorisations end on their own threads, unannounced: a general worker looks again every 100 ms.
-    work_.wait_for(lock, std::chrono::milliseconds(100), [&] {
+    const auto ready = [&] {
       return stopping_ || (std::any_of(queue_.begin(), queue_.end(), mine) && (small_lane || !general_lane_full()));
-    });
+    };
+    // Abandoned factorisations end on their own threads, unannounced: while one holds back a job, a general worker
+    // looks again every 100 ms; otherwise an enqueue, a release or the shutdown wakes it.
+    if (!small_lane && contact::abandoned_background_work() > 0)
+      work_.wait_for(lock, std::chrono::milliseconds(100), ready);
+    else
+      work_.wait(lock, ready);
     if (stopping_) return nullptr;
     if (!small_lane && general_lane_full()) continue;
     const auto it = std::find_if(queue_.begin(), queue_.end(), mine);

@@ -106,22 +106,28 @@ with Server(args=["--workers", "1"]) as server:
 
 section("abandoned factorisations count against the workers")
 with Server(args=["--workers", "1", "--small-job-workers", "0"]) as server:
-    big = server.submit_id(blocks(400, name="big"))
-    server.wait_for(big, lambda j: j["state"] == "RUNNING", 30)
-    time.sleep(1.0)  # into the factorisation of its two bodies (set-up of about 6 s)
-    server.request("POST", f"/v1/jobs/{big}/cancel")
-    cancelled = server.wait_done(big, 10)
-    check("the large job stops within a second of the cancel", cancelled.get("state") == "CANCELLED", cancelled)
-    after = server.submit_id(flat_patch(name="after"))
-    abandoned_until, seen = time.time(), 0.0
-    deadline = time.time() + 60
-    while time.time() < deadline:
-        count = server.metric("contactd_abandoned_factorisations") or 0.0
-        seen = max(seen, count)
-        if count == 0:
-            break
+    # A cancel must land inside the factorisation (after the assembly): tried at growing delays until it does.
+    seen, abandoned_until, after = 0.0, time.time(), None
+    for delay in (1.0, 1.5, 2.5, 0.5):
+        big = server.submit_id(blocks(400, name="big"))
+        server.wait_for(big, lambda j: j["state"] == "RUNNING", 30)
+        time.sleep(delay)  # into the factorisation of its two bodies (set-up of about 6 s)
+        server.request("POST", f"/v1/jobs/{big}/cancel")
+        cancelled = server.wait_done(big, 10)
+        check("the large job stops within a second of the cancel", cancelled.get("state") == "CANCELLED", cancelled)
+        after = server.submit_id(flat_patch(name="after"))
         abandoned_until = time.time()
-        time.sleep(0.05)
+        deadline = time.time() + 60
+        while time.time() < deadline:
+            count = server.metric("contactd_abandoned_factorisations") or 0.0
+            seen = max(seen, count)
+            if count == 0:
+                break
+            abandoned_until = time.time()
+            time.sleep(0.05)
+        if seen >= 1:
+            break
+        server.wait_done(after, 60)
     check("the cancel left its factorisations running (the metric counts them)", seen >= 1, seen)
     done = server.wait_done(after, 60)
     started = seconds(done["started"]) if done.get("started") else 0.0
