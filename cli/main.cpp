@@ -294,19 +294,17 @@ int solve_and_write(contact::Session& session, contact::Problem& problem, const 
     std::fflush(stdout);
     return code;
   };
-  if (result.steps.empty()) {
-    std::cerr << "error: " << result.message << "\n";
-    return finish(1);
+  if (result.steps.empty()) {  // no file: nothing solved, or no step held and its iterate was not asked for
+    const bool error = result.stop_reason == contact::StopReason::error;
+    std::cerr << (error ? "error: " : "not converged, no result file: ") << result.message << "\n";
+    return finish(error ? 1 : 3);
   }
   if (!ndjson) {
-    // A solve that stopped short of convergence leaves an iterate, not an answer: said before its numbers. A
-    // later load step that failed leaves the steps that held, the last of them below.
-    std::size_t held = 0;
-    for (const auto& step : result.steps) held += step.converged;
+    // A solve that stopped short of convergence leaves the steps that held (and its last iterate, not an answer,
+    // only if the job asked for it: output.iterate): said before the numbers of the last of them.
     if (!result.converged && result.steps.back().converged)
-      std::printf("not converged: the result file keeps the %zu load step%s that held (converged 1); below, the "
-                  "last of them (load factor %.6g)\n",
-                  held, held == 1 ? "" : "s", result.steps.back().load_factor);
+      std::printf("not converged: %s; below, the last of them (load factor %.6g)\n", result.kept.c_str(),
+                  result.steps.back().load_factor);
     else if (!result.converged)
       std::printf("not converged: the last iterate, below and in the result file (converged 0), is not an answer\n");
     print_final_step(result.steps.back());
@@ -379,6 +377,10 @@ int main(int argc, char** argv) {
                  "the pairs whose detail each progress line lists: names or patterns (* ?) separated by commas, or "
                  "'all' (overrides the job's output.progress_pairs; default: every pair while there are few, else "
                  "the totals and the pairs that stand out)");
+  bool keep_iterate = false;
+  app.add_flag("--keep-iterate", keep_iterate,
+               "when a step does not converge, keep its last iterate in the result file, flagged converged 0 (no "
+               "answer: for diagnosis; as the job's output.iterate). Default: the steps that held only");
   bool no_mesh_files = false;
   app.add_flag("--no-mesh-files", no_mesh_files,
                "refuse Gmsh meshes given by file, as contactd does (it passes this flag): only \"data\"");
@@ -405,6 +407,7 @@ int main(int argc, char** argv) {
   }
   contact::Problem& problem = *parsed.problem;
   if (threads >= 0) problem.solver.threads = threads;
+  if (keep_iterate) problem.output.iterate = true;
   if (validate_only) {
     long dofs = 0;
     for (const auto& b : problem.bodies) dofs += 2L * b.mesh.num_nodes();

@@ -26,17 +26,22 @@ double max_penetration(const Step& step) {
 
 // The monolithic reference solves the coupled system however little holds a floating body (its rigid motion
 // then comes out zero, one of many solutions): a solution at which the contacts in contact do not hold every
-// floating body is refused as interface Newton refuses it, with no result.
-void refuse_unheld_bodies(const Problem& problem, Result& result) {
+// floating body is refused as interface Newton refuses it, with no result (the iterate left out of the result,
+// output.iterate unset, is checked too: a run stopped on it is refused for that reason, not for the iterations).
+void refuse_unheld_bodies(const Problem& problem, Result& result, const Step* dropped_iterate) {
   if (result.stop_reason != StopReason::converged && result.stop_reason != StopReason::max_iterations) return;
-  for (const auto& step : result.steps) {
-    const std::string unheld = unheld_floating_bodies(problem, step);
+  std::vector<const Step*> reached;
+  for (const auto& step : result.steps) reached.push_back(&step);
+  if (dropped_iterate) reached.push_back(dropped_iterate);
+  for (const Step* step : reached) {
+    const std::string unheld = unheld_floating_bodies(problem, *step);
     if (unheld.empty()) continue;
     result.stop_reason = StopReason::error;
     result.converged = false;
     result.message = "monolithic: " + unheld;
     result.steps.clear();
     result.step_history.clear();
+    result.kept.clear();
     return;
   }
 }
@@ -59,7 +64,7 @@ std::string tensile_pairs(const Step& step) {
 // they stopped on short of convergence may not, and the message says it is no answer. A solve that claims
 // convergence on one is refused (no result): its stop test was wrong.
 void refuse_tension(Result& result) {
-  if (result.steps.empty()) return;
+  if (result.steps.empty() || (!result.converged && result.steps.back().converged)) return;
   const std::string pulling = tensile_pairs(result.steps.back());
   if (pulling.empty()) return;
   const std::string what = "contact " + pulling + " pulls, and a contact only pushes";
@@ -72,6 +77,27 @@ void refuse_tension(Result& result) {
   result.message = "the solve stopped on a state that is not an answer: " + what + " (" + result.message + ")";
   result.steps.clear();
   result.step_history.clear();
+  result.kept.clear();
+}
+
+// What the result of a run that did not converge keeps: the steps that held and, if the job asked for it
+// (OutputSettings::iterate), the last iterate flagged as not converged. Empty when nothing was solved.
+std::string what_the_result_keeps(const Problem& problem, const ddm::StepLog& steps) {
+  const int held = steps.held();
+  const bool iterate = steps.ends_with_iterate();
+  if (held == 0 && !iterate && !steps.dropped_iterate()) return "";
+  const std::string kind = problem.adaptivity.enabled ? "adaptive step" : problem.loading.factors.size() > 1 ? "load step" : "step";
+  std::ostringstream os;
+  if (held == 0)
+    os << "no " << kind << " held: the result keeps ";
+  else
+    os << "the result keeps the " << held << " " << kind << (held == 1 ? "" : "s") << " that held";
+  if (iterate)
+    os << (held == 0 ? "" : " and ") << "the last iterate (converged 0), which is not an answer";
+  else if (steps.dropped_iterate())
+    os << (held == 0 ? "nothing" : "") << (held == 0 ? " (" : ", not the last iterate (")
+       << "set output.iterate to keep it, flagged as not converged)";
+  return os.str();
 }
 
 }  // namespace
@@ -127,7 +153,7 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
     }
     ddm::RunContext context{observer, cancel, runner, start};
     const std::unique_ptr<ddm::ContactMethod> method = ddm::make_method(system, active.solver);
-    ddm::StepLog steps(problem.output.steps);  // every step's scalars; the fields the job keeps
+    ddm::StepLog steps(problem.output);  // every step's scalars; the fields the job keeps
     ddm::MethodOutcome outcome;
     if (adaptive) {
       system.set_load_step(problem.loading.factors.size() - 1, problem.loading.factors.back());
@@ -147,9 +173,12 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
     result.indicator_seconds = outcome.indicator_seconds;
     result.history = std::move(outcome.history);
     result.factorization_seconds = system.total_factorization_seconds();
+    if (!outcome.converged) result.kept = what_the_result_keeps(active, steps);
+    if (!result.kept.empty()) result.message += "; " + result.kept;
     result.steps = steps.take_steps();
     result.step_history = steps.take_summaries();
-    if (problem.solver.method == Method::monolithic) refuse_unheld_bodies(active, result);
+    if (problem.solver.method == Method::monolithic)
+      refuse_unheld_bodies(active, result, steps.dropped_iterate() ? &steps.dropped_step() : nullptr);
     if (result.stop_reason != StopReason::error && result.stop_reason != StopReason::cancelled) refuse_tension(result);
     if (outcome.updates > 0 && !result.steps.empty()) {
       std::ostringstream os;

@@ -1150,12 +1150,12 @@ TEST(JobOutput, StepsDefaultToLastForAdaptiveJobsAndAllOtherwiseAndBadValuesAreN
   ParseResult r = parse(job);
   ASSERT_TRUE(r.ok()) << listing(r);
   EXPECT_EQ(r.problem->output.steps, contact::StepOutput::all);
-  EXPECT_EQ(r.problem->normalized["output"], json({{"steps", "all"}}));
+  EXPECT_EQ(r.problem->normalized["output"], json({{"steps", "all"}, {"iterate", false}}));
   job["adaptivity"] = json::object();
   r = parse(job);
   ASSERT_TRUE(r.ok()) << listing(r);
   EXPECT_EQ(r.problem->output.steps, contact::StepOutput::last);
-  EXPECT_EQ(r.problem->normalized["output"], json({{"steps", "last"}}));
+  EXPECT_EQ(r.problem->normalized["output"], json({{"steps", "last"}, {"iterate", false}}));
   job["output"] = {{"steps", "all"}};
   r = parse(job);
   ASSERT_TRUE(r.ok()) << listing(r);
@@ -1172,6 +1172,14 @@ TEST(JobOutput, StepsDefaultToLastForAdaptiveJobsAndAllOtherwiseAndBadValuesAreN
   expect_only_error(parse(steps), "/output/fields", "fields");
   steps["output"] = "last";
   expect_only_error(parse(steps), "/output", "object");
+  // iterate: whether an unconverged step keeps its iterate; a boolean, false unless asked for.
+  steps["output"] = {{"iterate", true}};
+  r = parse(steps);
+  ASSERT_TRUE(r.ok()) << listing(r);
+  EXPECT_TRUE(r.problem->output.iterate);
+  EXPECT_EQ(r.problem->normalized["output"]["iterate"], true);
+  steps["output"] = {{"iterate", "yes"}};
+  expect_only_error(parse(steps), "/output/iterate", "iterate");
 }
 
 // ---- friction and load histories (docs/job-format.md, "Friction") ----------------------------------------

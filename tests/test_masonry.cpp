@@ -312,13 +312,24 @@ TEST(Masonry, AStepThatDidNotConvergeIsCutAndIfThatFailsKeptOnlyAsTheLastAndFlag
   EXPECT_NE(cut.message.find("load step 2 of 2 (cut "), std::string::npos) << cut.message;
   const Eigen::Vector2d load = applied_load(job, 1);
   EXPECT_NEAR(support_reactions(cut.steps[1]).x(), -load.x(), 1e-8 * load.norm());
-  // A shear of 0.55 needs more than three steps even in 1/32 of the step: the run stops there, the first step
-  // flagged converged, the second (the last sub-step tried) not.
+  // A shear of 0.55 needs more than three steps even in 1/32 of the step: the run stops there. By default the
+  // result keeps the first step only, converged, and says so; asked for (output.iterate), the second (the last
+  // sub-step tried) follows it, flagged.
   job = wall(4, 4, "--head-joints --friction 0.6 --shear 0.55");
   job["solver"]["max_iterations"] = 3;
+  const Result held = run(job);
+  EXPECT_FALSE(held.converged);
+  ASSERT_EQ(held.steps.size(), 1u) << held.message;
+  EXPECT_TRUE(held.steps[0].converged);
+  ASSERT_EQ(held.step_history.size(), 1u);
+  EXPECT_NE(held.message.find("the result keeps the 1 load step that held, not the last iterate"), std::string::npos)
+      << held.message;
+  job["output"] = {{"iterate", true}};
   const Result r = run(job);
   EXPECT_FALSE(r.converged);
   EXPECT_NE(r.message.find("cut 5 times"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("the result keeps the 1 load step that held and the last iterate (converged 0)"),
+            std::string::npos) << r.message;
   ASSERT_EQ(r.steps.size(), 2u) << r.message;
   EXPECT_TRUE(r.steps[0].converged) << r.message;
   EXPECT_FALSE(r.steps[1].converged);
@@ -356,6 +367,7 @@ TEST(Masonry, FromRestWithClosedJointsTheAnswerIsProportionalToTheLoadSoAFailedF
   // One Newton step is too few for it (it takes three): the step fails once, uncut.
   json failing = wall(4, 4, "--head-joints --friction 0.6 --shear 0.3");
   failing["solver"]["max_iterations"] = 1;
+  failing["output"] = {{"iterate", true}};  // to see the step that failed
   const Result r = run(failing);
   EXPECT_FALSE(r.converged);
   EXPECT_NE(r.message.find("load step 1 of 2 (not cut: from rest with every joint closed"), std::string::npos)

@@ -107,7 +107,18 @@ TEST(Cancellation, ARunningSolveStopsWithinOneIteration) {
     EXPECT_FALSE(r.converged);
     EXPECT_EQ(r.iterations, 2) << method;
     EXPECT_EQ(rec.reports.size(), 2u);
-    EXPECT_EQ(r.steps.size(), 1u);  // the state reached is still returned
+    EXPECT_TRUE(r.steps.empty()) << "an iterate is kept only if asked for";
+  }
+  for (const char* method : {"neumann", "monolithic"}) {
+    Problem p = seed(method);
+    p.output.iterate = true;
+    Recorder rec;
+    CancelToken cancel;
+    rec.cancel_at_two = &cancel;
+    const Result r = solve(p, rec, cancel);
+    EXPECT_EQ(r.stop_reason, StopReason::cancelled) << method;
+    ASSERT_EQ(r.steps.size(), 1u) << "the state reached, asked for (output.iterate)";
+    EXPECT_FALSE(r.steps[0].converged);
   }
 }
 
@@ -151,6 +162,7 @@ TEST(Parallelism, BodiesFactorisedAndSolvedConcurrentlyGiveTheSequentialAnswer) 
     body["mesh"]["block"]["ny"] = 80;
   }
   job["solver"]["max_iterations"] = 3;
+  job["output"] = {{"iterate", true}};  // the iterates after 3 iterations are compared
   Result results[2];
   for (int threads : {1, 2}) {
     job["solver"]["threads"] = threads;

@@ -144,7 +144,8 @@ JobRecord JobRun::outcome_of(const contact::Result& result, CancelReason reason)
       break;
     case contact::StopReason::max_iterations:
     case contact::StopReason::stagnation:
-      // Not an answer: the last iterate is kept in the result file (flagged converged 0), the job fails.
+      // Not an answer: the job fails; the result keeps the steps that held (and the last iterate, flagged
+      // converged 0, only if the job asked for it: output.iterate), as the message says.
       outcome.state = JobState::failed;
       outcome.message = "the solve did not converge (" + outcome.stop_reason + "): " + result.message;
       break;
@@ -161,6 +162,7 @@ JobRecord JobRun::outcome_of(const contact::Result& result, CancelReason reason)
         outcome.state = JobState::cancelled;
         outcome.message = "cancelled after " + std::to_string(result.iterations) + " iterations";
       }
+      if (!result.kept.empty()) outcome.message += "; " + result.kept;
       break;
   }
   return outcome;
@@ -176,7 +178,7 @@ void JobRun::write_result_files(const contact::Result& result, JobRecord& outcom
   }
   // Every step that held is kept, also when a later one failed (an error stop: the statics refused a load step,
   // the friction Newton did not converge); the file's steps say which converged, the job's message which step
-  // failed and why. Nothing is written when no step was solved.
+  // failed, why, and what the result keeps (Result::kept). Nothing is written when no step is kept.
   if (!problem_ || result.steps.empty()) return;
   try {
     contact::io::WriteInfo info;
@@ -184,13 +186,6 @@ void JobRun::write_result_files(const contact::Result& result, JobRecord& outcom
     contact::io::write_result(store.result_path(id_), *problem_, result, info);
     contact::io::write_xdmf(store.xmf_path(id_), "result.hdf", result);
     outcome.result_available = true;
-    if (result.stop_reason == contact::StopReason::error) {
-      std::size_t held = 0;
-      for (const auto& step : result.steps) held += step.converged;
-      outcome.message += held == 0 ? std::string("; no load step held (the result file has the last iterate, converged 0)")
-                                   : "; the result file keeps the " + std::to_string(held) + " load step" +
-                                         (held == 1 ? "" : "s") + " that held";
-    }
   } catch (const std::exception& e) {
     log_line("job " + id_ + ": cannot write the result file: " + e.what());
     store.remove_result(id_);  // also frees the space a full disk needs for the state change below

@@ -254,8 +254,8 @@ ddm::MethodOutcome converge_then_refine(Problem& working, ddm::ContactSystem& sy
     for (const auto& e : eta) total.indicator_seconds += e.seconds;
     Step solved = make_step(system, o.u, o.z, total.iterations, step, eta);
     solved.converged = o.converged;
-    steps.push_back(std::move(solved));
-    const StepMeasures now = measure(steps.back(), eta);
+    const StepMeasures now = measure(solved, eta);
+    steps.push_back(std::move(solved));  // an unconverged one only if the job asks for its iterate (StepLog)
     AdaptiveStepReport report =
         step_report(step, working, total, now, step > 0 ? &previous : nullptr, eta, context.elapsed());
     previous = now;
@@ -430,7 +430,9 @@ ddm::MethodOutcome paper_interleaving(Problem& working, ddm::ContactSystem& syst
     if (k == settings.max_iterations) {
       out.reason = StopReason::max_iterations;
       out.message = "adaptive (paper): max_iterations reached";
-      steps.push_back(make_step(system, u, {}, k, step, {}));
+      Step reached = make_step(system, u, {}, k, step, {});
+      reached.converged = false;
+      steps.push_back(std::move(reached));
     }
   }
   out.u = std::move(u);

@@ -12,13 +12,25 @@ namespace contact::ddm {
 
 class StepLog {
  public:
-  explicit StepLog(StepOutput keep = StepOutput::all) : keep_(keep) {}
+  explicit StepLog(StepOutput keep = StepOutput::all, bool keep_iterate = true)
+      : keep_(keep), keep_iterate_(keep_iterate) {}
+  explicit StepLog(const OutputSettings& output) : StepLog(output.steps, output.iterate) {}
 
-  // Records the step's scalars and keeps its fields (with StepOutput::last in place of the previous step's).
+  // Records the step's scalars and keeps its fields (with StepOutput::last in place of the previous step's). A step
+  // that did not converge is an iterate, no answer: without keep_iterate (OutputSettings::iterate) it is not
+  // recorded at all, so that with StepOutput::last the step that held before it stays the one kept.
   void push_back(Step step);
-  // The step reached last (push_back must have been called).
+  // The step kept last (push_back must have recorded one).
   const Step& back() const { return steps_.back(); }
+  // The iterate push_back left out, if it left one out: not in the result, but checks of what the run stopped on
+  // (a floating body its contacts do not hold) still look at it.
+  bool dropped_iterate() const { return dropped_; }
+  const Step& dropped_step() const { return dropped_step_; }
   bool empty() const { return steps_.empty(); }
+  // How many of the steps recorded converged (every step's, whatever StepOutput keeps of their fields).
+  int held() const;
+  // Whether the last step recorded is an iterate that did not converge (kept with keep_iterate).
+  bool ends_with_iterate() const { return !summaries_.empty() && !summaries_.back().converged; }
 
   // The mesh nodes of the steps whose fields stay kept when another step is pushed (every step's with
   // StepOutput::all, none with last): what a next step adds to the result on top of them.
@@ -30,6 +42,9 @@ class StepLog {
 
  private:
   StepOutput keep_;
+  bool keep_iterate_;
+  bool dropped_ = false;
+  Step dropped_step_;
   std::vector<Step> steps_;
   std::vector<StepSummary> summaries_;
   double nodes_ = 0;  // over steps_

@@ -394,22 +394,26 @@ void JobReader::read_loading_steps(const json& value, const std::string& pointer
   problem_.loading.factors = std::move(factors);
 }
 
-// {"steps": "last" | "all", "progress_pairs": [glob, ...]}. steps: which steps' fields the result keeps. The
+// {"steps": "last" | "all", "progress_pairs": [glob, ...], "iterate": bool}. steps: which steps' fields the result keeps. The
 // default depends on the job (after adaptivity was read): an adaptive run's steps are ever finer meshes on the way
 // to the answer, each about as large as the last, so only the last is kept; load steps are answers to different
 // loads, kept all. progress_pairs: the pairs whose detail the progress lists (contact/progress_json.hpp), each
-// pattern matching at least one pair (after the contacts were read).
+// pattern matching at least one pair (after the contacts were read). iterate: whether a step that did not converge
+// keeps its last iterate (flagged); not by default (OutputSettings::iterate).
 void JobReader::read_output(const Fields& top) {
   json& out = sub_object(normalized_, "output");
   problem_.output.steps = problem_.adaptivity.enabled ? StepOutput::last : StepOutput::all;
   if (const json* v = top.find("output")) {
-    Fields f(*v, top.at("output"), "output", {"steps", "progress_pairs"}, errors_);
+    Fields f(*v, top.at("output"), "output", {"steps", "progress_pairs", "iterate"}, errors_);
     if (const json* s = f.find("steps"))
       if (auto c = choice(*s, f.at("steps"), "steps", {"last", "all"}, errors_))
         problem_.output.steps = *c == "last" ? StepOutput::last : StepOutput::all;
     if (const json* p = f.find("progress_pairs")) read_progress_pairs(*p, f.at("progress_pairs"));
+    if (const json* i = f.find("iterate"))
+      if (auto b = read::boolean(*i, f.at("iterate"), "iterate", errors_)) problem_.output.iterate = *b;
   }
   set_default(out, "steps", problem_.output.steps == StepOutput::last ? "last" : "all");
+  set_default(out, "iterate", problem_.output.iterate);
 }
 
 void JobReader::read_progress_pairs(const json& value, const std::string& pointer) {

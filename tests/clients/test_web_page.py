@@ -387,7 +387,7 @@ def test_with_token(b, downloads):
         check("token: the examples load", b.wait(lambda: len(Select(b.el("example")).options) > 5, 10))
 
         # A job that runs a few seconds, followed live through the stream read with the token.
-        b.set_job_text(json.dumps(long_job(max_iterations=ITERATIONS, name="web-token")))
+        b.set_job_text(json.dumps(long_job(max_iterations=ITERATIONS, name="web-token", iterate=True)))
         b.el("submit").click()
         job_id = b.wait(lambda: b.text("job-id"), 10)
         if not check("token: submitted through the page", bool(job_id), b.text("submit-message")):
@@ -395,7 +395,8 @@ def test_with_token(b, downloads):
         live = b.wait(lambda: points(b) > 0 and server.job(job_id)["state"] == "RUNNING" and points(b), 20)
         check("token: points arrive while the job runs", bool(live), points(b))
         end = server.wait_done(job_id, 60)
-        # It stops at its max_iterations short of its tolerance: FAILED (not converged), its last iterate kept.
+        # It stops at its max_iterations short of its tolerance: FAILED (not converged), its last iterate kept
+        # (asked for: output.iterate).
         check("token: the job runs to its end (FAILED at max_iterations, its result kept)",
               end.get("state") == "FAILED" and end.get("stop_reason") == "max_iterations"
               and end.get("result_available"), end)

@@ -116,7 +116,7 @@ def iteration_count(line):
 
 
 with tempfile.TemporaryDirectory() as tmp:
-    job = long_job()
+    job = long_job(iterate=True)  # the result keeps the iterate a stop leaves (output.iterate)
     job["solver"]["tolerance"] = 1e-15  # the run: never reached, so only a stop ends it
     job_path = os.path.join(tmp, "long.json")
     with open(job_path, "w") as f:

@@ -97,11 +97,12 @@ with tempfile.TemporaryDirectory() as tmp:
     r = run(EXAMPLE, "--validate")
     check("--validate exits 0", r.returncode == 0 and "valid" in r.stdout, r.stdout + r.stderr)
 
-    # A solve that stops without converging (issue 32, item 6): the roller example with its base contact
-    # frictionless has no equilibrium once the plate is pushed sideways (nothing holds the roller and the plate
-    # against sliding along the base); its friction Newton ran to max_iterations and its last iterate pulled at
-    # the base contact. Exit 3 (README: stopped without converging), the stop line and the final lines say it is
-    # not an answer, and the file is flagged converged 0.
+    # A solve that stops without converging (issue 32, item 6; issue 31, item 1): the roller example with its base
+    # contact frictionless has no equilibrium once the plate is pushed sideways in its second load step (nothing
+    # holds the roller and the plate against sliding along the base). Never exit 0. By default the file keeps the
+    # load step that held and not the iterate the failed step stopped on; with --keep-iterate (output.iterate) it
+    # keeps that iterate too, flagged converged 0, said before the final numbers to be no answer, and any contact
+    # it pulls at is named as no answer.
     with open(os.path.join(EXAMPLES, "roller_friction.json")) as f:
         roller = json.load(f)
     del roller["contacts"][0]["friction"]
@@ -109,24 +110,57 @@ with tempfile.TemporaryDirectory() as tmp:
     with open(roller_path, "w") as f:
         json.dump(roller, f)
     roller_out = os.path.join(tmp, "roller_frictionless_base.hdf")
-    r = run(roller_path, "-o", roller_out)
-    stop = next((l for l in r.stdout.splitlines() if l.startswith("stop: ")), "")
-    # (A solver that finds out that nothing holds the bodies would refuse the job instead: exit 1, no result.)
-    check("not converged: never exit 0", r.returncode in (1, 3), f"{r.returncode} {stop} {r.stderr}")
-    if r.returncode == 3:
-        check("not converged: the stop line names the reason", stop.startswith("stop: max_iterations after "), stop)
+    for keep in (False, True):
+        what = "not converged" + (", --keep-iterate" if keep else "")
+        if os.path.exists(roller_out):
+            os.remove(roller_out)
+        r = run(roller_path, "-o", roller_out, *(["--keep-iterate"] if keep else []))
+        stop = next((l for l in r.stdout.splitlines() if l.startswith("stop: ")), "")
+        check(f"{what}: never exit 0, the stop names load step 2", r.returncode in (1, 3)
+              and stop.startswith("stop: ") and "load step 2 of 3" in stop, f"{r.returncode} {stop} {r.stderr}")
+        with h5py.File(roller_out, "r") as f:
+            flags = list(f["history/steps/converged"][()])
+            check(f"{what}: the file says the run did not converge",
+                  int(f.attrs["converged"]) == 0 and str(f.attrs["stop_reason"]) != "converged", dict(f.attrs))
+            check(f"{what}: the file keeps step 1, converged" + (", then the iterate, converged 0" if keep else ""),
+                  flags == ([1, 0] if keep else [1]) and len(f["steps"]) == len(flags)
+                  and int(f["steps/0"].attrs["converged"]) == 1, (flags, list(f["steps"].keys())))
+        if not keep:
+            check(f"{what}: the stop says what the file keeps and how to keep the iterate",
+                  stop.endswith("the result keeps the 1 load step that held, not the last iterate (set "
+                                "output.iterate to keep it, flagged as not converged)"), stop[-300:])
+            check(f"{what}: the final lines are the held step's",
+                  "not converged: the result keeps the 1 load step that held, not the last iterate" in r.stdout
+                  and "below, the last of them (load factor 1)" in r.stdout, r.stdout[-800:])
+            continue
         pulls = re.findall(r"^pair (\S+): exact contact, force (-[0-9.e+]+)", r.stdout, re.M)
-        check("not converged: a pulling contact is said to be no answer",
+        check(f"{what}: a pulling contact is said to be no answer",
               all(f"'{name}' (force " in stop for name, _ in pulls) and (not pulls or (
                   "the last iterate is not an answer: contact '" in stop and "pulls, and a contact only pushes" in stop)),
               (pulls, stop))
-        check("not converged: said before the final numbers",
+        check(f"{what}: said before the final numbers",
               "not converged: the last iterate, below and in the result file (converged 0), is not an answer"
-              in r.stdout, r.stdout[-800:])
-        with h5py.File(roller_out, "r") as f:
-            check("not converged: the file says converged 0 and max_iterations",
-                  int(f.attrs["converged"]) == 0 and str(f.attrs["stop_reason"]) == "max_iterations",
-                  dict(f.attrs))
+              in r.stdout and "the result keeps the 1 load step that held and the last iterate (converged 0), "
+              "which is not an answer" in stop, r.stdout[-800:])
+
+    # A run in which no step held and the iterate is not asked for writes no file: exit 3 (max_iterations), said.
+    one_step = os.path.join(tmp, "one_step.json")
+    with open(EXAMPLE) as f:
+        job = json.load(f)
+    job["solver"] = {"method": "neumann", "max_iterations": 2}
+    with open(one_step, "w") as f:
+        json.dump(job, f)
+    nothing = os.path.join(tmp, "nothing.hdf")
+    r = run(one_step, "-o", nothing, "-q")
+    check("max_iterations, nothing held: exit 3, no file, the error says why",
+          r.returncode == 3 and not os.path.exists(nothing) and "not converged, no result file: " in r.stderr
+          and "no step held: the result keeps nothing (set output.iterate" in r.stderr, (r.returncode, r.stderr))
+    r = run(one_step, "-o", nothing, "-q", "--keep-iterate")
+    with h5py.File(nothing, "r") as f:
+        check("max_iterations, --keep-iterate: the iterate is kept, flagged",
+              r.returncode == 3 and list(f["history/steps/converged"][()]) == [0]
+              and int(f.attrs["converged"]) == 0 and str(f.attrs["stop_reason"]) == "max_iterations",
+              (r.returncode, dict(f.attrs)))
 
     # A bad job: exit code 2, every error with its JSON pointer, nothing written.
     with open(EXAMPLE) as f:
@@ -292,7 +326,7 @@ with tempfile.TemporaryDirectory() as tmp:
           and "load step 2 of 2: contact 'b3_0.bottom-b2_0.top': friction cannot hold body 'b3_0'" in r.stdout
           and "1.083 times" in r.stdout, r.stdout[:600])
     check("failed step 2: the lines below are the held step's",
-          "not converged: the result file keeps the 1 load step that held (converged 1)" in r.stdout, r.stdout[:600])
+          "not converged: the result keeps the 1 load step that held" in r.stdout, r.stdout[:600])
     with h5py.File(out, "r") as f:
         check("failed step 2: the file keeps step 1, converged, and the run flagged not converged",
               list(f["history/steps/converged"][()]) == [1] and list(f["steps"].keys()) == ["0"]

@@ -54,9 +54,10 @@ def flat_patch(displacement=-0.001, name="flat_patch"):
     return job
 
 
-def long_job(max_iterations=100000, name="long"):
+def long_job(max_iterations=100000, name="long", iterate=False):
     """The paper's two layers on a tall mesh (32 x 256 per body, about 2 ms per iteration) with a tolerance the
-    iteration does not reach before max_iterations: a job that runs until cancelled, or for a bounded time."""
+    iteration does not reach before max_iterations: a job that runs until cancelled, or for a bounded time. With
+    `iterate` its result keeps the iterate it stops on (output.iterate; without, a stopped run keeps nothing)."""
     job = example("seed_layers.json")
     job["name"] = name
     for body in job["bodies"]:
@@ -65,6 +66,8 @@ def long_job(max_iterations=100000, name="long"):
     # The paper's scheme spelled out (plain relaxation, penalty): slow and steady, ~2 ms per iteration.
     job["solver"].update(method="neumann", acceleration="none", enforcement="penalty", criterion="residual",
                          tolerance=1e-14, gamma=0.002, max_iterations=max_iterations)
+    if iterate:
+        job["output"] = {"iterate": True}
     return job
 
 

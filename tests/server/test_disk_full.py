@@ -55,7 +55,7 @@ def fill(server):
 
 try:
     a = NamespacedServer().start()
-    blocker = a.submit_id(long_job(max_iterations=100000, name="fills-the-disk"))
+    blocker = a.submit_id(long_job(max_iterations=100000, name="fills-the-disk", iterate=True))
     a.wait_for(blocker, lambda j: j["state"] == "RUNNING" and j["iterations"] >= 5, timeout=60)
     queued = a.submit_id(long_job(name="waits"))
     # Every byte taken (the server's reserve aside); the running job's events now fail to be written.

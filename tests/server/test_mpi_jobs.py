@@ -71,7 +71,7 @@ with tempfile.TemporaryDirectory() as tmp, \
     check("MPI job and in-process job: same iterations", it_local == it_mpi, (it_local, it_mpi))
 
     # Cancelled while it runs: SIGUSR1 reaches every rank, which stop together at their next exchange.
-    long = long_job()
+    long = long_job(iterate=True)  # its result keeps the iterate the cancel stops on
     long["parallel"] = {"ranks": 2}
     long_id = server.submit_id(long)
     server.wait_for(long_id, lambda j: j.get("state") == "RUNNING" and j.get("iterations", 0) >= 20, timeout=120)

@@ -2,7 +2,8 @@
 """contactd: a job's outcome says whether it holds an answer, and a bad job answers one error per cause.
 
 - Issue 32, item 6: a job whose solve stops without converging (max_iterations) ended SUCCEEDED. It ends FAILED,
-  the reason in its message, its last iterate kept in the result file (flagged converged 0).
+  the reason in its message, its last iterate kept in the result file (flagged converged 0) if the job asks for it
+  (output.iterate), no result otherwise.
 - Issue 32, item 6: the roller example with the friction removed from its base contact ended SUCCEEDED after 2004
   Newton steps with a tensile contact force (-3865). It ends FAILED, and its message says that the last iterate
   pulls at a contact and is not an answer.
@@ -83,13 +84,24 @@ def row_of_blocks(count):
 
 
 with Server(args=["--workers", "1"]) as server:
-    # --- max_iterations: FAILED, its last iterate kept -----------------------------------------------------
-    job_id = server.submit_id(long_job(max_iterations=20, name="stops-short"))
+    # --- max_iterations: FAILED; its last iterate kept only if the job asks for it (output.iterate) ------------
+    job_id = server.submit_id(long_job(max_iterations=20, name="stops-short", iterate=True))
     final = ends_failed_not_converged(server, job_id, "a job stopped at max_iterations", "max_iterations")
     check("its iterations are all there", final.get("iterations") == 20, final)
+    check("its message says the iterate is kept and no answer", final.get("message", "").endswith(
+        "; no step held: the result keeps the last iterate (converged 0), which is not an answer"), final.get("message"))
+    job_id = server.submit_id(long_job(max_iterations=20, name="stops-short-no-iterate"))
+    final = server.wait_done(job_id, timeout=300)
+    check("not asked for: FAILED at max_iterations with no result, and the message says how to keep the iterate",
+          final.get("state") == "FAILED" and final.get("stop_reason") == "max_iterations"
+          and final.get("result_available") is False and server.get(f"/v1/jobs/{job_id}/result").status == 404
+          and final.get("message", "").endswith("; no step held: the result keeps nothing (set output.iterate to "
+                                                "keep it, flagged as not converged)"), final)
 
     # --- the roller on a frictionless base: never SUCCEEDED, never a pulling contact as an answer ------------
-    job_id = server.submit_id(roller_without_base_friction())
+    roller = roller_without_base_friction()
+    roller["output"] = {"iterate": True}  # to check what its iterate says
+    job_id = server.submit_id(roller)
     final = server.wait_done(job_id, timeout=300)
     check("roller on a frictionless base: not SUCCEEDED", final.get("state") == "FAILED", final)
     message = final.get("message", "")
@@ -114,7 +126,7 @@ with Server(args=["--workers", "1"]) as server:
     message = final.get("message") or ""
     check("a refused load step: FAILED with the step and the cause", final.get("state") == "FAILED"
           and message.startswith("load step 2 of 2: friction cannot hold") and "1.083 times" in message, message[:300])
-    check("its message says the step that held is kept", message.endswith("; the result file keeps the 1 load step that held"),
+    check("its message says the step that held is kept", message.endswith("; the result keeps the 1 load step that held"),
           message[-200:])
     check("the result is downloadable", final.get("result_available") is True, final)
     r = server.get(f"/v1/jobs/{job_id}/result")

@@ -39,7 +39,8 @@ try:
     done_resource = a.job(done_id)
 
     # About 1500 iterations of 2 ms: long enough to be killed while running, short enough to finish after.
-    r = a.submit(long_job(max_iterations=1500, name="interrupted"), headers={"Idempotency-Key": "restart-key"})
+    r = a.submit(long_job(max_iterations=1500, name="interrupted", iterate=True),
+                 headers={"Idempotency-Key": "restart-key"})
     running_id = r.json()["id"]
     waiting_id = a.submit_id(flat_patch(-0.002, name="waiting"))
     state = wait_iterations(a, running_id, 20)
@@ -83,7 +84,8 @@ try:
     check("unacknowledged submission not listed", len(b.get("/v1/jobs").json()["jobs"]) == 3)
 
     final = b.wait_done(running_id, timeout=120)
-    # It runs to its max_iterations, short of its tolerance: FAILED (not converged), its last iterate kept.
+    # It runs to its max_iterations, short of its tolerance: FAILED (not converged), its last iterate kept
+    # (asked for: output.iterate).
     check("interrupted job ran again to completion", final and final["state"] == "FAILED" and
           final["stop_reason"] == "max_iterations" and final["iterations"] == 1500 and final["attempts"] == 2
           and final["result_available"], final)
@@ -111,7 +113,8 @@ try:
     check("Last-Event-ID from before the restart resumes", resumed and resumed[0]["seq"] == events_before[-1]["seq"] + 1
           and resumed[-1]["type"] == "end")
 
-    r = b.submit(long_job(max_iterations=1500, name="interrupted"), headers={"Idempotency-Key": "restart-key"})
+    r = b.submit(long_job(max_iterations=1500, name="interrupted", iterate=True),
+                 headers={"Idempotency-Key": "restart-key"})
     check("Idempotency-Key remembered across the restart", r.status == 202 and r.json()["id"] == running_id, r)
 
     # --- graceful shutdown: SIGTERM while a job runs --------------------------------------------------------

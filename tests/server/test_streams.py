@@ -16,7 +16,7 @@ from checks import check, finish  # noqa: E402
 
 with Server(args=["--workers", "1", "--small-job-workers", "0", "--max-streams", "24"]) as server:  # flat patches queue
     # --- cancel during a run ----------------------------------------------------------------------------------
-    job_id = server.submit_id(long_job(name="to-cancel"))
+    job_id = server.submit_id(long_job(name="to-cancel", iterate=True))
     stream = Stream(server, job_id)
     seen = []
     while len([e for e in seen if e["type"] == "iteration"]) < 5:

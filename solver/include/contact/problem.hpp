@@ -233,6 +233,10 @@ struct OutputSettings {
   // The pairs whose detail the progress lists (shell globs on pair names; contact/progress_json.hpp). Empty: every
   // pair while they are few, past that a summary and the pairs that stand out.
   std::vector<std::string> progress_pairs;
+  // Whether a step whose solve did not converge (a load step that could not be held, a run stopped by
+  // max_iterations, stagnation or a cancel) keeps its last iterate in the result, flagged converged 0. Not by
+  // default: the result then holds the steps that held only, and a run in which none held writes none.
+  bool iterate = false;
 };
 
 struct Problem {

@@ -177,6 +177,9 @@ struct Result {
   std::vector<IterationReport> history;
   std::vector<Step> steps;  // the last one is the final solution; with StepOutput::last the only one
   std::vector<StepSummary> step_history;  // every step's scalars, in order (solve() fills it; empty: from steps)
+  // When the run did not converge: what the result keeps, as the end of `message` says it ("the result keeps the 2
+  // load steps that held, not the last iterate (...)"); empty when it converged or nothing was solved.
+  std::string kept;
   double wall_seconds = 0.0;
   double setup_seconds = 0.0;       // assembly + factorisations
   double factorization_seconds = 0.0;
