@@ -68,6 +68,9 @@ class ProgressPrinter final : public contact::Observer {
  public:
   ProgressPrinter(bool quiet, bool ndjson, contact::io::ProgressSelection selection)
       : quiet_(quiet), ndjson_(ndjson), selection_(std::move(selection)) {}
+  // The steps go to the result file as they are reached (contact::io::ResultStream).
+  void set_step_sink(contact::StepSink* sink) { sink_ = sink; }
+  contact::StepSink* step_sink() override { return sink_; }
   void on_iteration(const contact::IterationReport& r) override {
     if (ndjson_) {
       nlohmann::json line = contact::io::bounded_progress(contact::io::iteration_json(r), selection_);
@@ -167,12 +170,20 @@ class ProgressPrinter final : public contact::Observer {
  private:
   bool quiet_, ndjson_;
   contact::io::ProgressSelection selection_;
+  contact::StepSink* sink_ = nullptr;
 };
 
 // Ranks other than 0 report nothing.
+// The other ranks under MPI: no progress, and no step kept but the last (rank 0 writes the file).
 class Silent final : public contact::Observer {
  public:
   void on_iteration(const contact::IterationReport&) override {}
+  contact::StepSink* step_sink() override { return &discard_; }
+
+ private:
+  struct Discard final : contact::StepSink {
+    void take(const contact::Step&) override {}
+  } discard_;
 };
 
 std::string read_file(const std::string& path) {
@@ -222,13 +233,16 @@ void print_final_step(const contact::Step& step) {
 }
 
 // The result file and its XDMF sidecar; throws what cannot be written.
-void write_files(const std::string& output, const contact::Problem& problem, const contact::Result& result,
-                 const std::string& job_id, bool ndjson) {
+std::string xmf_path_of(const std::string& output) {
+  return std::filesystem::path(output).replace_extension(".xmf").string();
+}
+
+void write_files(contact::io::ResultStream& stream, const std::string& output, const contact::Problem& problem,
+                 const contact::Result& result, const std::string& job_id, bool ndjson) {
   contact::io::WriteInfo info;
   info.job_id = job_id;
-  contact::io::write_result(output, problem, result, info);
-  std::filesystem::path xmf = std::filesystem::path(output).replace_extension(".xmf");
-  contact::io::write_xdmf(xmf.string(), std::filesystem::path(output).filename().string(), result);
+  stream.finish(problem, result, info);
+  std::filesystem::path xmf = xmf_path_of(output);
   // ParaView's Xdmf3 readers abort on a bare file name (they join it with the data file's name): "./x.xmf".
   if (!xmf.has_parent_path()) xmf = std::filesystem::path(".") / xmf;
   if (!ndjson)
@@ -266,6 +280,9 @@ int solve_and_write(contact::Session& session, contact::Problem& problem, const 
   }
   if (root && !ndjson) print_header(session, problem);
   ProgressPrinter printer(quiet, ndjson, std::move(selection));
+  // The result file, written as the steps are reached (rank 0 only; an unfinished one is removed).
+  contact::io::ResultStream stream(output, xmf_path_of(output), std::filesystem::path(output).filename().string());
+  if (root) printer.set_step_sink(&stream);
   Silent silent;
   const contact::Result result =
       session.solve(problem, root ? static_cast<contact::Observer&>(printer) : silent, &g_stop_request, &cancel);
@@ -310,7 +327,7 @@ int solve_and_write(contact::Session& session, contact::Problem& problem, const 
     print_final_step(result.steps.back());
   }
   try {
-    write_files(output, problem, result, job_id, ndjson);
+    write_files(stream, output, problem, result, job_id, ndjson);
     summary["result_written"] = true;
     for (const auto& step : result.step_history) summary["steps"].push_back(contact::io::step_json(step));
   } catch (const std::exception& e) {

@@ -40,6 +40,7 @@ void refuse_unheld_bodies(const Problem& problem, Result& result, const Step* dr
     result.converged = false;
     result.message = "monolithic: " + unheld;
     result.steps.clear();
+    result.streamed_steps = 0;
     result.step_history.clear();
     result.kept.clear();
     return;
@@ -76,6 +77,7 @@ void refuse_tension(Result& result) {
   result.converged = false;
   result.message = "the solve stopped on a state that is not an answer: " + what + " (" + result.message + ")";
   result.steps.clear();
+  result.streamed_steps = 0;
   result.step_history.clear();
   result.kept.clear();
 }
@@ -153,7 +155,9 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
     }
     ddm::RunContext context{observer, cancel, runner, start};
     const std::unique_ptr<ddm::ContactMethod> method = ddm::make_method(system, active.solver);
-    ddm::StepLog steps(problem.output);  // every step's scalars; the fields the job keeps
+    // Every step's scalars; the fields the job keeps, streamed to the observer's sink if it has one. Not for the
+    // monolithic reference, whose every step refuse_unheld_bodies checks once the run ends.
+    ddm::StepLog steps(problem.output, problem.solver.method == Method::monolithic ? nullptr : observer.step_sink());
     ddm::MethodOutcome outcome;
     if (adaptive) {
       system.set_load_step(problem.loading.factors.size() - 1, problem.loading.factors.back());
@@ -175,6 +179,7 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
     result.factorization_seconds = system.total_factorization_seconds();
     if (!outcome.converged) result.kept = what_the_result_keeps(active, steps);
     if (!result.kept.empty()) result.message += "; " + result.kept;
+    result.streamed_steps = steps.streamed();
     result.steps = steps.take_steps();
     result.step_history = steps.take_summaries();
     if (problem.solver.method == Method::monolithic)

@@ -45,6 +45,7 @@ TEST(Outcome, AnIterateThatPullsAtAContactIsSaidToBeNoAnswer) {
   std::ifstream in(std::string(CONTACT_SOURCE_DIR) + "/api/examples/roller_friction.json");
   nlohmann::json job = nlohmann::json::parse(in);
   job["contacts"][0].erase("friction");
+  job["output"] = {{"iterate", true}};  // the iterate it stops on is kept, to be judged
   auto parsed = job::parse(job);
   ASSERT_TRUE(parsed.ok()) << job::format_errors(parsed.errors);
   Recorder recorder;
@@ -144,11 +145,17 @@ TEST(Divergence, TooLargeGammaIsStoppedEarlyWithAMessageNamingGamma) {
   EXPECT_LT(r.iterations, 200);
   EXPECT_NE(r.message.find("gamma"), std::string::npos) << r.message;
   // A gamma far above the bound whose iterates do grow is reported as divergence, not as NaNs.
+  // Its iterate, asked for (output.iterate), holds no NaN; not asked for, it is left out.
   p.solver.gamma = 1.9;
   p.solver.initial_guess = InitialGuess::zero;
+  const Result left_out = solve(p, quiet, cancel);
+  EXPECT_NE(left_out.stop_reason, StopReason::converged);
+  EXPECT_TRUE(left_out.steps.empty());
+  p.output.iterate = true;
   const Result d = solve(p, quiet, cancel);
   EXPECT_NE(d.stop_reason, StopReason::converged);
   EXPECT_NE(d.message.find("gamma"), std::string::npos) << d.message;
+  ASSERT_FALSE(d.steps.empty()) << d.message;
   for (const auto& pair : d.steps.back().pairs) EXPECT_TRUE(std::isfinite(pair.force));
 }
 

@@ -87,6 +87,9 @@ contact::Result JobRun::solve() {
     ProgressObserver observer(*job_, context_.registry, context_.metrics,
                               contact::io::ProgressSelection{problem_->output.progress_pairs, false});
     if (problem_->ranks > 1) return solve_on_ranks(observer);
+    JobStore& store = context_.store;
+    stream_ = std::make_unique<contact::io::ResultStream>(store.result_path(id_), store.xmf_path(id_), "result.hdf");
+    observer.set_step_sink(stream_.get());
     return contact::solve(*problem_, observer, job_->cancel);
   } catch (const std::bad_alloc&) {
     return failed("out of memory");
@@ -179,14 +182,18 @@ void JobRun::write_result_files(const contact::Result& result, JobRecord& outcom
   // Every step that held is kept, also when a later one failed (an error stop: the statics refused a load step,
   // the friction Newton did not converge); the file's steps say which converged, the job's message which step
   // failed, why, and what the result keeps (Result::kept). Nothing is written when no step is kept.
-  if (!problem_ || result.steps.empty()) return;
+  if (!problem_ || !stream_ || result.steps.empty()) {
+    stream_.reset();  // a partial file is removed
+    return;
+  }
   try {
     contact::io::WriteInfo info;
     info.job_id = id_;
-    contact::io::write_result(store.result_path(id_), *problem_, result, info);
-    contact::io::write_xdmf(store.xmf_path(id_), "result.hdf", result);
+    stream_->finish(*problem_, result, info);
+    stream_.reset();
     outcome.result_available = true;
   } catch (const std::exception& e) {
+    stream_.reset();
     log_line("job " + id_ + ": cannot write the result file: " + e.what());
     store.remove_result(id_);  // also frees the space a full disk needs for the state change below
     outcome.state = JobState::failed;
@@ -244,6 +251,7 @@ void JobRun::finish(JobRecord outcome) {
 
 void JobRun::requeue_after_shutdown() {
   job_->set_pair_detail(nullptr);
+  stream_.reset();  // its partial file is removed
   context_.store.remove_result(id_);
   const std::string message = "interrupted by a shutdown; it runs again when the server restarts";
   if (!context_.registry.commit(

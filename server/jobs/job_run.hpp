@@ -22,6 +22,7 @@
 
 #include "contact/problem.hpp"
 #include "contact/result.hpp"
+#include "contact/result_file.hpp"
 
 #include <chrono>
 #include <functional>
@@ -72,6 +73,9 @@ class JobRun {
   const std::string id_;
   std::optional<contact::Problem> problem_;
   std::optional<MpiOutcome> mpi_;  // a job run on MPI ranks: the child wrote the result file
+  // A job run here: its result file, written as the steps are reached and put in place by write_result_files
+  // (removed unfinished if the run leaves no result).
+  std::unique_ptr<contact::io::ResultStream> stream_;
 };
 
 }  // namespace contactd

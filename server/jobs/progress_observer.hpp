@@ -24,12 +24,16 @@ class ProgressObserver final : public contact::Observer {
   void on_iteration(const contact::IterationReport& report) override;
   // The same for an iteration as JSON with every pair (an MPI run's progress lines: contactd asks for all).
   void on_iteration_json(nlohmann::json full);
+  // Where the job's steps go as they are reached: its result file (contact::io::ResultStream).
+  void set_step_sink(contact::StepSink* sink) { sink_ = sink; }
+  contact::StepSink* step_sink() override { return sink_; }
 
  private:
   Job& job_;
   JobRegistry& registry_;
   Metrics& metrics_;
   contact::io::ProgressSelection selection_;
+  contact::StepSink* sink_ = nullptr;
 };
 
 }  // namespace contactd

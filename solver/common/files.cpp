@@ -24,24 +24,39 @@ void remove_keeping_errno(const std::string& tmp) {
 
 }  // namespace
 
-void replace_file_atomically(const std::string& path, const std::function<void(const std::string& tmp)>& write,
-                             bool durable) {
-  const std::string tmp = path + ".tmp";
-  ::unlink(tmp.c_str());  // a leftover (or a planted link) is never written through
+PendingFile::PendingFile(std::string path) : path_(std::move(path)), tmp_(path_ + ".tmp") {
+  ::unlink(tmp_.c_str());  // a leftover (or a planted link) is never written through
+}
+
+void PendingFile::abandon() {
+  if (!open_) return;
+  open_ = false;
+  remove_keeping_errno(tmp_);
+}
+
+void PendingFile::commit(bool durable) {
+  if (!open_) throw FileError("cannot rename '" + tmp_ + "' onto '" + path_ + "': abandoned or renamed before", 0);
   try {
-    write(tmp);
-    if (durable) sync_file(tmp);
+    if (durable) sync_file(tmp_);
   } catch (...) {
-    remove_keeping_errno(tmp);
+    abandon();
     throw;
   }
-  if (::rename(tmp.c_str(), path.c_str()) != 0) {
-    remove_keeping_errno(tmp);
-    fail(path, "rename onto");
+  if (::rename(tmp_.c_str(), path_.c_str()) != 0) {
+    abandon();
+    fail(path_, "rename onto");
   }
+  open_ = false;
   if (!durable) return;
-  const auto slash = path.find_last_of('/');
-  sync_directory(slash == std::string::npos ? "." : path.substr(0, slash));
+  const auto slash = path_.find_last_of('/');
+  sync_directory(slash == std::string::npos ? "." : path_.substr(0, slash));
+}
+
+void replace_file_atomically(const std::string& path, const std::function<void(const std::string& tmp)>& write,
+                             bool durable) {
+  PendingFile file(path);
+  write(file.tmp());  // whatever it throws: the destructor removes tmp
+  file.commit(durable);
 }
 
 void write_file_atomically(const std::string& path, std::string_view content, bool durable) {

@@ -15,6 +15,11 @@ void StepLog::push_back(Step step) {
     steps_.clear();
     nodes_ = 0;
   }
+  if (sink_) {  // stored there: only the last stays in memory
+    sink_->take(step);
+    ++streamed_;
+    steps_.clear();
+  }
   for (const auto& body : step.bodies) nodes_ += static_cast<double>(body.mesh.num_nodes());
   steps_.push_back(std::move(step));
 }

@@ -12,9 +12,12 @@ namespace contact::ddm {
 
 class StepLog {
  public:
-  explicit StepLog(StepOutput keep = StepOutput::all, bool keep_iterate = true)
-      : keep_(keep), keep_iterate_(keep_iterate) {}
-  explicit StepLog(const OutputSettings& output) : StepLog(output.steps, output.iterate) {}
+  explicit StepLog(StepOutput keep = StepOutput::all, bool keep_iterate = true, StepSink* sink = nullptr)
+      : keep_(keep), keep_iterate_(keep_iterate), sink_(keep == StepOutput::all ? sink : nullptr) {}
+  // With a sink, the steps go to it as they are recorded and only the last stays here (StepOutput::all only: with
+  // last, a step is replaced by the next one and never stored before the end).
+  explicit StepLog(const OutputSettings& output, StepSink* sink = nullptr)
+      : StepLog(output.steps, output.iterate, sink) {}
 
   // Records the step's scalars and keeps its fields (with StepOutput::last in place of the previous step's). A step
   // that did not converge is an iterate, no answer: without keep_iterate (OutputSettings::iterate) it is not
@@ -33,16 +36,19 @@ class StepLog {
   bool ends_with_iterate() const { return !summaries_.empty() && !summaries_.back().converged; }
 
   // The mesh nodes of the steps whose fields stay kept when another step is pushed (every step's with
-  // StepOutput::all, none with last): what a next step adds to the result on top of them.
+  // StepOutput::all, streamed or not, none with last): what a next step adds to the result on top of them.
   double committed_nodes() const { return keep_ == StepOutput::all ? nodes_ : 0.0; }
   bool keeps_all() const { return keep_ == StepOutput::all; }
 
   std::vector<Step> take_steps() { return std::move(steps_); }
+  int streamed() const { return streamed_; }  // the steps the sink took
   std::vector<StepSummary> take_summaries() { return std::move(summaries_); }
 
  private:
   StepOutput keep_;
   bool keep_iterate_;
+  StepSink* sink_;
+  int streamed_ = 0;
   bool dropped_ = false;
   Step dropped_step_;
   std::vector<Step> steps_;

@@ -5,6 +5,8 @@
 #include "contact/utc_time.hpp"
 #include "view_layout.hpp"
 #include "file_util.hpp"
+#include "xdmf_series.hpp"
+#include "contact/files.hpp"
 #include "h5.hpp"
 #include "h5_eigen.hpp"
 #include "vtkhdf.hpp"
@@ -389,57 +391,139 @@ void write_pair(hid_t contacts, const PairField& p, const std::string& where) {
   write_matrix(g, "segments", segments);
 }
 
+// One step's fields as /steps/<k>; `row` is its row in /history/steps.
+void write_step(hid_t steps, const Step& s, size_t k, size_t row) {
+  const std::string where = "step " + std::to_string(k);
+  Handle g = h5::create_group(steps, std::to_string(k));
+  h5::write_attribute<std::int32_t>(g, "step", static_cast<std::int32_t>(row));
+  h5::write_attribute<std::int32_t>(g, "iteration", s.iteration);
+  h5::write_attribute<double>(g, "load_factor", s.load_factor);
+  h5::write_attribute<std::int8_t>(g, "converged", s.converged ? 1 : 0);
+  h5::write_attribute(g, "body_names", body_names_of(s));
+  h5::write_attribute(g, "pair_names", pair_names_of(s));
+  Handle bodies = h5::create_group(g, "bodies");
+  for (const auto& b : s.bodies) write_body(bodies, b, where);
+  Handle contacts = h5::create_group(g, "contacts");
+  for (const auto& p : s.pairs) write_pair(contacts, p, where);
+}
+
+void check_kept_steps(std::size_t kept, std::size_t history_rows) {
+  if (kept > history_rows)
+    throw std::runtime_error(std::to_string(kept) + " steps kept, more than the " + std::to_string(history_rows) +
+                             " rows of the step history");
+}
+
 // The steps whose fields were kept: every step, or the last ones (output.steps "last": one). Each group's `step`
 // is its row in /history/steps.
 void write_steps(hid_t file, const Result& result, std::size_t history_rows) {
   Handle steps = h5::create_group(file, "steps");
   h5::write_attribute<std::int32_t>(steps, "count", static_cast<std::int32_t>(result.steps.size()));
-  if (result.steps.size() > history_rows)
-    throw std::runtime_error(std::to_string(result.steps.size()) + " steps kept, more than the " +
-                             std::to_string(history_rows) + " rows of the step history");
-  for (size_t k = 0; k < result.steps.size(); ++k) {
-    const Step& s = result.steps[k];
-    const std::string where = "step " + std::to_string(k);
-    Handle g = h5::create_group(steps, std::to_string(k));
-    h5::write_attribute<std::int32_t>(g, "step", static_cast<std::int32_t>(history_rows - result.steps.size() + k));
-    h5::write_attribute<std::int32_t>(g, "iteration", s.iteration);
-    h5::write_attribute<double>(g, "load_factor", s.load_factor);
-    h5::write_attribute<std::int8_t>(g, "converged", s.converged ? 1 : 0);
-    h5::write_attribute(g, "body_names", body_names_of(s));
-    h5::write_attribute(g, "pair_names", pair_names_of(s));
-    Handle bodies = h5::create_group(g, "bodies");
-    for (const auto& b : s.bodies) write_body(bodies, b, where);
-    Handle contacts = h5::create_group(g, "contacts");
-    for (const auto& p : s.pairs) write_pair(contacts, p, where);
-  }
+  check_kept_steps(result.steps.size(), history_rows);
+  for (size_t k = 0; k < result.steps.size(); ++k)
+    write_step(steps, result.steps[k], k, history_rows - result.steps.size() + k);
 }
 
-void write_contents(hid_t file, const Problem& problem, const Result& result, const WriteInfo& info) {
+// Everything but /steps: the root's attributes, the job, the provenance, both histories, the final step's copy
+// for ParaView.
+void write_all_but_steps(hid_t file, const Problem& problem, const Result& result, const WriteInfo& info,
+                         const std::vector<StepSummary>& rows) {
   write_root_attributes(file, problem, result, info);
   write_input(file, problem);
   write_provenance(file, result, info);
-  const std::vector<StepSummary> rows = step_rows(result);
   {
     Handle history = h5::create_group(file, "history");
     write_iteration_history(history, problem, result);
     write_step_history(history, rows);
   }
-  write_steps(file, result, rows.size());
   if (!result.steps.empty()) write_vtkhdf(file, result.steps.back());
+}
+
+WriteInfo filled(const WriteInfo& info) {
+  WriteInfo out = info;
+  if (out.created.empty()) out.created = iso8601_utc(now_unix_us(), TimePrecision::seconds);
+  if (out.host.empty()) out.host = detail::host_name();
+  return out;
 }
 
 }  // namespace
 
 void write_result(const std::string& path, const Problem& problem, const Result& result, const WriteInfo& info) {
-  WriteInfo filled = info;
-  if (filled.created.empty()) filled.created = iso8601_utc(now_unix_us(), TimePrecision::seconds);
-  if (filled.host.empty()) filled.host = detail::host_name();
+  const WriteInfo with = filled(info);
   detail::write_atomically(path, "result file", [&](const std::string& tmp) {
     h5::QuietErrors quiet;
     Handle file = h5::create_file(tmp);
-    write_contents(file, problem, result, filled);
+    const std::vector<StepSummary> rows = step_rows(result);
+    write_steps(file, result, rows.size());
+    write_all_but_steps(file, problem, result, with, rows);
     file.close("close the file");
   });
+}
+
+// ---- the result file written as the run goes ------------------------------------------------------------
+
+// The file being written (destroyed in reverse: the handles are closed before the unfinished file is removed).
+struct ResultStream::Open {
+  PendingFile pending;
+  Handle file, steps;
+  detail::XdmfSeries xdmf;
+  Open(const std::string& path, const std::string& hdf_name_in_xmf) : pending(path), xdmf(hdf_name_in_xmf) {}
+};
+
+ResultStream::ResultStream(std::string path, std::string xmf_path, std::string hdf_name_in_xmf)
+    : path_(std::move(path)), xmf_path_(std::move(xmf_path)), xmf_hdf_name_(std::move(hdf_name_in_xmf)) {}
+
+ResultStream::~ResultStream() = default;  // an unfinished file is removed (PendingFile)
+
+void ResultStream::take(const Step& step) {
+  if (!error_.empty() || finished_) return;  // already failed: the error is thrown by finish
+  try {
+    h5::QuietErrors quiet;
+    if (!open_) {
+      open_ = std::make_unique<Open>(path_, xmf_hdf_name_);
+      open_->file = h5::create_file(open_->pending.tmp());
+      open_->steps = h5::create_group(open_->file, "steps");
+    }
+    write_step(open_->steps, step, taken_, taken_);
+    open_->xdmf.add(step);
+    ++taken_;
+  } catch (const std::exception& e) {
+    error_ = "cannot write result file '" + path_ + "': " + e.what();
+    open_.reset();  // removes the partial file: the space it took may be what the disk lacks
+  }
+}
+
+void ResultStream::finish(const Problem& problem, const Result& result, const WriteInfo& info) {
+  if (finished_) throw std::runtime_error("result file '" + path_ + "' finished twice");
+  finished_ = true;
+  if (!error_.empty()) throw std::runtime_error(error_);
+  if (taken_ == 0) {  // nothing streamed: the whole file at once
+    write_result(path_, problem, result, info);
+    write_xdmf(xmf_path_, xmf_hdf_name_, result);
+    return;
+  }
+  if (static_cast<std::size_t>(result.streamed_steps) != taken_)
+    throw std::runtime_error("result file '" + path_ + "': " + std::to_string(taken_) + " steps written, the run says " +
+                             std::to_string(result.streamed_steps));
+  try {
+    h5::QuietErrors quiet;
+    const std::vector<StepSummary> rows = step_rows(result);
+    check_kept_steps(taken_, rows.size());
+    h5::write_attribute<std::int32_t>(open_->steps, "count", static_cast<std::int32_t>(taken_));
+    write_all_but_steps(open_->file, problem, result, filled(info), rows);
+    open_->steps = Handle();
+    open_->file.close("close the file");
+    open_->pending.commit(true);
+  } catch (const std::exception& e) {
+    open_.reset();
+    throw std::runtime_error("cannot write result file '" + path_ + "': " + e.what());
+  }
+  const std::unique_ptr<Open> done = std::move(open_);
+  done->xdmf.write(xmf_path_);
+}
+
+void ResultStream::abandon() {
+  finished_ = true;
+  open_.reset();
 }
 
 }  // namespace contact::io

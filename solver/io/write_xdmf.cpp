@@ -8,6 +8,7 @@
 #include "contact/result_file.hpp"
 
 #include "file_util.hpp"
+#include "xdmf_series.hpp"
 
 #include <cerrno>
 #include <cstring>
@@ -125,42 +126,58 @@ std::string xdmf_path_for(const std::string& hdf_path) {
   return hdf_path + ".xmf";
 }
 
-void write_xdmf(const std::string& xmf_path, const std::string& hdf_file_name, const Result& result) {
+namespace detail {
+
+XdmfSeries::XdmfSeries(std::string hdf_file_name) : hdf_(xml_escape(hdf_file_name)) {}
+
+void XdmfSeries::add(const Step& step) {
   Writer w;
-  w.hdf = xml_escape(hdf_file_name);
-  auto& out = w.out;
+  w.hdf = hdf_;
+  const std::string path = "/steps/" + std::to_string(grids_.size());
+  for (const auto& b : step.bodies) w.body(path, b);
+  for (const auto& p : step.pairs) w.pair(path, p);
+  grids_.push_back(w.out.str());
+  load_factors_.push_back(step.load_factor);
+}
+
+void XdmfSeries::write(const std::string& xmf_path) const {
+  std::ostringstream out;
   out << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
       << "<Xdmf Version=\"3.0\">\n"
       << "  <Domain>\n"
       << "    <Grid Name=\"steps\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
   // Load steps are timed by their load factor (ParaView's time axis is then the load), when the factors
   // increase; adaptive steps (all at one load) by their index.
-  bool by_load = result.steps.size() > 1;
-  for (size_t k = 1; k < result.steps.size(); ++k)
-    by_load = by_load && result.steps[k].load_factor > result.steps[k - 1].load_factor;
-  for (size_t k = 0; k < result.steps.size(); ++k) {
-    const Step& s = result.steps[k];
+  bool by_load = grids_.size() > 1;
+  for (size_t k = 1; k < grids_.size(); ++k) by_load = by_load && load_factors_[k] > load_factors_[k - 1];
+  for (size_t k = 0; k < grids_.size(); ++k) {
     std::ostringstream time;
     time.precision(17);
-    if (by_load) time << s.load_factor;
+    if (by_load) time << load_factors_[k];
     else time << k;
     out << "    <Grid Name=\"step " << k << "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n"
-        << "      <Time Value=\"" << time.str() << "\"/>\n";
-    for (const auto& b : s.bodies) w.body("/steps/" + std::to_string(k), b);
-    for (const auto& p : s.pairs) w.pair("/steps/" + std::to_string(k), p);
-    out << "    </Grid>\n";
+        << "      <Time Value=\"" << time.str() << "\"/>\n"
+        << grids_[k] << "    </Grid>\n";
   }
   out << "    </Grid>\n"
       << "  </Domain>\n"
       << "</Xdmf>\n";
   const std::string text = out.str();
-  detail::write_atomically(xmf_path, "XDMF file", [&](const std::string& tmp) {
+  write_atomically(xmf_path, "XDMF file", [&](const std::string& tmp) {
     std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
     if (!f) throw std::runtime_error("cannot create '" + tmp + "': " + std::strerror(errno));
     f << text;
     f.close();
     if (!f) throw std::runtime_error("cannot write '" + tmp + "': " + std::strerror(errno));
   });
+}
+
+}  // namespace detail
+
+void write_xdmf(const std::string& xmf_path, const std::string& hdf_file_name, const Result& result) {
+  detail::XdmfSeries series(hdf_file_name);
+  for (const auto& step : result.steps) series.add(step);
+  series.write(xmf_path);
 }
 
 }  // namespace contact::io

@@ -14,6 +14,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 
 namespace contact {
 
@@ -25,6 +26,26 @@ class FileError : public std::runtime_error {
 
  private:
   int code_;
+};
+
+// The replacement of `path` spread over time, for a file written piece by piece (the result file streamed as the
+// steps are solved): the pieces go to tmp() = "<path>.tmp" (a leftover is removed at construction), commit()
+// syncs it (with `durable`) and renames it over `path`; abandon(), or destruction before a commit, removes it.
+class PendingFile {
+ public:
+  explicit PendingFile(std::string path);
+  ~PendingFile() { abandon(); }
+  PendingFile(const PendingFile&) = delete;
+  PendingFile& operator=(const PendingFile&) = delete;
+
+  const std::string& path() const { return path_; }
+  const std::string& tmp() const { return tmp_; }
+  void commit(bool durable = true);  // throws FileError (the tmp file is removed then)
+  void abandon();                    // idempotent; nothing after a commit
+
+ private:
+  std::string path_, tmp_;
+  bool open_ = true;
 };
 
 // Replaces `path` atomically with what write(tmp) creates at tmp = "<path>.tmp" (a leftover tmp is removed

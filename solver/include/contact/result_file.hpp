@@ -15,6 +15,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,41 @@ void write_result(const std::string& path, const Problem& problem, const Result&
 // so `hdf_file_name` should be the result file's name relative to the sidecar's directory (normally the bare
 // file name: both are written side by side). Same temporary-file-then-rename discipline and errors as above.
 void write_xdmf(const std::string& xmf_path, const std::string& hdf_file_name, const Result& result);
+
+// The result file and its XDMF sidecar written as the run goes: handed to solve() as the observer's StepSink
+// (Observer::step_sink), it writes each step's fields (/steps/<k>) when the solver reaches it, so that a job
+// that keeps every step holds one step in memory, not all (solve() then returns the last step only,
+// Result::streamed_steps); finish() writes the rest when the run ends. The file is built under "<path>.tmp" and
+// renamed over `path` by finish() only: a crash, an error or abandon() (and destruction before finish) never leave
+// a partial file under the final name. Not thread safe: one run feeds it, from one thread.
+class ResultStream : public StepSink {
+ public:
+  // `hdf_name_in_xmf`: the result file as the sidecar names it (normally its bare file name).
+  ResultStream(std::string path, std::string xmf_path, std::string hdf_name_in_xmf);
+  ~ResultStream() override;
+  ResultStream(const ResultStream&) = delete;
+  ResultStream& operator=(const ResultStream&) = delete;
+
+  // Writes the step as /steps/<the number taken before>. A failure (a full disk) is kept, the partial file
+  // removed, and finish() throws it; later steps are ignored.
+  void take(const Step& step) override;
+  // Writes what the steps do not (root attributes, input, provenance, histories, the final step's copy for
+  // ParaView) and the sidecar, and puts both in place. `result` is the run's (its streamed_steps the steps taken
+  // here); with none taken, the whole of `result` is written as write_result and write_xdmf do. Throws
+  // std::runtime_error naming the file, also for an error take() met.
+  void finish(const Problem& problem, const Result& result, const WriteInfo& info = {});
+  // No result after all (nothing held, the run refused): the partial file is removed.
+  void abandon();
+  std::size_t steps_taken() const { return taken_; }
+
+ private:
+  struct Open;
+  std::string path_, xmf_path_, xmf_hdf_name_;
+  std::unique_ptr<Open> open_;
+  std::size_t taken_ = 0;
+  std::string error_;
+  bool finished_ = false;
+};
 
 // The sidecar's conventional name next to a result file: "x.hdf" -> "x.xmf" (other names get ".xmf" appended).
 std::string xdmf_path_for(const std::string& hdf_path);
