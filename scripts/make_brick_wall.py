@@ -143,6 +143,13 @@ def main():
         p.error("--head-friction must be >= 0")
     if a.friction is None and a.head_joints:
         p.error("--head-joints needs --friction or --abutments: frictionless courses with free ends are not held sideways")
+    if a.head_joints and a.cells < 4:
+        # A half brick of one element rests on its bed joint by one multiplier: its other bed node is a crosspoint
+        # (three bodies meet there; docs/algorithm.md, "Crosspoints with friction"), whose multiplier is dropped, and
+        # one multiplier carries a uniform pressure only, no moment. Sheared, it turns away from its head joint and
+        # nothing holds it: every solver fails, the monolithic reference included (docs/friction.md, "Limits").
+        p.error(f"--head-joints needs --cells 4 or more (got {a.cells}): a half brick of one element rests on a "
+                "single contact multiplier, which cannot hold the moment of a shear")
     job = wall(a.rows, a.bricks, a.cells, abutments=a.abutments, head_joints=a.head_joints, friction=a.friction,
                shear=a.shear, head_friction=a.head_friction)
     text = json.dumps(job, indent=1) + "\n"

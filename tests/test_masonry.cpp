@@ -410,3 +410,27 @@ TEST(Statics, TheInclinedPlaneHoldsBelowTheClassicalThresholdAndIsRefusedAboveIt
     EXPECT_NE(slides.message.find("1.000 times"), std::string::npos) << slides.message;
   }
 }
+
+// Two half bricks of one element on a brick (docs/friction.md, "Limits"): the right half brick's other bed node is
+// a crosspoint (three bodies meet there), so it rests on one multiplier, which carries no moment; sheared, no
+// solver holds it. The direct solver's failure names that body and how many of its rigid motions the sets leave
+// free, instead of "a floating body" only; the generator refuses such a wall, so it is made from one of four
+// elements per brick with every element count halved.
+TEST(Masonry, ASingularSetsSystemNamesTheBodyItLeavesFree) {
+  json job = wall(2, 1, "--head-joints --cells 4 --friction 0.6 --shear 0.3");
+  for (auto& body : job["bodies"]) {
+    auto& block = body["mesh"]["block"];
+    block["nx"] = std::max(1, block["nx"].get<int>() / 2);
+    block["ny"] = std::max(1, block["ny"].get<int>() / 2);
+  }
+  job["solver"] = {{"method", "interface_newton"}, {"interface", {{"solver", "direct"}}}};
+  const Result r = run(job);
+  EXPECT_FALSE(r.converged);
+  EXPECT_EQ(r.stop_reason, StopReason::error);
+  EXPECT_NE(r.message.find("the predicted sets hold no contact node that fixes body 'b1_1' (1 of its 3 rigid "
+                           "motions)"),
+            std::string::npos)
+      << r.message;
+  ASSERT_EQ(r.steps.size(), 1u) << "the precompression held and is kept";
+  EXPECT_TRUE(r.steps[0].converged);
+}

@@ -10,6 +10,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 using namespace contact;
@@ -222,4 +223,41 @@ TEST(StepLog, WithASinkHoldsTheLastStepAndLeavesTheUnaskedIterateOut) {
     ASSERT_EQ(steps.size(), 1u);
     EXPECT_EQ(steps[0].index, iterate ? 3 : 2);
   }
+}
+
+// An iterate with non-finite values is never kept, asked for or not (issue 31, item 1).
+TEST(StepLog, AnIterateWithNonFiniteValuesIsNeverKept) {
+  ddm::StepLog log(StepOutput::all, /*keep_iterate=*/true);
+  Step held;
+  held.index = 0;
+  log.push_back(held);
+  Step bad;
+  bad.index = 1;
+  bad.converged = false;
+  PairField p;
+  p.arc_length = Eigen::VectorXd::LinSpaced(3, 0.0, 1.0);
+  p.status = Eigen::VectorXi::Zero(3);
+  p.pressure = Eigen::VectorXd::Constant(3, 1.0);
+  p.pressure[1] = std::numeric_limits<double>::infinity();
+  p.normal_gap = Eigen::VectorXd::Zero(3);
+  bad.pairs.push_back(p);
+  log.push_back(bad);
+  EXPECT_TRUE(log.dropped_iterate());
+  EXPECT_TRUE(log.dropped_unfit());
+  const auto steps = log.take_steps();
+  ASSERT_EQ(steps.size(), 1u);
+  EXPECT_EQ(steps[0].index, 0);
+  // A finite one is kept when asked for; NaN where a node has no value (status other than 0) is no reason to
+  // drop it (docs/results-format.md), NaN at a contact node is.
+  ddm::StepLog asked(StepOutput::all, true);
+  bad.pairs[0].pressure[1] = 2.0;
+  bad.pairs[0].status[2] = 2;
+  bad.pairs[0].normal_gap[2] = std::numeric_limits<double>::quiet_NaN();
+  asked.push_back(bad);
+  EXPECT_FALSE(asked.dropped_iterate());
+  EXPECT_EQ(asked.take_steps().size(), 1u);
+  ddm::StepLog nan_at_contact(StepOutput::all, true);
+  bad.pairs[0].normal_gap[0] = std::numeric_limits<double>::quiet_NaN();
+  nan_at_contact.push_back(bad);
+  EXPECT_TRUE(nan_at_contact.dropped_unfit());
 }

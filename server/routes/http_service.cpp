@@ -42,6 +42,7 @@ nlohmann::json RouteContext::job_resource(const JobRecord& r, int queue_position
                       {"progress", !r.progress ? nlohmann::json(nullptr) : listed ? progress_digest(*r.progress) : *r.progress},
                       {"timings", timings},
                       {"result_available", r.result_available},
+                      {"result_bytes", r.result_available ? nlohmann::json(r.result_bytes) : nlohmann::json(nullptr)},
                       {"events_dropped", r.events_dropped},
                       {"links", links}};
   j["queue_position"] =

@@ -20,14 +20,17 @@ class StepLog {
       : StepLog(output.steps, output.iterate, sink) {}
 
   // Records the step's scalars and keeps its fields (with StepOutput::last in place of the previous step's). A step
-  // that did not converge is an iterate, no answer: without keep_iterate (OutputSettings::iterate) it is not
-  // recorded at all, so that with StepOutput::last the step that held before it stays the one kept.
+  // that did not converge is an iterate, no answer: without keep_iterate (OutputSettings::iterate), or with
+  // non-finite values, it is not recorded at all, so that with StepOutput::last the step that held before it
+  // stays the one kept.
   void push_back(Step step);
   // The step kept last (push_back must have recorded one).
   const Step& back() const { return steps_.back(); }
   // The iterate push_back left out, if it left one out: not in the result, but checks of what the run stopped on
   // (a floating body its contacts do not hold) still look at it.
   bool dropped_iterate() const { return dropped_; }
+  // Whether it was left out, asked for or not, because it holds non-finite values.
+  bool dropped_unfit() const { return dropped_unfit_; }
   const Step& dropped_step() const { return dropped_step_; }
   bool empty() const { return steps_.empty(); }
   // How many of the steps recorded converged (every step's, whatever StepOutput keeps of their fields).
@@ -49,7 +52,7 @@ class StepLog {
   bool keep_iterate_;
   StepSink* sink_;
   int streamed_ = 0;
-  bool dropped_ = false;
+  bool dropped_ = false, dropped_unfit_ = false;
   Step dropped_step_;
   std::vector<Step> steps_;
   std::vector<StepSummary> summaries_;

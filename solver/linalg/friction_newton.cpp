@@ -199,6 +199,7 @@ FrictionNewtonResult Newton::run(FrictionSets sets) {
       result_.stop = cancelled_                      ? FrictionStop::stopped
                      : result_.steps >= s_.max_steps ? FrictionStop::max_steps
                                                      : FrictionStop::singular;
+      if (result_.stop == FrictionStop::singular) result_.unsolvable = sets;
       if (have_x_) result_.iterate = x_;
       return result_;
     }

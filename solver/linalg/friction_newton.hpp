@@ -60,6 +60,7 @@ enum class FrictionStop {
 struct FrictionNewtonResult {
   FrictionIterate iterate;  // the last (for singular: the last solvable one; empty if none was)
   FrictionSets sets;        // the sets of the last solve
+  FrictionSets unsolvable;  // singular: the predicted sets whose system (and every one towards them) was singular
   int steps = 0;            // linear systems solved (each step's, the halvings included)
   int damped_steps = 0;     // steps the line search shortened
   FrictionStop stop = FrictionStop::max_steps;

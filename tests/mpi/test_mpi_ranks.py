@@ -118,7 +118,7 @@ with tempfile.TemporaryDirectory() as tmp:
     # The masonry walls of issue 28: no dowels, head and bed joints, precompression then a shear of 0.3 of the
     # vertical load (two load steps, the second driven by history); Coulomb mu 0.6 everywhere; mixed (Coulomb bed
     # joints, frictionless head joints); Tresca (bound 1) everywhere. (With --cells 2 these fail in every solver,
-    # the monolithic reference included: issue 28's notes.)
+    # the monolithic reference included, and the generator refuses them: docs/friction.md, "Limits".)
     masonry = os.path.join(tmp, "wall_8x8_masonry.json")
     subprocess.run(["/usr/bin/python3", os.path.join(SRC, "scripts", "make_brick_wall.py"), "--rows", "8", "--bricks",
                     "8", "--head-joints", "--friction", "0.6", "--shear", "0.3", "-o", masonry], check=True,

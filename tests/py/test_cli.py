@@ -321,6 +321,14 @@ with tempfile.TemporaryDirectory() as tmp:
     subprocess.run(["/usr/bin/python3", os.path.join(SRC, "scripts", "make_brick_wall.py"), "--rows", "4", "--bricks",
                     "4", "--friction", "0.6", "--shear", "0.65", "-o", job], check=True, capture_output=True)
     out = os.path.join(tmp, "wall.hdf")
+    # The generator refuses head joints on bricks too coarse to hold a shear (a half brick of one element rests on
+    # one multiplier: docs/friction.md, "Limits"), saying why.
+    coarse = subprocess.run(["/usr/bin/python3", os.path.join(SRC, "scripts", "make_brick_wall.py"), "--head-joints",
+                             "--cells", "2", "--friction", "0.6", "-o", os.path.join(tmp, "coarse.json")],
+                            capture_output=True, text=True)
+    check("the generator refuses --head-joints with --cells 2, naming the cause", coarse.returncode == 2
+          and "--head-joints needs --cells 4 or more (got 2)" in coarse.stderr
+          and not os.path.exists(os.path.join(tmp, "coarse.json")), coarse.stderr[-300:])
     r = run(job, "-o", out, "-q")
     check("failed step 2: exit 1, the stop names the step and the ratio", r.returncode == 1
           and "load step 2 of 2: contact 'b3_0.bottom-b2_0.top': friction cannot hold body 'b3_0'" in r.stdout

@@ -151,8 +151,9 @@ def stepped_run(steps):
         done = server.wait_done(job_id, timeout=300)
         growth = ((server.rss_kb("VmHWM") or 0) - before) * 1024
         r = server.get(f"/v1/jobs/{job_id}/result", timeout=120)
-        check(f"{steps} steps: SUCCEEDED with its result", done.get("state") == "SUCCEEDED" and r.status == 200,
-              (done.get("state"), done.get("message"), r.status))
+        check(f"{steps} steps: SUCCEEDED with its result, of the size the job resource says",
+              done.get("state") == "SUCCEEDED" and r.status == 200 and done.get("result_bytes") == len(r.body),
+              (done.get("state"), done.get("message"), r.status, done.get("result_bytes"), len(r.body)))
         rows = []
         if r.status == 200:
             with tempfile.NamedTemporaryFile(suffix=".hdf") as f:

@@ -4,6 +4,8 @@
 #include "../../linalg/friction_newton.hpp"
 #include "../friction_rows.hpp"
 
+#include <Eigen/SVD>
+
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -81,9 +83,45 @@ bool first_sets_from_coarse(const SparseMatrix& F, const InterfaceQp& qp, const 
   return true;
 }
 
+// The floating bodies whose rigid motions the rows of `sets` leave free, as "body 'b1_1' (1 of its 3 rigid
+// motions)": the rows of G P of each body (G its equilibrium rows, P the sets' parametrisation of the free
+// multipliers: open rows fixed at 0, slip rows tied to their normal) of rank below their count. Each row is
+// scaled to unit length first (forces and moments have different units). Empty if every body is held row by row
+// (a group of bodies held by nothing together is not named).
+std::string bodies_held_by_nothing(const InterfaceQp& qp, const FrictionSets& sets, const std::vector<FrictionRow>& rows,
+                                   const std::vector<char>& mask) {
+  if (qp.equilibrium.G.rows() == 0 || sets.active.size() != static_cast<size_t>(qp.g.size())) return "";
+  const linalg::FrictionParametrization p = linalg::parametrize(sets, rows, mask);
+  const SparseMatrix GP = qp.equilibrium.G * p.P;
+  const auto& bodies = qp.problem.system().problem().bodies;
+  std::ostringstream os;
+  int named = 0, more = 0;
+  for (const auto& f : qp.problem.floating()) {
+    Eigen::MatrixXd block = SparseMatrix(GP.middleRows(f.offset, f.count)).toDense();
+    int free = 0;
+    for (Eigen::Index i = 0; i < block.rows(); ++i) {
+      const double norm = block.row(i).norm();
+      if (norm > 0) block.row(i) /= norm;
+    }
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(block * block.transpose());
+    const Eigen::VectorXd s = svd.singularValues();
+    for (Eigen::Index i = 0; i < s.size(); ++i) free += s[i] <= 1e-12 * std::max(1.0, s.size() ? s[0] : 1.0);
+    if (free == 0) continue;
+    if (named == 5) {
+      ++more;
+      continue;
+    }
+    os << (named ? ", " : "") << "body '" << bodies[f.body].name << "' (" << free << " of its " << f.count
+       << " rigid motions)";
+    ++named;
+  }
+  if (more > 0) os << " and " << more << " more";
+  return os.str();
+}
+
 // The stop of the Newton as the interface solver's answer.
 void describe_stop(const linalg::FrictionNewtonResult& r, const InterfaceQp& qp, int max_steps, double complementarity,
-                   linalg::ActiveSetResult& result) {
+                   const std::string& unheld, linalg::ActiveSetResult& result) {
   result.steps = r.steps;
   switch (r.stop) {
     case linalg::FrictionStop::settled: {
@@ -111,8 +149,9 @@ void describe_stop(const linalg::FrictionNewtonResult& r, const InterfaceQp& qp,
       os.precision(3);
       os << "the friction Newton did not converge: at step " << r.steps
          << " the stick and slip sets it predicted, and every set between them and the last solved one, leave a "
-            "floating body (or a group of them) held by nothing (a singular system); the complementarity residual "
-            "of the last iterate is "
+            "floating body (or a group of them) held by nothing (a singular system"
+         << (unheld.empty() ? std::string() : "; the predicted sets hold no contact node that fixes " + unheld)
+         << "); the complementarity residual of the last iterate is "
          << complementarity
          << ". The statics check before the solve found no set of bodies that friction cannot hold along a flat "
             "joint, so either the solver failed (try smaller load steps) or the loads move a body that check cannot "
@@ -175,7 +214,9 @@ linalg::ActiveSetResult FrictionDirectSolver::solve(const InterfaceQp& qp, const
   result.alpha = r.iterate.other;
   if (r.iterate.lambda.size() == n) last_alpha_ = r.iterate.other;
   const double residual = r.iterate.lambda.size() == n ? linalg::friction_complementarity(r.iterate.lambda, r.iterate.h, c, rows, mask) : 1.0;
-  describe_stop(r, qp, context.max_steps, residual, result);
+  const std::string unheld =
+      r.stop == linalg::FrictionStop::singular ? bodies_held_by_nothing(qp, r.unsolvable, rows, mask) : std::string();
+  describe_stop(r, qp, context.max_steps, residual, unheld, result);
   return result;
 }
 
