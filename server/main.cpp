@@ -95,7 +95,7 @@ void add_job_limit_flags(CLI::App& app, Config& c) {
       ->capture_default_str();
   app.add_option("--max-result-bytes", c.queue.max_result_bytes,
                  "largest result a job may write, estimated before it runs from its meshes' nodes and the steps it "
-                 "keeps (the solver holds the kept steps in memory until it writes them)")
+                 "keeps (the disk a job's result takes; its steps are written as they are solved)")
       ->envname("CONTACTD_MAX_RESULT_BYTES")
       ->check(CLI::Range(1e6, 1e15))
       ->capture_default_str();

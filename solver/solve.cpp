@@ -96,12 +96,10 @@ std::string what_the_result_keeps(const Problem& problem, const ddm::StepLog& st
     os << "the result keeps the " << held << " " << kind << (held == 1 ? "" : "s") << " that held";
   if (iterate)
     os << (held == 0 ? "" : " and ") << "the last iterate (converged 0), which is not an answer";
-  else if (steps.dropped_unfit())
-    os << (held == 0 ? "nothing" : "") << (held == 0 ? " (" : ", not the last iterate (")
-       << "it holds non-finite values)";
   else if (steps.dropped_iterate())
-    os << (held == 0 ? "nothing" : "") << (held == 0 ? " (" : ", not the last iterate (")
-       << "set output.iterate to keep it, flagged as not converged)";
+    os << (held == 0 ? "nothing (" : ", not the last iterate (")
+       << (steps.dropped_unfit() ? "it holds non-finite values)"
+                                 : "set output.iterate to keep it, flagged as not converged)");
   return os.str();
 }
 

@@ -31,7 +31,7 @@ struct Limits {
   int max_updates = 1'000;             // solver.augmented_lagrangian.max_updates
   int max_adaptive_steps = 100;        // adaptivity.max_steps
   int max_load_steps = 1000;           // loading.steps, or the number of loading.factors
-  // The result file (and the kept steps the solver holds in memory until it writes them), as estimated before
+  // The result file's size (the disk a job takes; its steps are streamed to it as solved), as estimated before
   // the job runs (io::estimated_result_bytes: nodes x kept steps); 0: no limit (the command line), contactd's
   // --max-result-bytes otherwise.
   double max_result_bytes = 0;

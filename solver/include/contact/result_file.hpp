@@ -82,8 +82,8 @@ class ResultStream : public StepSink {
 // The sidecar's conventional name next to a result file: "x.hdf" -> "x.xmf" (other names get ".xmf" appended).
 std::string xdmf_path_for(const std::string& hdf_path);
 
-// About how many bytes the result file of a job takes, and the solver holds of its kept steps until it writes
-// them: `kept_steps` steps' fields (and the final step's copy for ParaView, /VTKHDF) over `nodes` mesh nodes,
+// About how many bytes the result file of a job takes (its steps are streamed to it, ResultStream, so this bounds
+// the disk, not the memory): `kept_steps` steps' fields (and the final step's copy for ParaView, /VTKHDF) over `nodes` mesh nodes,
 // `bodies` bodies and `pairs` contact pairs. Measured (format version 2): 270-280 bytes a node and step on two
 // 40 x 40 to 80 x 80 blocks, and some 25 kB a body and 5 kB a pair and step in metadata and small datasets (a
 // 22 x 22 brick wall, 496 bodies: 30 MB for 2 steps). Job admission compares it with Limits::max_result_bytes.
