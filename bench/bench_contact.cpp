@@ -83,7 +83,7 @@ Figures one_solve(const json& job) {
   const double t0 = now();
   parallel::ThreadTaskRunner runner(parallel::choose_threads(0, p.bodies.size()));
   ddm::ContactSystem system(p, runner, ddm::ContactSystem::Factorization::plain);
-  const auto u = system.solve_bodies(ddm::Displacements(p.bodies.size()), runner);
+  const auto u = system.solve_bodies(ddm::Displacements(p.bodies.size()));
   Figures f;
   f.seconds = now() - t0;
   f.setup = system.setup_seconds();

@@ -1,7 +1,6 @@
 #include "contact/solve.hpp"
 
 #include "adapt/adaptive.hpp"
-#include "ddm/driver.hpp"
 #include "ddm/load_steps.hpp"
 #include "held_bodies.hpp"
 
@@ -25,8 +24,8 @@ double max_penetration(const Step& step) {
 }
 
 // The monolithic reference solves the coupled system however little holds a floating body (its rigid motion
-// then comes out zero, one of many solutions): a solution at which the contacts in contact do not hold every
-// floating body is refused as interface Newton refuses it, with no result (the iterate left out of the result,
+// then comes out zero, one of many solutions; MethodFacts::checks_held_bodies): a solution at which the contacts in
+// contact do not hold every floating body is refused as interface Newton refuses it, with no result (the iterate left out of the result,
 // output.iterate unset, is checked too: a run stopped on it is refused for that reason, not for the iterations).
 void refuse_unheld_bodies(const Problem& problem, Result& result, const Step* dropped_iterate) {
   if (result.stop_reason != StopReason::converged && result.stop_reason != StopReason::max_iterations) return;
@@ -38,7 +37,7 @@ void refuse_unheld_bodies(const Problem& problem, Result& result, const Step* dr
     if (unheld.empty()) continue;
     result.stop_reason = StopReason::error;
     result.converged = false;
-    result.message = "monolithic: " + unheld;
+    result.message = result.method + ": " + unheld;
     result.steps.clear();
     result.streamed_steps = 0;
     result.step_history.clear();
@@ -119,14 +118,17 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
 
 Result solve(const Problem& problem, Observer& observer, const CancelToken& cancel, parallel::TaskRunner& runner) {
   const auto start = std::chrono::steady_clock::now();
+  const auto seconds_since_start = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
   Result result;
   result.method = to_string(problem.solver.method);
   result.enforcement = to_string(problem.solver.enforcement);
+  const ddm::MethodFacts& facts = ddm::facts_of(problem.solver.method);
   try {
-    if (runner.distributed() && problem.solver.method == Method::monolithic) {
+    if (runner.distributed() && !facts.not_distributed.empty()) {
       result.stop_reason = StopReason::error;
-      result.message = "method 'monolithic' factorises all bodies as one system in one process: run it on one rank "
-                       "(without mpirun), or choose interface_newton, neumann or robin";
+      result.message = facts.not_distributed;
       return result;
     }
     // Adaptivity refines the meshes: it works on its own copy of the problem.
@@ -134,59 +136,43 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
     const bool adaptive = problem.adaptivity.enabled;
     if (adaptive) working = problem;
     const Problem& active = adaptive ? working : problem;
-    // The monolithic reference factorises the coupled system itself; the other methods factorise each body once,
-    // interface Newton with the contact unknowns last (its Schur complements come from the factor).
-    const auto factorization = problem.solver.method == Method::monolithic         ? ddm::ContactSystem::Factorization::none
-                               : problem.solver.method == Method::interface_newton ? ddm::ContactSystem::Factorization::interface
-                                                                                   : ddm::ContactSystem::Factorization::plain;
-    ddm::ContactSystem system(active, runner, factorization, &cancel);
+    ddm::RunFrame frame(active.solver, observer, cancel, runner, start);
+    ddm::ContactSystem system(active, runner, facts.factorization, frame.stop_check());
     result.setup_seconds = system.setup_seconds();
     result.factorization_seconds = system.factorization_seconds();
     if (system.cancelled()) {
       result.stop_reason = StopReason::cancelled;
       result.message = "cancelled during the set-up (assembly and factorisation of the bodies): nothing solved yet";
-      result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      result.wall_seconds = seconds_since_start();
       return result;
     }
     if (!system.ok()) {
       result.stop_reason = StopReason::error;
       result.message = system.error();
-      result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      result.wall_seconds = seconds_since_start();
       return result;
     }
-    ddm::RunContext context{observer, cancel, runner, start};
-    const std::unique_ptr<ddm::ContactMethod> method = ddm::make_method(system, active.solver);
-    // Every step's scalars; the fields the job keeps, streamed to the observer's sink if it has one. Not for the
-    // monolithic reference, whose every step refuse_unheld_bodies checks once the run ends.
-    ddm::StepLog steps(problem.output, problem.solver.method == Method::monolithic ? nullptr : observer.step_sink());
-    ddm::MethodOutcome outcome;
+    const std::unique_ptr<ddm::ContactMethod> method = ddm::make_method(system, active.solver.method);
+    // Every step's scalars; the fields the job keeps, streamed to the observer's sink if it has one. Not for a
+    // method whose solution is checked once the run ends (then every step is checked before any is kept).
+    ddm::StepLog steps(problem.output, facts.checks_held_bodies ? nullptr : observer.step_sink());
     if (adaptive) {
       system.set_load_step(problem.loading.factors.size() - 1, problem.loading.factors.back());
-      outcome = adapt::run_adaptive(working, system, context, *method, steps);
+      adapt::run_adaptive(working, system, frame, *method, steps);
     } else {
-      outcome = ddm::run_load_steps(system, problem.solver, problem.loading.factors, context, *method, steps);
+      ddm::run_load_steps(system, problem.loading.factors, frame, *method, steps);
     }
-    result.converged = outcome.converged;
-    result.stop_reason = outcome.reason;
-    result.message = outcome.message;
-    result.iterations = outcome.iterations;
-    result.gamma = outcome.gamma;
-    result.subdomain_solves = outcome.solves_per_body;
-    result.interface_solver = outcome.interface_solver;
-    result.interface_iterations = outcome.interface_iterations;
-    result.updates = outcome.updates;
-    result.indicator_seconds = outcome.indicator_seconds;
-    result.history = std::move(outcome.history);
+    static_cast<RunOutcome&>(result) = static_cast<RunOutcome&&>(frame.take_outcome());
     result.factorization_seconds = system.total_factorization_seconds();
-    if (!outcome.converged) result.kept = what_the_result_keeps(active, steps);
+    if (!result.converged) result.kept = what_the_result_keeps(active, steps);
     if (!result.kept.empty()) result.message += "; " + result.kept;
     result.streamed_steps = steps.streamed();
     result.steps = steps.take_steps();
     result.step_history = steps.take_summaries();
-    if (problem.solver.method == Method::monolithic)
+    if (facts.checks_held_bodies)
       refuse_unheld_bodies(active, result, steps.dropped_iterate() ? &steps.dropped_step() : nullptr);
     if (result.stop_reason != StopReason::error && result.stop_reason != StopReason::cancelled) refuse_tension(result);
-    if (outcome.updates > 0 && !result.steps.empty()) {
+    if (result.updates > 0 && !result.steps.empty()) {
       std::ostringstream os;
       os << "; remaining penetration " << max_penetration(result.steps.back());
       result.message += os.str();
@@ -195,7 +181,7 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
     result.stop_reason = StopReason::error;
     result.message = std::string("internal error: ") + e.what();
   }
-  result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.wall_seconds = seconds_since_start();
   return result;
 }
 

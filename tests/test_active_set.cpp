@@ -22,7 +22,7 @@ Eigen::MatrixXd compliance(int n) {
   return K.inverse();
 }
 
-bool always(const Eigen::VectorXd&, const Eigen::VectorXd&, const ActiveSetStep&) { return true; }
+bool always(const Eigen::VectorXd&, const Eigen::VectorXd&, const ActiveSetStep&) { return false; }  // never stops
 
 }  // namespace
 

@@ -22,7 +22,7 @@ bool adapts(const AdaptivitySettings& s, size_t body) {
 // Indicator of every adaptive body (empty vector for the others).
 std::vector<IndicatorResult> estimate(const Problem& problem, const ddm::ContactSystem& system,
                                       const ddm::Displacements& u, const ddm::Displacements& contact_loads,
-                                      parallel::TaskRunner& runner, const CancelToken* cancel = nullptr) {
+                                      parallel::TaskRunner& runner, const std::function<bool()>& stop = {}) {
   std::vector<IndicatorResult> out(problem.bodies.size());
   const parallel::BodyShare share{[&](size_t a, parallel::Packer& p) {
                                p.put(out[a].eta);
@@ -40,14 +40,12 @@ std::vector<IndicatorResult> estimate(const Problem& problem, const ddm::Contact
                                out[a].reference2 = in.get_double();
                                out[a].cancelled = in.get_double() != 0.0;
                              }};
-  std::function<bool()> cancelled;
-  if (cancel) cancelled = [cancel] { return cancel->cancelled(); };
   runner.run_bodies(problem.bodies.size(), [&](size_t a) {
     if (!adapts(problem.adaptivity, a)) return;
     const Body& body = problem.bodies[a];
     const Normalization norm = problem.adaptivity.normalization;
     out[a] = problem.adaptivity.indicator == Indicator::fem_bem
-                 ? fem_bem_indicator(body, problem.model, system.body(a), u[a], contact_loads[a], norm, cancelled)
+                 ? fem_bem_indicator(body, problem.model, system.body(a), u[a], contact_loads[a], norm, stop)
                  : zz_indicator(body, system.body(a), u[a], norm);
   }, share);
   return out;
@@ -220,53 +218,50 @@ bool any_cancelled(const std::vector<IndicatorResult>& eta) {
   return false;
 }
 
-// One solve on the current meshes (run_enforced), folded into `solves` (its first report carries the elements
-// refined before it); returns the total, whose answer and stop are now this solve's.
-const ddm::MethodOutcome& solve_step(ddm::ContactSystem& system, const Problem& working, ddm::RunContext& context,
-                                     ddm::ContactMethod& method, ddm::OutcomeAccumulator& solves,
+// One solve on the current meshes (run_enforced) in a frame nested in `frame` (its first report carries the
+// elements refined before it); returns the total, whose answer and stop are now this solve's.
+const ddm::MethodOutcome& solve_step(ddm::ContactSystem& system, ddm::RunFrame& frame, ddm::ContactMethod& method,
                                      std::vector<int>& refined_last, const ddm::Displacements& warm) {
-  return solves.run(context, warm.empty() ? nullptr : &warm, ddm::InnerMarks{0, std::exchange(refined_last, {})},
-                    [&](ddm::RunContext& inner) { return ddm::run_enforced(system, working.solver, inner, method); });
+  return frame.nested(warm.empty() ? nullptr : &warm, ddm::InnerMarks{0, std::exchange(refined_last, {})},
+                      [&](ddm::RunFrame& inner) { ddm::run_enforced(system, inner, method); });
 }
 
 // Solve, estimate, report the step, and stop (stop test, max_steps, nothing refinable, cancellation) or refine.
-ddm::MethodOutcome converge_then_refine(Problem& working, ddm::ContactSystem& system, ddm::RunContext& context,
-                                        ddm::ContactMethod& method, ddm::StepLog& steps) {
+void converge_then_refine(Problem& working, ddm::ContactSystem& system, ddm::RunFrame& frame,
+                          ddm::ContactMethod& method, ddm::StepLog& steps) {
   const auto& s = working.adaptivity;
-  ddm::OutcomeAccumulator solves;
-  ddm::MethodOutcome& total = solves.total();
+  ddm::MethodOutcome& total = frame.outcome();
   std::vector<int> refined_last;
   ddm::Displacements warm;
   StepMeasures previous;
   for (int step = 0;; ++step) {
-    const ddm::MethodOutcome& o = solve_step(system, working, context, method, solves, refined_last, warm);
-    if (o.u.empty()) return solves.take();
-    if (context.cancel.cancelled()) {  // stopped inside the solve: keep what it reached, skip the estimate
+    const ddm::MethodOutcome& o = solve_step(system, frame, method, refined_last, warm);
+    if (o.u.empty()) return;
+    if (frame.stop_requested()) {  // stopped inside the solve: keep what it reached, skip the estimate
       Step reached = make_step(system, o.u, o.z, total.iterations, step, {});
       reached.converged = false;
       steps.push_back(std::move(reached));
-      total.reason = StopReason::cancelled;
+      total.stop_reason = StopReason::cancelled;
       total.converged = false;
-      return solves.take();
+      return;
     }
     const ddm::Displacements loads = o.z.empty() ? system.contact_loads(o.u) : system.loads_from_pressures(o.z);
-    const auto eta = estimate(working, system, o.u, loads, context.runner, &context.cancel);
+    const auto eta = estimate(working, system, o.u, loads, frame.runner(), frame.stop_check());
     for (const auto& e : eta) total.indicator_seconds += e.seconds;
     Step solved = make_step(system, o.u, o.z, total.iterations, step, eta);
     solved.converged = o.converged;
     const StepMeasures now = measure(solved, eta);
     steps.push_back(std::move(solved));  // an unconverged one only if the job asks for its iterate (StepLog)
     AdaptiveStepReport report =
-        step_report(step, working, total, now, step > 0 ? &previous : nullptr, eta, context.elapsed());
+        step_report(step, working, total, now, step > 0 ? &previous : nullptr, eta, frame.elapsed());
     previous = now;
     const auto finish = [&](const std::string& message) {
       if (!message.empty()) total.message = message;
-      context.observer.on_adaptive_step(report);
-      return solves.take();
+      frame.report(report);
     };
-    if (context.cancel.cancelled() || any_cancelled(eta)) {
+    if (frame.stop_requested() || any_cancelled(eta)) {
       if (any_cancelled(eta)) report.estimate = report.estimate_change = std::nan("");  // only partly estimated
-      total.reason = StopReason::cancelled;
+      total.stop_reason = StopReason::cancelled;
       total.converged = false;
       return finish("cancelled during adaptive step " + std::to_string(step) +
                     " (the result holds that step's solution)");
@@ -282,33 +277,33 @@ ddm::MethodOutcome converge_then_refine(Problem& working, ddm::ContactSystem& sy
          << " refinement steps (" << (r.note.empty() ? "" : r.note + "; ") << "last solve: " << o.message << ")";
       return finish(os.str());
     }
-    if (context.cancel.cancelled()) {  // during the marking and refinement: the refined meshes are not solved
-      total.reason = StopReason::cancelled;
+    if (frame.stop_requested()) {  // during the marking and refinement: the refined meshes are not solved
+      total.stop_reason = StopReason::cancelled;
       total.converged = false;
       return finish("cancelled during adaptive step " + std::to_string(step) +
                     " (the result holds that step's solution)");
     }
     for (size_t a = 0; a < report.bodies.size() && a < r.refined.size(); ++a)
       report.bodies[a].elements_refined = r.refined[a];
-    context.observer.on_adaptive_step(report);
+    frame.report(report);
     warm = o.u;
     transfer(warm, working, r);
-    system.rebuild(r.changed, context.runner, &context.cancel);
+    system.rebuild(r.changed, frame.stop_check());
     method.reset();
     refined_last = r.refined;
     if (system.cancelled()) {  // during the refined meshes' assembly or factorisation: they are not solved
-      total.reason = StopReason::cancelled;
+      total.stop_reason = StopReason::cancelled;
       total.converged = false;
       total.message = "cancelled during adaptive step " + std::to_string(step + 1) +
                       " (assembling and factorising its refined meshes; the result holds step " +
                       std::to_string(step) + "'s solution)";
-      return total;
+      return;
     }
     if (!system.ok()) {
-      total.reason = StopReason::error;
+      total.stop_reason = StopReason::error;
       total.converged = false;
       total.message = "adaptive: " + system.error();
-      return solves.take();
+      return;
     }
   }
 }
@@ -337,10 +332,10 @@ RelaxedUpdate relaxed_update(const ddm::ContactSystem& system, const ddm::Displa
 }
 
 // gamma: the job's, or with "auto" from the Neumann map's spectral radius (as the fixed-point methods choose it).
-double paper_gamma(const ddm::ContactSystem& system, const SolverSettings& settings, ddm::RunContext& context,
-                   int& solves_per_body) {
+double paper_gamma(const ddm::ContactSystem& system, const ddm::RunFrame& frame, int& solves_per_body) {
+  const SolverSettings& settings = frame.settings();
   if (!settings.gamma_auto) return settings.gamma;
-  ddm::NeumannMap map(system, context.runner);
+  ddm::NeumannMap map(system, frame.runner());
   int solves = 0;
   const double gamma = std::min(1.0, 1.8 / (2.0 + ddm::estimate_spectral_radius(system, map, 12, solves)));
   solves_per_body += solves;
@@ -349,10 +344,10 @@ double paper_gamma(const ddm::ContactSystem& system, const SolverSettings& setti
 
 // After a refinement: the iterate carried to the new meshes and the system rebuilt on them. An empty message when
 // it went well, else why the loop stops (the reason in `reason`).
-std::string rebuild_after_refinement(Problem& working, ddm::ContactSystem& system, ddm::RunContext& context,
+std::string rebuild_after_refinement(Problem& working, ddm::ContactSystem& system, const ddm::RunFrame& frame,
                                      const RefineOutcome& r, ddm::Displacements& u, StopReason& reason) {
   transfer(u, working, r);
-  system.rebuild(r.changed, context.runner, &context.cancel);
+  system.rebuild(r.changed, frame.stop_check());
   if (system.cancelled()) {
     reason = StopReason::cancelled;
     return "cancelled during the refined meshes' assembly and factorisation (the result holds the steps before)";
@@ -366,29 +361,28 @@ std::string rebuild_after_refinement(Problem& working, ddm::ContactSystem& syste
 
 // The paper's interleaving: one Neumann update (16)-(17), then estimate and refine, every iteration; it stops when
 // the DDM criterion holds and no cell is marked.
-ddm::MethodOutcome paper_interleaving(Problem& working, ddm::ContactSystem& system, ddm::RunContext& context,
-                                      ddm::StepLog& steps) {
-  const SolverSettings& settings = working.solver;
-  ddm::MethodOutcome out;
-  ddm::Displacements u = ddm::initial_iterate(system, settings, context, out.solves_per_body);
-  out.gamma = paper_gamma(system, settings, context, out.solves_per_body);
+void paper_interleaving(Problem& working, ddm::ContactSystem& system, ddm::RunFrame& frame, ddm::StepLog& steps) {
+  const SolverSettings& settings = frame.settings();
+  ddm::MethodOutcome& out = frame.outcome();
+  ddm::Displacements u = ddm::initial_iterate(system, frame, out.subdomain_solves);
+  out.gamma = paper_gamma(system, frame, out.subdomain_solves);
   std::vector<std::vector<char>> active;
   int step = 0;
   for (int k = 1; k <= settings.max_iterations; ++k) {
-    if (context.cancel.cancelled()) {
-      out.reason = StopReason::cancelled;
+    if (frame.stop_requested()) {
+      out.stop_reason = StopReason::cancelled;
       out.message = "cancelled";
       break;
     }
     // (16) on the current meshes, then (17); the estimate on the body solutions of (16) with the contact tractions
     // they were solved with.
     const ddm::Displacements loads = system.contact_loads(u);
-    const ddm::Displacements u_tilde = system.solve_bodies(loads, context.runner);
-    ++out.solves_per_body;
+    const ddm::Displacements u_tilde = system.solve_bodies(loads);
+    ++out.subdomain_solves;
     RelaxedUpdate update = relaxed_update(system, u, u_tilde, out.gamma);
     const bool ddm_converged =
         (settings.criterion == Criterion::paper ? update.paper : update.residual) <= settings.tolerance;
-    const auto eta = estimate(working, system, u_tilde, loads, context.runner);
+    const auto eta = estimate(working, system, u_tilde, loads, frame.runner());  // (not stopped within)
     for (const auto& e : eta) out.indicator_seconds += e.seconds;
     IterationReport rep = system.report(k, update.u_new, active);
     rep.paper_criterion = update.paper;
@@ -402,15 +396,13 @@ ddm::MethodOutcome paper_interleaving(Problem& working, ddm::ContactSystem& syst
         mark_and_refine(working, eta, st, steps.committed_nodes() + (steps.keeps_all() ? mesh_nodes : 0.0));
     for (size_t a = 0; a < rep.bodies.size(); ++a) rep.bodies[a].elements_refined = r.refined[a];
     rep.note = r.note;
-    rep.elapsed_seconds = context.elapsed();
-    context.observer.on_iteration(rep);
-    out.history.push_back(std::move(rep));
+    frame.report(std::move(rep));
     out.iterations = k;
     u = std::move(update.u_new);
     if (!r.any && ddm_converged) {
       steps.push_back(std::move(st));
       out.converged = true;
-      out.reason = StopReason::converged;
+      out.stop_reason = StopReason::converged;
       out.message = "adaptive (paper): the DDM criterion holds and " +
                     std::string(r.blocked ? "nothing marked can be refined" : "no cell is marked") + " (" +
                     std::to_string(step) + " refinements" + (r.blocked && !r.note.empty() ? "; " + r.note : "") + ")";
@@ -419,16 +411,16 @@ ddm::MethodOutcome paper_interleaving(Problem& working, ddm::ContactSystem& syst
     if (r.any) {
       steps.push_back(std::move(st));
       ++step;
-      out.message = rebuild_after_refinement(working, system, context, r, u, out.reason);
+      out.message = rebuild_after_refinement(working, system, frame, r, u, out.stop_reason);
       if (!out.message.empty()) break;
     }
     if (!std::isfinite(update.residual)) {
-      out.reason = StopReason::error;
+      out.stop_reason = StopReason::error;
       out.message = "the iteration diverges; reduce gamma";
       break;
     }
     if (k == settings.max_iterations) {
-      out.reason = StopReason::max_iterations;
+      out.stop_reason = StopReason::max_iterations;
       out.message = "adaptive (paper): max_iterations reached";
       Step reached = make_step(system, u, {}, k, step, {});
       reached.converged = false;
@@ -436,15 +428,14 @@ ddm::MethodOutcome paper_interleaving(Problem& working, ddm::ContactSystem& syst
     }
   }
   out.u = std::move(u);
-  return out;
 }
 
 }  // namespace
 
-ddm::MethodOutcome run_adaptive(Problem& working, ddm::ContactSystem& system, ddm::RunContext& context,
-                                ddm::ContactMethod& method, ddm::StepLog& steps) {
-  if (working.adaptivity.strategy == AdaptStrategy::paper) return paper_interleaving(working, system, context, steps);
-  return converge_then_refine(working, system, context, method, steps);
+void run_adaptive(Problem& working, ddm::ContactSystem& system, ddm::RunFrame& frame, ddm::ContactMethod& method,
+                  ddm::StepLog& steps) {
+  if (working.adaptivity.strategy == AdaptStrategy::paper) return paper_interleaving(working, system, frame, steps);
+  converge_then_refine(working, system, frame, method, steps);
 }
 
 }  // namespace contact::adapt

@@ -1,4 +1,4 @@
-// The adaptive loop (paper section 3; ALGORITHM.md section 3), both ways:
+// The adaptive loop (paper section 3; docs/algorithm.md), both ways:
 //  * paper: every iteration does one Neumann update (paper (16)-(17)), then estimates and refines the adaptive
 //    bodies; the refined mesh starts the next iteration (the iterate transferred to it). Stops when the DDM
 //    criterion holds and no cell is marked.
@@ -13,8 +13,8 @@
 
 namespace contact::adapt {
 
-// `working` is the problem the system was built from; its meshes are refined in place.
-ddm::MethodOutcome run_adaptive(Problem& working, ddm::ContactSystem& system, ddm::RunContext& context,
-                                ddm::ContactMethod& method, ddm::StepLog& steps);
+// `working` is the problem the system was built from; its meshes are refined in place. Builds the frame's outcome.
+void run_adaptive(Problem& working, ddm::ContactSystem& system, ddm::RunFrame& frame, ddm::ContactMethod& method,
+                  ddm::StepLog& steps);
 
 }  // namespace contact::adapt

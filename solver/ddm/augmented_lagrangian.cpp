@@ -58,16 +58,13 @@ class UzawaMultipliers {
 // point has g >= 0 where lambda = 0 and g = 0 where lambda > 0: exact non-penetration, for any theta.
 // Plain Uzawa converges linearly and slowly where points at the edge of the contact zone have both gap and
 // multiplier near zero (100 updates on stack3), so the multiplier fixed point is Anderson-mixed (UzawaMultipliers).
-MethodOutcome run_augmented_lagrangian(ContactSystem& system, const SolverSettings& settings, RunContext& context,
-                                       ContactMethod& method) {
-  OutcomeAccumulator updates_so_far;
-  MethodOutcome& total = updates_so_far.total();
+void run_augmented_lagrangian(ContactSystem& system, RunFrame& frame, ContactMethod& method) {
+  MethodOutcome& total = frame.outcome();
   Displacements warm;
-  const auto& al = settings.augmented_lagrangian;
+  const auto& al = frame.settings().augmented_lagrangian;
   UzawaMultipliers multipliers(system);
   for (int update = 1; update <= al.max_updates; ++update) {
-    updates_so_far.run(context, warm.empty() ? nullptr : &warm, InnerMarks{update, {}},
-                       [&](RunContext& inner) { return method.run(inner); });
+    frame.nested(warm.empty() ? nullptr : &warm, InnerMarks{update, {}}, [&](RunFrame& inner) { method.run(inner); });
     total.updates = update;
     // The updates' stop is their own (below); their answer is the last solve's displacements, pressures and
     // floating bodies' rigid amplitudes (the result's rigid motion), without tangential multipliers (friction
@@ -75,9 +72,9 @@ MethodOutcome run_augmented_lagrangian(ContactSystem& system, const SolverSettin
     total.converged = false;
     total.q.clear();
     const std::string inner_message = std::move(total.message);
-    if (total.reason != StopReason::converged) {
+    if (total.stop_reason != StopReason::converged) {
       total.message = "augmented Lagrangian update " + std::to_string(update) + ": " + inner_message;
-      return updates_so_far.take();
+      return;
     }
     const Eigen::VectorXd image = multipliers.image(total.z.empty() ? system.penalty_pressures(total.u) : total.z);
     const Eigen::VectorXd residual = multipliers.residual(image);
@@ -85,23 +82,22 @@ MethodOutcome run_augmented_lagrangian(ContactSystem& system, const SolverSettin
     if (change <= al.tolerance) {
       // Keep the multipliers the last solve used, so that the reported pressures are exactly its pressures.
       total.converged = true;
-      total.reason = StopReason::converged;
+      total.stop_reason = StopReason::converged;
       std::ostringstream os;
       os << "augmented Lagrangian: pressures settled (relative change " << change << " <= " << al.tolerance << ") after "
          << update << " updates; last inner solve: " << inner_message;
       total.message = os.str();
-      return updates_so_far.take();
+      return;
     }
     multipliers.update(system, image, residual);
     warm = total.u;
     if (update == al.max_updates) {
-      total.reason = StopReason::max_iterations;
+      total.stop_reason = StopReason::max_iterations;
       std::ostringstream os;
       os << "augmented Lagrangian: max_updates = " << update << " reached with a relative pressure change of " << change;
       total.message = os.str();
     }
   }
-  return updates_so_far.take();
 }
 
 }  // namespace contact::ddm

@@ -7,7 +7,6 @@ namespace contact::ddm {
 
 // Augmented Lagrangian (Uzawa): solve the penalty problem on the gaps shifted by theta lambda, then set lambda to
 // the resulting pressures; repeat until the pressures settle (augmented_lagrangian.cpp). The outcome counts the updates.
-MethodOutcome run_augmented_lagrangian(ContactSystem& system, const SolverSettings& settings, RunContext& context,
-                                       ContactMethod& method);
+void run_augmented_lagrangian(ContactSystem& system, RunFrame& frame, ContactMethod& method);
 
 }  // namespace contact::ddm

@@ -36,7 +36,7 @@ std::string body_errors(const std::vector<std::pair<std::string, std::string>>& 
 }  // namespace
 
 ContactSystem::ContactSystem(const Problem& problem, parallel::TaskRunner& runner, Factorization factorization,
-                             const CancelToken* cancel)
+                             std::function<bool()> stop)
     : problem_(problem), factorization_(factorization), runner_(runner) {
   ScopedTimer timer(setup_seconds_);
   fem::limit_blas_threads();
@@ -44,22 +44,20 @@ ContactSystem::ContactSystem(const Problem& problem, parallel::TaskRunner& runne
   bodies_.resize(problem.bodies.size());
   std::vector<size_t> all(bodies_.size());
   for (size_t a = 0; a < all.size(); ++a) all[a] = a;
-  build_bodies(all, runner, cancel);
+  build_bodies(all, stop);
 }
 
-std::unique_ptr<fem::BodySolver> ContactSystem::make_body(size_t a, bool local, const CancelToken* cancel) const {
-  std::function<bool()> cancelled;
-  if (cancel) cancelled = [cancel] { return cancel->cancelled(); };
+std::unique_ptr<fem::BodySolver> ContactSystem::make_body(size_t a, bool local, const std::function<bool()>& stop) const {
   auto b = std::make_unique<fem::BodySolver>(problem_.bodies[a], problem_.model, factorization_ != Factorization::none,
-                                             interface_dofs(a), may_float(a), local, std::move(cancelled));
+                                             interface_dofs(a), may_float(a), local, stop);
   b->set_load_between(load_step_, previous_factor_, load_factor_, step_fraction_);
   return b;
 }
 
-void ContactSystem::build_bodies(const std::vector<size_t>& todo, parallel::TaskRunner& runner, const CancelToken* cancel) {
-  runner.run_bodies(todo, [&](size_t a) {
+void ContactSystem::build_bodies(const std::vector<size_t>& todo, const std::function<bool()>& stop) {
+  runner_.run_bodies(todo, [&](size_t a) {
     bodies_[a].reset();  // free the old factorisation first
-    bodies_[a] = make_body(a, true, cancel);
+    bodies_[a] = make_body(a, true, stop);
   }, body_outcome_share());
   std::vector<std::pair<std::string, std::string>> failed;
   for (size_t a : todo) {
@@ -122,13 +120,13 @@ std::vector<int> ContactSystem::interface_dofs(size_t a) const {
   return dofs;
 }
 
-void ContactSystem::rebuild(const std::vector<char>& changed, parallel::TaskRunner& runner, const CancelToken* cancel) {
+void ContactSystem::rebuild(const std::vector<char>& changed, const std::function<bool()>& stop) {
   discretize_pairs();
   std::vector<size_t> todo;
   for (size_t a = 0; a < bodies_.size(); ++a)
     if (changed[a] || (factorization_ == Factorization::interface && interface_dofs(a) != bodies_[a]->interface_dofs()))
       todo.push_back(a);
-  build_bodies(todo, runner, cancel);
+  build_bodies(todo, stop);
 }
 
 Pressures ContactSystem::penalty_pressures(const Displacements& u) const {
@@ -192,9 +190,9 @@ Eigen::VectorXd ContactSystem::zone_normals(size_t a, const Eigen::VectorXd& u_a
   return out;
 }
 
-Displacements ContactSystem::solve_bodies(const Displacements& loads, parallel::TaskRunner& runner) const {
+Displacements ContactSystem::solve_bodies(const Displacements& loads) const {
   Displacements u(bodies_.size());
-  runner.run_bodies(bodies_.size(), [&](size_t a) { u[a] = bodies_[a]->solve(loads[a]); }, share_vectors(u));
+  runner_.run_bodies(bodies_.size(), [&](size_t a) { u[a] = bodies_[a]->solve(loads[a]); }, share_vectors(u));
   return u;
 }
 
@@ -202,12 +200,12 @@ parallel::BodyShare share_vectors(std::vector<Eigen::VectorXd>& v) {
   return {[&v](size_t a, parallel::Packer& out) { out.put(v[a]); }, [&v](size_t a, parallel::Unpacker& in) { v[a] = in.get_vector(); }};
 }
 
-Displacements ContactSystem::elastic_layer_guess(parallel::TaskRunner& runner) const {
+Displacements ContactSystem::elastic_layer_guess() const {
   // Each body's response to its own loads with free contact zones; where the rigid approach (the overlap of
   // these free responses) exceeds the gap, each layer of height h_a under uniaxial strain (modulus M_a)
   // carries the pressure (approach - d) / (h_1/M_1 + h_2/M_2); the initial displacements are each body's
   // response to that pressure.
-  const Displacements free_u = solve_bodies(Displacements(bodies_.size()), runner);
+  const Displacements free_u = solve_bodies(Displacements(bodies_.size()));
   auto M = [&](int body) {
     const Material& m = problem_.bodies[static_cast<size_t>(body)].material;
     if (problem_.model.plane == Plane::strain) return m.E * (1 - m.nu) / ((1 + m.nu) * (1 - 2 * m.nu));
@@ -220,7 +218,7 @@ Displacements ContactSystem::elastic_layer_guess(parallel::TaskRunner& runner) c
     const Eigen::VectorXd g = pair.nodal_gap(free_u[static_cast<size_t>(pair.slave_body)], free_u[static_cast<size_t>(pair.master_body)]);
     z[k] = (-g).cwiseMax(0.0) / compliance;
   }
-  return solve_bodies(loads_from_pressures(z), runner);
+  return solve_bodies(loads_from_pressures(z));
 }
 
 Pressures ContactSystem::nodal_gaps(const Displacements& u) const {

@@ -12,6 +12,7 @@
 #include "contact/result.hpp"
 #include "../parallel/task_runner.hpp"
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -30,16 +31,17 @@ class ContactSystem {
   };
 
   // Discretises every pair, then assembles every body and factorises them as asked, in parallel through
-  // `runner`. Check ok() / error(). With `cancel`, a cancel during the assembly or a factorisation stops the set-up
+  // `runner`, which every per-body work of the system runs on from then on. Check ok() / error(). With `stop` (the
+  // run's stop check, RunFrame::stop_check), a stop asked during the assembly or a factorisation ends the set-up
   // within a poll (fem/body_solver.hpp): then cancelled() and not ok(), and the system must not be used.
   ContactSystem(const Problem& problem, parallel::TaskRunner& runner, Factorization factorization = Factorization::plain,
-                const CancelToken* cancel = nullptr);
+                std::function<bool()> stop = {});
 
   // After the meshes of the bodies flagged in `changed` were refined (in the Problem this system refers to):
   // rediscretises every pair and reassembles and refactorises the changed bodies, and any other body whose
   // interface unknowns changed (an unchanged body keeps its factorisation). Multipliers are dropped. Check ok();
   // a cancel (as for the constructor) leaves cancelled() true and the system unusable.
-  void rebuild(const std::vector<char>& changed, parallel::TaskRunner& runner, const CancelToken* cancel = nullptr);
+  void rebuild(const std::vector<char>& changed, const std::function<bool()>& stop = {});
 
   bool ok() const { return error_.empty() && !cancelled_; }
   bool cancelled() const { return cancelled_; }
@@ -95,10 +97,10 @@ class ContactSystem {
   Eigen::VectorXd zone_normals(size_t a, const Eigen::VectorXd& u_a) const;
 
   // Each body solved with the given loads, in parallel.
-  Displacements solve_bodies(const Displacements& loads, parallel::TaskRunner& runner) const;
+  Displacements solve_bodies(const Displacements& loads) const;
 
   // The "elastic layer" initial guess (paper section 4, ALGORITHM.md section 5).
-  Displacements elastic_layer_guess(parallel::TaskRunner& runner) const;
+  Displacements elastic_layer_guess() const;
 
   // Per-iteration report for pressures z and nodal gaps g (per pair, per row); `previous_active` holds each
   // pair's active flags of the previous report and is updated. The other forms take the gaps of displacements
@@ -139,9 +141,9 @@ class ContactSystem {
   // Whether body a may float (held by its contacts): in a pair, and a method that handles it.
   bool may_float(size_t a) const;
   // Body a's solver: assembled and factorised (local), or only its constraints (owned by another process).
-  std::unique_ptr<fem::BodySolver> make_body(size_t a, bool local, const CancelToken* cancel = nullptr) const;
+  std::unique_ptr<fem::BodySolver> make_body(size_t a, bool local, const std::function<bool()>& stop = {}) const;
   // Builds the bodies `todo` (in parallel), then collects their errors and factorisation times.
-  void build_bodies(const std::vector<size_t>& todo, parallel::TaskRunner& runner, const CancelToken* cancel);
+  void build_bodies(const std::vector<size_t>& todo, const std::function<bool()>& stop);
   parallel::BodyShare body_outcome_share();
 
   const Problem& problem_;

@@ -1,16 +1,12 @@
-// Runs one contact method, with or without augmented-Lagrangian updates, on a ContactSystem: what solve(), the
-// load steps and the adaptive loop call.
+// Runs one contact method, with or without augmented-Lagrangian updates, on a ContactSystem: what the load steps
+// and the adaptive loop call.
 #pragma once
 
 #include "method.hpp"
-#include "outcome_accumulator.hpp"
-
-#include <memory>
 
 namespace contact::ddm {
 
-// The method, inside augmented-Lagrangian updates if the settings ask for them (the outcome counts them).
-MethodOutcome run_enforced(ContactSystem& system, const SolverSettings& settings, RunContext& context,
-                           ContactMethod& method);
+// The method, inside augmented-Lagrangian updates if the frame's settings ask for them (the outcome counts them).
+void run_enforced(ContactSystem& system, RunFrame& frame, ContactMethod& method);
 
 }  // namespace contact::ddm

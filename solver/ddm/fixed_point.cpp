@@ -55,7 +55,7 @@ Pressures linear_pressures(const ContactSystem& system, const Displacements& du)
   return dz;
 }
 
-Displacements NeumannMap::apply(const Displacements& u) { return system_.solve_bodies(system_.contact_loads(u), runner_); }
+Displacements NeumannMap::apply(const Displacements& u) { return system_.solve_bodies(system_.contact_loads(u)); }
 
 Displacements NeumannMap::linear_response(const Displacements& du) {
   const Displacements loads = system_.loads_from_pressures(linear_pressures(system_, du));
@@ -64,12 +64,11 @@ Displacements NeumannMap::linear_response(const Displacements& du) {
   return out;
 }
 
-Displacements initial_iterate(const ContactSystem& system, const SolverSettings& settings, const RunContext& context,
-                              int& solves) {
-  if (context.warm_start) return *context.warm_start;
-  if (settings.initial_guess == InitialGuess::elastic_layer) {
+Displacements initial_iterate(const ContactSystem& system, const RunFrame& frame, int& solves) {
+  if (frame.warm_start()) return *frame.warm_start();
+  if (frame.settings().initial_guess == InitialGuess::elastic_layer) {
     solves += 2;
-    return system.elastic_layer_guess(context.runner);
+    return system.elastic_layer_guess();
   }
   Displacements u(system.n_bodies());
   for (size_t a = 0; a < u.size(); ++a) u[a] = Eigen::VectorXd::Zero(system.body(a).n_dofs());
@@ -116,20 +115,20 @@ struct Image {
 // restarts) and the record of residuals the stop tests read. run() is the loop; each member below is one phase.
 class FixedPointIteration {
  public:
-  FixedPointIteration(const ContactSystem& system, const SolverSettings& settings, RunContext& context, BodyMap& map,
-                      Displacements u)
-      : system_(system), settings_(settings), context_(context), map_(map), n_(system.n_bodies()),
-        gamma_(settings.gamma), anderson_requested_(settings.acceleration == Acceleration::anderson),
+  FixedPointIteration(const ContactSystem& system, RunFrame& frame, BodyMap& map, Displacements u)
+      : system_(system), settings_(frame.settings()), frame_(frame), map_(map), n_(system.n_bodies()), out_(frame.outcome()),
+        gamma_(settings_.gamma), anderson_requested_(settings_.acceleration == Acceleration::anderson),
         anderson_(anderson_requested_), u_(std::move(u)), zone_(stacked_zone_normals(system, u_)),
-        zone_per_body_(n_), history_(static_cast<size_t>(std::max(1, settings.anderson_depth))), best_u_(u_) {
+        zone_per_body_(n_), history_(static_cast<size_t>(std::max(1, settings_.anderson_depth))), best_u_(u_) {
     for (size_t a = 0; a < n_; ++a) zone_per_body_[a] = system.zone_normals(a, u_[a]);
   }
 
-  MethodOutcome run() {
+  // Builds the frame's outcome.
+  void run() {
     choose_gamma();
     for (int k = 1; k <= settings_.max_iterations; ++k) {
-      if (context_.cancel.cancelled()) {
-        out_.reason = StopReason::cancelled;
+      if (frame_.stop_requested()) {
+        out_.stop_reason = StopReason::cancelled;
         out_.message = "cancelled";
         break;
       }
@@ -144,8 +143,7 @@ class FixedPointIteration {
     if (anderson_requested_ && !anderson_) out_.message += " (Anderson acceleration was abandoned for plain relaxation)";
     out_.u = std::move(u_);
     out_.gamma = gamma_;
-    out_.solves_per_body = solves_;
-    return std::move(out_);
+    out_.subdomain_solves = solves_;
   }
 
  private:
@@ -267,9 +265,7 @@ class FixedPointIteration {
     rep.fixed_point_residual = residual;
     rep.gamma = gamma_;
     rep.note = note;
-    rep.elapsed_seconds = context_.elapsed();
-    context_.observer.on_iteration(rep);
-    out_.history.push_back(std::move(rep));
+    frame_.report(std::move(rep));
     out_.iterations = k;
   }
 
@@ -278,7 +274,7 @@ class FixedPointIteration {
     const double measure = settings_.criterion == Criterion::paper ? paper : residual;
     if (measure <= settings_.tolerance) {
       out_.converged = true;
-      out_.reason = StopReason::converged;
+      out_.stop_reason = StopReason::converged;
       std::ostringstream os;
       os << (settings_.criterion == Criterion::paper ? "paper's criterion " : "fixed-point residual ") << measure
          << " <= " << settings_.tolerance;
@@ -292,7 +288,7 @@ class FixedPointIteration {
       os << "the iteration stagnates: the fixed-point residual has not fallen below " << smallest_residual_
          << " (reached at iteration " << best_iteration_ << ") in " << stagnation_window << " iterations";
       if (smallest_residual_ > 1e-6) os << "; gamma = " << gamma_ << " is probably above the stability bound: reduce it";
-      out_.reason = StopReason::stagnation;
+      out_.stop_reason = StopReason::stagnation;
       out_.message = os.str();
       return true;
     }
@@ -301,12 +297,12 @@ class FixedPointIteration {
       std::ostringstream os;
       os << "the iteration diverges: the fixed-point residual grew from " << smallest_residual_ << " to " << residual
          << " at iteration " << k << "; reduce gamma (now " << gamma_ << ") or use gamma \"auto\"";
-      out_.reason = StopReason::error;
+      out_.stop_reason = StopReason::error;
       out_.message = os.str();
       return true;
     }
     if (k == settings_.max_iterations) {
-      out_.reason = StopReason::max_iterations;
+      out_.stop_reason = StopReason::max_iterations;
       std::ostringstream os;
       os << "max_iterations = " << k << " reached; fixed-point residual " << residual << ", paper's criterion " << paper;
       out_.message = os.str();
@@ -316,10 +312,10 @@ class FixedPointIteration {
 
   const ContactSystem& system_;
   const SolverSettings& settings_;
-  RunContext& context_;
+  RunFrame& frame_;
   BodyMap& map_;
   const size_t n_;
-  MethodOutcome out_;
+  MethodOutcome& out_;  // the frame's
   int solves_ = 0;
   double gamma_;
   std::string pending_note_;  // for the first report: how gamma was chosen
@@ -344,9 +340,8 @@ class FixedPointIteration {
 
 }  // namespace
 
-MethodOutcome run_fixed_point(const ContactSystem& system, const SolverSettings& settings, RunContext& context,
-                              BodyMap& map, Displacements u) {
-  return FixedPointIteration(system, settings, context, map, std::move(u)).run();
+void run_fixed_point(const ContactSystem& system, RunFrame& frame, BodyMap& map, Displacements u) {
+  FixedPointIteration(system, frame, map, std::move(u)).run();
 }
 
 }  // namespace contact::ddm

@@ -24,14 +24,13 @@ class BodyMap {
   virtual int factorizations() const { return 0; }
 };
 
-// The iteration's start: the context's warm start if any, else the settings' initial guess (zero, or the
+// The iteration's start: the frame's warm start if any, else the settings' initial guess (zero, or the
 // elastic-layer model: 2 solves per body, added to `solves`).
-Displacements initial_iterate(const ContactSystem& system, const SolverSettings& settings, const RunContext& context,
-                              int& solves);
+Displacements initial_iterate(const ContactSystem& system, const RunFrame& frame, int& solves);
 
 // Runs the iteration from u0 with the settings' gamma (or auto), acceleration, criterion and limits.
-MethodOutcome run_fixed_point(const ContactSystem& system, const SolverSettings& settings, RunContext& context,
-                              BodyMap& map, Displacements u0);
+// Builds the frame's outcome.
+void run_fixed_point(const ContactSystem& system, RunFrame& frame, BodyMap& map, Displacements u0);
 
 // Spectral radius of the map's Jacobian (all contact points active) by power iterations on the contact-zone
 // normal displacements; `solves` is increased by the solves per body spent.

@@ -14,11 +14,11 @@ namespace {
 // the load path more closely; they are not output steps (the step's result is its last sub-step's).
 constexpr int kMaxCuts = 5;
 
-bool may_cut(const ContactSystem& system, const MethodOutcome& outcome, const RunContext& context) {
+bool may_cut(const ContactSystem& system, const MethodOutcome& outcome, const RunFrame& frame) {
   // Not: frictionless steps (path independent: a cut solves the same problem), a statics refusal (the loads of the
   // step's end are refused whatever the path) or a cancel.
   return system.has_friction() && !outcome.converged && !outcome.refused &&
-         outcome.reason != StopReason::cancelled && !context.cancel.cancelled();
+         outcome.stop_reason != StopReason::cancelled && !frame.stop_requested();
 }
 
 // Whether the step's solve starts from rest with every joint closed and no gap: the first step (its loads grow
@@ -35,10 +35,9 @@ bool homogeneous_from_rest(const ContactSystem& system, size_t k, double done) {
 
 }  // namespace
 
-MethodOutcome run_load_steps(ContactSystem& system, const SolverSettings& settings, const std::vector<double>& factors,
-                             RunContext& context, ContactMethod& method, StepLog& steps) {
-  OutcomeAccumulator steps_so_far;
-  MethodOutcome& total = steps_so_far.total();
+void run_load_steps(ContactSystem& system, const std::vector<double>& factors, RunFrame& frame, ContactMethod& method,
+                    StepLog& steps) {
+  MethodOutcome& total = frame.outcome();
   Displacements warm;
   for (size_t k = 0; k < factors.size(); ++k) {
     const double previous = k == 0 ? 0.0 : factors[k - 1];
@@ -48,8 +47,8 @@ MethodOutcome run_load_steps(ContactSystem& system, const SolverSettings& settin
     while (true) {
       const double t = std::min(1.0, done + increment);
       system.set_load_between(k, previous, factors[k], t);
-      steps_so_far.run(context, warm.empty() ? nullptr : &warm, InnerMarks{},
-                       [&](RunContext& inner) { return run_enforced(system, settings, inner, method); });
+      frame.nested(warm.empty() ? nullptr : &warm, InnerMarks{},
+                   [&](RunFrame& inner) { run_enforced(system, inner, method); });
       if (total.converged && t < 1.0) {  // a sub-step held: its state is the next one's start
         system.accept_step(total.u);
         warm = total.u;
@@ -57,7 +56,7 @@ MethodOutcome run_load_steps(ContactSystem& system, const SolverSettings& settin
         ++sub_steps;
         continue;
       }
-      if (total.converged || cuts == kMaxCuts || !may_cut(system, total, context)) break;
+      if (total.converged || cuts == kMaxCuts || !may_cut(system, total, frame)) break;
       if (homogeneous_from_rest(system, k, done)) {
         not_cut = true;
         break;
@@ -76,7 +75,7 @@ MethodOutcome run_load_steps(ContactSystem& system, const SolverSettings& settin
       prefix += std::string(prefix.empty() ? "" : " ") +
                 "(not cut: from rest with every joint closed, a smaller increment is the same problem scaled)";
     if (!prefix.empty()) total.message = prefix + ": " + total.message;
-    if (total.u.empty()) return steps_so_far.take();
+    if (total.u.empty()) return;
     Step step = total.z.empty() ? system.fields(total.u, total.iterations)
                                 : system.fields(total.u, total.z, total.iterations, &total.rigid_amplitudes,
                                                 total.q.empty() ? nullptr : &total.q);
@@ -84,11 +83,10 @@ MethodOutcome run_load_steps(ContactSystem& system, const SolverSettings& settin
     step.load_factor = system.load_factor();  // factors[k], or where a cut step failed the fraction tried
     step.converged = total.converged;
     steps.push_back(std::move(step));
-    if (!total.converged) return steps_so_far.take();
+    if (!total.converged) return;
     system.accept_step(total.u);  // friction: the next step's slip is measured from here
     warm = total.u;
   }
-  return steps_so_far.take();
 }
 
 }  // namespace contact::ddm

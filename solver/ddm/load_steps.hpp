@@ -12,7 +12,7 @@
 
 namespace contact::ddm {
 
-MethodOutcome run_load_steps(ContactSystem& system, const SolverSettings& settings, const std::vector<double>& factors,
-                             RunContext& context, ContactMethod& method, StepLog& steps);
+void run_load_steps(ContactSystem& system, const std::vector<double>& factors, RunFrame& frame, ContactMethod& method,
+                    StepLog& steps);
 
 }  // namespace contact::ddm

@@ -1,4 +1,4 @@
-// The contact methods as classes behind ContactMethod (method.hpp), and the one place that picks them.
+// The contact methods as classes behind ContactMethod (method.hpp), their facts, and the one place that picks them.
 #include "method.hpp"
 
 #include "interface/interface_newton.hpp"
@@ -8,20 +8,16 @@ namespace contact::ddm {
 namespace {
 
 // Without contact pairs the bodies are independent: one solve each is the answer, whatever the method.
-MethodOutcome solve_independent_bodies(const ContactSystem& system, RunContext& context) {
-  MethodOutcome out;
+void solve_independent_bodies(const ContactSystem& system, RunFrame& frame) {
+  MethodOutcome& out = frame.outcome();
   std::vector<std::vector<char>> active;
-  out.u = system.solve_bodies(Displacements(system.n_bodies()), context.runner);
+  out.u = system.solve_bodies(Displacements(system.n_bodies()));
   out.iterations = 1;
-  out.solves_per_body = 1;
-  IterationReport r = system.report(1, out.u, active);
-  r.elapsed_seconds = context.elapsed();
-  context.observer.on_iteration(r);
-  out.history.push_back(std::move(r));
+  out.subdomain_solves = 1;
+  frame.report(system.report(1, out.u, active));
   out.converged = true;
-  out.reason = StopReason::converged;
+  out.stop_reason = StopReason::converged;
   out.message = "no contact pairs: each body solved once";
-  return out;
 }
 
 class NeumannMethod final : public ContactMethod {
@@ -29,7 +25,7 @@ class NeumannMethod final : public ContactMethod {
   using ContactMethod::ContactMethod;
 
  protected:
-  MethodOutcome solve(RunContext& context) override { return run_neumann(system_, settings_, context); }
+  void solve(RunFrame& frame) override { run_neumann(system_, frame); }
 };
 
 class RobinMethod final : public ContactMethod {
@@ -37,7 +33,7 @@ class RobinMethod final : public ContactMethod {
   using ContactMethod::ContactMethod;
 
  protected:
-  MethodOutcome solve(RunContext& context) override { return run_robin(system_, settings_, context); }
+  void solve(RunFrame& frame) override { run_robin(system_, frame); }
 };
 
 class MonolithicMethod final : public ContactMethod {
@@ -45,7 +41,7 @@ class MonolithicMethod final : public ContactMethod {
   using ContactMethod::ContactMethod;
 
  protected:
-  MethodOutcome solve(RunContext& context) override { return run_monolithic(system_, settings_, context); }
+  void solve(RunFrame& frame) override { run_monolithic(system_, frame); }
 };
 
 // Keeps the interface problem between runs on the same meshes (augmented-Lagrangian updates and load steps only
@@ -56,15 +52,14 @@ class InterfaceNewtonMethod final : public ContactMethod {
   void reset() override { interface_newton_.reset(); }
 
  protected:
-  MethodOutcome solve(RunContext& context) override {
+  void solve(RunFrame& frame) override {
     int setup = 0;
     if (!interface_newton_) {
-      interface_newton_ = std::make_unique<InterfaceNewton>(system_, settings_, context.runner);
+      interface_newton_ = std::make_unique<InterfaceNewton>(system_, frame.settings(), frame.runner());
       setup = 1;  // the free response of every body
     }
-    MethodOutcome out = interface_newton_->solve(settings_, context);
-    out.solves_per_body += setup;
-    return out;
+    interface_newton_->solve(frame);
+    frame.outcome().subdomain_solves += setup;
   }
 
  private:
@@ -73,19 +68,37 @@ class InterfaceNewtonMethod final : public ContactMethod {
 
 }  // namespace
 
-MethodOutcome ContactMethod::run(RunContext& context) {
-  if (system_.pairs().empty()) return solve_independent_bodies(system_, context);
-  return solve(context);
+void ContactMethod::run(RunFrame& frame) {
+  if (system_.pairs().empty()) return solve_independent_bodies(system_, frame);
+  solve(frame);
 }
 
-std::unique_ptr<ContactMethod> make_method(const ContactSystem& system, const SolverSettings& settings) {
-  switch (settings.method) {
-    case Method::monolithic: return std::make_unique<MonolithicMethod>(system, settings);
-    case Method::robin: return std::make_unique<RobinMethod>(system, settings);
-    case Method::interface_newton: return std::make_unique<InterfaceNewtonMethod>(system, settings);
+const MethodFacts& facts_of(Method method) {
+  using F = ContactSystem::Factorization;
+  static const MethodFacts interface_newton{F::interface, "", false};
+  static const MethodFacts fixed_point{F::plain, "", false};
+  static const MethodFacts monolithic{
+      F::none,
+      "method 'monolithic' factorises all bodies as one system in one process: run it on one rank (without mpirun), "
+      "or choose interface_newton, neumann or robin",
+      true};
+  switch (method) {
+    case Method::interface_newton: return interface_newton;
+    case Method::monolithic: return monolithic;
+    case Method::neumann:
+    case Method::robin: break;
+  }
+  return fixed_point;
+}
+
+std::unique_ptr<ContactMethod> make_method(const ContactSystem& system, Method method) {
+  switch (method) {
+    case Method::monolithic: return std::make_unique<MonolithicMethod>(system);
+    case Method::robin: return std::make_unique<RobinMethod>(system);
+    case Method::interface_newton: return std::make_unique<InterfaceNewtonMethod>(system);
     case Method::neumann: break;
   }
-  return std::make_unique<NeumannMethod>(system, settings);
+  return std::make_unique<NeumannMethod>(system);
 }
 
 }  // namespace contact::ddm

@@ -1,78 +1,60 @@
-// What every contact method (interface Newton, Neumann DDM, Robin, monolithic reference) takes and returns, and
-// the one interface they share (ContactMethod, made by make_method), so that the outer loops (augmented
-// Lagrangian, load steps, adaptivity) and solve() know no method by name.
+// The one interface every contact method (interface Newton, Neumann DDM, Robin, monolithic reference) shares
+// (ContactMethod, made by make_method) and the facts each declares about itself (MethodFacts, facts_of), so that
+// the outer loops (augmented Lagrangian, load steps, adaptivity) and solve() know no method by name: method.cpp
+// is the one place that does.
 #pragma once
 
-#include "contact/result.hpp"
-#include "contact_system.hpp"
+#include "run_frame.hpp"
 
-#include <chrono>
 #include <memory>
 #include <string>
-#include <vector>
 
 namespace contact::ddm {
 
-struct RunContext {
-  Observer& observer;
-  const CancelToken& cancel;
-  parallel::TaskRunner& runner;
-  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
-  const std::vector<Eigen::VectorXd>* warm_start = nullptr;  // start of the iterative methods, if given
-  double elapsed() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); }
-};
-
-struct MethodOutcome {
-  Displacements u;  // final displacements per body
-  Pressures z;      // final contact pressures per pair, where they are not the penalty pressures of u (exact)
-  Pressures q;      // friction: final tangential multipliers per pair (empty: frictionless; contact/pair.hpp)
-  std::vector<Eigen::VectorXd> rigid_amplitudes;  // per body: floating bodies' rigid-mode amplitudes (else empty)
-  bool converged = false;
-  StopReason reason = StopReason::error;
-  std::string message;
-  // Refused before any solve (statics: friction cannot hold the loads, ddm/friction_statics.hpp; or the settings):
-  // a smaller increment of the same step would be refused too (load_steps.cpp cuts only the other failures).
-  bool refused = false;
-  int iterations = 0;
-  int updates = 0;  // augmented-Lagrangian updates (0 for the penalty or exact problem alone)
-  double gamma = 0.0;
-  int solves_per_body = 0;  // subdomain solves (back-substitutions) per body, initial guess included
-  double indicator_seconds = 0.0;  // adaptivity: time spent estimating (BEM solves and evaluations)
-  std::string interface_solver;    // interface_newton: "direct" or "iterative" (the last one used)
-  long interface_iterations = 0;   // the iterative interface solver's products with the interface operator
-  std::vector<IterationReport> history;
-};
-
 // A contact method on a ContactSystem: run() solves once on the pairs' current gaps (and augmented-Lagrangian
-// multipliers); without contact pairs every method's answer is each body solved once, which run() gives for all.
-// A method may keep what it built for the system between runs (interface Newton: its interface problem); reset()
-// forgets it after the meshes changed. A new method is a class here and a case in make_method (method.cpp).
+// multipliers) under the frame's settings, building the frame's outcome; without contact pairs every method's
+// answer is each body solved once, which run() gives for all. A method may keep what it built for the system
+// between runs (interface Newton: its interface problem); reset() forgets it after the meshes changed. A new
+// method is a class in method.cpp, a case in make_method and its facts in facts_of.
 class ContactMethod {
  public:
-  ContactMethod(const ContactSystem& system, const SolverSettings& settings) : system_(system), settings_(settings) {}
+  explicit ContactMethod(const ContactSystem& system) : system_(system) {}
   virtual ~ContactMethod() = default;
   ContactMethod(const ContactMethod&) = delete;
   ContactMethod& operator=(const ContactMethod&) = delete;
 
-  MethodOutcome run(RunContext& context);
+  void run(RunFrame& frame);
   virtual void reset() {}
 
  protected:
-  virtual MethodOutcome solve(RunContext& context) = 0;
+  virtual void solve(RunFrame& frame) = 0;
   const ContactSystem& system_;
-  const SolverSettings& settings_;
 };
 
-std::unique_ptr<ContactMethod> make_method(const ContactSystem& system, const SolverSettings& settings);
+// What solve() must know of a method before and after it runs, declared by the method.
+struct MethodFacts {
+  // The bodies' factorisations it needs (the monolithic reference factorises the coupled system itself; interface
+  // Newton needs each body's contact unknowns last, for the Schur complements).
+  ContactSystem::Factorization factorization = ContactSystem::Factorization::plain;
+  // Why it cannot run with its bodies spread over processes (empty: it can).
+  std::string not_distributed;
+  // Whether its solution must be checked once the run ends (the monolithic reference: held floating bodies,
+  // held_bodies.hpp); such a run keeps its steps until then (they are not streamed to the result file).
+  bool checks_held_bodies = false;
+};
+
+const MethodFacts& facts_of(Method method);
+
+std::unique_ptr<ContactMethod> make_method(const ContactSystem& system, Method method);
 
 // The paper's parallel Neumann scheme (16)-(17) on fixed meshes.
-MethodOutcome run_neumann(const ContactSystem& system, const SolverSettings& settings, RunContext& context);
+void run_neumann(const ContactSystem& system, RunFrame& frame);
 
-// The Robin-type variant (ALGORITHM.md): each body's matrix carries the Robin weight on its contact zone.
-MethodOutcome run_robin(const ContactSystem& system, const SolverSettings& settings, RunContext& context);
+// The Robin-type variant (docs/algorithm.md): each body's matrix carries the Robin weight on its contact zone.
+void run_robin(const ContactSystem& system, RunFrame& frame);
 
 // The same discrete problem (exact or penalty, per the settings' enforcement) solved in one system: the
 // reference solver (monolithic.cpp).
-MethodOutcome run_monolithic(const ContactSystem& system, const SolverSettings& settings, RunContext& context);
+void run_monolithic(const ContactSystem& system, RunFrame& frame);
 
 }  // namespace contact::ddm

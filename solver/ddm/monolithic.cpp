@@ -203,13 +203,13 @@ double zone_change(const ContactSystem& system, const Displacements& u, std::vec
   return paper;
 }
 
-MethodOutcome run_exact(const ContactSystem& system, const SolverSettings& settings, RunContext& context) {
-  MethodOutcome out;
+void run_exact(const ContactSystem& system, RunFrame& frame) {
+  MethodOutcome& out = frame.outcome();
   if (std::string sliding = friction_cannot_hold(system); !sliding.empty()) {  // statics: no solver can hold it
-    out.reason = StopReason::error;
+    out.stop_reason = StopReason::error;
     out.refused = true;
     out.message = sliding;
-    return out;
+    return;
   }
   const Stacked s = stack(system, false);
   const Eigen::Index m = s.g0.size();
@@ -229,9 +229,9 @@ MethodOutcome run_exact(const ContactSystem& system, const SolverSettings& setti
   const linalg::FrictionNewtonProblem problem{s.friction, mask, c, [&](const linalg::FrictionParametrization& p, linalg::FrictionIterate& it) {
                                                 return solve_sets(s, p, it);
                                               },
-                                              [&] { return context.cancel.cancelled(); }};
+                                              [&] { return frame.stop_requested(); }};
   linalg::FrictionNewtonSettings newton;
-  newton.max_steps = std::max(1, settings.max_iterations);
+  newton.max_steps = std::max(1, frame.settings().max_iterations);
   newton.tolerance = 1e-12;
   const auto on_step = [&](const linalg::FrictionIterate& it, const linalg::ActiveSetStep& step) {
     const Displacements u = to_bodies(system, s, it.other);
@@ -244,17 +244,15 @@ MethodOutcome run_exact(const ContactSystem& system, const SolverSettings& setti
     r.measure = Measure::complementarity;
     r.complementarity = step.complementarity;
     r.active_set_changes = step.changes;
-    r.elapsed_seconds = context.elapsed();
-    context.observer.on_iteration(r);
-    out.history.push_back(std::move(r));
-    return !context.cancel.cancelled();
+    frame.report(std::move(r));
+    return frame.stop_requested();
   };
   const linalg::FrictionNewtonResult result = linalg::friction_newton(problem, std::move(sets), newton, on_step);
   out.iterations = result.steps;
   switch (result.stop) {
     case linalg::FrictionStop::settled: {
       out.converged = true;
-      out.reason = StopReason::converged;
+      out.stop_reason = StopReason::converged;
       int na = 0;
       for (Eigen::Index j = 0; j < m; ++j) na += result.sets.active[static_cast<size_t>(j)] && !mask[static_cast<size_t>(j)];
       std::ostringstream os;
@@ -264,18 +262,18 @@ MethodOutcome run_exact(const ContactSystem& system, const SolverSettings& setti
       break;
     }
     case linalg::FrictionStop::stopped:
-      out.reason = StopReason::cancelled;
+      out.stop_reason = StopReason::cancelled;
       out.message = "cancelled";
       break;
     case linalg::FrictionStop::singular:
-      out.reason = StopReason::error;
+      out.stop_reason = StopReason::error;
       out.message = std::string("monolithic: the saddle-point system of the ") +
                     (s.friction.empty() ? "active set" : "stick and slip sets") + " is singular at step " +
                     std::to_string(result.steps) +
                     (floating ? ": a floating body is held by none of the contact nodes in contact" : "");
-      return out;
+      return;
     case linalg::FrictionStop::max_steps:
-      out.reason = StopReason::max_iterations;
+      out.stop_reason = StopReason::max_iterations;
       out.message = "monolithic: the active set did not settle within max_iterations";
       break;
   }
@@ -284,7 +282,6 @@ MethodOutcome run_exact(const ContactSystem& system, const SolverSettings& setti
   out.u = to_bodies(system, s, x);
   out.z = split_rows(system, s, lambda);
   if (!s.friction.empty()) out.q = split_tangential(system, s, lambda);
-  return out;
 }
 
 // The penalty problem on the stacked system: the convex energy
@@ -338,13 +335,13 @@ double line_search(const PenaltyEnergy& energy, Eigen::VectorXd& x, const Eigen:
   return alpha;
 }
 
-MethodOutcome run_penalty(const ContactSystem& system, const SolverSettings& settings, RunContext& context) {
-  MethodOutcome out;
+void run_penalty(const ContactSystem& system, RunFrame& frame) {
+  MethodOutcome& out = frame.outcome();
   const Stacked s = stack(system, true);
   if (!s.friction.empty()) {  // (the job reader refuses it first)
-    out.reason = StopReason::error;
+    out.stop_reason = StopReason::error;
     out.message = "monolithic: friction needs exact contact (enforcement exact)";
-    return out;
+    return;
   }
   const PenaltyEnergy energy(system, s);
   Eigen::VectorXd x = Eigen::VectorXd::Zero(s.b.size());
@@ -354,10 +351,10 @@ MethodOutcome run_penalty(const ContactSystem& system, const SolverSettings& set
   zone_change(system, to_bodies(system, s, x), zone, false);  // the start's zones
   const double b_norm = std::max(s.b.norm(), 1e-300);
   Eigen::CholmodDecomposition<SpMat, Eigen::Lower> factor;
-  const int max_newton = std::max(settings.max_iterations, 1);
+  const int max_newton = std::max(frame.settings().max_iterations, 1);
   for (int k = 1; k <= max_newton; ++k) {
-    if (context.cancel.cancelled()) {
-      out.reason = StopReason::cancelled;
+    if (frame.stop_requested()) {
+      out.stop_reason = StopReason::cancelled;
       out.message = "cancelled";
       break;
     }
@@ -365,7 +362,7 @@ MethodOutcome run_penalty(const ContactSystem& system, const SolverSettings& set
     const Eigen::VectorXd grad = energy.gradient(x);
     factor.compute(energy.newton_matrix(x, k == 1 && floating));
     if (factor.info() != Eigen::Success) {
-      out.reason = StopReason::error;
+      out.stop_reason = StopReason::error;
       out.message = std::string("monolithic: the Newton matrix could not be factorised") +
                     (floating ? " (a floating body is not held by the contact nodes in contact)" : "");
       break;
@@ -380,35 +377,32 @@ MethodOutcome run_penalty(const ContactSystem& system, const SolverSettings& set
     r.paper_criterion = paper;
     r.measure = Measure::gradient;
     r.fixed_point_residual = residual;  // for Newton: the relative norm of the energy gradient
-    r.elapsed_seconds = context.elapsed();
     const int changed = r.active_set_changes;
-    context.observer.on_iteration(r);
-    out.history.push_back(std::move(r));
+    frame.report(std::move(r));
     out.iterations = k;
     // Stop: the active set unchanged and the gradient or the step negligible.
     const double step_size = alpha * step.norm() / std::max(x.norm(), 1e-300);
     if (k > 1 && changed == 0 && (residual <= 1e-12 || step_size <= 1e-13)) {
       out.converged = true;
-      out.reason = StopReason::converged;
+      out.stop_reason = StopReason::converged;
       std::ostringstream os;
       os << "Newton converged (active set unchanged, gradient " << residual << ")";
       out.message = os.str();
       break;
     }
     if (k == max_newton) {
-      out.reason = StopReason::max_iterations;
+      out.stop_reason = StopReason::max_iterations;
       out.message = "monolithic: Newton did not settle within max_iterations";
     }
   }
   out.u = to_bodies(system, s, x);
-  return out;
 }
 
 }  // namespace
 
-MethodOutcome run_monolithic(const ContactSystem& system, const SolverSettings& settings, RunContext& context) {
-  if (settings.enforcement == Enforcement::exact) return run_exact(system, settings, context);
-  return run_penalty(system, settings, context);
+void run_monolithic(const ContactSystem& system, RunFrame& frame) {
+  if (frame.settings().enforcement == Enforcement::exact) return run_exact(system, frame);
+  run_penalty(system, frame);
 }
 
 }  // namespace contact::ddm

@@ -7,13 +7,12 @@
 
 namespace contact::ddm {
 
-MethodOutcome run_neumann(const ContactSystem& system, const SolverSettings& settings, RunContext& context) {
+void run_neumann(const ContactSystem& system, RunFrame& frame) {
   int initial_solves = 0;
-  Displacements u0 = initial_iterate(system, settings, context, initial_solves);
-  NeumannMap map(system, context.runner);
-  MethodOutcome out = run_fixed_point(system, settings, context, map, std::move(u0));
-  out.solves_per_body += initial_solves;
-  return out;
+  Displacements u0 = initial_iterate(system, frame, initial_solves);
+  NeumannMap map(system, frame.runner());
+  run_fixed_point(system, frame, map, std::move(u0));
+  frame.outcome().subdomain_solves += initial_solves;
 }
 
 }  // namespace contact::ddm

@@ -129,16 +129,16 @@ class RobinMap final : public BodyMap {
 
 }  // namespace
 
-MethodOutcome run_robin(const ContactSystem& system, const SolverSettings& settings, RunContext& context) {
+void run_robin(const ContactSystem& system, RunFrame& frame) {
   int initial_solves = 0;
-  Displacements u0 = initial_iterate(system, settings, context, initial_solves);
-  RobinMap map(system, settings, context.runner);
-  MethodOutcome out = run_fixed_point(system, settings, context, map, std::move(u0));
-  out.solves_per_body += initial_solves;
+  Displacements u0 = initial_iterate(system, frame, initial_solves);
+  RobinMap map(system, frame.settings(), frame.runner());
+  run_fixed_point(system, frame, map, std::move(u0));
+  MethodOutcome& out = frame.outcome();
+  out.subdomain_solves += initial_solves;
   std::ostringstream os;
   os << "; " << map.factorizations() << " Robin factorisations";
   out.message += os.str();
-  return out;
 }
 
 }  // namespace contact::ddm

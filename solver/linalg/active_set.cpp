@@ -182,7 +182,7 @@ Eigen::VectorXd nested_initial_guess(const SparseMatrix& H, const Eigen::VectorX
   if (levels) levels->emplace_back(nc, 0);
   const Eigen::VectorXd guess = nested_initial_guess(Hc, gc, line_c, position_c, coarse_eq, levels, coarsest);
   const ActiveSetResult coarse =
-      solve_active_set(Hc, gc, 50, [](const Eigen::VectorXd&, const Eigen::VectorXd&, const ActiveSetStep&) { return true; },
+      solve_active_set(Hc, gc, 50, [](const Eigen::VectorXd&, const Eigen::VectorXd&, const ActiveSetStep&) { return false; },
                        guess.cwiseAbs().maxCoeff() > 0 ? &guess : nullptr, coarse_eq);
   if (levels) (*levels)[at].second = coarse.steps;
   if (!coarse.converged) return Eigen::VectorXd::Zero(n);  // no guess: the fine problem starts as without one
@@ -275,7 +275,7 @@ void PrimalDualActiveSet::fallback(const StepCallback& on_step, ActiveSetResult&
   for (Eigen::Index j = 0; j < n_; ++j) step.active += out.z[j] > 0;
   step.complementarity = complementarity(out.z, out.h);
   out.steps = step.step;
-  if (!on_step(out.z, out.h, step)) {
+  if (on_step(out.z, out.h, step)) {
     out.cancelled = true;
     out.message = "cancelled";
     return;
@@ -305,7 +305,7 @@ ActiveSetResult PrimalDualActiveSet::run(int max_steps, const StepCallback& on_s
     ActiveSetStep report;
     std::vector<char> next;
     if (!step(k, active, out, report, next)) return out;
-    if (!on_step(out.z, out.h, report)) {
+    if (on_step(out.z, out.h, report)) {
       out.cancelled = true;
       out.message = "cancelled";
       return out;

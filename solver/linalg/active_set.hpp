@@ -65,7 +65,8 @@ struct ActiveSetResult {
 
 using StepCallback = std::function<bool(const Eigen::VectorXd& z, const Eigen::VectorXd& h, const ActiveSetStep&)>;
 
-// on_step is called after every step with the current z and h; returning false cancels. `z0` (optional, same
+// on_step is called after every step with the current z and h; returning true stops (cancels), as every stop
+// callback of the solver returns. `z0` (optional, same
 // size as g) gives the first active set {z0 - h(z0) / H_jj > 0} ({z0 > 0} with equalities: a floating body's
 // own position is not known before the solve); without it, the nodes where g < 0, or every node with equalities.
 ActiveSetResult solve_active_set(const SparseMatrix& H, const Eigen::VectorXd& g, int max_steps,

@@ -87,7 +87,7 @@ bool sticking_sets(const FrictionLevel& level, const std::vector<char>& mask, Fr
   const SparseMatrix Fnn = level.F.topLeftCorner(level.m, level.m);
   const ActiveSetResult normal = solve_active_set(
       Fnn, level.g.head(level.m), 100,
-      [](const Eigen::VectorXd&, const Eigen::VectorXd&, const ActiveSetStep&) { return true; }, nullptr,
+      [](const Eigen::VectorXd&, const Eigen::VectorXd&, const ActiveSetStep&) { return false; }, nullptr,
       normal_equalities(level.eq, level.m));
   if (!normal.converged) return false;
   sets.active.assign(mask.size(), 0);

@@ -218,7 +218,7 @@ FrictionNewtonResult Newton::run(FrictionSets sets) {
     for (size_t j = 0; j < next.active.size(); ++j) info.active += next.active[j] && !p_.mask[j];
     info.complementarity = friction_complementarity(x_.lambda, x_.h, p_.c, p_.rows, p_.mask);
     result_.iterate = x_;
-    if (on_step_ && !on_step_(x_, info)) {
+    if (on_step_ && on_step_(x_, info)) {
       result_.stop = FrictionStop::stopped;
       return result_;
     }

@@ -66,7 +66,7 @@ struct FrictionNewtonResult {
   FrictionStop stop = FrictionStop::max_steps;
 };
 
-// After every accepted step: the iterate and the step's counts; false stops.
+// After every accepted step: the iterate and the step's counts; true stops.
 using FrictionStepCallback = std::function<bool(const FrictionIterate& x, const ActiveSetStep& step)>;
 
 FrictionNewtonResult friction_newton(const FrictionNewtonProblem& problem, FrictionSets start,

@@ -168,7 +168,7 @@ void coulomb_outer(Smalbe& smalbe, const FrictionData& d, const Eigen::VectorXd*
     change = bound_change(b, next);
     const linalg::ActiveSetStep info = outer_step(outer, d, out, previous);
     out.steps = outer;
-    if (!context.on_step(out.z, out.h, info)) {
+    if (context.on_step(out.z, out.h, info)) {
       out.cancelled = true;
       out.message = "cancelled";
       return;

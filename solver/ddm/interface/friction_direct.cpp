@@ -34,7 +34,7 @@ FrictionSets first_sets(const SparseMatrix& F, const InterfaceQp& qp, const Eige
   const linalg::Equalities held = linalg::normal_equalities(qp.equilibrium, m);
   const std::vector<int> line(qp.line.begin(), qp.line.begin() + m);
   const Eigen::VectorXd guess = linalg::nested_initial_guess(Fnn, gn, line, qp.position.head(m), held);
-  const linalg::StepCallback quiet = [](const Eigen::VectorXd&, const Eigen::VectorXd&, const linalg::ActiveSetStep&) { return true; };
+  const linalg::StepCallback quiet = [](const Eigen::VectorXd&, const Eigen::VectorXd&, const linalg::ActiveSetStep&) { return false; };
   const linalg::ActiveSetResult normal = linalg::solve_active_set(Fnn, gn, 100, quiet, &guess, held);
   if (normal.converged) {
     lambda.head(m) = normal.z;
@@ -196,9 +196,7 @@ linalg::ActiveSetResult FrictionDirectSolver::solve(const InterfaceQp& qp, const
   const linalg::FrictionNewtonProblem problem{rows, mask, c, [&](const linalg::FrictionParametrization& p, linalg::FrictionIterate& x) {
                                                 return linalg::solve_on_friction_sets(F, qp.g, qp.equilibrium, p, x);
                                               },
-                                              // One process: the token between solves; several: only at the steps'
-                                              // reports, where interface Newton reads it the same on every rank.
-                                              [&] { return !context.runner.distributed() && context.cancel.cancelled(); }};
+                                              [&] { return context.frame.stop_requested(); }};
   linalg::FrictionNewtonSettings settings;
   settings.max_steps = context.max_steps;
   const linalg::FrictionStepCallback on_step = [&](const linalg::FrictionIterate& x, const linalg::ActiveSetStep& info) {

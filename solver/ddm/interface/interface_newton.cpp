@@ -61,15 +61,16 @@ InterfaceQp InterfaceNewton::make_qp(const SolverSettings& settings) const {
   return qp;
 }
 
-MethodOutcome InterfaceNewton::solve(const SolverSettings& settings, RunContext& context) {
-  MethodOutcome out;
-  if (system_.has_histories()) problem_.refresh_loads(context.runner);  // loads not proportional to the last ones
+void InterfaceNewton::solve(RunFrame& frame) {
+  const SolverSettings& settings = frame.settings();
+  MethodOutcome& out = frame.outcome();
+  if (system_.has_histories()) problem_.refresh_loads(frame.runner());  // loads not proportional to the last ones
   if (system_.has_friction())
     if (std::string overload = friction_cannot_hold(system_); !overload.empty()) {
-      out.reason = StopReason::error;
+      out.stop_reason = StopReason::error;
       out.refused = true;
       out.message = overload;
-      return out;
+      return;
     }
   const InterfaceProblem& ip = problem_;
   const Eigen::Index m = ip.size();
@@ -90,12 +91,10 @@ MethodOutcome InterfaceNewton::solve(const SolverSettings& settings, RunContext&
     r.active_set_changes = step.changes;
     if (step.step == 1)
       r.note = std::string("interface solver ") + solver_name + (solver_note->empty() ? "" : "; ") + *solver_note;
-    r.elapsed_seconds = context.elapsed();
-    context.observer.on_iteration(r);
-    out.history.push_back(std::move(r));
-    return !context.cancel.cancelled();
+    frame.report(std::move(r));
+    return frame.stop_requested();
   };
-  InterfaceSolveContext ctx{context.runner, context.cancel, on_step, std::max(1, settings.max_iterations), {}};
+  InterfaceSolveContext ctx{frame, on_step, std::max(1, settings.max_iterations), {}};
   solver_note = &ctx.note;
   const Eigen::VectorXd* z0 = last_z_.size() == m && m > 0 && last_z_.cwiseAbs().maxCoeff() > 0 ? &last_z_ : nullptr;
   linalg::ActiveSetResult result = solver_->solve(qp, z0, ctx);
@@ -129,26 +128,25 @@ MethodOutcome InterfaceNewton::solve(const SolverSettings& settings, RunContext&
   out.interface_solver = took_over ? "iterative" : solver_->name();
   out.interface_iterations = result.inner_iterations;
   if (result.cancelled) {
-    out.reason = StopReason::cancelled;
+    out.stop_reason = StopReason::cancelled;
     out.message = "cancelled";
   } else if (result.converged) {
     out.converged = true;
-    out.reason = StopReason::converged;
+    out.stop_reason = StopReason::converged;
     out.message = "interface Newton: " + result.message;
   } else if (!result.unrestrained.empty()) {
-    out.reason = StopReason::error;
+    out.stop_reason = StopReason::error;
     out.message = "interface Newton: " + unheld_bodies(result.unrestrained);
-    return out;
+    return;
   } else {
-    out.reason = result.steps >= max_steps ? StopReason::max_iterations : StopReason::error;
+    out.stop_reason = result.steps >= max_steps ? StopReason::max_iterations : StopReason::error;
     out.message = "interface Newton: " + result.message;
   }
   out.z = ip.split(result.z);
   if (system_.has_friction()) out.q = ip.split_tangential(result.z);
-  out.u = ip.displacements(result.z, result.alpha, context.runner);
+  out.u = ip.displacements(result.z, result.alpha);
   out.rigid_amplitudes = rigid_amplitudes(result.alpha);
-  out.solves_per_body = 1;
-  return out;
+  out.subdomain_solves = 1;
 }
 
 }  // namespace contact::ddm

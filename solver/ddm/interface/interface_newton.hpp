@@ -23,8 +23,9 @@ class InterfaceNewton {
         kind_(choose_interface_solver(settings.interface, system, runner)),
         problem_(system, runner, interface_options(kind_, settings.interface, system.has_friction())),
         solver_(make_interface_solver(kind_, settings.interface, system.has_friction())) {}
-  // Solves with the settings' enforcement on the pairs' current multipliers; reports every active-set step.
-  MethodOutcome solve(const SolverSettings& settings, RunContext& context);
+  // Solves with the frame's enforcement on the pairs' current multipliers, building the frame's outcome; reports
+  // every active-set step.
+  void solve(RunFrame& frame);
   const InterfaceProblem& problem() const { return problem_; }
   const InterfaceSolver& solver() const { return *solver_; }
 

@@ -298,11 +298,10 @@ Eigen::VectorXd InterfaceProblem::stack(const Pressures& per_pair) const {
   return out;
 }
 
-Displacements InterfaceProblem::displacements(const Eigen::VectorXd& z, const Eigen::VectorXd& alpha,
-                                              parallel::TaskRunner& runner) const {
+Displacements InterfaceProblem::displacements(const Eigen::VectorXd& z, const Eigen::VectorXd& alpha) const {
   CONTACT_ASSERT_SIZE(z.size(), size(), "the interface multipliers");
   const Pressures q = split_tangential(z);
-  Displacements u = system_.solve_bodies(system_.loads_from_pressures(split(z), &q), runner);
+  Displacements u = system_.solve_bodies(system_.loads_from_pressures(split(z), &q));
   if (alpha.size() == equilibrium_.G.rows())
     for (const auto& f : floating_) u[f.body] += system_.body(f.body).rigid_modes() * alpha.segment(f.offset, f.count);
   return u;

@@ -101,7 +101,7 @@ class InterfaceProblem {
 
   // The bodies' displacements for pressures z and rigid-mode amplitudes alpha (empty without floating bodies):
   // one solve per body, in parallel.
-  Displacements displacements(const Eigen::VectorXd& z, const Eigen::VectorXd& alpha, parallel::TaskRunner& runner) const;
+  Displacements displacements(const Eigen::VectorXd& z, const Eigen::VectorXd& alpha) const;
 
  private:
   struct BodyParts;  // what one body's task computes

@@ -18,6 +18,7 @@
 
 #include "contact/problem.hpp"
 #include "contact/result.hpp"
+#include "../run_frame.hpp"
 #include "interface_problem.hpp"
 
 #include <memory>
@@ -35,10 +36,11 @@ struct InterfaceQp {
   Eigen::VectorXd position;
 };
 
+// What an interface solver receives: the run's frame (its runner and its stop check) and the interface Newton's
+// report of each step.
 struct InterfaceSolveContext {
-  parallel::TaskRunner& runner;
-  const CancelToken& cancel;
-  const linalg::StepCallback& on_step;  // after every active-set step / outer iteration; false cancels
+  RunFrame& frame;
+  const linalg::StepCallback& on_step;  // after every active-set step / outer iteration (reports); true stops
   int max_steps = 100;                  // active-set steps / outer iterations
   std::string note;                     // out: what the first report says (coarse solves, solver chosen)
 };

@@ -27,12 +27,11 @@ bool Smalbe::apply_H(const Eigen::VectorXd& x, Eigen::VectorXd& y) {
   bool stop = false;
   {
     ScopedTimer timer(seconds_F_);  // the per-iteration costs docs/parallel.md's model is built from
-    stop = qp_.problem.apply(x, y, ctx_.runner);
+    stop = qp_.problem.apply(x, y, ctx_.frame.runner());
   }
   if (qp_.penalty.size() == m_) y += qp_.penalty.cwiseProduct(x);
-  // One process: the token directly; several: only the agreed answer of the sum, the same on every process.
-  if (!ctx_.runner.distributed()) stop = stop || ctx_.cancel.cancelled();
-  return stop;
+  // Several processes: the sum carried every process's stop request, and the frame's check gives the agreed one.
+  return stop || ctx_.frame.stop_requested();
 }
 
 bool Smalbe::apply_A(const Eigen::VectorXd& x, Eigen::VectorXd& y) {
@@ -50,8 +49,7 @@ bool Smalbe::apply_A(const Eigen::VectorXd& x, Eigen::VectorXd& y) {
 bool Smalbe::precondition(const Eigen::VectorXd& r, Eigen::VectorXd& y) {
   const Eigen::VectorXd Pr = coarse_.project(r);
   Eigen::VectorXd Mr;
-  bool stop = qp_.problem.apply_preconditioner(Pr, Mr, ctx_.runner);
-  if (!ctx_.runner.distributed()) stop = stop || ctx_.cancel.cancelled();
+  const bool stop = qp_.problem.apply_preconditioner(Pr, Mr, ctx_.frame.runner()) || ctx_.frame.stop_requested();
   y = coarse_.project(Mr) + (r - Pr) / rho_;
   return stop;
 }
@@ -201,7 +199,7 @@ void Smalbe::solve(const Bounds& bounds, const Eigen::VectorXd* z0, const Solve&
     x = r.x;
     out.steps = outer;
     const bool stop = finish(x, bounds, out) || r.cancelled;
-    if (stop || (how.report && !report(outer, how, out))) {
+    if (stop || (how.report && report(outer, how, out))) {
       out.cancelled = true;
       out.message = "cancelled";
       return;

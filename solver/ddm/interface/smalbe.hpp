@@ -50,7 +50,7 @@ class Smalbe {
   bool precondition(const Eigen::VectorXd& r, Eigen::VectorXd& y);
   void setup();
   bool finish(const Eigen::VectorXd& x, const Bounds& bounds, linalg::ActiveSetResult& out);
-  bool report(int step, const Solve& how, linalg::ActiveSetResult& out);
+  bool report(int step, const Solve& how, linalg::ActiveSetResult& out);  // true: stop (the step callback asked)
   bool update_multipliers(const Eigen::VectorXd& x, const linalg::MprgpResult& r, int outer, double& M,
                           double& previous_L, std::vector<double>& violation);
   bool stagnating(const std::vector<double>& violation) const;

@@ -162,19 +162,25 @@ struct StepSummary {
 // The step's scalars; the contact zone interpolated between nodes (solver/contact/extent.hpp; 0, 0 if none).
 StepSummary summarize(const Step& step);
 
-struct Result {
+// How a run ended and what it cost: what every level of a run builds (ddm::MethodOutcome adds the answer it carries
+// between levels) and the Result reports, so the one is handed to the other whole.
+struct RunOutcome {
   bool converged = false;
   StopReason stop_reason = StopReason::error;
   std::string message;  // human-readable detail of the stop (error text when stop_reason == error)
   int iterations = 0;
-  std::string method;   // "interface_newton", "neumann", "robin" or "monolithic"
-  std::string enforcement;  // "exact", "penalty" or "augmented_lagrangian"
   double gamma = 0.0;   // relaxation used (0 for monolithic)
   int subdomain_solves = 0;  // back-substitutions per body (the DDM's unit of work), initial guess included
   int updates = 0;           // augmented-Lagrangian updates (0 for the pure penalty method)
   std::string interface_solver;   // interface_newton: "direct" or "iterative" (solver.interface.solver)
   long interface_iterations = 0;  // the iterative interface solver's MPRGP iterations, all solves together
+  double indicator_seconds = 0.0;   // adaptivity: estimating (for fem_bem: the boundary-element work)
   std::vector<IterationReport> history;
+};
+
+struct Result : RunOutcome {
+  std::string method;   // "interface_newton", "neumann", "robin" or "monolithic"
+  std::string enforcement;  // "exact", "penalty" or "augmented_lagrangian"
   // The steps whose fields are kept; the last one is the final solution; with StepOutput::last the only one. When
   // the observer stored the steps as they came (Observer::step_sink, streamed_steps > 0) only the last is here.
   std::vector<Step> steps;
@@ -186,7 +192,6 @@ struct Result {
   double wall_seconds = 0.0;
   double setup_seconds = 0.0;       // assembly + factorisations
   double factorization_seconds = 0.0;
-  double indicator_seconds = 0.0;   // adaptivity: estimating (for fem_bem: the boundary-element work)
 };
 
 // One step of the adaptive loop (converge_then_refine), reported once its mesh is solved and estimated.
