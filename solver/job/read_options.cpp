@@ -128,8 +128,8 @@ void JobReader::resolve_method_defaults() {
   json& out = sub_object(normalized_, "solver");
   const bool paper_strategy = problem_.adaptivity.enabled && problem_.adaptivity.strategy == AdaptStrategy::paper;
   if (!method_given_) s.method = paper_strategy ? Method::neumann : Method::interface_newton;
-  const bool fixed_point = s.method == Method::neumann || s.method == Method::robin;
-  if (!enforcement_given_) s.enforcement = fixed_point || paper_strategy ? Enforcement::penalty : Enforcement::exact;
+  if (!enforcement_given_)
+    s.enforcement = iterates_on_penalty(s.method) || paper_strategy ? Enforcement::penalty : Enforcement::exact;
   if (paper_strategy && s.method != Method::neumann)
     errors_.add(method_pointer_.empty() ? "/adaptivity/strategy" : method_pointer_,
                 std::string("the adaptive strategy \"paper\" interleaves single Neumann iterations (paper (16)-(17)) "
@@ -139,12 +139,8 @@ void JobReader::resolve_method_defaults() {
     errors_.add(enforcement_pointer_,
                 "the adaptive strategy \"paper\" runs the paper's penalty iteration: enforcement must be \"penalty\" "
                 "(use strategy \"converge_then_refine\" for exact or augmented-Lagrangian contact)");
-  else if (fixed_point && s.enforcement == Enforcement::exact)
-    errors_.add(enforcement_pointer_,
-                std::string("method \"") + to_string(s.method) +
-                    "\" iterates on the penalty problem: enforcement \"exact\" is not available with it (use "
-                    "\"penalty\", or \"augmented_lagrangian\" for exact contact in the limit, or method "
-                    "\"interface_newton\")");
+  else if (const std::string conflict = settings_conflict(s); !conflict.empty())
+    errors_.add(enforcement_pointer_, conflict);  // solve() refuses a Problem built in code with the same words
   set_default(out, "method", to_string(s.method));
   set_default(out, "enforcement", to_string(s.enforcement));
 }

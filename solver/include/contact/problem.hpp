@@ -178,6 +178,15 @@ struct SolverSettings {
   InterfaceSolverSettings interface;
 };
 
+// neumann and robin iterate on the penalty problem (exact contact only in the limit, through augmented_lagrangian):
+// penalty is their default enforcement, exact is not available to them.
+bool iterates_on_penalty(Method method);
+
+// Why these settings cannot run together, in the one wording both the job reader (at the job's pointer) and
+// solve() (for a Problem built in code) give; empty when they can. The rule: exact enforcement with a method that
+// iterates on the penalty problem.
+std::string settings_conflict(const SolverSettings& settings);
+
 // h-adaptivity (paper section 3): indicator per cell, refine where it exceeds delta.
 enum class Indicator { fem_bem, zz };
 // paper: one DDM update, then estimate and refine, every iteration (the paper's interleaving);
