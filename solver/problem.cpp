@@ -3,6 +3,7 @@
 #include <array>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace contact {
 
@@ -39,6 +40,18 @@ std::optional<Enforcement> enforcement_named(const std::string& name) {
   for (const auto& [value, text] : kEnforcements)
     if (name == text) return value;
   return std::nullopt;
+}
+
+std::vector<std::string> method_names() {
+  std::vector<std::string> names;
+  for (const auto& entry : kMethods) names.emplace_back(entry.second);
+  return names;
+}
+
+std::vector<std::string> enforcement_names() {
+  std::vector<std::string> names;
+  for (const auto& entry : kEnforcements) names.emplace_back(entry.second);
+  return names;
 }
 
 bool iterates_on_penalty(Method method) { return method == Method::neumann || method == Method::robin; }

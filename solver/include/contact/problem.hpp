@@ -128,6 +128,9 @@ const char* to_string(Method m);
 const char* to_string(Enforcement e);
 std::optional<Method> method_named(const std::string& name);
 std::optional<Enforcement> enforcement_named(const std::string& name);
+// Every name of the table, in its order: what the job reader accepts and lists in its messages.
+std::vector<std::string> method_names();
+std::vector<std::string> enforcement_names();
 
 // Robin weight psi (force per length^3, like 1/theta): a constant over every contact zone, or 1/theta on the
 // current active set and 0 elsewhere ("active_set").
