@@ -381,7 +381,7 @@ void JobReader::check_floating_bodies() {
                       "their normals: nothing resists its " + modes + "; prescribe a displacement component that "
                       "stops it, on an edge or a named vertex");
     } else if (method == Method::neumann || method == Method::robin) {
-      errors_.add(method_pointer_.empty() ? child(in.pointer, "boundary") : method_pointer_,
+      errors_.add(method_.pointer.empty() ? child(in.pointer, "boundary") : method_.pointer,
                   "body '" + in.body.name + "' floats (" + free + ": only its contacts hold it), and method \"" +
                       to_string(method) +
                       "\" solves every body on its own with contact tractions as loads, which a floating body "

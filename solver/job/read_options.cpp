@@ -54,10 +54,10 @@ void JobReader::read_solver_fields(const json& value, const std::string& pointer
 
 // "method": remembered as given (resolve_method_defaults fills it in otherwise).
 void JobReader::read_method(const json& value, const std::string& pointer) {
-  method_pointer_ = pointer;
+  method_.pointer = pointer;
   if (auto x = choice(value, pointer, "method", method_names(), errors_)) {
     problem_.solver.method = *method_named(*x);
-    method_given_ = true;
+    method_.valid = true;
   }
 }
 
@@ -84,10 +84,10 @@ void JobReader::read_gamma(const json& value, const std::string& pointer) {
 
 // "enforcement": remembered as given (resolve_method_defaults fills it in otherwise).
 void JobReader::read_enforcement(const json& value, const std::string& pointer) {
-  enforcement_pointer_ = pointer;
+  enforcement_.pointer = pointer;
   if (auto x = choice(value, pointer, "enforcement", enforcement_names(), errors_)) {
     problem_.solver.enforcement = *enforcement_named(*x);
-    enforcement_given_ = true;
+    enforcement_.valid = true;
   }
 }
 
@@ -128,20 +128,20 @@ void JobReader::resolve_method_defaults() {
   json& out = sub_object(normalized_, "solver");
   const bool paper_strategy = problem_.adaptivity.enabled && problem_.adaptivity.strategy == AdaptStrategy::paper;
   const SolverSettings defaults;
-  if (!method_given_) s.method = paper_strategy ? Method::neumann : defaults.method;
-  if (!enforcement_given_)
+  if (!method_.valid) s.method = paper_strategy ? Method::neumann : defaults.method;
+  if (!enforcement_.valid)
     s.enforcement = iterates_on_penalty(s.method) || paper_strategy ? Enforcement::penalty : defaults.enforcement;
   if (paper_strategy && s.method != Method::neumann)
-    errors_.add(method_pointer_.empty() ? "/adaptivity/strategy" : method_pointer_,
+    errors_.add(method_.pointer.empty() ? "/adaptivity/strategy" : method_.pointer,
                 std::string("the adaptive strategy \"paper\" interleaves single Neumann iterations (paper (16)-(17)) "
                             "with refinement: it needs method \"neumann\", not \"") +
                     to_string(s.method) + "\" (or use strategy \"converge_then_refine\", which works with every method)");
   else if (paper_strategy && s.enforcement != Enforcement::penalty)
-    errors_.add(enforcement_pointer_,
+    errors_.add(enforcement_.pointer,
                 "the adaptive strategy \"paper\" runs the paper's penalty iteration: enforcement must be \"penalty\" "
                 "(use strategy \"converge_then_refine\" for exact or augmented-Lagrangian contact)");
   else if (const std::string conflict = settings_conflict(s); !conflict.empty())
-    errors_.add(enforcement_pointer_, conflict);  // solve() refuses a Problem built in code with the same words
+    errors_.add(enforcement_.pointer, conflict);  // solve() refuses a Problem built in code with the same words
   set_default(out, "method", to_string(s.method));
   set_default(out, "enforcement", to_string(s.enforcement));
 }
