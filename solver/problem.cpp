@@ -1,7 +1,9 @@
 #include "contact/problem.hpp"
 
 #include <array>
+#include <string>
 #include <utility>
+#include <vector>
 
 namespace contact {
 
@@ -38,6 +40,28 @@ std::optional<Enforcement> enforcement_named(const std::string& name) {
   for (const auto& [value, text] : kEnforcements)
     if (name == text) return value;
   return std::nullopt;
+}
+
+std::vector<std::string> method_names() {
+  std::vector<std::string> names;
+  for (const auto& entry : kMethods) names.emplace_back(entry.second);
+  return names;
+}
+
+std::vector<std::string> enforcement_names() {
+  std::vector<std::string> names;
+  for (const auto& entry : kEnforcements) names.emplace_back(entry.second);
+  return names;
+}
+
+bool iterates_on_penalty(Method method) { return method == Method::neumann || method == Method::robin; }
+
+std::string settings_conflict(const SolverSettings& settings) {
+  if (iterates_on_penalty(settings.method) && settings.enforcement == Enforcement::exact)
+    return std::string("method \"") + to_string(settings.method) +
+           "\" iterates on the penalty problem: enforcement \"exact\" is not available with it (use \"penalty\", or "
+           "\"augmented_lagrangian\" for exact contact in the limit, or method \"interface_newton\")";
+  return {};
 }
 
 }  // namespace contact

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "job_reader.hpp"
+#include "names.hpp"
 #include "read.hpp"
 
 namespace contact::job {
@@ -135,6 +136,9 @@ ParseResult JobReader::finish() {
   return result;
 }
 
+// The job format's default name (a Problem built in code has none).
+constexpr const char* kDefaultJobName = "job";
+
 void JobReader::read_header(const Fields& top) {
   if (const json* v = top.find("name")) {
     if (auto s = read::string(*v, top.at("name"), "name", errors_)) {
@@ -147,9 +151,9 @@ void JobReader::read_header(const Fields& top) {
         problem_.name = *s;
     }
   } else {
-    problem_.name = "job";
+    problem_.name = kDefaultJobName;
   }
-  set_default(normalized_, "name", "job");
+  set_default(normalized_, "name", kDefaultJobName);
   if (const json* v = top.find("version")) {
     auto n = read::integer(*v, top.at("version"), "version", errors_);
     if (n && *n != 1)
@@ -163,16 +167,14 @@ void JobReader::read_model(const Fields& top) {
   json& out = sub_object(normalized_, "model");
   if (const json* v = top.find("model")) {
     Fields f(*v, top.at("model"), "model", {"plane", "thickness"}, errors_);
-    if (const json* p = f.find("plane")) {
-      if (auto s = choice(*p, f.at("plane"), "plane", {"strain", "stress"}, errors_))
-        problem_.model.plane = *s == "stress" ? Plane::stress : Plane::strain;
-    }
+    if (const json* p = f.find("plane")) read_name(*p, f.at("plane"), "plane", problem_.model.plane, errors_);
     if (const json* t = f.find("thickness")) {
       if (auto x = positive(*t, f.at("thickness"), "thickness", errors_)) problem_.model.thickness = *x;
     }
   }
-  set_default(out, "plane", "strain");
-  set_default(out, "thickness", 1.0);
+  const Model d;  // contact/problem.hpp's defaults
+  set_default(out, "plane", name_of(d.plane));
+  set_default(out, "thickness", d.thickness);
 }
 
 // The normalized counterpart of a sub-object, created as {} if absent. Where the submitted value has the

@@ -187,8 +187,14 @@ class JobReader {
   json discarded_;
   Errors errors_;
   Problem problem_;
-  bool method_given_ = false, enforcement_given_ = false;
-  std::string method_pointer_, enforcement_pointer_ = "/solver";
+  // The job's "method" and "enforcement": their defaults depend on the rest of the job (resolve_method_defaults),
+  // and the checks that involve them point at them. `pointer` is set once the field is present (the enforcement's
+  // stands at "/solver" until then), `valid` once its name was read without error.
+  struct GivenSetting {
+    std::string pointer;
+    bool valid = false;
+  };
+  GivenSetting method_, enforcement_{"/solver"};
   std::vector<std::string> friction_pointers_;  // per contact pair of problem_.contacts (empty: frictionless)
   // One error for one cause: what a part refused whole (over a limit, of the wrong type) or read only in part
   // leaves unknown, so the checks that depend on it are not run (docs/job-format.md, "Validation and errors").

@@ -89,7 +89,8 @@ void JobReader::read_body(const json& value, BodyInput& in, json& out) {
   set_default(out, "boundary", json::array());
   if (const json* b = f.find("body_force"))
     if (auto v = read::pair(*b, f.at("body_force"), "body_force", errors_)) in.body.body_force = *v;
-  set_default(out, "body_force", json::array({0.0, 0.0}));
+  const Eigen::Vector2d none = Body{}.body_force;  // contact/problem.hpp's default
+  set_default(out, "body_force", json::array({none.x(), none.y()}));
 }
 
 void JobReader::read_material(const json& value, const std::string& pointer, Material& material) {
@@ -380,7 +381,7 @@ void JobReader::check_floating_bodies() {
                       "their normals: nothing resists its " + modes + "; prescribe a displacement component that "
                       "stops it, on an edge or a named vertex");
     } else if (method == Method::neumann || method == Method::robin) {
-      errors_.add(method_pointer_.empty() ? child(in.pointer, "boundary") : method_pointer_,
+      errors_.add(method_.pointer.empty() ? child(in.pointer, "boundary") : method_.pointer,
                   "body '" + in.body.name + "' floats (" + free + ": only its contacts hold it), and method \"" +
                       to_string(method) +
                       "\" solves every body on its own with contact tractions as loads, which a floating body "

@@ -137,11 +137,12 @@ void JobReader::read_gap(const Fields& contact, GapSpec& gap, json& out) {
         gap.parabola_r0 = read::number(*r, pf.at("r0"), "r0", errors_);
       if (const json* x0 = pf.find("x0"))
         if (auto x = read::number(*x0, pf.at("x0"), "x0", errors_)) gap.parabola_x0 = *x;
-      set_default(sub_object(out, "parabola"), "x0", 0.0);
+      set_default(sub_object(out, "parabola"), "x0", GapSpec{}.parabola_x0);
     }
   }
-  set_default(out, "geometric", true);
-  set_default(out, "constant", 0.0);
+  const GapSpec d;  // contact/problem.hpp's defaults
+  set_default(out, "geometric", d.geometric);
+  set_default(out, "constant", d.constant);
 }
 
 }  // namespace contact::job::detail

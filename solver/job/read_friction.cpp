@@ -71,13 +71,13 @@ void JobReader::check_friction_and_histories() {
       errors_.add(at, std::string("friction is solved on the interface problem (semismooth Newton on stick and slip): "
                                   "method \"") + to_string(s.method) +
                           "\" cannot take it; use method \"interface_newton\" (the default) or \"monolithic\"" +
-                          (method_pointer_.empty() ? "" : " at " + method_pointer_));
+                          (method_.pointer.empty() ? "" : " at " + method_.pointer));
       return;
     }
     if (s.enforcement != Enforcement::exact) {
       errors_.add(at, "friction needs exact contact (enforcement \"exact\", the default of interface_newton), not \"" +
                           std::string(to_string(s.enforcement)) +
-                          "\" at " + enforcement_pointer_);
+                          "\" at " + enforcement_.pointer);
       return;
     }
     if (problem_.adaptivity.enabled) {

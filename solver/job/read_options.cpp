@@ -3,6 +3,7 @@
 #include "job_reader.hpp"
 
 #include "contact/progress_json.hpp"
+#include "names.hpp"
 
 #include <algorithm>
 #include <string>
@@ -28,19 +29,15 @@ void JobReader::read_solver_fields(const json& value, const std::string& pointer
   if (const json* g = f.find("gamma")) read_gamma(*g, f.at("gamma"));
   if (const json* t = f.find("tolerance"))
     if (auto x = positive(*t, f.at("tolerance"), "tolerance", errors_)) s.tolerance = *x;
-  if (const json* c = f.find("criterion"))
-    if (auto x = choice(*c, f.at("criterion"), "criterion", {"paper", "residual"}, errors_))
-      s.criterion = *x == "residual" ? Criterion::residual : Criterion::paper;
+  if (const json* c = f.find("criterion")) read_name(*c, f.at("criterion"), "criterion", s.criterion, errors_);
   if (const json* n = f.find("max_iterations"))
     if (auto x = bounded_int(*n, f.at("max_iterations"), "max_iterations", 1, errors_)) s.max_iterations = *x;
   if (const json* g = f.find("initial_guess"))
-    if (auto x = choice(*g, f.at("initial_guess"), "initial_guess", {"zero", "elastic_layer"}, errors_))
-      s.initial_guess = *x == "zero" ? InitialGuess::zero : InitialGuess::elastic_layer;
+    read_name(*g, f.at("initial_guess"), "initial_guess", s.initial_guess, errors_);
   if (const json* t = f.find("threads"))
     if (auto x = bounded_int(*t, f.at("threads"), "threads", 0, errors_)) s.threads = *x;
   if (const json* a = f.find("acceleration"))
-    if (auto x = choice(*a, f.at("acceleration"), "acceleration", {"none", "anderson"}, errors_))
-      s.acceleration = *x == "anderson" ? Acceleration::anderson : Acceleration::none;
+    read_name(*a, f.at("acceleration"), "acceleration", s.acceleration, errors_);
   if (const json* d = f.find("anderson_depth")) {
     if (auto x = bounded_int(*d, f.at("anderson_depth"), "anderson_depth", 1, errors_)) {
       if (*x > 50)
@@ -57,10 +54,10 @@ void JobReader::read_solver_fields(const json& value, const std::string& pointer
 
 // "method": remembered as given (resolve_method_defaults fills it in otherwise).
 void JobReader::read_method(const json& value, const std::string& pointer) {
-  method_pointer_ = pointer;
-  if (auto x = choice(value, pointer, "method", {"neumann", "monolithic", "interface_newton", "robin"}, errors_)) {
+  method_.pointer = pointer;
+  if (auto x = choice(value, pointer, "method", method_names(), errors_)) {
     problem_.solver.method = *method_named(*x);
-    method_given_ = true;
+    method_.valid = true;
   }
 }
 
@@ -87,34 +84,37 @@ void JobReader::read_gamma(const json& value, const std::string& pointer) {
 
 // "enforcement": remembered as given (resolve_method_defaults fills it in otherwise).
 void JobReader::read_enforcement(const json& value, const std::string& pointer) {
-  enforcement_pointer_ = pointer;
-  if (auto x = choice(value, pointer, "enforcement", {"exact", "penalty", "augmented_lagrangian"}, errors_)) {
+  enforcement_.pointer = pointer;
+  if (auto x = choice(value, pointer, "enforcement", enforcement_names(), errors_)) {
     problem_.solver.enforcement = *enforcement_named(*x);
-    enforcement_given_ = true;
+    enforcement_.valid = true;
   }
 }
 
-// Every default of "solver" into the normalized copy.
+// Every default of "solver" into the normalized copy: SolverSettings' own (contact/problem.hpp), so that the
+// copy says what a Problem left at its defaults runs. Method and enforcement depend on the rest of the job
+// (resolve_method_defaults).
 void JobReader::write_solver_defaults(json& out) {
-  set_default(out, "penalty", json{{"c", 0.05}});
-  set_default(out, "gamma", "auto");
-  set_default(out, "tolerance", 1e-8);
-  set_default(out, "criterion", "residual");
-  set_default(out, "max_iterations", 2000);
-  set_default(out, "initial_guess", "elastic_layer");
-  set_default(out, "threads", 0);
-  set_default(out, "acceleration", "anderson");
-  set_default(out, "anderson_depth", 10);
-  set_default(out, "robin", json{{"psi", "active_set"}});
-  set_default(out, "augmented_lagrangian", json{{"tolerance", 1e-6}, {"max_updates", 100}});
-  json& al = out["augmented_lagrangian"];
-  set_default(al, "tolerance", 1e-6);
-  set_default(al, "max_updates", 100);
+  const SolverSettings d;
+  set_default(out, "penalty", json{{"c", d.penalty.c}});
+  set_default(out, "gamma", d.gamma_auto ? json("auto") : json(d.gamma));
+  set_default(out, "tolerance", d.tolerance);
+  set_default(out, "criterion", name_of(d.criterion));
+  set_default(out, "max_iterations", d.max_iterations);
+  set_default(out, "initial_guess", name_of(d.initial_guess));
+  set_default(out, "threads", d.threads);
+  set_default(out, "acceleration", name_of(d.acceleration));
+  set_default(out, "anderson_depth", d.anderson_depth);
+  // Written only where "robin" is left out: a given "robin" without psi stays as given (psi "active_set").
+  set_default(out, "robin", json{{"psi", d.robin.active_set ? json("active_set") : json(d.robin.psi)}});
+  json& al = sub_object(out, "augmented_lagrangian");
+  set_default(al, "tolerance", d.augmented_lagrangian.tolerance);
+  set_default(al, "max_updates", d.augmented_lagrangian.max_updates);
   json& in = sub_object(out, "interface");
-  set_default(in, "solver", "auto");
-  set_default(in, "preconditioner", "dirichlet");
-  set_default(in, "tolerance", 1e-12);
-  set_default(in, "max_iterations", 100000);
+  set_default(in, "solver", name_of(d.interface.solver));
+  set_default(in, "preconditioner", name_of(d.interface.preconditioner));
+  set_default(in, "tolerance", d.interface.tolerance);
+  set_default(in, "max_iterations", d.interface.max_iterations);
 }
 
 // The method and enforcement defaults depend on each other and on the adaptive strategy, so they are filled
@@ -127,24 +127,21 @@ void JobReader::resolve_method_defaults() {
   SolverSettings& s = problem_.solver;
   json& out = sub_object(normalized_, "solver");
   const bool paper_strategy = problem_.adaptivity.enabled && problem_.adaptivity.strategy == AdaptStrategy::paper;
-  if (!method_given_) s.method = paper_strategy ? Method::neumann : Method::interface_newton;
-  const bool fixed_point = s.method == Method::neumann || s.method == Method::robin;
-  if (!enforcement_given_) s.enforcement = fixed_point || paper_strategy ? Enforcement::penalty : Enforcement::exact;
+  const SolverSettings defaults;
+  if (!method_.valid) s.method = paper_strategy ? Method::neumann : defaults.method;
+  if (!enforcement_.valid)
+    s.enforcement = iterates_on_penalty(s.method) || paper_strategy ? Enforcement::penalty : defaults.enforcement;
   if (paper_strategy && s.method != Method::neumann)
-    errors_.add(method_pointer_.empty() ? "/adaptivity/strategy" : method_pointer_,
+    errors_.add(method_.pointer.empty() ? "/adaptivity/strategy" : method_.pointer,
                 std::string("the adaptive strategy \"paper\" interleaves single Neumann iterations (paper (16)-(17)) "
                             "with refinement: it needs method \"neumann\", not \"") +
                     to_string(s.method) + "\" (or use strategy \"converge_then_refine\", which works with every method)");
   else if (paper_strategy && s.enforcement != Enforcement::penalty)
-    errors_.add(enforcement_pointer_,
+    errors_.add(enforcement_.pointer,
                 "the adaptive strategy \"paper\" runs the paper's penalty iteration: enforcement must be \"penalty\" "
                 "(use strategy \"converge_then_refine\" for exact or augmented-Lagrangian contact)");
-  else if (fixed_point && s.enforcement == Enforcement::exact)
-    errors_.add(enforcement_pointer_,
-                std::string("method \"") + to_string(s.method) +
-                    "\" iterates on the penalty problem: enforcement \"exact\" is not available with it (use "
-                    "\"penalty\", or \"augmented_lagrangian\" for exact contact in the limit, or method "
-                    "\"interface_newton\")");
+  else if (const std::string conflict = settings_conflict(s); !conflict.empty())
+    errors_.add(enforcement_.pointer, conflict);  // solve() refuses a Problem built in code with the same words
   set_default(out, "method", to_string(s.method));
   set_default(out, "enforcement", to_string(s.enforcement));
 }
@@ -159,17 +156,12 @@ void JobReader::read_adaptivity(const json& value, const std::string& pointer) {
   a.enabled = true;
   a.max_total_dofs = limits_.max_dofs;
   json& out = normalized_["adaptivity"];
-  if (const json* i = f.find("indicator"))
-    if (auto x = choice(*i, f.at("indicator"), "indicator", {"fem_bem", "zz"}, errors_))
-      a.indicator = *x == "zz" ? Indicator::zz : Indicator::fem_bem;
+  if (const json* i = f.find("indicator")) read_name(*i, f.at("indicator"), "indicator", a.indicator, errors_);
   if (const json* nz = f.find("normalization"))
-    if (auto x = choice(*nz, f.at("normalization"), "normalization", {"rms", "area"}, errors_))
-      a.normalization = *x == "area" ? Normalization::area : Normalization::rms;
+    read_name(*nz, f.at("normalization"), "normalization", a.normalization, errors_);
   if (const json* d = f.find("delta"))
     if (auto x = positive(*d, f.at("delta"), "delta", errors_)) a.delta = *x;
-  if (const json* mk = f.find("marking"))
-    if (auto x = choice(*mk, f.at("marking"), "marking", {"contact", "plain"}, errors_))
-      a.marking = *x == "plain" ? MarkingRule::plain : MarkingRule::contact;
+  if (const json* mk = f.find("marking")) read_name(*mk, f.at("marking"), "marking", a.marking, errors_);
   if (const json* g = f.find("grading"))
     if (auto x = read::number(*g, f.at("grading"), "grading", errors_)) {
       if (*x < 0.0)
@@ -186,9 +178,7 @@ void JobReader::read_adaptivity(const json& value, const std::string& pointer) {
     }
   if (const json* d = f.find("max_dofs"))
     if (auto x = bounded_int(*d, f.at("max_dofs"), "max_dofs", 1, errors_)) a.max_dofs = *x;
-  if (const json* st = f.find("strategy"))
-    if (auto x = choice(*st, f.at("strategy"), "strategy", {"paper", "converge_then_refine"}, errors_))
-      a.strategy = *x == "paper" ? AdaptStrategy::paper : AdaptStrategy::converge_then_refine;
+  if (const json* st = f.find("strategy")) read_name(*st, f.at("strategy"), "strategy", a.strategy, errors_);
   if (const json* n = f.find("max_steps"))
     if (auto x = bounded_int(*n, f.at("max_steps"), "max_steps", 1, errors_)) a.max_steps = *x;
   if (const json* t = f.find("stop_tolerance"))
@@ -229,24 +219,25 @@ void JobReader::read_adaptive_bodies(const json& value, const std::string& point
   }
 }
 
-// Every default of "adaptivity" into the normalized copy (bodies: all named ones).
+// Every default of "adaptivity" into the normalized copy: AdaptivitySettings' own (bodies: all named ones).
 void JobReader::write_adaptivity_defaults(json& out) {
-  set_default(out, "indicator", "fem_bem");
-  set_default(out, "normalization", "rms");
-  set_default(out, "delta", 0.1);
-  set_default(out, "marking", "contact");
-  set_default(out, "grading", 0.0);
+  const AdaptivitySettings d;
+  set_default(out, "indicator", name_of(d.indicator));
+  set_default(out, "normalization", name_of(d.normalization));
+  set_default(out, "delta", d.delta);
+  set_default(out, "marking", name_of(d.marking));
+  set_default(out, "grading", d.grading);
   if (!out.contains("bodies")) {
     json all = json::array();
     for (const auto& in : inputs_)
       if (in.has_name) all.push_back(in.body.name);
     out["bodies"] = all;
   }
-  set_default(out, "max_level", 8);
-  set_default(out, "max_dofs", 400000);
-  set_default(out, "strategy", "converge_then_refine");
-  set_default(out, "max_steps", 20);
-  set_default(out, "stop_tolerance", 0.005);
+  set_default(out, "max_level", d.max_level);
+  set_default(out, "max_dofs", d.max_dofs);
+  set_default(out, "strategy", name_of(d.strategy));
+  set_default(out, "max_steps", d.max_steps);
+  set_default(out, "stop_tolerance", d.stop_tolerance);
 }
 
 void JobReader::read_robin(const json& value, const std::string& pointer) {
@@ -277,16 +268,9 @@ void JobReader::read_interface_solver(const json& value, const std::string& poin
   Fields f(value, pointer, "interface", {"solver", "preconditioner", "tolerance", "max_iterations"}, errors_);
   if (!f.ok()) return;
   auto& in = problem_.solver.interface;
-  if (const json* v = f.find("solver"))
-    if (auto x = choice(*v, f.at("solver"), "solver", {"auto", "direct", "iterative"}, errors_))
-      in.solver = *x == "direct"      ? InterfaceSolverKind::direct
-                  : *x == "iterative" ? InterfaceSolverKind::iterative
-                                      : InterfaceSolverKind::automatic;
+  if (const json* v = f.find("solver")) read_name(*v, f.at("solver"), "solver", in.solver, errors_);
   if (const json* v = f.find("preconditioner"))
-    if (auto x = choice(*v, f.at("preconditioner"), "preconditioner", {"none", "lumped", "dirichlet"}, errors_))
-      in.preconditioner = *x == "none"     ? InterfacePreconditioner::none
-                          : *x == "lumped" ? InterfacePreconditioner::lumped
-                                           : InterfacePreconditioner::dirichlet;
+    read_name(*v, f.at("preconditioner"), "preconditioner", in.preconditioner, errors_);
   if (const json* t = f.find("tolerance")) {
     auto x = positive(*t, f.at("tolerance"), "tolerance", errors_);
     if (x && *x >= 1e-2)
@@ -315,22 +299,24 @@ void JobReader::read_penalty(const json& value, const std::string& pointer, json
     if (auto x = positive(*c, f.at("c"), "c", errors_)) p.c = *x;
   if (const json* l = f.find("length"))
     if (auto x = positive(*l, f.at("length"), "length", errors_)) p.length = *x;
-  set_default(out, "c", 0.05);
+  set_default(out, "c", PenaltySpec{}.c);
 }
 
 // "parallel": {"ranks": N}: the MPI ranks a server runs the job on (docs/parallel.md); contact-solve takes
 // mpirun's number instead.
 void JobReader::read_parallel(const Fields& top) {
+  const int default_ranks = Problem{}.ranks;
   const json* v = top.find("parallel");
   if (!v) {
-    set_default(normalized_, "parallel", json{{"ranks", 1}});
+    set_default(normalized_, "parallel", json{{"ranks", default_ranks}});
     return;
   }
   Fields f(*v, top.at("parallel"), "parallel", {"ranks"}, errors_);
   if (!f.ok()) return;
   const json* n = f.find("ranks");
   if (!n) {
-    if (normalized_.is_object() && normalized_["parallel"].is_object()) normalized_["parallel"]["ranks"] = 1;
+    if (normalized_.is_object() && normalized_["parallel"].is_object())
+      normalized_["parallel"]["ranks"] = default_ranks;
     return;
   }
   if (auto x = bounded_int(*n, f.at("ranks"), "ranks", 1, errors_)) {
@@ -347,8 +333,8 @@ void JobReader::read_parallel(const Fields& top) {
 // "loading": {"steps": N} (factors 1/N, 2/N, ..., 1) or {"factors": [f1, f2, ...]}.
 void JobReader::read_loading(const Fields& top) {
   const json* v = top.find("loading");
-  if (!v) {
-    set_default(normalized_, "loading", json{{"steps", 1}});
+  if (!v) {  // LoadingSpec's default: one step, the full load
+    set_default(normalized_, "loading", json{{"steps", static_cast<int>(LoadingSpec{}.factors.size())}});
     return;
   }
   const std::string pointer = top.at("loading");
@@ -402,18 +388,16 @@ void JobReader::read_loading_steps(const json& value, const std::string& pointer
 // keeps its last iterate (flagged); not by default (OutputSettings::iterate).
 void JobReader::read_output(const Fields& top) {
   json& out = sub_object(normalized_, "output");
-  problem_.output.steps = problem_.adaptivity.enabled ? StepOutput::last : StepOutput::all;
+  problem_.output.steps = problem_.adaptivity.enabled ? StepOutput::last : OutputSettings{}.steps;
   if (const json* v = top.find("output")) {
     Fields f(*v, top.at("output"), "output", {"steps", "progress_pairs", "iterate"}, errors_);
-    if (const json* s = f.find("steps"))
-      if (auto c = choice(*s, f.at("steps"), "steps", {"last", "all"}, errors_))
-        problem_.output.steps = *c == "last" ? StepOutput::last : StepOutput::all;
+    if (const json* s = f.find("steps")) read_name(*s, f.at("steps"), "steps", problem_.output.steps, errors_);
     if (const json* p = f.find("progress_pairs")) read_progress_pairs(*p, f.at("progress_pairs"));
     if (const json* i = f.find("iterate"))
       if (auto b = read::boolean(*i, f.at("iterate"), "iterate", errors_)) problem_.output.iterate = *b;
   }
-  set_default(out, "steps", problem_.output.steps == StepOutput::last ? "last" : "all");
-  set_default(out, "iterate", problem_.output.iterate);
+  set_default(out, "steps", name_of(problem_.output.steps));
+  set_default(out, "iterate", problem_.output.iterate);  // OutputSettings' default where not given
 }
 
 void JobReader::read_progress_pairs(const json& value, const std::string& pointer) {

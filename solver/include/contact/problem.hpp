@@ -128,6 +128,9 @@ const char* to_string(Method m);
 const char* to_string(Enforcement e);
 std::optional<Method> method_named(const std::string& name);
 std::optional<Enforcement> enforcement_named(const std::string& name);
+// Every name of the table, in its order: what the job reader accepts and lists in its messages.
+std::vector<std::string> method_names();
+std::vector<std::string> enforcement_names();
 
 // Robin weight psi (force per length^3, like 1/theta): a constant over every contact zone, or 1/theta on the
 // current active set and 0 elsewhere ("active_set").
@@ -177,6 +180,15 @@ struct SolverSettings {
   AugmentedLagrangianSettings augmented_lagrangian;
   InterfaceSolverSettings interface;
 };
+
+// neumann and robin iterate on the penalty problem (exact contact only in the limit, through augmented_lagrangian):
+// penalty is their default enforcement, exact is not available to them.
+bool iterates_on_penalty(Method method);
+
+// Why these settings cannot run together, in the one wording both the job reader (at the job's pointer) and
+// solve() (for a Problem built in code) give; empty when they can. The rule: exact enforcement with a method that
+// iterates on the penalty problem.
+std::string settings_conflict(const SolverSettings& settings);
 
 // h-adaptivity (paper section 3): indicator per cell, refine where it exceeds delta.
 enum class Indicator { fem_bem, zz };
