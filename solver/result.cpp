@@ -1,6 +1,6 @@
 #include "contact/result.hpp"
 
-#include "contact/extent.hpp"  // solver/contact/: the contact zone between nodes
+#include "mortar/extent.hpp"  // solver/mortar/: the contact zone between nodes
 
 namespace contact {
 

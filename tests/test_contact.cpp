@@ -1,8 +1,8 @@
-// The dual mortar discretisation (solver/contact/) and the patch tests of contact, built in code (independent of
+// The dual mortar discretisation (solver/mortar/) and the patch tests of contact, built in code (independent of
 // the job parser). Every expected number is a mathematical fact of the method or an exact solution.
-#include "contact/dual_basis.hpp"
-#include "contact/pair.hpp"
-#include "contact/segments.hpp"
+#include "mortar/dual_basis.hpp"
+#include "mortar/pair.hpp"
+#include "mortar/segments.hpp"
 #include "contact/solve.hpp"
 
 #include <gtest/gtest.h>

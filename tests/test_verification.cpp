@@ -1,6 +1,6 @@
 // Verification on the job examples (api/examples): the DDM against the monolithic reference, equilibrium,
 // Hertz, symmetry, and the paper's run. Every expected number comes from mathematics, not from a past run.
-#include "contact/extent.hpp"
+#include "mortar/extent.hpp"
 #include "contact/job.hpp"
 #include "contact/solve.hpp"
 #include "support.hpp"
@@ -291,7 +291,7 @@ TEST(PaperScheme, NodalMortarPenaltyReproducesTheRemovedGaussPointSchemeOnMatchi
 }
 
 TEST(Hertz, InterpolatedContactEdgeIsCloserToTheFormulaThanTheLastNodeInContact) {
-  // The result's contact_end (contact/extent.hpp: p^2 extrapolated linearly from the last two nodes in contact)
+  // The result's contact_end (mortar/extent.hpp: p^2 extrapolated linearly from the last two nodes in contact)
   // against Hertz's half-width a, on two meshes: within a third of the node spacing there, and closer than the
   // last node in contact (the quantised edge reported before).
   for (int nx : {80, 160}) {

@@ -3,10 +3,10 @@
 // per-iteration reports, final fields). Rebuilt when a mesh changes.
 //
 // Contact pressures are per pair one value per mortar row (contact node), positive in compression
-// (contact/pair.hpp); `Pressures` holds them for all pairs.
+// (mortar/pair.hpp); `Pressures` holds them for all pairs.
 #pragma once
 
-#include "../contact/pair.hpp"
+#include "../mortar/pair.hpp"
 #include "../fem/body_solver.hpp"
 #include "contact/problem.hpp"
 #include "contact/result.hpp"

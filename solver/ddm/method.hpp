@@ -25,7 +25,7 @@ struct RunContext {
 struct MethodOutcome {
   Displacements u;  // final displacements per body
   Pressures z;      // final contact pressures per pair, where they are not the penalty pressures of u (exact)
-  Pressures q;      // friction: final tangential multipliers per pair (empty: frictionless; contact/pair.hpp)
+  Pressures q;      // friction: final tangential multipliers per pair (empty: frictionless; mortar/pair.hpp)
   std::vector<Eigen::VectorXd> rigid_amplitudes;  // per body: floating bodies' rigid-mode amplitudes (else empty)
   bool converged = false;
   StopReason reason = StopReason::error;

@@ -3,8 +3,8 @@
 // pressures, gaps, normals and friction results). The system's set-up and solves are contact_system.cpp.
 #include "contact_system.hpp"
 
-#include "../contact/extent.hpp"
-#include "../contact/segments.hpp"
+#include "../mortar/extent.hpp"
+#include "../mortar/segments.hpp"
 
 #include <Eigen/QR>
 

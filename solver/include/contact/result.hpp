@@ -23,7 +23,7 @@ struct BodyReport {
 };
 
 // Contact pressure is positive in compression; it is the nodal multiplier of the dual mortar discretisation
-// (contact/pair.hpp), one value per slave node (0 where a node carries none).
+// (mortar/pair.hpp), one value per slave node (0 where a node carries none).
 struct PairReport {
   std::string name;
   double force = 0.0;          // total normal contact force (per unit thickness in plane strain)
@@ -159,7 +159,7 @@ struct StepSummary {
   std::vector<double> tangential_force;                   // per pair: friction's (0 for a frictionless pair)
 };
 
-// The step's scalars; the contact zone interpolated between nodes (solver/contact/extent.hpp; 0, 0 if none).
+// The step's scalars; the contact zone interpolated between nodes (solver/mortar/extent.hpp; 0, 0 if none).
 StepSummary summarize(const Step& step);
 
 struct Result {
