@@ -21,7 +21,7 @@ namespace contact::ddm {
 namespace {
 
 using linalg::ActiveSetResult;
-using linalg::Contact;
+using Contact = linalg::FrictionState;  // a friction row's state
 using linalg::FrictionRow;
 
 constexpr double infinity = std::numeric_limits<double>::infinity();

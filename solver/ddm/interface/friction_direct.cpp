@@ -14,7 +14,7 @@ namespace contact::ddm {
 
 namespace {
 
-using linalg::Contact;
+using Contact = linalg::FrictionState;  // a friction row's state
 using linalg::FrictionRow;
 using linalg::FrictionSets;
 
