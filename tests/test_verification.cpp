@@ -1,6 +1,6 @@
 // Verification on the job examples (api/examples): the DDM against the monolithic reference, equilibrium,
 // Hertz, symmetry, and the paper's run. Every expected number comes from mathematics, not from a past run.
-#include "mortar/extent.hpp"
+#include "contact_extent.hpp"
 #include "contact/job.hpp"
 #include "contact/solve.hpp"
 #include "support.hpp"
@@ -291,7 +291,7 @@ TEST(PaperScheme, NodalMortarPenaltyReproducesTheRemovedGaussPointSchemeOnMatchi
 }
 
 TEST(Hertz, InterpolatedContactEdgeIsCloserToTheFormulaThanTheLastNodeInContact) {
-  // The result's contact_end (mortar/extent.hpp: p^2 extrapolated linearly from the last two nodes in contact)
+  // The result's contact_end (contact_extent.hpp: p^2 extrapolated linearly from the last two nodes in contact)
   // against Hertz's half-width a, on two meshes: within a third of the node spacing there, and closer than the
   // last node in contact (the quantised edge reported before).
   for (int nx : {80, 160}) {
@@ -308,7 +308,7 @@ TEST(Hertz, InterpolatedContactEdgeIsCloserToTheFormulaThanTheLastNodeInContact)
     ASSERT_GT(last, 0);
     ASSERT_LT(last + 1, pair.pressure.size());
     const double h = pair.arc_length[last + 1] - pair.arc_length[last];
-    const double edge = mortar::contact_extent(pair.arc_length, pair.pressure).end;
+    const double edge = contact_extent(pair.arc_length, pair.pressure).end;
     EXPECT_LE(std::abs(edge - a), h / 3) << nx;
     EXPECT_LT(std::abs(edge - a), std::abs(pair.arc_length[last] - a)) << nx;
   }
