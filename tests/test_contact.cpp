@@ -43,7 +43,8 @@ ContactPair pair_of(int slave, const std::string& slave_edge, int master, const 
   return pair;
 }
 
-// TEST_PROBLEMS.md section 2: lower [0,2]x[-1,0], upper [0,2]x[0,1] (the slave), zero gap, pressed by delta.
+// ../shared/design/TEST_PROBLEMS.md section 2: lower [0,2]x[-1,0], upper [0,2]x[0,1] (the slave), zero gap,
+// pressed by delta.
 Problem flat_patch(int n_upper, int n_lower, double E_upper, double E_lower, double delta) {
   Problem p;
   p.name = "flat_patch";

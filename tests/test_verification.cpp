@@ -224,7 +224,8 @@ TEST(SeedLayers, PaperParametersStopByThePapersCriterionWithContactNearTheOrigin
   ASSERT_TRUE(r.converged) << r.message;
   EXPECT_LE(r.history.back().paper_criterion, 0.0015);
   EXPECT_GT(r.history[r.history.size() - 2 < r.history.size() ? r.history.size() - 2 : 0].paper_criterion, 0.0015);
-  // ALGORITHM.md: the paper's test stops long before the fixed-point residual is small (about 0.075 bound).
+  // docs/algorithm.md ("The Neumann DDM"): the paper's test stops long before the fixed-point residual is small (it
+  // bounds it by eps / gamma = 0.075 only).
   EXPECT_GT(r.history.back().fixed_point_residual, r.history.back().paper_criterion);
   const auto& pair = r.steps.back().pairs.at(0);
   // Contact on roughly 0 <= x <= 1 with the largest pressure at x = 0.
@@ -239,10 +240,10 @@ TEST(SeedLayers, PaperParametersStopByThePapersCriterionWithContactNearTheOrigin
 }
 
 TEST(SeedLayers, CurvedBodyAndAnalyticGapAgreeUpToADifferenceThatShrinksLikeHSquared) {
-  // TEST_PROBLEMS.md section 1: the linearised theory treats y = r0 x^2 as a gap function on a flat surface;
-  // the really curved body with the projected gap must give nearly the same contact. The two discretisations
-  // differ by the chord error of the curved edge, r0 h^2 / 8 per element, which the stiff penalty turns into a
-  // pressure difference of order r0 h^2 / theta: it must fall by about 4 when h halves.
+  // ../shared/design/TEST_PROBLEMS.md section 1: the linearised theory treats y = r0 x^2 as a gap function on a
+  // flat surface; the really curved body with the projected gap must give nearly the same contact. The two
+  // discretisations differ by the chord error of the curved edge, r0 h^2 / 8 per element, which the stiff penalty
+  // turns into a pressure difference of order r0 h^2 / theta: it must fall by about 4 when h halves.
   auto pressure_gap = [](int nx, double& force_difference) {
     json flat = load_example("seed_layers.json");
     json curved = load_example("seed_layers_curved.json");

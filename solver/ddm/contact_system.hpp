@@ -97,7 +97,7 @@ class ContactSystem {
   // Each body solved with the given loads, in parallel.
   Displacements solve_bodies(const Displacements& loads, parallel::TaskRunner& runner) const;
 
-  // The "elastic layer" initial guess (paper section 4, ALGORITHM.md section 5).
+  // The "elastic layer" initial guess (paper section 4; docs/algorithm.md, "Initial guess").
   Displacements elastic_layer_guess(parallel::TaskRunner& runner) const;
 
   // Per-iteration report for pressures z and nodal gaps g (per pair, per row); `previous_active` holds each

@@ -68,7 +68,7 @@ std::unique_ptr<ContactMethod> make_method(const ContactSystem& system, const So
 // The paper's parallel Neumann scheme (16)-(17) on fixed meshes.
 MethodOutcome run_neumann(const ContactSystem& system, const SolverSettings& settings, RunContext& context);
 
-// The Robin-type variant (ALGORITHM.md): each body's matrix carries the Robin weight on its contact zone.
+// The Robin-type variant (docs/algorithm.md): each body's matrix carries the Robin weight on its contact zone.
 MethodOutcome run_robin(const ContactSystem& system, const SolverSettings& settings, RunContext& context);
 
 // The same discrete problem (exact or penalty, per the settings' enforcement) solved in one system: the
