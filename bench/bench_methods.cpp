@@ -54,7 +54,8 @@ void run_table(const std::string& title, const json& job, bool sweep) {
 
   std::vector<Row> rows = {{"paper scheme, gamma 0.02", {{"method", "neumann"}, {"gamma", 0.02}}}};
   if (sweep) {
-    // Best fixed gamma: a short sweep below the stability bound (ALGORITHM.md: about 0.067 on seed_layers).
+    // Best fixed gamma: a short sweep below the stability bound (docs/algorithm.md, "Stability: which gamma
+    // converges": gamma < 2 / (1 + mu_max / theta), about 0.067 on seed_layers).
     for (double g : {0.03, 0.045, 0.06}) {
       char name[64];
       std::snprintf(name, sizeof name, "paper scheme, gamma %.3g", g);

@@ -1,6 +1,6 @@
 #include "contact/result.hpp"
 
-#include "contact/extent.hpp"  // solver/contact/: the contact zone between nodes
+#include "contact_extent.hpp"
 
 namespace contact {
 
@@ -47,7 +47,7 @@ StepSummary summarize(const Step& step) {
     s.pair_names.push_back(p.name);
     s.force.push_back(p.force);
     s.tangential_force.push_back(p.tangential_force);
-    const mortar::ContactExtent extent = mortar::contact_extent(p.arc_length, p.pressure);
+    const ContactExtent extent = contact_extent(p.arc_length, p.pressure);
     s.contact_begin.push_back(extent.begin);
     s.contact_end.push_back(extent.end);
   }

@@ -1,8 +1,8 @@
-// The dual mortar discretisation (solver/contact/) and the patch tests of contact, built in code (independent of
+// The dual mortar discretisation (solver/mortar/) and the patch tests of contact, built in code (independent of
 // the job parser). Every expected number is a mathematical fact of the method or an exact solution.
-#include "contact/dual_basis.hpp"
-#include "contact/pair.hpp"
-#include "contact/segments.hpp"
+#include "mortar/dual_basis.hpp"
+#include "mortar/pair.hpp"
+#include "mortar/segments.hpp"
 #include "contact/solve.hpp"
 
 #include <gtest/gtest.h>
@@ -43,7 +43,8 @@ ContactPair pair_of(int slave, const std::string& slave_edge, int master, const 
   return pair;
 }
 
-// TEST_PROBLEMS.md section 2: lower [0,2]x[-1,0], upper [0,2]x[0,1] (the slave), zero gap, pressed by delta.
+// ../shared/design/TEST_PROBLEMS.md section 2: lower [0,2]x[-1,0], upper [0,2]x[0,1] (the slave), zero gap,
+// pressed by delta.
 Problem flat_patch(int n_upper, int n_lower, double E_upper, double E_lower, double delta) {
   Problem p;
   p.name = "flat_patch";

@@ -1,6 +1,6 @@
 // Verification on the job examples (api/examples): the DDM against the monolithic reference, equilibrium,
 // Hertz, symmetry, and the paper's run. Every expected number comes from mathematics, not from a past run.
-#include "contact/extent.hpp"
+#include "contact_extent.hpp"
 #include "contact/job.hpp"
 #include "contact/solve.hpp"
 #include "support.hpp"
@@ -224,7 +224,8 @@ TEST(SeedLayers, PaperParametersStopByThePapersCriterionWithContactNearTheOrigin
   ASSERT_TRUE(r.converged) << r.message;
   EXPECT_LE(r.history.back().paper_criterion, 0.0015);
   EXPECT_GT(r.history[r.history.size() - 2 < r.history.size() ? r.history.size() - 2 : 0].paper_criterion, 0.0015);
-  // ALGORITHM.md: the paper's test stops long before the fixed-point residual is small (about 0.075 bound).
+  // docs/algorithm.md ("The Neumann DDM"): the paper's test stops long before the fixed-point residual is small (it
+  // bounds it by eps / gamma = 0.075 only).
   EXPECT_GT(r.history.back().fixed_point_residual, r.history.back().paper_criterion);
   const auto& pair = r.steps.back().pairs.at(0);
   // Contact on roughly 0 <= x <= 1 with the largest pressure at x = 0.
@@ -239,10 +240,10 @@ TEST(SeedLayers, PaperParametersStopByThePapersCriterionWithContactNearTheOrigin
 }
 
 TEST(SeedLayers, CurvedBodyAndAnalyticGapAgreeUpToADifferenceThatShrinksLikeHSquared) {
-  // TEST_PROBLEMS.md section 1: the linearised theory treats y = r0 x^2 as a gap function on a flat surface;
-  // the really curved body with the projected gap must give nearly the same contact. The two discretisations
-  // differ by the chord error of the curved edge, r0 h^2 / 8 per element, which the stiff penalty turns into a
-  // pressure difference of order r0 h^2 / theta: it must fall by about 4 when h halves.
+  // ../shared/design/TEST_PROBLEMS.md section 1: the linearised theory treats y = r0 x^2 as a gap function on a
+  // flat surface; the really curved body with the projected gap must give nearly the same contact. The two
+  // discretisations differ by the chord error of the curved edge, r0 h^2 / 8 per element, which the stiff penalty
+  // turns into a pressure difference of order r0 h^2 / theta: it must fall by about 4 when h halves.
   auto pressure_gap = [](int nx, double& force_difference) {
     json flat = load_example("seed_layers.json");
     json curved = load_example("seed_layers_curved.json");
@@ -291,7 +292,7 @@ TEST(PaperScheme, NodalMortarPenaltyReproducesTheRemovedGaussPointSchemeOnMatchi
 }
 
 TEST(Hertz, InterpolatedContactEdgeIsCloserToTheFormulaThanTheLastNodeInContact) {
-  // The result's contact_end (contact/extent.hpp: p^2 extrapolated linearly from the last two nodes in contact)
+  // The result's contact_end (contact_extent.hpp: p^2 extrapolated linearly from the last two nodes in contact)
   // against Hertz's half-width a, on two meshes: within a third of the node spacing there, and closer than the
   // last node in contact (the quantised edge reported before).
   for (int nx : {80, 160}) {
@@ -308,7 +309,7 @@ TEST(Hertz, InterpolatedContactEdgeIsCloserToTheFormulaThanTheLastNodeInContact)
     ASSERT_GT(last, 0);
     ASSERT_LT(last + 1, pair.pressure.size());
     const double h = pair.arc_length[last + 1] - pair.arc_length[last];
-    const double edge = mortar::contact_extent(pair.arc_length, pair.pressure).end;
+    const double edge = contact_extent(pair.arc_length, pair.pressure).end;
     EXPECT_LE(std::abs(edge - a), h / 3) << nx;
     EXPECT_LT(std::abs(edge - a), std::abs(pair.arc_length[last] - a)) << nx;
   }

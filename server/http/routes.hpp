@@ -82,7 +82,8 @@ struct RouteContext {
   // Reads a JSON job body within the body budget; on failure the response is set and the result is false.
   bool read_json_body(const Request& req, Response& res, const ContentReader& reader, std::string& body,
                       BodyBudget::Slot& slot) const;
-  // The job the path names, or null with 404 set (a malformed id is no job either).
+  // The job the path names, or null with the answer set: 404 (a malformed id is no job either), or 500 corrupt-job
+  // when its files are damaged.
   std::shared_ptr<Job> find_job(const Request& req, Response& res) const;
   // The job as JSON; `listed`: as the job list carries it (its progress a bounded digest, progress_digest).
   nlohmann::json job_resource(const JobRecord& record, int queue_position, bool listed = false) const;

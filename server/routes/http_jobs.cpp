@@ -51,6 +51,20 @@ void send_no_job(httplib::Response& res, const std::string& id, const std::strin
   send_problem(res, 404, "", "no job with id '" + clip(id, 64) + "'", instance);
 }
 
+// The job `id` names, or null with the answer set: 404 when it names none (a malformed id never reaches the disk),
+// 500 corrupt-job when its files are damaged. GET, the streams (find_job) and cancel answer alike.
+std::shared_ptr<Job> job_or_problem(const JobQueue& queue, const std::string& id, httplib::Response& res,
+                                    const std::string& instance) {
+  std::shared_ptr<Job> job = is_job_id(id) ? queue.find(id) : nullptr;
+  if (!job) {
+    if (auto problem = is_job_id(id) ? queue.damage(id) : std::nullopt)
+      send_problem(res, 500, "corrupt-job", "job " + id + ": " + *problem, instance);
+    else
+      send_no_job(res, id, instance);
+  }
+  return job;
+}
+
 void send_busy(httplib::Response& res, const std::string& what, const std::string& instance) {
   res.set_header("Retry-After", "5");
   send_problem(res, 503, "busy", "the server is at its limit of " + what + "; retry later", instance);
@@ -101,18 +115,7 @@ bool RouteContext::read_json_body(const Request& req, Response& res, const Conte
 
 std::shared_ptr<Job> RouteContext::find_job(const Request& req, Response& res) const {
   const std::string id = req.matches.size() > 1 ? std::string(req.matches[1]) : std::string();
-  if (!is_job_id(id)) {  // anything else never reaches the disk
-    send_no_job(res, id, req.path);
-    return nullptr;
-  }
-  std::shared_ptr<Job> job = queue.find(id);
-  if (!job) {
-    if (auto problem = queue.damage(id))
-      send_problem(res, 500, "corrupt-job", "job " + id + ": " + *problem, req.path);
-    else
-      send_no_job(res, id, req.path);
-  }
-  return job;
+  return job_or_problem(queue, id, res, req.path);
 }
 
 namespace {
@@ -306,14 +309,8 @@ void handle_cancel(RouteContext& ctx, const Request& req, Response& res) {
   // Called from the pre-routing handler too (a POST without a body), where req.matches is not set.
   std::string id;
   if (std::regex_match(req.path, match, kCancelRoute)) id = match[1];
-  std::shared_ptr<Job> job = is_job_id(id) ? ctx.queue.find(id) : nullptr;
-  if (!job) {
-    if (auto problem = is_job_id(id) ? ctx.queue.damage(id) : std::nullopt)
-      send_problem(res, 500, "corrupt-job", "job " + id + ": " + *problem, req.path);
-    else
-      send_no_job(res, id, req.path);
-    return;
-  }
+  const std::shared_ptr<Job> job = job_or_problem(ctx.queue, id, res, req.path);
+  if (!job) return;
   const auto outcome = ctx.queue.cancel(id);
   int position = 0;
   const JobRecord record = ctx.queue.snapshot(*job, &position);

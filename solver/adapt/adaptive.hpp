@@ -1,4 +1,4 @@
-// The adaptive loop (paper section 3; docs/algorithm.md), both ways:
+// The adaptive loop (paper section 3; docs/algorithm.md, "h-adaptivity"), both ways:
 //  * paper: every iteration does one Neumann update (paper (16)-(17)), then estimates and refines the adaptive
 //    bodies; the refined mesh starts the next iteration (the iterate transferred to it). Stops when the DDM
 //    criterion holds and no cell is marked.

@@ -1,4 +1,4 @@
-// Error indicators per cell and marking (paper section 3; ALGORITHM.md section 3).
+// Error indicators per cell and marking (paper section 3; docs/algorithm.md, "h-adaptivity").
 //
 // Both indicators compare the FE stresses sigma_F with a reference field sigma_R, ||s||_D = sqrt(int_D s_ij s_ij)
 // (in-plane components: sxx^2 + syy^2 + 2 sxy^2; the 2x2 Gauss rule of a quadrilateral, the three-point rule of

@@ -1,5 +1,5 @@
 // 2D elastostatic boundary element method: the FEM-BEM error indicator's independent solution of one body
-// (docs/bem.md; ALGORITHM.md section 3; the paper's section 3).
+// (docs/bem.md; docs/algorithm.md, "h-adaptivity"; the paper's section 3).
 //
 // Direct collocation BEM with straight two-node elements: displacements continuous and linear, tractions linear
 // on each element and free to jump between elements; Kelvin fundamental solution of plane strain (plane stress

@@ -1,6 +1,6 @@
 #include "background.hpp"
 
-#include "contact/solve.hpp"
+#include "contact/background_work.hpp"
 
 namespace contact {
 

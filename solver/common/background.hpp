@@ -6,7 +6,7 @@
 //
 // The work must own everything it touches (capture copies or shared pointers, never references to the caller's
 // state: the caller may be gone when it ends). Programs that may exit while such work runs call
-// wait_for_background_work() first (contact/solve.hpp says what a program should do).
+// wait_for_background_work() first (contact/background_work.hpp says what a program should do).
 #pragma once
 
 #include <chrono>

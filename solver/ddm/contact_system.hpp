@@ -3,10 +3,10 @@
 // per-iteration reports, final fields). Rebuilt when a mesh changes.
 //
 // Contact pressures are per pair one value per mortar row (contact node), positive in compression
-// (contact/pair.hpp); `Pressures` holds them for all pairs.
+// (mortar/pair.hpp); `Pressures` holds them for all pairs.
 #pragma once
 
-#include "../contact/pair.hpp"
+#include "../mortar/pair.hpp"
 #include "../fem/body_solver.hpp"
 #include "contact/problem.hpp"
 #include "contact/result.hpp"
@@ -99,7 +99,7 @@ class ContactSystem {
   // Each body solved with the given loads, in parallel.
   Displacements solve_bodies(const Displacements& loads) const;
 
-  // The "elastic layer" initial guess (paper section 4, ALGORITHM.md section 5).
+  // The "elastic layer" initial guess (paper section 4; docs/algorithm.md, "Initial guess").
   Displacements elastic_layer_guess() const;
 
   // Per-iteration report for pressures z and nodal gaps g (per pair, per row); `previous_active` holds each

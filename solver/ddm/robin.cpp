@@ -1,4 +1,4 @@
-// The Robin-type variant (ALGORITHM.md, "Robin-type variants"; reconstructed from the authors' later papers):
+// The Robin-type variant (docs/algorithm.md, "Robin variant"; reconstructed from the authors' later papers):
 //   a_a(u~_a, v) + int psi u~_an v_n = l_a(v) + int psi u_an^k v_n + (1/theta) int (d - u_1n^k - u_2n^k)^- v_n,
 // then the same relaxation as the Neumann scheme. psi = 0 is the paper's scheme. Discretely the Robin term is
 // Psi_a = sum over the pairs of body a of G_a^T diag(psi_r / D_r) G_a (G_a = G_s or G_m: the penalty's own

@@ -25,7 +25,7 @@ namespace contact::ddm {
 struct MethodOutcome : RunOutcome {
   Displacements u;  // final displacements per body
   Pressures z;      // final contact pressures per pair, where they are not the penalty pressures of u (exact)
-  Pressures q;      // friction: final tangential multipliers per pair (empty: frictionless; contact/pair.hpp)
+  Pressures q;      // friction: final tangential multipliers per pair (empty: frictionless; mortar/pair.hpp)
   std::vector<Eigen::VectorXd> rigid_amplitudes;  // per body: floating bodies' rigid-mode amplitudes (else empty)
   // Refused before any solve (statics: friction cannot hold the loads, ddm/friction_statics.hpp; or the settings):
   // a smaller increment of the same step would be refused too (load_steps.cpp cuts only the other failures).

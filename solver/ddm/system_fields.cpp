@@ -3,8 +3,8 @@
 // pressures, gaps, normals and friction results). The system's set-up and solves are contact_system.cpp.
 #include "contact_system.hpp"
 
-#include "../contact/extent.hpp"
-#include "../contact/segments.hpp"
+#include "../contact_extent.hpp"
+#include "../mortar/segments.hpp"
 
 #include <Eigen/QR>
 
@@ -42,7 +42,7 @@ IterationReport ContactSystem::report_gaps(int iteration, const Pressures& z, co
       pr.max_pressure = std::max(pr.max_pressure, p[row]);
     }
     const Eigen::VectorXd pn = pair.to_nodes(p, 0.0);
-    const mortar::ContactExtent extent = mortar::contact_extent(pair.node_arc, pn);
+    const ContactExtent extent = contact_extent(pair.node_arc, pn);
     pr.extent_begin = extent.begin;
     pr.extent_end = extent.end;
     pr.positions.assign(pair.node_arc.data(), pair.node_arc.data() + pair.node_arc.size());

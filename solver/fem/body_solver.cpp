@@ -5,7 +5,7 @@
 
 #include "element.hpp"
 #include "../common/scoped_timer.hpp"
-#include "rigid_modes.hpp"
+#include "../mesh/rigid_modes.hpp"
 
 #include <Eigen/QR>
 
@@ -48,7 +48,7 @@ void BodySolver::setup_constraints() {
   for (const auto& [node, ends] : mesh::hanging_nodes(body_.mesh))
     for (int c = 0; c < 2; ++c)
       constraints_.add_line(2 * node + c, {{2 * ends.first + c, 0.5}, {2 * ends.second + c, 0.5}});
-  std::vector<PrescribedDof> prescribed;
+  std::vector<mesh::PrescribedDof> prescribed;
   for (const auto& bc : body_.boundary) {
     if (!prescribes_displacement(bc)) continue;
     for (int node : condition_nodes(body_.mesh, bc)) {
@@ -63,7 +63,7 @@ void BodySolver::setup_constraints() {
     }
   }
   // CHOLMOD factorises a singular stiffness without complaint (a tiny pivot), so check the supports first.
-  RigidModes modes = free_rigid_modes(body_.mesh, prescribed);
+  mesh::RigidModes modes = mesh::free_rigid_modes(body_.mesh, prescribed);
   if (modes.modes.cols() > 0 && !allow_floating_) {
     std::string list;
     for (const auto& m : modes.names) list += (list.empty() ? "" : ", ") + m;

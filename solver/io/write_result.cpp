@@ -1,7 +1,7 @@
 // write_result: Result -> HDF5 file in the layout of docs/results-format.md.
 #include "contact/result_file.hpp"
 
-#include "contact/solve.hpp"
+#include "contact/version.hpp"
 #include "contact/utc_time.hpp"
 #include "view_layout.hpp"
 #include "file_util.hpp"

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "../fem/rigid_modes.hpp"
+#include "../mesh/rigid_modes.hpp"
 
 namespace contact::job::detail {
 
@@ -248,7 +248,7 @@ void JobReader::check_loads_off_supports(const Fields& f, const std::string& bp,
 // still be held by its contacts (check_floating_bodies decides, once the contacts and the method are known).
 void JobReader::check_restrained(BodyInput& in) {
   const mesh::Mesh& mesh = in.body.mesh;
-  std::set<fem::PrescribedDof> dofs;
+  std::set<mesh::PrescribedDof> dofs;
   for (const auto& bc : in.body.boundary) {
     if (!prescribes_displacement(bc)) continue;
     for (int node : condition_nodes(mesh, bc)) {
@@ -256,7 +256,7 @@ void JobReader::check_restrained(BodyInput& in) {
       if (bc.uy) dofs.insert({node, 1});
     }
   }
-  in.free_motions = fem::free_rigid_motions(mesh, std::vector<fem::PrescribedDof>(dofs.begin(), dofs.end()));
+  in.free_motions = mesh::free_rigid_motions(mesh, std::vector<mesh::PrescribedDof>(dofs.begin(), dofs.end()));
 }
 
 // A traction or force whose every node is held in both directions by displacement conditions would go straight
@@ -293,8 +293,8 @@ namespace {
 // The directions in which body i is held whatever the loads, at best: its prescribed components, and the normal of
 // every node of its contact edges (a frictionless contact pushes only along it); a contact with friction may also
 // hold along the tangent, so at best in every direction.
-std::vector<fem::HeldDirection> best_held_directions(const Body& body, const std::vector<ContactPair>& contacts, size_t i) {
-  std::vector<fem::HeldDirection> held;
+std::vector<mesh::HeldDirection> best_held_directions(const Body& body, const std::vector<ContactPair>& contacts, size_t i) {
+  std::vector<mesh::HeldDirection> held;
   for (const auto& bc : body.boundary) {
     if (!prescribes_displacement(bc)) continue;
     for (int node : condition_nodes(body.mesh, bc)) {
@@ -364,7 +364,7 @@ void JobReader::check_floating_bodies() {
                   "body '" + in.body.name + "' is not restrained against rigid motion (" + free +
                       ") and touches no other body: prescribe a displacement component on one of its edges or "
                       "vertices, or give it a contact that can hold it");
-    } else if (const auto loose = fem::free_rigid_modes_along(in.body.mesh, best_held_directions(in.body, problem_.contacts, i)).names;
+    } else if (const auto loose = mesh::free_rigid_modes_along(in.body.mesh, best_held_directions(in.body, problem_.contacts, i)).names;
                !loose.empty()) {
       // Frictionless contacts push only along their normals: a motion no normal resists is free whatever the
       // loads (a plate sliding along a flat contact, a roller spinning about its centre, where all its normals

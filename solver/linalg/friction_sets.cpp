@@ -11,7 +11,7 @@ int FrictionSets::changes(const FrictionSets& o) const {
   int n = 0;
   for (size_t j = 0; j < active.size() && j < o.active.size(); ++j) n += active[j] != o.active[j];
   for (size_t t = 0; t < state.size() && t < o.state.size(); ++t)
-    n += state[t] != o.state[t] || (state[t] == Contact::slip && sign[t] != o.sign[t]);
+    n += state[t] != o.state[t] || (state[t] == FrictionState::slip && sign[t] != o.sign[t]);
   return n;
 }
 
@@ -22,10 +22,10 @@ std::vector<char> tangential_mask(Eigen::Index size, const std::vector<FrictionR
 }
 
 void stick_where_in_contact(FrictionSets& sets, const std::vector<FrictionRow>& rows) {
-  sets.state.assign(rows.size(), Contact::open);
+  sets.state.assign(rows.size(), FrictionState::open);
   sets.sign.assign(rows.size(), 0);
   for (size_t t = 0; t < rows.size(); ++t)
-    if (sets.active[static_cast<size_t>(rows[t].normal)] || !rows[t].coulomb) sets.state[t] = Contact::stick;
+    if (sets.active[static_cast<size_t>(rows[t].normal)] || !rows[t].coulomb) sets.state[t] = FrictionState::stick;
 }
 
 namespace {
@@ -44,7 +44,7 @@ FrictionSets predict_friction_sets(const Eigen::VectorXd& lambda, const Eigen::V
   s.active.assign(static_cast<size_t>(n), 0);
   for (Eigen::Index j = 0; j < n; ++j)
     if (!is_tangential[static_cast<size_t>(j)]) s.active[static_cast<size_t>(j)] = lambda[j] - c[j] * h[j] > 0;
-  s.state.assign(rows.size(), Contact::open);
+  s.state.assign(rows.size(), FrictionState::open);
   s.sign.assign(rows.size(), 0);
   for (size_t t = 0; t < rows.size(); ++t) {
     const auto& r = rows[t];
@@ -52,9 +52,9 @@ FrictionSets predict_friction_sets(const Eigen::VectorXd& lambda, const Eigen::V
     const double trial = lambda[r.tangential] - c[r.tangential] * h[r.tangential];
     const double b = bound_of(r, lambda[r.normal] - c[r.normal] * h[r.normal]);
     if (std::abs(trial) <= b) {
-      s.state[t] = Contact::stick;
+      s.state[t] = FrictionState::stick;
     } else {
-      s.state[t] = Contact::slip;
+      s.state[t] = FrictionState::slip;
       s.sign[t] = trial > 0 ? 1 : -1;
     }
   }
@@ -73,14 +73,14 @@ FrictionParametrization parametrize(const FrictionSets& sets, const std::vector<
       out.rows.push_back(j);
     }
   for (size_t t = 0; t < rows.size(); ++t)
-    if (sets.state[t] == Contact::stick) {
+    if (sets.state[t] == FrictionState::stick) {
       column[static_cast<size_t>(rows[t].tangential)] = static_cast<Eigen::Index>(out.rows.size());
       out.rows.push_back(rows[t].tangential);
     }
   std::vector<Eigen::Triplet<double>> entries;
   for (Eigen::Index j : out.rows) entries.emplace_back(j, column[static_cast<size_t>(j)], 1.0);
   for (size_t t = 0; t < rows.size(); ++t) {
-    if (sets.state[t] != Contact::slip) continue;
+    if (sets.state[t] != FrictionState::slip) continue;
     const auto& r = rows[t];
     if (r.coulomb)  // q_t = s mu z_i: a share of z_i's column
       entries.emplace_back(r.tangential, column[static_cast<size_t>(r.normal)], sets.sign[t] * r.mu);

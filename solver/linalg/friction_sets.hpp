@@ -41,12 +41,13 @@ struct FrictionRow {
   double bound = 0.0;  // Tresca
 };
 
-enum class Contact : char { open = 0, stick = 1, slip = 2 };
+// The state of one friction row: open (no bound, q = 0: a Coulomb row whose normal row is inactive), stick or slip.
+enum class FrictionState : char { open = 0, stick = 1, slip = 2 };
 
 struct FrictionSets {
-  std::vector<char> active;     // per unknown of lambda: 1 for an active normal row (tangential rows: unused)
-  std::vector<Contact> state;   // per friction row
-  std::vector<int> sign;        // per friction row: s_t where it slips
+  std::vector<char> active;          // per unknown of lambda: 1 for an active normal row (tangential rows: unused)
+  std::vector<FrictionState> state;  // per friction row
+  std::vector<int> sign;             // per friction row: s_t where it slips
   bool operator==(const FrictionSets& o) const { return active == o.active && state == o.state && sign == o.sign; }
   int changes(const FrictionSets& o) const;  // unknowns whose state differs
 };

@@ -21,7 +21,7 @@ namespace contact::ddm {
 namespace {
 
 using linalg::ActiveSetResult;
-using linalg::Contact;
+using linalg::FrictionState;
 using linalg::FrictionRow;
 
 constexpr double infinity = std::numeric_limits<double>::infinity();
@@ -88,8 +88,8 @@ std::string settled_message(const FrictionData& d, const ActiveSetResult& out, i
   int active = 0, stick = 0, slip = 0;
   for (char a : sets.active) active += a;
   for (auto st : sets.state) {
-    stick += st == Contact::stick;
-    slip += st == Contact::slip;
+    stick += st == FrictionState::stick;
+    slip += st == FrictionState::slip;
   }
   std::ostringstream os;
   os << "FETI (projected MPRGP on the box, SMALBE) with " << (d.coulomb ? "Coulomb" : "Tresca")

@@ -14,7 +14,7 @@ namespace contact::ddm {
 
 namespace {
 
-using linalg::Contact;
+using linalg::FrictionState;
 using linalg::FrictionRow;
 using linalg::FrictionSets;
 
@@ -127,8 +127,8 @@ void describe_stop(const linalg::FrictionNewtonResult& r, const InterfaceQp& qp,
     case linalg::FrictionStop::settled: {
       int stick = 0, slip = 0, active = 0;
       for (auto st : r.sets.state) {
-        stick += st == Contact::stick;
-        slip += st == Contact::slip;
+        stick += st == FrictionState::stick;
+        slip += st == FrictionState::slip;
       }
       for (Eigen::Index j = 0; j < qp.problem.normal_size(); ++j) active += r.sets.active[static_cast<size_t>(j)];
       std::ostringstream os;

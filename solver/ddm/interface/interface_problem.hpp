@@ -42,7 +42,7 @@ class InterfaceProblem {
     // only its own bodies' blocks (the iterative solver applies them where they live).
     bool replicate_blocks = true;
     // Friction pairs add a tangential row per contact node (after all the normal rows): the weighted slip of this
-    // load step, conjugate to the tangential multiplier (contact/pair.hpp).
+    // load step, conjugate to the tangential multiplier (mortar/pair.hpp).
     bool friction = false;
   };
 

@@ -23,14 +23,14 @@ struct BodyReport {
 };
 
 // Contact pressure is positive in compression; it is the nodal multiplier of the dual mortar discretisation
-// (contact/pair.hpp), one value per slave node (0 where a node carries none).
+// (mortar/pair.hpp), one value per slave node (0 where a node carries none).
 struct PairReport {
   std::string name;
   double force = 0.0;          // total normal contact force (per unit thickness in plane strain)
   Eigen::Vector2d resultant = Eigen::Vector2d::Zero();  // the force vector on the slave (PairField::resultant)
   double max_pressure = 0.0;
-  double extent_begin = 0.0;   // arc length along the slave edge of the first and last active node
-  double extent_end = 0.0;     // (both 0 when nothing is in contact)
+  double extent_begin = 0.0;   // arc lengths along the slave edge where the contact zone begins and ends,
+  double extent_end = 0.0;     // interpolated between nodes (solver/contact_extent.hpp; both 0 without contact)
   int active_nodes = 0;        // slave nodes in contact (pressure > 0)
   int changed_nodes = 0;       // slave nodes whose contact status changed since the last iteration
   double theta = 0.0;          // penalty parameter (0 when contact is enforced exactly)
@@ -159,7 +159,7 @@ struct StepSummary {
   std::vector<double> tangential_force;                   // per pair: friction's (0 for a frictionless pair)
 };
 
-// The step's scalars; the contact zone interpolated between nodes (solver/contact/extent.hpp; 0, 0 if none).
+// The step's scalars; the contact zone interpolated between nodes (solver/contact_extent.hpp; 0, 0 if none).
 StepSummary summarize(const Step& step);
 
 // How a run ended and what it cost: what every level of a run builds (ddm::MethodOutcome adds the answer it carries

@@ -6,7 +6,7 @@
 #include <iomanip>
 #include <sstream>
 
-namespace contact::fem {
+namespace contact::mesh {
 
 namespace {
 
@@ -31,7 +31,7 @@ std::string describe_translation(Eigen::Vector2d d) {
 
 }  // namespace
 
-std::vector<std::string> free_rigid_motions(const mesh::Mesh& mesh, const std::vector<PrescribedDof>& prescribed) {
+std::vector<std::string> free_rigid_motions(const Mesh& mesh, const std::vector<PrescribedDof>& prescribed) {
   return free_rigid_modes(mesh, prescribed).names;
 }
 
@@ -39,7 +39,7 @@ namespace {
 
 // The body's centroid (area-weighted cell centres) and the distance to its farthest node, which scales the
 // rotation mode to unit size so that the three modes are comparable in the SVD.
-void centroid_and_radius(const mesh::Mesh& mesh, Eigen::Vector2d& centroid, double& radius) {
+void centroid_and_radius(const Mesh& mesh, Eigen::Vector2d& centroid, double& radius) {
   centroid = Eigen::Vector2d::Zero();
   double area = 0.0;
   for (int c = 0; c < mesh.num_cells(); ++c) {
@@ -58,14 +58,14 @@ void centroid_and_radius(const mesh::Mesh& mesh, Eigen::Vector2d& centroid, doub
 
 }  // namespace
 
-RigidModes free_rigid_modes(const mesh::Mesh& mesh, const std::vector<PrescribedDof>& prescribed) {
+RigidModes free_rigid_modes(const Mesh& mesh, const std::vector<PrescribedDof>& prescribed) {
   std::vector<HeldDirection> held;
   for (const auto& p : prescribed)
     held.push_back({p[0], p[1] == 0 ? Eigen::Vector2d(1, 0) : Eigen::Vector2d(0, 1)});
   return free_rigid_modes_along(mesh, held);
 }
 
-RigidModes free_rigid_modes_along(const mesh::Mesh& mesh, const std::vector<HeldDirection>& held) {
+RigidModes free_rigid_modes_along(const Mesh& mesh, const std::vector<HeldDirection>& held) {
   Eigen::Vector2d centroid;
   double radius = 1.0;
   centroid_and_radius(mesh, centroid, radius);
@@ -132,4 +132,4 @@ RigidModes free_rigid_modes_along(const mesh::Mesh& mesh, const std::vector<Held
   return out;
 }
 
-}  // namespace contact::fem
+}  // namespace contact::mesh

@@ -1,8 +1,8 @@
-#include "extent.hpp"
+#include "contact_extent.hpp"
 
 #include <algorithm>
 
-namespace contact::mortar {
+namespace contact {
 
 namespace {
 
@@ -34,4 +34,4 @@ ContactExtent contact_extent(const Eigen::VectorXd& arc, const Eigen::VectorXd& 
   return out;
 }
 
-}  // namespace contact::mortar
+}  // namespace contact

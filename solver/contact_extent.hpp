@@ -6,11 +6,15 @@
 // taken within [s_j, s_{j+1}]. Where the pressure does not fall towards the edge (a punch's corner, a single node in
 // contact) nothing is extrapolated: the edge is the last node in contact. With no open node beyond (the contact
 // reaches the end of the slave edge) the edge is that end node.
+//
+// A reading of a pair's nodal pressures, not part of the mortar discretisation: the step summary (result.cpp,
+// StepSummary's contact_begin and contact_end) and the iteration reports (ddm/system_fields.cpp, PairReport's
+// extent_begin and extent_end) both take it.
 #pragma once
 
 #include <Eigen/Core>
 
-namespace contact::mortar {
+namespace contact {
 
 struct ContactExtent {
   double begin = 0.0, end = 0.0;  // arc lengths along the slave edge (both 0 without contact)
@@ -20,4 +24,4 @@ struct ContactExtent {
 // arc: the slave nodes' arc lengths in order; pressure: their nodal pressures (> 0 in contact).
 ContactExtent contact_extent(const Eigen::VectorXd& arc, const Eigen::VectorXd& pressure);
 
-}  // namespace contact::mortar
+}  // namespace contact

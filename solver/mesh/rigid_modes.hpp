@@ -14,7 +14,7 @@
 
 #include <Eigen/Core>
 
-namespace contact::fem {
+namespace contact::mesh {
 
 // One prescribed displacement component: node index and component (0 = x, 1 = y).
 using PrescribedDof = std::array<int, 2>;
@@ -24,7 +24,7 @@ using PrescribedDof = std::array<int, 2>;
 // "rotation about (x, y)". Empty when the body is restrained. Method: the three rigid modes about the
 // centroid (two unit translations and a rotation scaled to unit size at the farthest node) evaluated at the
 // prescribed components; their null space, by SVD with a relative tolerance of 1e-10, holds the free motions.
-std::vector<std::string> free_rigid_motions(const mesh::Mesh& mesh, const std::vector<PrescribedDof>& prescribed);
+std::vector<std::string> free_rigid_motions(const Mesh& mesh, const std::vector<PrescribedDof>& prescribed);
 
 // The same free motions as vectors: `modes` is n_dofs x k (dof = 2 node + component), its columns an orthonormal
 // basis (in the coefficients of the three modes about the centroid, the rotation scaled to unit size at the
@@ -34,7 +34,7 @@ struct RigidModes {
   Eigen::MatrixXd modes;
   std::vector<std::string> names;
 };
-RigidModes free_rigid_modes(const mesh::Mesh& mesh, const std::vector<PrescribedDof>& prescribed);
+RigidModes free_rigid_modes(const Mesh& mesh, const std::vector<PrescribedDof>& prescribed);
 
 // The same for motions held along arbitrary directions at nodes (a support's component, or a frictionless
 // contact's normal, which stops a node only along it).
@@ -42,6 +42,6 @@ struct HeldDirection {
   int node = 0;
   Eigen::Vector2d direction = Eigen::Vector2d::UnitX();
 };
-RigidModes free_rigid_modes_along(const mesh::Mesh& mesh, const std::vector<HeldDirection>& held);
+RigidModes free_rigid_modes_along(const Mesh& mesh, const std::vector<HeldDirection>& held);
 
-}  // namespace contact::fem
+}  // namespace contact::mesh
