@@ -64,4 +64,14 @@ std::string settings_conflict(const SolverSettings& settings) {
   return {};
 }
 
+std::string friction_conflict(const SolverSettings& settings) {
+  if (iterates_on_penalty(settings.method))
+    return std::string("friction is solved on the interface problem (semismooth Newton on stick and slip): method \"") +
+           to_string(settings.method) + "\" cannot take it; use method \"interface_newton\" (the default) or \"monolithic\"";
+  if (settings.enforcement != Enforcement::exact)
+    return std::string("friction needs exact contact (enforcement \"exact\", the default of interface_newton), not \"") +
+           to_string(settings.enforcement) + "\"";
+  return {};
+}
+
 }  // namespace contact

@@ -63,6 +63,9 @@ inline nlohmann::json cap_pulled_off_base() {
   })");
 }
 
+// The largest absolute entry (0 for an empty matrix).
+inline double max_abs(const Eigen::MatrixXd& m) { return m.size() ? m.cwiseAbs().maxCoeff() : 0.0; }
+
 // The body of a step by name (throws if it has none).
 inline const BodyField& body(const Step& s, const std::string& name) {
   for (const auto& b : s.bodies)

@@ -14,10 +14,7 @@
 
 using namespace contact;
 using nlohmann::json;
-using contact::testing::example;
-using contact::testing::body;
-using contact::testing::run;
-using contact::testing::parse_or_fail;
+using namespace contact::testing;  // the shared helpers (support.hpp)
 
 namespace {
 

@@ -12,10 +12,7 @@
 
 using namespace contact;
 using nlohmann::json;
-using contact::testing::example;
-using contact::testing::parse_or_fail;
-using contact::testing::run;
-using contact::testing::solve_quietly;
+using namespace contact::testing;  // the shared helpers (support.hpp)
 
 namespace {
 

@@ -12,12 +12,9 @@
 
 using namespace contact;
 using nlohmann::json;
-using contact::testing::example;
-using contact::testing::run;
+using namespace contact::testing;  // the shared helpers (support.hpp)
 
 namespace {
-
-double max_abs(const Eigen::MatrixXd& m) { return m.size() ? m.cwiseAbs().maxCoeff() : 0.0; }
 
 void expect_same_solution(const Result& a, const Result& b, double rel, const std::string& what) {
   ASSERT_FALSE(a.steps.empty()) << what << ": " << a.message;

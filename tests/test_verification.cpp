@@ -13,6 +13,7 @@
 
 using namespace contact;
 using nlohmann::json;
+using contact::testing::max_abs;
 using contact::testing::parse_or_fail;
 
 namespace {
@@ -34,7 +35,6 @@ std::pair<Result, Result> ddm_and_monolithic(json job, double gamma) {
   return {std::move(ddm), std::move(mono)};
 }
 
-double max_abs(const Eigen::MatrixXd& m) { return m.cwiseAbs().maxCoeff(); }
 
 void expect_same_solution(const Result& a, const Result& b, double rel) {
   ASSERT_FALSE(a.steps.empty());

@@ -338,9 +338,9 @@ double line_search(const PenaltyEnergy& energy, Eigen::VectorXd& x, const Eigen:
 void run_penalty(const ContactSystem& system, RunFrame& frame) {
   MethodOutcome& out = frame.outcome();
   const Stacked s = stack(system, true);
-  if (!s.friction.empty()) {  // (the job reader refuses it first)
+  if (!s.friction.empty()) {  // (the job reader refuses it first, in the same words)
     out.stop_reason = StopReason::error;
-    out.message = "monolithic: friction needs exact contact (enforcement exact)";
+    out.message = "monolithic: " + friction_conflict(frame.settings());
     return;
   }
   const PenaltyEnergy energy(system, s);

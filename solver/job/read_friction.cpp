@@ -67,17 +67,9 @@ void JobReader::check_friction_and_histories() {
   for (size_t k = 0; k < problem_.contacts.size() && k < friction_pointers_.size(); ++k) {
     if (!problem_.contacts[k].friction.active()) continue;
     const std::string& at = friction_pointers_[k];
-    if (s.method == Method::neumann || s.method == Method::robin) {
-      errors_.add(at, std::string("friction is solved on the interface problem (semismooth Newton on stick and slip): "
-                                  "method \"") + to_string(s.method) +
-                          "\" cannot take it; use method \"interface_newton\" (the default) or \"monolithic\"" +
-                          (method_.pointer.empty() ? "" : " at " + method_.pointer));
-      return;
-    }
-    if (s.enforcement != Enforcement::exact) {
-      errors_.add(at, "friction needs exact contact (enforcement \"exact\", the default of interface_newton), not \"" +
-                          std::string(to_string(s.enforcement)) +
-                          "\" at " + enforcement_.pointer);
+    if (const std::string conflict = friction_conflict(s); !conflict.empty()) {
+      const std::string& where = iterates_on_penalty(s.method) ? method_.pointer : enforcement_.pointer;
+      errors_.add(at, conflict + (where.empty() ? "" : " at " + where));
       return;
     }
     if (problem_.adaptivity.enabled) {

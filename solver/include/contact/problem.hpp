@@ -190,6 +190,11 @@ bool iterates_on_penalty(Method method);
 // iterates on the penalty problem.
 std::string settings_conflict(const SolverSettings& settings);
 
+// Why these settings cannot solve a frictional contact, in the one wording of the job reader (at the friction's
+// pointer) and of the solvers (for a Problem built in code); empty when they can. Friction is solved on the
+// interface problem or the monolithic one (not by neumann or robin), with exact contact.
+std::string friction_conflict(const SolverSettings& settings);
+
 // h-adaptivity (paper section 3): indicator per cell, refine where it exceeds delta.
 enum class Indicator { fem_bem, zz };
 // paper: one DDM update, then estimate and refine, every iteration (the paper's interleaving);
