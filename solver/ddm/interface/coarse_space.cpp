@@ -76,8 +76,13 @@ std::vector<Eigen::Index> CoarseSpace::unheld_by(const std::vector<char>& column
   return dependent_rows(problem_, GA * GAt);
 }
 
+Eigen::VectorXd CoarseSpace::solve_GGt(const Eigen::VectorXd& v) const {
+  if (empty()) return Eigen::VectorXd();
+  return factor_->llt.solve(v);
+}
+
 Eigen::VectorXd CoarseSpace::multipliers(const Eigen::VectorXd& r, const std::vector<char>& columns,
-                                         bool indeterminate) const {
+                                         bool indeterminate, const Eigen::VectorXd* prior) const {
   if (empty()) return Eigen::VectorXd();
   const SparseMatrix GA = columns_of(columns);
   const SparseMatrix GAt = GA.transpose();
@@ -85,22 +90,28 @@ Eigen::VectorXd CoarseSpace::multipliers(const Eigen::VectorXd& r, const std::ve
   const Eigen::VectorXd rhs = -(GA * r);
   // Singular with each body's block regular: a group of bodies held by nothing as a whole (two bricks joined by a
   // head joint on a slipping course); CHOLMOD says so by failing, quietly.
-  const auto solve = [&](const SparseMatrix& A, Eigen::VectorXd& alpha) {
+  const auto solve = [&](const SparseMatrix& A, const Eigen::VectorXd& b, Eigen::VectorXd& alpha) {
     Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> llt;
     llt.cholmod().print = 0;
     llt.compute(A);
     if (llt.info() != Eigen::Success) return false;
-    alpha = llt.solve(rhs);
+    alpha = llt.solve(b);
     return alpha.allFinite();
   };
   Eigen::VectorXd alpha;
   const bool dependent = !dependent_rows(problem_, GAGAt).empty();
-  if (!dependent && solve(GAGAt, alpha)) return alpha;
+  if (!dependent && solve(GAGAt, rhs, alpha)) return alpha;
   if (!indeterminate) return Eigen::VectorXd();
   const double eps = 1e-10 * std::max(GAGAt.diagonal().cwiseAbs().maxCoeff(), 1e-300);
   SparseMatrix shift(GAGAt.rows(), GAGAt.cols());
   shift.setIdentity();
-  if (solve(SparseMatrix(GAGAt + eps * shift), alpha)) return alpha;
+  const SparseMatrix regularised = GAGAt + eps * shift;
+  // With a prior the unknown is the correction to it: the least one along the motions no column holds.
+  if (prior && prior->size() == G_.rows()) {
+    if (solve(regularised, Eigen::VectorXd(-(GA * (r + Gt_ * *prior))), alpha)) return *prior + alpha;
+  } else if (solve(regularised, rhs, alpha)) {
+    return alpha;
+  }
   return Eigen::VectorXd();
 }
 

@@ -38,9 +38,13 @@ class CoarseSpace {
   // (G_A G_A^T)^-1 G_A (-r_A). Empty when G_A G_A^T is singular (the active set leaves a body unheld), unless
   // `indeterminate` allows it: then the least-squares solution with the least |alpha| along the motions no column
   // holds (G_A G_A^T + eps I, eps = 1e-10 of its largest diagonal entry), the choice the direct solver makes for
-  // a brick whose joints all slip (linalg/friction_nested.cpp, solve_sets_system).
-  Eigen::VectorXd multipliers(const Eigen::VectorXd& r, const std::vector<char>& columns,
-                              bool indeterminate = false) const;
+  // a brick whose joints all slip (linalg/friction_nested.cpp, solve_sets_system). With `prior`, the solution
+  // nearest to it along those motions instead of the least (the QP's own equality multipliers, which make every
+  // slip point the way its friction force resists: Smalbe::finish).
+  Eigen::VectorXd multipliers(const Eigen::VectorXd& r, const std::vector<char>& columns, bool indeterminate = false,
+                              const Eigen::VectorXd* prior = nullptr) const;
+  // (G G^T)^-1 v.
+  Eigen::VectorXd solve_GGt(const Eigen::VectorXd& v) const;
   // The rows of the floating bodies that the columns `columns` alone cannot hold (their block of G_A G_A^T is
   // singular): the bodies an active set leaves unheld.
   std::vector<Eigen::Index> unheld_by(const std::vector<char>& columns) const;

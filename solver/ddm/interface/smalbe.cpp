@@ -101,9 +101,13 @@ bool Smalbe::finish(const Eigen::VectorXd& x, const Bounds& bounds, ActiveSetRes
   if (!coarse_.empty()) {
     // With friction a floating body whose contact nodes all sit on their bounds (a brick whose bed joints both
     // slip) has an indeterminate rigid motion along the slip when its loads balance (SMALBE's equalities, checked
-    // apart): the least rigid motion is taken, and a body that would slide away is still named, by the stagnating
-    // equality violation.
-    out.alpha = coarse_.multipliers(out.h, active, upper);
+    // apart): the least rigid motion is not the answer there, since it lets some slip point along its friction
+    // force. SMALBE's own equality multipliers are: MPRGP's gradient P h + nu, which its stop makes sign-consistent
+    // on every bound, is h + G^T alpha_s with alpha_s = (G G^T)^-1 G (nu - h). So the motions no free column fixes
+    // are taken nearest to alpha_s; the others by the least squares on the free columns, as without friction. A
+    // body that would slide away is still named, by the stagnating equality violation.
+    const Eigen::VectorXd prior = upper ? coarse_.solve_GGt(coarse_.G() * (nu_ - out.h)) : Eigen::VectorXd();
+    out.alpha = coarse_.multipliers(out.h, active, upper, upper ? &prior : nullptr);
     if (out.alpha.size() != coarse_.rows()) {
       out.unrestrained = coarse_.unheld_by(active);
       if (out.unrestrained.empty())
