@@ -1,8 +1,10 @@
 #include "active_set.hpp"
 #include "../common/assert.hpp"
+#include "refined_solve.hpp"
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/Cholesky>
+#include <Eigen/UmfPackSupport>
 
 #include <algorithm>
 #include <set>
@@ -40,10 +42,77 @@ SparseMatrix columns_of(const SparseMatrix& G, const std::vector<Eigen::Index>& 
   return out;
 }
 
+// The rows of G that the columns GA do not reach (a floating body with no node in A): zero, relative to the
+// largest row, in G_A.
+std::vector<Eigen::Index> rows_not_reached(const SparseMatrix& GA) {
+  Eigen::VectorXd norm2 = Eigen::VectorXd::Zero(GA.rows());
+  for (int col = 0; col < GA.outerSize(); ++col)
+    for (SparseMatrix::InnerIterator it(GA, col); it; ++it) norm2[it.row()] += it.value() * it.value();
+  const double scale = std::max(norm2.maxCoeff(), 1e-300);
+  std::vector<Eigen::Index> out;
+  for (Eigen::Index i = 0; i < GA.rows(); ++i)
+    if (!(norm2[i] > 1e-24 * scale)) out.push_back(i);
+  return out;
+}
+
+// Up to this many equality rows (a few floating bodies) the Schur complement on alpha is taken dense: r solves
+// with H_AA's factor, cheaper than a factorisation of the saddle system when H_AA is dense (two bodies with one
+// contact zone); past it, the sparse saddle system.
+constexpr Eigen::Index kDenseSchurRows = 48;
+
+// zA (H_AA^-1 rhs on entry) and alpha by the dense Schur complement S = G_A H_AA^-1 G_A^T; false, with
+// `unrestrained` filled, when S is singular (a row no node of A reaches: its diagonal vanishes; or a group).
+bool solve_by_schur(const Factor& llt, const SparseMatrix& GA, const Eigen::VectorXd& e, Eigen::VectorXd& zA,
+                    Eigen::VectorXd& alpha, std::vector<Eigen::Index>& unrestrained) {
+  const Eigen::Index r = GA.rows();
+  const Eigen::MatrixXd Y = llt.solve(Eigen::MatrixXd(GA.transpose()));  // H_AA^-1 G_A^T
+  const Eigen::MatrixXd S = GA * Y;
+  const double scale = std::max(S.diagonal().cwiseAbs().maxCoeff(), 1e-300);
+  for (Eigen::Index i = 0; i < r; ++i)
+    if (!(S(i, i) > 1e-12 * scale)) unrestrained.push_back(i);
+  Eigen::LDLT<Eigen::MatrixXd> ldlt(S);
+  if (!unrestrained.empty() || ldlt.info() != Eigen::Success || ldlt.isNegative() ||
+      ldlt.vectorD().cwiseAbs().minCoeff() <= 1e-12 * scale) {
+    if (unrestrained.empty())
+      for (Eigen::Index i = 0; i < r; ++i) unrestrained.push_back(i);
+    return false;
+  }
+  alpha = ldlt.solve(GA * zA - e);
+  zA -= Y * alpha;
+  return true;
+}
+
+// zA and alpha from the sparse saddle system [H_AA G_A^T; G_A 0] [zA; alpha] = [rhs; e] by LU with a step of
+// refinement; false when it is singular to rounding (refined_solve.hpp).
+bool solve_saddle(const SparseMatrix& HAA, const SparseMatrix& GA, const Eigen::VectorXd& rhs, const Eigen::VectorXd& e,
+                  Eigen::VectorXd& zA, Eigen::VectorXd& alpha) {
+  const Eigen::Index na = HAA.rows(), r = GA.rows();
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(static_cast<size_t>(HAA.nonZeros() + 2 * GA.nonZeros()));
+  for (int col = 0; col < HAA.outerSize(); ++col)
+    for (SparseMatrix::InnerIterator it(HAA, col); it; ++it) entries.emplace_back(it.row(), it.col(), it.value());
+  for (int col = 0; col < GA.outerSize(); ++col)
+    for (SparseMatrix::InnerIterator it(GA, col); it; ++it) {
+      entries.emplace_back(na + it.row(), it.col(), it.value());
+      entries.emplace_back(it.col(), na + it.row(), it.value());
+    }
+  SparseMatrix K(na + r, na + r);
+  K.setFromTriplets(entries.begin(), entries.end());
+  Eigen::VectorXd b(na + r), x;
+  b << rhs, e;
+  if (!refined_solve<Eigen::UmfPackLU<SparseMatrix>>(K, b, 1, /*strict=*/true, x)) return false;
+  zA = x.head(na);
+  alpha = x.tail(r);
+  return true;
+}
+
 // z (and alpha) with h_A = 0 on the index set A, z = 0 elsewhere, and G z = e: H_AA z_A + G_A^T alpha = -g_A,
-// solved by the Schur complement S = G_A H_AA^-1 G_A^T on alpha (r x r, dense: r is three rows per floating body).
-// `ok` is false when H_AA is not positive definite; `unrestrained` receives the rows of G that A leaves without
-// support (S singular there).
+// G_A z_A = e. Without equalities by the Cholesky factor of H_AA; with a few, by the dense Schur complement on
+// alpha; with many, as the sparse saddle system [H_AA G_A^T; G_A 0] by LU (UMFPACK, one refinement step): its cost
+// is that of its sparse factor, where the Schur complement (r x r, and H_AA^-1 G_A^T, |A| x r) is dense in the
+// number of floating bodies (three rows each: 1,488 at a 22 x 22 wall). `ok` is false when H_AA is not positive
+// definite; `unrestrained` receives the rows of G that A leaves without support: a body no node of A touches, or
+// every row when the system is singular (a group of bodies A holds by nothing as a whole).
 Eigen::VectorXd solve_on(const SparseMatrix& H, const Eigen::VectorXd& g, const std::vector<Eigen::Index>& A,
                          const Equalities& eq, Eigen::VectorXd& alpha, bool& ok, std::vector<Eigen::Index>& unrestrained) {
   Eigen::VectorXd z = Eigen::VectorXd::Zero(g.size());
@@ -57,29 +126,24 @@ Eigen::VectorXd solve_on(const SparseMatrix& H, const Eigen::VectorXd& g, const 
   }
   Eigen::VectorXd rhs(na);
   for (Eigen::Index i = 0; i < na; ++i) rhs[i] = -g[A[static_cast<size_t>(i)]];
-  Factor llt(restrict_to(H, A));
+  const SparseMatrix HAA = restrict_to(H, A);
+  Factor llt(HAA);
   if (llt.info() != Eigen::Success) {
     ok = false;
     return z;
   }
-  Eigen::VectorXd zA = llt.solve(rhs);
-  if (r > 0) {
+  Eigen::VectorXd zA;
+  if (r > kDenseSchurRows) {
     const SparseMatrix GA = columns_of(eq.G, A);
-    const Eigen::MatrixXd Y = llt.solve(Eigen::MatrixXd(GA.transpose()));  // H_AA^-1 G_A^T
-    const Eigen::MatrixXd S = GA * Y;
-    // A row of G the active nodes do not reach has a zero diagonal in S (relative to its size elsewhere).
-    const double scale = std::max(S.diagonal().cwiseAbs().maxCoeff(), 1e-300);
-    for (Eigen::Index i = 0; i < r; ++i)
-      if (!(S(i, i) > 1e-12 * scale)) unrestrained.push_back(i);
-    Eigen::LDLT<Eigen::MatrixXd> ldlt(S);
-    if (!unrestrained.empty() || ldlt.info() != Eigen::Success || ldlt.isNegative() ||
-        ldlt.vectorD().cwiseAbs().minCoeff() <= 1e-12 * scale) {
-      if (unrestrained.empty())
-        for (Eigen::Index i = 0; i < r; ++i) unrestrained.push_back(i);
+    unrestrained = rows_not_reached(GA);
+    if (!unrestrained.empty()) return z;
+    if (!solve_saddle(HAA, GA, rhs, eq.e, zA, alpha)) {
+      for (Eigen::Index i = 0; i < r; ++i) unrestrained.push_back(i);
       return z;
     }
-    alpha = ldlt.solve(GA * zA - eq.e);
-    zA -= Y * alpha;
+  } else {
+    zA = llt.solve(rhs);
+    if (r > 0 && !solve_by_schur(llt, columns_of(eq.G, A), eq.e, zA, alpha, unrestrained)) return z;
   }
   for (Eigen::Index i = 0; i < na; ++i) z[A[static_cast<size_t>(i)]] = zA[i];
   return z;

@@ -11,12 +11,13 @@
 //   C_j(z) = z_j - max(0, z_j - c_j h_j / D_j),   c_j = D_j / H_jj  (the node's own stiffness: c h / D = h / H_jj
 //   is the pressure that would close the gap h_j alone),
 // predicting the active set A = {j : z_j - h_j / H_jj > 0}, then solving h_A = 0 with z = 0 off A (with G: the
-// saddle-point system of A, by its Schur complement on alpha): the map is piecewise linear, so the step on the
+// saddle-point system of A, sparse, by LU): the map is piecewise linear, so the step on the
 // right active set is exact, and the iteration stops when the set repeats. Should the sets ever cycle, a primal
 // active-set method for the QP (Lawson & Hanson's NNLS generalised; without G only) takes over: it ends in
 // finitely many steps.
 //
-// Every matrix is sparse: H_AA is factorised by CHOLMOD (supernodal) at every step, so a problem whose H couples
+// Every matrix is sparse: H_AA is factorised by CHOLMOD (supernodal) at every step (with G: the saddle system by
+// UMFPACK; no block is dense in the number of floating bodies), so a problem whose H couples
 // each unknown to a few others (the interface of many bodies) costs what its sparse factor costs, while a dense H
 // (two bodies with one contact zone) costs what a dense Cholesky costs. Pure linear algebra: nothing here knows
 // of bodies or meshes.
