@@ -1,6 +1,6 @@
 // Closed contact curves solved (issue 29, item 2): the shrink fit of api/examples/shrink_fit.json as a full
 // 360-degree model, one closed contact curve per body (the shaft's rim, the ring's bore), on polar meshes built in
-// code and on a Gmsh mesh read from tests/data; the closed curve as the slave and as the master.
+// code and on a Gmsh mesh read from tests/data; the closed curve as the slave and as the master, with friction too.
 //
 // Lame (plane strain): p = E' delta / (2 a) (1 - a^2 / b^2) = 109.89, E' = E / (1 - nu^2), uniform round the bore.
 #include "contact/job.hpp"
@@ -11,6 +11,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
+#include <string>
 
 using namespace contact;
 using nlohmann::json;
@@ -190,4 +192,60 @@ TEST(ClosedCurves, FullShrinkFitFromGmshWithOneClosedPhysicalCurvePerBody) {
     std::printf("[ measured ] gmsh 128, %s slave: min %.4f max %.4f mean %.4f force-averaged %.4f (Lame %.4f)\n",
                 ring_slave ? "ring" : "shaft", s.min, s.max, s.mean, s.force_averaged, p);
   }
+}
+
+TEST(ClosedCurves, AShrinkFitUnderTorqueSticksAndItsFrictionCarriesTheTorqueAsSlaveOrAsMaster) {
+  // The fit on matching meshes (64 nodes round) with Coulomb friction, mu = 0.3, and a torque T on the shaft: four
+  // tangential point loads at r = a / 2, the shaft held at its centre only, so only the contact's friction holds
+  // its rotation. T makes the mean shear T / (2 pi a^2) half of mu times Lame's pressure: every node sticks. On
+  // matching meshes each row's tangential force acts at its own node (D diagonal, M = D), so the moment of the
+  // tractions about the centre is the torque exactly (the shaft's equilibrium: its centre support exerts none,
+  // the radial normal forces none), to the solver's tolerance. The closed curve as slave or master: the same.
+  const FullShrinkFit fit;
+  const double mu = 0.3, pi = 3.14159265358979323846;
+  const double torque = 0.5 * mu * fit.lame() * 2 * pi * fit.a * fit.a;
+  std::map<long, double> pressures_by_angle[2];
+  for (const bool ring_slave : {true, false}) {
+    const int nt = 64;
+    Problem problem = fit.problem(nt, nt, ring_slave);
+    Body& shaft = problem.bodies[0];
+    shaft.boundary.pop_back();  // "east" in y: the rotation is the friction's to hold
+    const int ring = fit.shaft_rings / 2;
+    const double r = fit.a * ring / fit.shaft_rings;
+    for (int q = 0; q < 4; ++q) {
+      const int node = 1 + (ring - 1) * nt + q * nt / 4;
+      const std::string name = "torque" + std::to_string(q);
+      shaft.mesh.vertices[name] = node;
+      BoundaryCondition bc;
+      bc.kind = BoundaryCondition::Kind::force;
+      bc.vertex = name;
+      const Eigen::Vector2d x = shaft.mesh.nodes[static_cast<size_t>(node)];
+      bc.force = torque / (4 * r) * Eigen::Vector2d(-x.y(), x.x()) / x.norm();
+      shaft.boundary.push_back(bc);
+    }
+    problem.contacts[0].friction.law = FrictionSpec::Law::coulomb;
+    problem.contacts[0].friction.coefficient = mu;
+    const Result res = solve_quietly(problem);
+    ASSERT_TRUE(res.converged) << res.message;
+    const PairField& pair = res.steps.back().pairs.at(0);
+    double moment = 0;  // of the master's tractions on the slave, about the centre
+    int nodes = 0;
+    for (Eigen::Index i = 0; i < pair.pressure.size(); ++i) {
+      if (pair.status[i] != 0) continue;
+      ++nodes;
+      EXPECT_EQ(pair.stick[i], 1) << i;
+      EXPECT_LT(std::abs(pair.tangential_traction[i]), mu * pair.pressure[i]) << i;
+      const Eigen::Vector2d x = pair.position.row(i).transpose(), t = pair.tangent.row(i).transpose();
+      moment += pair.weight[i] * pair.tangential_traction[i] * (x.x() * t.y() - x.y() * t.x());
+    }
+    EXPECT_EQ(nodes, nt);
+    // The master's tractions on the slave: on the ring (the slave) the shaft's, turning with the torque (+T); on
+    // the shaft (the slave) the ring's, holding it against the torque (-T).
+    EXPECT_NEAR(moment, ring_slave ? torque : -torque, 1e-6 * torque);
+    pressures_by_angle[ring_slave ? 0 : 1] = by_angle(pair);
+    std::printf("[ measured ] torque, %s slave: moment of the friction %.6g, torque %.6g\n", ring_slave ? "ring" : "shaft",
+                moment, torque);
+  }
+  ASSERT_EQ(pressures_by_angle[0].size(), pressures_by_angle[1].size());
+  for (const auto& [angle, p] : pressures_by_angle[0]) EXPECT_NEAR(pressures_by_angle[1].at(angle), p, 1e-6 * p) << angle;
 }

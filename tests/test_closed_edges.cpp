@@ -1,6 +1,7 @@
 // Closed contact curves (issue 29, item 2) module by module: an edge set that is a closed loop (a bore, a shaft's
 // rim) accepted and ordered, kept by refinement; a set of several pieces still refused; the mortar pair of two
 // loops without ends; where a contact zone lies on a loop.
+#include "contact/job.hpp"
 #include "contact_extent.hpp"
 #include "mortar/pair.hpp"
 #include "polar_meshes.hpp"
@@ -28,7 +29,49 @@ double signed_area(const mesh::Mesh& m, const std::vector<int>& nodes) {
   return a;
 }
 
+// An annulus as an explicit job mesh: its nodes, quads, the edges "bore" (the inner circle) and "outside", and its
+// vertices.
+nlohmann::json explicit_annulus(double a, double b, int nr, int nt) {
+  const PolarMesh p = polar_annulus(a, b, nr, nt);
+  nlohmann::json nodes = nlohmann::json::array(), quads = nlohmann::json::array();
+  for (const auto& x : p.mesh.nodes) nodes.push_back({x.x(), x.y()});
+  for (const auto& c : p.mesh.cells) quads.push_back({c[0], c[1], c[2], c[3]});
+  return {{"nodes", nodes}, {"quads", quads}, {"edges", {{"bore", p.inner}, {"outside", p.outer}}},
+          {"vertices", p.mesh.vertices}};
+}
+
 }  // namespace
+
+TEST(ClosedEdges, AnExplicitJobNamesALoopAndItsFloatingBodyIsHeldAllRoundButSpinsWithoutFriction) {
+  // A tube (250 .. 500) in a ring (500 .. 1000), both explicit meshes with closed edges, the ring held at three
+  // outer vertices, the tube only by the contact of its "outside" loop with the ring's "bore". Frictionless, the
+  // loop's radial normals hold the tube's translations, the start's included, but not its rotation about the
+  // centre, and the reader says so; with friction the job is accepted.
+  nlohmann::json job = {
+      {"name", "tube_in_ring"}, {"version", 1},
+      {"bodies",
+       {{{"name", "tube"}, {"material", {{"E", 2e5}, {"nu", 0.3}}}, {"mesh", explicit_annulus(250, 500, 4, 32)}},
+        {{"name", "ring"}, {"material", {{"E", 2e5}, {"nu", 0.3}}}, {"mesh", explicit_annulus(500, 1000, 4, 32)},
+         {"boundary",
+          {{{"vertex", "east"}, {"displacement", {{"y", 0}}}}, {{"vertex", "west"}, {"displacement", {{"y", 0}}}},
+           {{"vertex", "north"}, {"displacement", {{"x", 0}}}}}}}}},
+      {"contacts", {{{"slave", "ring.bore"}, {"master", "tube.outside"}, {"gap", {{"constant", -0.5}}}}}}};
+  auto parsed = job::parse(job);
+  ASSERT_FALSE(parsed.ok());
+  const std::string errors = job::format_errors(parsed.errors);
+  EXPECT_NE(errors.find("body 'tube' floats"), std::string::npos) << errors;
+  EXPECT_NE(errors.find("nothing resists its rotation about (0, 0) (it spins: every contact normal passes through "
+                        "that point); prescribe"),
+            std::string::npos) << errors;  // its rotation only, no translation
+  job["contacts"][0]["friction"] = {{"coefficient", 0.3}};
+  parsed = job::parse(job);
+  ASSERT_TRUE(parsed.ok()) << job::format_errors(parsed.errors);
+  for (const auto& [body, edge] : {std::pair{0, "outside"}, std::pair{1, "bore"}}) {
+    const mesh::Mesh& m = parsed.problem->bodies[static_cast<size_t>(body)].mesh;
+    EXPECT_TRUE(m.edge_set_closed(edge)) << edge;
+    EXPECT_EQ(m.edge_set_nodes(edge).size(), 32u) << edge;
+  }
+}
 
 TEST(ClosedEdges, ARingOfQuadsAroundAHoleGivesTwoLoopsOrderedWithTheBodyOnTheLeftFromTheFirstSideGiven) {
   PolarMesh p = polar_annulus(1.0, 2.0, 2, 8);  // inner nodes 0..7, outer 16..23
