@@ -4,14 +4,21 @@
 //
 // Lame (plane strain): p = E' delta / (2 a) (1 - a^2 / b^2) = 109.89, E' = E / (1 - nu^2), uniform round the bore.
 #include "contact/job.hpp"
+#include "contact/result_file.hpp"
 #include "contact/solve.hpp"
+#include "io/h5.hpp"
 #include "polar_meshes.hpp"
 #include "support.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <map>
+#include <sstream>
+
+#include <unistd.h>
 #include <string>
 
 using namespace contact;
@@ -248,4 +255,49 @@ TEST(ClosedCurves, AShrinkFitUnderTorqueSticksAndItsFrictionCarriesTheTorqueAsSl
   }
   ASSERT_EQ(pressures_by_angle[0].size(), pressures_by_angle[1].size());
   for (const auto& [angle, p] : pressures_by_angle[0]) EXPECT_NEAR(pressures_by_angle[1].at(angle), p, 1e-6 * p) << angle;
+}
+
+TEST(ClosedCurves, TheResultFileDrawsALoopClosed) {
+  // The result file's views of a pair on a closed slave edge: the slave polyline's segments close the loop (the
+  // last row joins the last node to the first), in /steps/<k>/contacts/<pair>/segments (the XDMF sidecar's
+  // polyline) and in /VTKHDF's line cells; each node once.
+  const FullShrinkFit fit;
+  const int nt = 32;
+  const Problem problem = fit.problem(nt, nt, true);
+  const Result r = solve_quietly(problem);
+  ASSERT_TRUE(r.converged) << r.message;
+  const auto dir = std::filesystem::temp_directory_path() / ("closed_curves_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string hdf = (dir / "fit.hdf").string(), xmf = (dir / "fit.hdf.xmf").string();
+  io::write_result(hdf, problem, r);
+  io::write_xdmf(xmf, "fit.hdf", r);
+  {
+    io::h5::Handle file = io::h5::open_file(hdf);
+    const std::string pair = r.steps.back().pairs.at(0).name;
+    io::h5::Handle g = io::h5::open_group(file, "steps/" + std::to_string(r.steps.size() - 1) + "/contacts/" + pair);
+    std::vector<hsize_t> dims;
+    const auto segments = io::h5::read_dataset<std::int64_t>(g, "segments", 2, dims);
+    ASSERT_EQ(dims, (std::vector<hsize_t>{static_cast<hsize_t>(nt), 2}));
+    for (int j = 0; j < nt; ++j) {
+      EXPECT_EQ(segments[static_cast<size_t>(2 * j)], j);
+      EXPECT_EQ(segments[static_cast<size_t>(2 * j + 1)], (j + 1) % nt);
+    }
+    io::h5::Handle v = io::h5::open_group(file, "VTKHDF");
+    const auto points = io::h5::read_vector<std::int64_t>(v, "NumberOfPoints");
+    const auto cells = io::h5::read_vector<std::int64_t>(v, "NumberOfCells");
+    const auto ids = io::h5::read_vector<std::int64_t>(v, "NumberOfConnectivityIds");
+    ASSERT_EQ(cells.size(), 3u);  // the shaft, the ring, the pair
+    EXPECT_EQ(points[2], nt);
+    EXPECT_EQ(cells[2], nt);
+    EXPECT_EQ(ids[2], 2 * nt);
+  }
+  std::ifstream in(xmf);
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_NE(text.str().find("TopologyType=\"Polyline\" NodesPerElement=\"2\" NumberOfElements=\"" + std::to_string(nt) + "\""),
+            std::string::npos);
+  // Read back whole.
+  const io::ResultFile back = io::read_result(hdf);
+  EXPECT_EQ(back.steps.back().pairs.at(0).pressure, r.steps.back().pairs.at(0).pressure);
+  std::filesystem::remove_all(dir);
 }
