@@ -21,7 +21,13 @@ struct ContactExtent {
   bool any = false;
 };
 
+// On a closed slave edge (loop_length > 0: the loop's length, its closing segment included; arc from its start)
+// there are no ends: the zone is the shortest stretch of the loop that holds every node in contact, the loop less
+// its longest open stretch, extrapolated at both edges as above with the neighbours taken round the loop. A zone
+// across the start has begin > end (it runs from begin through the start to end); a loop in contact all round is
+// [0, loop_length].
+//
 // arc: the slave nodes' arc lengths in order; pressure: their nodal pressures (> 0 in contact).
-ContactExtent contact_extent(const Eigen::VectorXd& arc, const Eigen::VectorXd& pressure);
+ContactExtent contact_extent(const Eigen::VectorXd& arc, const Eigen::VectorXd& pressure, double loop_length = 0.0);
 
 }  // namespace contact

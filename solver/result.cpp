@@ -32,6 +32,21 @@ const char* to_string(Measure m) {
   return "fixed_point";
 }
 
+namespace {
+
+// The length of a pair's slave edge where it is a closed loop (its closing segment, from the last node back to
+// the first, included), else 0.
+double loop_length(const Step& step, const PairField& p) {
+  const auto n = p.arc_length.size();
+  if (n < 2 || p.position.rows() != n) return 0.0;
+  for (const auto& b : step.bodies)
+    if (b.name == p.slave_body && b.mesh.edge_set_closed(p.slave_edge))
+      return p.arc_length[n - 1] + (p.position.row(0) - p.position.row(n - 1)).norm();
+  return 0.0;
+}
+
+}  // namespace
+
 StepSummary summarize(const Step& step) {
   StepSummary s;
   s.index = step.index;
@@ -47,7 +62,7 @@ StepSummary summarize(const Step& step) {
     s.pair_names.push_back(p.name);
     s.force.push_back(p.force);
     s.tangential_force.push_back(p.tangential_force);
-    const ContactExtent extent = contact_extent(p.arc_length, p.pressure);
+    const ContactExtent extent = contact_extent(p.arc_length, p.pressure, loop_length(step, p));
     s.contact_begin.push_back(extent.begin);
     s.contact_end.push_back(extent.end);
   }

@@ -298,6 +298,23 @@ TEST(GmshErrors, InvertedDegenerateAndNonConvexCellsAreNamed) {
   EXPECT_TRUE(named) << q.errors[0];
 }
 
+TEST(GmshSurface, APhysicalCurveAllRoundIsAClosedEdgeFromItsFirstLinesFirstNode) {
+  // "bottom" all round the square: one closed loop, counter-clockwise (the body on its left) from the first node
+  // of its first line, 1 -> 6 (local nodes 0 and 5): 0, 5, 1, 2, 3.
+  Msh m = square();
+  m.blocks[1].elements = {{1, 6}, {6, 2}, {2, 3}, {3, 4}, {4, 1}};
+  auto s = surface_of(m, "sq");
+  ASSERT_TRUE(s.errors.empty()) << s.errors[0];
+  EXPECT_TRUE(s.mesh.edge_set_closed("bottom"));
+  EXPECT_EQ(s.mesh.edge_set_nodes("bottom"), (std::vector<int>{0, 5, 1, 2, 3}));
+  EXPECT_FALSE(s.mesh.edge_set_closed("top"));
+  // Given the other way round and from another line, the same loop from that line's counter-clockwise first node.
+  m.blocks[1].elements = {{3, 2}, {2, 6}, {6, 1}, {1, 4}, {4, 3}};
+  s = surface_of(m, "sq");
+  ASSERT_TRUE(s.errors.empty()) << s.errors[0];
+  EXPECT_EQ(s.mesh.edge_set_nodes("bottom"), (std::vector<int>{1, 2, 3, 0, 5}));
+}
+
 TEST(GmshErrors, CurvesOffTheBoundaryOrNotOneChainAndBodiesInPiecesAreRefused) {
   Msh m = square();
   m.blocks.push_back({1, 4, 1, {{1, 5}}});  // from a corner to the centre: through the interior
@@ -308,8 +325,8 @@ TEST(GmshErrors, CurvesOffTheBoundaryOrNotOneChainAndBodiesInPiecesAreRefused) {
   m.blocks[2].elements.push_back({1, 6});  // top = the top line and half of the bottom: two pieces
   expect_error(surface_of(m, "sq"), "physical curve 'top' on surface 'sq': its 2 sides are not one chain");
   m = square();
-  m.blocks[1].elements = {{1, 6}, {6, 2}, {2, 3}, {3, 4}, {4, 1}};  // "bottom" all around
-  expect_error(surface_of(m, "sq"), "closed loop");
+  m.blocks[1].elements = {{1, 6}, {6, 2}, {2, 3}, {3, 4}, {4, 1}, {3, 2}};  // all round, and one side twice
+  expect_error(surface_of(m, "sq"), "physical curve 'bottom' on surface 'sq': its 6 sides are not one chain along the boundary: two of them start at (2, 0)");
   m = square();
   m.nodes.push_back({5, 0, 0});
   m.nodes.push_back({6, 0, 0});

@@ -42,7 +42,7 @@ IterationReport ContactSystem::report_gaps(int iteration, const Pressures& z, co
       pr.max_pressure = std::max(pr.max_pressure, p[row]);
     }
     const Eigen::VectorXd pn = pair.to_nodes(p, 0.0);
-    const ContactExtent extent = contact_extent(pair.node_arc, pn);
+    const ContactExtent extent = contact_extent(pair.node_arc, pn, pair.loop_length);
     pr.extent_begin = extent.begin;
     pr.extent_end = extent.end;
     pr.positions.assign(pair.node_arc.data(), pair.node_arc.data() + pair.node_arc.size());
@@ -141,14 +141,17 @@ Eigen::Vector3d rigid_motion(const mesh::Mesh& mesh, const Eigen::Vector2d& cent
 }
 
 // A pair's normals at every slave node: a row's contact normal, elsewhere the mean of the adjacent slave segments'
-// outward normals.
+// outward normals (on a closed slave edge the segment from the last node to the first is one of them).
 Eigen::MatrixX2d node_normals(const mortar::PairDiscretization& pair, const Eigen::MatrixX2d& position) {
   const Eigen::Index n = position.rows();
   Eigen::MatrixX2d normal = Eigen::MatrixX2d::Zero(n, 2);
   for (Eigen::Index j = 0; j < n; ++j) {
     Eigen::Vector2d sum = Eigen::Vector2d::Zero();
-    for (Eigen::Index s : {j - 1, j})
-      if (s >= 0 && s + 1 < n) sum += mortar::outward_normal(position.row(s).transpose(), position.row(s + 1).transpose());
+    for (Eigen::Index s : {j - 1, j}) {
+      if (pair.closed && n > 1) s = (s + n) % n;
+      if (s >= 0 && s < n && (s + 1 < n || pair.closed))
+        sum += mortar::outward_normal(position.row(s).transpose(), position.row((s + 1) % n).transpose());
+    }
     if (sum.norm() > 0) normal.row(j) = sum.normalized().transpose();
   }
   for (size_t r = 0; r < pair.node_of_row.size(); ++r) normal.row(pair.node_of_row[r]) = pair.normal[r].transpose();

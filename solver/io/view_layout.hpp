@@ -2,6 +2,7 @@
 #pragma once
 
 #include "contact/mesh.hpp"
+#include "contact/result.hpp"
 
 #include <Eigen/Core>
 
@@ -28,6 +29,25 @@ inline StressTensor stress_tensor(const Eigen::MatrixX4d& s) {
   t.col(2) = s.col(3);
   t.col(3) = s.col(2);
   return t;
+}
+
+// Whether a pair's slave edge is a closed loop (a bore, a shaft's rim): its slave body's mesh in the step (the last
+// body of that name, as /VTKHDF takes the slave's values from) says so. Its polyline then has a segment more, from
+// the last node back to the first.
+inline bool slave_is_closed(const Step& step, const PairField& p) {
+  bool closed = false;
+  for (const auto& b : step.bodies)
+    if (b.name == p.slave_body) closed = b.mesh.edge_set_closed(p.slave_edge);
+  return closed;
+}
+
+// The slave polyline's line cells as rows (first, second) of the pair's positions: consecutive nodes, and on a
+// closed slave edge the last node back to the first.
+inline Eigen::Matrix<std::int64_t, Eigen::Dynamic, 2> pair_segments(Eigen::Index n, bool closed) {
+  const Eigen::Index count = closed && n > 2 ? n : std::max<Eigen::Index>(n - 1, 0);
+  Eigen::Matrix<std::int64_t, Eigen::Dynamic, 2> out(count, 2);
+  for (Eigen::Index j = 0; j < count; ++j) out.row(j) << j, (j + 1) % n;
+  return out;
 }
 
 }  // namespace contact::io

@@ -329,7 +329,7 @@ void write_body(hid_t bodies, const BodyField& b, const std::string& where) {
   }
 }
 
-void write_pair(hid_t contacts, const PairField& p, const std::string& where) {
+void write_pair(hid_t contacts, const PairField& p, bool closed, const std::string& where) {
   check_link_name("contact pair", p.name);
   const Eigen::Index n = p.position.rows();
   const std::string at = where + " pair '" + p.name + "': ";
@@ -385,10 +385,9 @@ void write_pair(hid_t contacts, const PairField& p, const std::string& where) {
     write_column(g, "slip", p.slip);
     write_column(g, "stick", p.stick.cast<std::int8_t>().eval());
   }
-  // The slave polyline as line cells (rows of position), for the XDMF view of the contact surface.
-  Eigen::Matrix<std::int64_t, Eigen::Dynamic, 2> segments(std::max<Eigen::Index>(n - 1, 0), 2);
-  for (Eigen::Index j = 0; j + 1 < n; ++j) segments.row(j) << j, j + 1;
-  write_matrix(g, "segments", segments);
+  // The slave polyline as line cells (rows of position), for the XDMF view of the contact surface; a closed
+  // slave edge's closes the loop.
+  write_matrix(g, "segments", pair_segments(n, closed));
 }
 
 // One step's fields as /steps/<k>; `row` is its row in /history/steps.
@@ -404,7 +403,7 @@ void write_step(hid_t steps, const Step& s, size_t k, size_t row) {
   Handle bodies = h5::create_group(g, "bodies");
   for (const auto& b : s.bodies) write_body(bodies, b, where);
   Handle contacts = h5::create_group(g, "contacts");
-  for (const auto& p : s.pairs) write_pair(contacts, p, where);
+  for (const auto& p : s.pairs) write_pair(contacts, p, slave_is_closed(s, p), where);
 }
 
 void check_kept_steps(std::size_t kept, std::size_t history_rows) {

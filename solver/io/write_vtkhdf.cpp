@@ -66,9 +66,8 @@ Grid size_grid(const Step& last) {
     g.has.indicator = g.has.indicator || b.indicator_cell.rows() > 0;
   }
   for (const auto& p : last.pairs) {
-    const Eigen::Index n = p.position.rows();
-    total_points += n;
-    total_cells += std::max<Eigen::Index>(n - 1, 0);
+    total_points += p.position.rows();
+    total_cells += pair_segments(p.position.rows(), slave_is_closed(last, p)).rows();
   }
   g.points.resize(total_points, 3);
   g.displacement.resize(total_points, 3);
@@ -121,17 +120,20 @@ void append_body(Grid& g, const BodyField& b, size_t id) {
   g.c0 += c;
 }
 
-// One pair's partition: its slave polyline (lines between consecutive points), the contact fields at its points
-// and the slave body's values at those nodes (`slave`: null if no body has the pair's slave name).
+// One pair's partition: its slave polyline (lines between consecutive points, and on a closed slave edge from the
+// last back to the first), the contact fields at its points and the slave body's values at those nodes (`slave`:
+// null if no body has the pair's slave name).
 void append_pair(Grid& g, const PairField& p, size_t k, const BodyField* slave) {
-  const Eigen::Index n = p.position.rows(), c = std::max<Eigen::Index>(n - 1, 0), p0 = g.p0, c0 = g.c0;
+  const bool closed = slave && slave->mesh.edge_set_closed(p.slave_edge);
+  const auto segments = pair_segments(p.position.rows(), closed);
+  const Eigen::Index n = p.position.rows(), c = segments.rows(), p0 = g.p0, c0 = g.c0;
   g.n_points.push_back(n);
   g.n_cells.push_back(c);
   g.n_ids.push_back(2 * c);
   g.offsets.push_back(0);
   for (Eigen::Index j = 0; j < c; ++j) {
-    g.connectivity.push_back(j);
-    g.connectivity.push_back(j + 1);
+    g.connectivity.push_back(segments(j, 0));
+    g.connectivity.push_back(segments(j, 1));
     g.offsets.push_back(2 * (j + 1));
     g.types.push_back(kVtkLine);
     g.body_id.push_back(-1);

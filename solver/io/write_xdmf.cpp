@@ -8,6 +8,7 @@
 #include "contact/result_file.hpp"
 
 #include "file_util.hpp"
+#include "view_layout.hpp"
 #include "xdmf_series.hpp"
 
 #include <cerrno>
@@ -92,14 +93,15 @@ struct Writer {
 
   // The contact surface of one pair: its slave polyline with the nodal pressure, gap and active flag (and with
   // friction its tangential traction, slip, stick flag and tangent).
-  void pair(const std::string& step_path, const PairField& p) {
+  void pair(const std::string& step_path, const PairField& p, bool closed) {
     const Eigen::Index n = p.position.rows();
     if (n < 2) return;
+    const Eigen::Index segments = pair_segments(n, closed).rows();
     const std::string base = step_path + "/contacts/" + p.name;
     const std::string in = "        ";
     out << "      <Grid Name=\"" << xml_escape(p.name) << "\" GridType=\"Uniform\">\n";
-    out << in << "<Topology TopologyType=\"Polyline\" NodesPerElement=\"2\" NumberOfElements=\"" << n - 1 << "\">\n";
-    data_item(in + "  ", base + "/segments", n - 1, 2, "Int", 8);
+    out << in << "<Topology TopologyType=\"Polyline\" NodesPerElement=\"2\" NumberOfElements=\"" << segments << "\">\n";
+    data_item(in + "  ", base + "/segments", segments, 2, "Int", 8);
     out << in << "</Topology>\n";
     out << in << "<Geometry GeometryType=\"XY\">\n";
     data_item(in + "  ", base + "/position", n, 2, "Float", 8);
@@ -135,7 +137,7 @@ void XdmfSeries::add(const Step& step) {
   w.hdf = hdf_;
   const std::string path = "/steps/" + std::to_string(grids_.size());
   for (const auto& b : step.bodies) w.body(path, b);
-  for (const auto& p : step.pairs) w.pair(path, p);
+  for (const auto& p : step.pairs) w.pair(path, p, slave_is_closed(step, p));
   grids_.push_back(w.out.str());
   load_factors_.push_back(step.load_factor);
 }

@@ -310,18 +310,21 @@ std::vector<mesh::HeldDirection> best_held_directions(const Body& body, const st
       // A node's normal: perpendicular to the chord through its neighbours (on a uniformly divided arc, exactly
       // radial). An end node has one neighbour: its one-sided normal is kept where the edge is straight there (it
       // equals its neighbour's), not where it is curved (it would hold a roller's spin that its end nodes, far
-      // from the contact, never do).
+      // from the contact, never do). A closed loop has no ends: its nodes' neighbours wrap round.
       const std::vector<int> nodes = body.mesh.edge_set_nodes(edge);
       const size_t n = nodes.size();
+      const bool closed = body.mesh.edge_set_closed(edge);
       const auto at = [&](size_t j) { return body.mesh.nodes[static_cast<size_t>(nodes[j])]; };
       const auto normal = [&](size_t j) {
-        const Eigen::Vector2d t = at(std::min(j + 1, n - 1)) - at(j == 0 ? 0 : j - 1);
+        const size_t next = closed ? (j + 1) % n : std::min(j + 1, n - 1);
+        const size_t previous = closed ? (j + n - 1) % n : (j == 0 ? 0 : j - 1);
+        const Eigen::Vector2d t = at(next) - at(previous);
         return t.norm() > 0 ? Eigen::Vector2d(Eigen::Vector2d(-t.y(), t.x()).normalized()) : Eigen::Vector2d::Zero();
       };
       for (size_t j = 0; j < n && n > 1; ++j) {
         const Eigen::Vector2d nu = normal(j);
         if (!(nu.norm() > 0)) continue;
-        const bool end = j == 0 || j + 1 == n;
+        const bool end = !closed && (j == 0 || j + 1 == n);
         if (end && n > 2) {
           const Eigen::Vector2d inner = normal(j == 0 ? 1 : n - 2);
           if (std::abs(nu.x() * inner.y() - nu.y() * inner.x()) > 1e-9) continue;  // curved at the end

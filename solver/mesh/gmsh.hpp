@@ -76,12 +76,13 @@ struct Surface {
 // quadrangles, renumbered from 0 in the order of the node tags, counter-clockwise (a surface meshed with its
 // normal along -z has every cell reversed; cells of both orientations are an error). Each physical curve with
 // 2-node line elements on this surface's boundary becomes an edge set of that name (mesh::add_edge_set: it must
-// be one open chain); its segments on other surfaces are not this body's. Each physical point whose point is a
+// be one open chain, or one closed loop, stored from the first node of its first line); its segments on other
+// surfaces are not this body's. Each physical point whose point is a
 // node of this surface becomes a named vertex (Mesh::vertices: point loads and supports). Every problem is
 // reported in `errors` naming the physical group and the Gmsh element tags: an unknown name (the known ones
 // listed), a 3-D or second-order element, nodes off a plane z = const, degenerate, inverted or non-convex cells,
 // a side shared by more than two cells, a body in more than one piece, a curve through the surface's interior, a
-// curve in several pieces or closed, a physical point with several points on the surface.
+// curve in several pieces, a physical point with several points on the surface.
 Surface surface(const File& file, const std::string& name);
 
 }  // namespace contact::mesh::gmsh

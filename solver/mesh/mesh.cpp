@@ -83,8 +83,14 @@ std::vector<int> Mesh::edge_set_nodes(const std::string& name) const {
   if (it == edge_sets.end() || it->second.empty()) return {};
   std::vector<int> out;
   for (const auto& e : it->second) out.push_back(edge_nodes(e)[0]);
-  out.push_back(edge_nodes(it->second.back())[1]);
+  if (!edge_set_closed(name)) out.push_back(edge_nodes(it->second.back())[1]);
   return out;
+}
+
+bool Mesh::edge_set_closed(const std::string& name) const {
+  auto it = edge_sets.find(name);
+  if (it == edge_sets.end() || it->second.empty()) return false;
+  return edge_nodes(it->second.back())[1] == edge_nodes(it->second.front())[0];
 }
 
 double Mesh::cell_area(int cell) const {
@@ -176,8 +182,9 @@ std::string point_text(const Point& p) {
   return os.str();
 }
 
-// Orders boundary sides (each in its cell's counter-clockwise direction) into one open chain; an error message
-// when they are several pieces or a closed loop.
+// Orders boundary sides (each in its cell's counter-clockwise direction) into one open chain, from its one end,
+// or into one closed loop (no side starts where none ends), from the first node of the side given first; an error
+// message when they are several pieces.
 std::optional<std::string> order_chain(const Mesh& m, std::vector<EdgeRef>& refs) {
   std::unordered_map<int, size_t> by_first;
   std::unordered_map<int, int> second_count;
@@ -191,19 +198,37 @@ std::optional<std::string> order_chain(const Mesh& m, std::vector<EdgeRef>& refs
     const int first = m.edge_nodes(refs[k])[0];
     if (!second_count.count(first)) starts.push_back(first);
   }
-  if (starts.empty())
-    return "its " + std::to_string(refs.size()) +
-           " sides form a closed loop around the body or a hole; an edge must be an open chain with two ends (split "
-           "it into two edges)";
+  const bool loop = starts.empty();
   std::vector<EdgeRef> chain;
-  if (starts.size() == 1 && by_first.size() == refs.size()) {
-    int cur = starts.front();
+  if ((loop || starts.size() == 1) && by_first.size() == refs.size()) {
+    const int start = loop ? m.edge_nodes(refs.front())[0] : starts.front();
+    int cur = start;
     while (chain.size() < refs.size()) {
       auto it = by_first.find(cur);
       if (it == by_first.end()) break;
       chain.push_back(refs[it->second]);
       cur = m.edge_nodes(refs[it->second])[1];
+      if (loop && cur == start) break;
     }
+  }
+  if (loop && by_first.size() != refs.size()) {
+    std::unordered_map<int, int> starting;
+    int twice = m.edge_nodes(refs.front())[0];
+    for (const auto& e : refs)
+      if (++starting[m.edge_nodes(e)[0]] == 2) {
+        twice = m.edge_nodes(e)[0];
+        break;
+      }
+    return "its " + std::to_string(refs.size()) + " sides are not one chain along the boundary: two of them start at " +
+           point_text(m.nodes[static_cast<size_t>(twice)]) +
+           " (a side given twice, or the boundary touching itself there); an edge must be one connected piece";
+  }
+  if (chain.size() != refs.size() && loop) {
+    const Point& p = m.nodes[static_cast<size_t>(m.edge_nodes(refs.front())[0])];
+    return "its " + std::to_string(refs.size()) +
+           " sides are not one chain along the boundary: they form several closed loops (one of " +
+           std::to_string(chain.size()) + " sides through " + point_text(p) +
+           "); an edge must be one connected piece (make each loop its own edge)";
   }
   if (chain.size() != refs.size()) {
     std::sort(starts.begin(), starts.end());

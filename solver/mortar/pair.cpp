@@ -82,7 +82,7 @@ bool crosspoint_between(const Problem& problem, int a, int b, const Eigen::Vecto
     if (!((q.slave_body == a && q.master_body == b) || (q.slave_body == b && q.master_body == a))) continue;
     const auto& mesh = problem.bodies[static_cast<size_t>(q.slave_body)].mesh;
     const std::vector<int> nodes = mesh.edge_set_nodes(q.slave_edge);
-    if (nodes.size() < 2) continue;
+    if (nodes.size() < 2 || mesh.edge_set_closed(q.slave_edge)) continue;  // a closed loop has no ends
     for (int end : {nodes.front(), nodes.back()}) {
       if ((mesh.nodes[static_cast<size_t>(end)] - x).norm() > tolerance) continue;
       const auto corners = slave_corners(problem, q, nodes, false);
@@ -96,11 +96,13 @@ bool crosspoint_between(const Problem& problem, int a, int b, const Eigen::Vecto
 std::map<int, Corner> slave_corners(const Problem& problem, const ContactPair& pair, const std::vector<int>& nodes,
                                     bool look_for_broken_loops) {
   std::map<int, Corner> out;
-  if (nodes.size() < 2) return out;
   const auto& mesh = problem.bodies[static_cast<size_t>(pair.slave_body)].mesh;
+  // A closed loop has no ends, so no corners: it meets another edge only where that edge ends on it, and there
+  // the boundary runs on along the loop.
+  if (nodes.size() < 2 || mesh.edge_set_closed(pair.slave_edge)) return out;
   auto meet = [&](const std::string& edge, bool third_body, bool friction, int other_master) {
     const std::vector<int> others = mesh.edge_set_nodes(edge);
-    if (others.size() < 2) return;
+    if (others.size() < 2 || mesh.edge_set_closed(edge)) return;
     for (size_t end : {size_t{0}, nodes.size() - 1})
       for (size_t j : {size_t{0}, others.size() - 1}) {
         if (others[j] != nodes[end]) continue;
@@ -210,19 +212,26 @@ PenaltyChoice choose_penalty(const Problem& problem, int pair_index) {
   const ContactPair& pair = problem.contacts[static_cast<size_t>(pair_index)];
   const Body& slave = problem.bodies[static_cast<size_t>(pair.slave_body)];
   const Body& master = problem.bodies[static_cast<size_t>(pair.master_body)];
-  // Mean outward normal of the master edge, weighted by segment length.
+  // Mean outward normal of the master edge, weighted by segment length. A closed master edge has none (its
+  // normals turn all the way round and sum to zero): a body's extent is then the smaller of its extents along x
+  // and y (a shaft's or a ring's diameter).
   const auto mpts = coordinates(master.mesh, master.mesh.edge_set_nodes(pair.master_edge));
+  const bool closed = master.mesh.edge_set_closed(pair.master_edge);
   Eigen::Vector2d n = Eigen::Vector2d::Zero();
   for (size_t i = 0; i + 1 < mpts.size(); ++i)
     if ((mpts[i + 1] - mpts[i]).norm() > 0) n += (mpts[i + 1] - mpts[i]).norm() * outward_normal(mpts[i], mpts[i + 1]);
   if (n.norm() > 0) n.normalize();
-  auto extent = [&](const mesh::Mesh& m) {
+  auto extent_along = [](const mesh::Mesh& m, const Eigen::Vector2d& d) {
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (const auto& p : m.nodes) {
-      lo = std::min(lo, p.dot(n));
-      hi = std::max(hi, p.dot(n));
+      lo = std::min(lo, p.dot(d));
+      hi = std::max(hi, p.dot(d));
     }
     return hi - lo;
+  };
+  auto extent = [&](const mesh::Mesh& m) {
+    if (closed) return std::min(extent_along(m, Eigen::Vector2d(1, 0)), extent_along(m, Eigen::Vector2d(0, 1)));
+    return extent_along(m, n);
   };
   PenaltyChoice c;
   c.slave_height = extent(slave.mesh);
@@ -289,27 +298,40 @@ class PairBuilder {
     number_rows();
     integrate();
     assemble_operators();
+    close_loop();
     return std::move(d_);
   }
 
  private:
   using VectorEntries = std::map<std::pair<int, int>, Eigen::Vector2d>;  // (row, node) -> vector coefficient
 
-  double arc(size_t i) const { return d_.node_arc[static_cast<Eigen::Index>(i)]; }
+  double arc(size_t i) const { return arc_[static_cast<Eigen::Index>(i)]; }
+
+  // An edge's nodes as a polyline: its nodes, and on a closed loop its first node again at the end (the side that
+  // closes the loop is then a segment like any other).
+  static std::vector<int> polyline(std::vector<int> nodes, bool closed) {
+    if (closed && !nodes.empty()) nodes.push_back(nodes.front());
+    return nodes;
+  }
 
   // The slave and master nodes, the segment mesh, arc lengths, and which mortar segments lie on each slave segment.
+  // The builder works on the slave polyline's positions 0 .. n_ - 1; on a closed slave edge position n_ - 1 is
+  // position 0 again (close_loop() folds it back once the operators are built).
   void cut_segments() {
     d_.slave_nodes = slave_.mesh.edge_set_nodes(pair_.slave_edge);
     d_.master_nodes = master_.mesh.edge_set_nodes(pair_.master_edge);
-    S_ = coordinates(slave_.mesh, d_.slave_nodes);
-    const auto Mx = coordinates(master_.mesh, d_.master_nodes);
+    closed_ = slave_.mesh.edge_set_closed(pair_.slave_edge);
+    poly_ = polyline(d_.slave_nodes, closed_);
+    master_poly_ = polyline(d_.master_nodes, master_.mesh.edge_set_closed(pair_.master_edge));
+    S_ = coordinates(slave_.mesh, poly_);
+    const auto Mx = coordinates(master_.mesh, master_poly_);
     n_ = S_.size();
     segments_ = build_segment_mesh(S_, Mx);
     const size_t n_segments = n_ < 2 ? 0 : n_ - 1;
     for (size_t j = 0; j + 1 < Mx.size(); ++j) master_length_.push_back((Mx[j + 1] - Mx[j]).norm());
-    d_.node_arc = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n_));
+    arc_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n_));
     for (size_t k = 1; k < n_; ++k)
-      d_.node_arc[static_cast<Eigen::Index>(k)] = d_.node_arc[static_cast<Eigen::Index>(k) - 1] + (S_[k] - S_[k - 1]).norm();
+      arc_[static_cast<Eigen::Index>(k)] = arc_[static_cast<Eigen::Index>(k) - 1] + (S_[k] - S_[k - 1]).norm();
     on_segment_.assign(n_segments, {});
     for (const auto& s : segments_.segments) {
       on_segment_[static_cast<size_t>(s.slave)].push_back(&s);
@@ -336,7 +358,8 @@ class PairBuilder {
   }
 
   // Which multiplier nodes carry a multiplier: covered enough, and not a crosspoint. The other slave nodes lie
-  // inside a multiplier segment.
+  // inside a multiplier segment. On a closed slave edge the start (positions 0 and n_ - 1) lies between the last
+  // run and the first, as every other multiplier node between its two runs: a loop has no ends.
   void classify_nodes() {
     d_.status.assign(n_, NodeStatus::inner);
     const auto prescribed = prescribed_components(slave_);
@@ -345,21 +368,25 @@ class PairBuilder {
       const size_t i = d_.multiplier_nodes[m];
       double support = 0, covered = 0;
       Eigen::Vector2d nu = Eigen::Vector2d::Zero();
-      for (size_t run : {m - 1, m}) {  // the runs before and after node i (m - 1 wraps for m = 0: skipped)
+      // The runs before and after node i, with node i's end of each (1: the run's last node, 0: its first); on
+      // an open edge m - 1 wraps for m = 0 and m is past the last run for m = n_runs_: skipped.
+      const bool wraps = closed_ && (m == 0 || m == n_runs_);
+      const std::array<std::pair<size_t, int>, 2> runs = {{{wraps ? n_runs_ - 1 : m - 1, 1}, {wraps ? 0 : m, 0}}};
+      for (const auto& [run, end] : runs) {
         if (run >= n_runs_) continue;
         const size_t a = d_.multiplier_nodes[run], b = d_.multiplier_nodes[run + 1];
         support += 0.5 * (arc(b) - arc(a));
         if (!basis_[run]) continue;
-        const double Dk = basis_[run]->D[run == m ? 0 : 1];
+        const double Dk = basis_[run]->D[end];
         covered += Dk;
-        const size_t k = run == m ? a : b - 1;  // the slave segment next to node i
+        const size_t k = end == 0 ? a : b - 1;  // the slave segment next to node i
         nu += Dk * segments_.slave_normal[k];
       }
       if (!(covered > 0)) {
         d_.status[i] = NodeStatus::uncovered;
       } else if (covered < kDropCoverage * support) {
         d_.status[i] = NodeStatus::barely_covered;
-      } else if (auto p = prescribed.find(d_.slave_nodes[i]); p != prescribed.end() && normal_is_prescribed(p->second, nu.normalized())) {
+      } else if (auto p = prescribed.find(poly_[i]); p != prescribed.end() && normal_is_prescribed(p->second, nu.normalized())) {
         d_.status[i] = NodeStatus::crosspoint;
       } else if (auto c = friction_corner(corners, i, nu); c && c->third_body) {
         d_.status[i] = NodeStatus::crosspoint;
@@ -373,7 +400,7 @@ class PairBuilder {
   // The corner (slave_corners) at slave node i with the multiplier's normal nu, if friction is involved there and
   // the other edge turns away.
   const Corner* friction_corner(const std::map<int, Corner>& corners, size_t i, const Eigen::Vector2d& nu) const {
-    const auto c = corners.find(d_.slave_nodes[i]);
+    const auto c = corners.find(poly_[i]);
     if (c == corners.end() || !c->second.friction || !(nu.norm() > 0)) return nullptr;
     return turns(Eigen::Vector2d(-nu.y(), nu.x()).normalized(), c->second.tangent) ? &c->second : nullptr;
   }
@@ -383,12 +410,13 @@ class PairBuilder {
   // added to the other's).
   void number_rows() {
     d_.row_of_node.assign(n_, -1);
-    for (size_t i = 0; i < n_; ++i)
+    for (size_t i = 0; i < d_.slave_nodes.size(); ++i)
       if (d_.status[i] == NodeStatus::contact) {
         d_.row_of_node[i] = static_cast<int>(d_.node_of_row.size());
         d_.node_of_row.push_back(static_cast<int>(i));
         d_.tangential_dropped.push_back(tangential_dropped_.count(i) ? 1 : 0);
       }
+    if (closed_ && n_ > 0) d_.row_of_node[n_ - 1] = d_.row_of_node[0];  // the start again: its row
     d_.node_from_rows.assign(n_, {});
     for (size_t m = 0; m < n_runs_; ++m) {
       const size_t a = d_.multiplier_nodes[m], b = d_.multiplier_nodes[m + 1];
@@ -431,7 +459,8 @@ class PairBuilder {
       const Eigen::Vector2d nk = segments_.slave_normal[k];
       const double L = segments_.slave_length[k];
       for (const auto* s : on_segment_[k]) {
-        const int m0 = d_.master_nodes[static_cast<size_t>(s->master)], m1 = d_.master_nodes[static_cast<size_t>(s->master) + 1];
+        const int m0 = master_poly_[static_cast<size_t>(s->master)], m1 = master_poly_[static_cast<size_t>(s->master) + 1];
+        const int n_master = static_cast<int>(d_.master_nodes.size());  // a closed master's last position is its first
         for (size_t q = 0; q < kGaussX.size(); ++q) {
           const double u = kGaussX[q];
           const double xi = s->xi0 + u * (s->xi1 - s->xi0);
@@ -451,10 +480,10 @@ class PairBuilder {
             d_.area[r] += w * phi;
             nu_[static_cast<size_t>(r)] += w * phi * nk;
             for (int l = 0; l < 2; ++l) {
-              add(gs_, {r, d_.slave_nodes[k + static_cast<size_t>(l)]}, w * phi * Ns[l] * nk);
-              ss_[{r, d_.slave_nodes[k + static_cast<size_t>(l)]}] += w * phi * Ns[l];
+              add(gs_, {r, poly_[k + static_cast<size_t>(l)]}, w * phi * Ns[l] * nk);
+              ss_[{r, poly_[k + static_cast<size_t>(l)]}] += w * phi * Ns[l];
               add(gm_, {r, l == 0 ? m0 : m1}, w * phi * Nm[l] * nk);
-              mm_[{r, s->master + l}] += w * phi * Nm[l];
+              mm_[{r, (s->master + l) % n_master}] += w * phi * Nm[l];
             }
           }
         }
@@ -494,6 +523,19 @@ class PairBuilder {
     if (pair_.friction.active()) tangential_operators();
   }
 
+  // The per-node results on the slave nodes, each once: on a closed slave edge the last position (the start
+  // again) is dropped, its row being the start's; node_arc runs along the loop from the start.
+  void close_loop() {
+    const size_t n = d_.slave_nodes.size();
+    d_.node_arc = arc_.head(static_cast<Eigen::Index>(n));
+    if (!closed_) return;
+    d_.closed = true;
+    d_.loop_length = n_ > 0 ? arc(n_ - 1) : 0.0;
+    d_.status.resize(n);
+    d_.row_of_node.resize(n);
+    d_.node_from_rows.resize(n);
+  }
+
   // Ts and Tm: the scalar mortar integrals of the slave and the master times the row's tangent.
   void tangential_operators() {
     VectorEntries ts, tm;
@@ -510,6 +552,9 @@ class PairBuilder {
   const Body& master_;
   const double thickness_;
   PairDiscretization d_;
+  std::vector<int> poly_, master_poly_;  // the slave's and the master's nodes as polylines (polyline())
+  bool closed_ = false;                  // the slave edge is a closed loop
+  Eigen::VectorXd arc_;                  // arc length at every slave polyline position
   std::vector<Eigen::Vector2d> S_;
   std::set<size_t> tangential_dropped_;  // slave nodes whose friction row is dropped (slave_corners)
   size_t n_ = 0, n_runs_ = 0;

@@ -47,11 +47,17 @@ struct PairDiscretization {
   int slave_body = -1, master_body = -1;
   double theta = 0.0;  // penalty parameter (used by the penalty and augmented-Lagrangian enforcement)
 
-  // Every slave node, in order along the slave edge.
+  // Every slave node, in order along the slave edge. A closed slave edge (mesh::Mesh::edge_set_closed) lists each
+  // node once, from the loop's start, and has no ends: its last segment joins the last node to the first, and the
+  // start is a multiplier node between the last multiplier segment and the first like any other.
   std::vector<int> slave_nodes;
-  std::vector<size_t> multiplier_nodes;  // positions (in slave_nodes) of the nodes that bound multiplier segments
+  // Positions (in slave_nodes) of the nodes that bound multiplier segments, the first and the last always among
+  // them; on a closed slave edge the last is slave_nodes.size(), the start again.
+  std::vector<size_t> multiplier_nodes;
   std::vector<std::vector<std::pair<int, double>>> node_from_rows;  // per slave node: (row, weight) giving its value
-  Eigen::VectorXd node_arc;         // arc length along the slave polyline from its first node
+  Eigen::VectorXd node_arc;         // arc length along the slave polyline from its first node (a loop's start)
+  bool closed = false;              // the slave edge is a closed loop
+  double loop_length = 0.0;         // a closed slave edge's length, its closing segment included (0 if open)
   std::vector<NodeStatus> status;   // per slave node
   std::vector<int> row_of_node;     // per slave node: its row, or -1
 
@@ -67,7 +73,7 @@ struct PairDiscretization {
   std::vector<Eigen::Vector2d> normal;  // unit normal of row r (direction of D_r nu_r): for reports
   SparseRows Gs;                    // rows x slave dofs
   SparseRows Gm;                    // rows x master dofs
-  std::vector<int> master_nodes;    // the master edge's nodes in order
+  std::vector<int> master_nodes;    // the master edge's nodes in order (a closed one's each once, from its start)
   SparseRows M;                     // rows x master edge nodes (scalar mortar matrix, summed over segments)
   double covered_length = 0.0;      // length of the slave edge opposite the master edge
 

@@ -153,7 +153,6 @@ def step_history(c):
     for name in ("force", "contact_begin", "contact_end"):
         expect(g[name].shape == (n, np_), f"history/steps/{name} has shape {g[name].shape}, expected {(n, np_)}")
     expect(g["load_factor"].shape == (n,) and np.all(g["load_factor"][()] > 0), "history/steps/load_factor")
-    expect(np.all(g["contact_begin"][()] <= g["contact_end"][()]), "contact_begin > contact_end")
     for k in range(n):
         st = c.f["steps"][str(k)]
         expect(float(st.attrs["load_factor"]) == float(g["load_factor"][k]), f"step {k} load_factor attribute")
@@ -161,13 +160,26 @@ def step_history(c):
             group = st["contacts"][pair]
             expect(float(g["force"][k, p]) == float(group.attrs["force"]), f"step {k} pair {pair} force vs attribute")
             arc, active = group["arc_length"][()], group["active"][()]
+            begin, end = g["contact_begin"][k, p], g["contact_end"][k, p]
+            if len(arc) > 2 and group["segments"].shape[0] == len(arc):
+                # A closed slave edge: the zone is the loop less its longest open stretch, across the start where
+                # begin > end, [0, the loop's length] all round.
+                position = group["position"][()]
+                length = arc[-1] + float(np.hypot(*(position[0] - position[-1])))
+                if active.all():
+                    expect(begin == 0 and abs(end - length) <= 1e-9 * length,
+                           f"step {k} pair {pair} a loop in contact all round: zone [{begin}, {end}], not [0, {length}]")
+                elif active.any():
+                    expect(0 <= begin < length and 0 <= end < length,
+                           f"step {k} pair {pair} contact zone [{begin}, {end}] is not on the loop [0, {length})")
+                continue
+            expect(begin <= end, f"step {k} pair {pair} contact_begin > contact_end")
             if active.any():
                 # Interpolated between nodes (docs/results-format.md): the zone holds every node in contact and
                 # ends before the first open node on either side.
                 on = np.flatnonzero(active == 1)
                 lo = arc[on[0] - 1] if on[0] > 0 else arc[on[0]]
                 hi = arc[on[-1] + 1] if on[-1] + 1 < len(arc) else arc[on[-1]]
-                begin, end = g["contact_begin"][k, p], g["contact_end"][k, p]
                 expect(lo <= begin <= arc[on[0]] and arc[on[-1]] <= end <= hi,
                        f"step {k} pair {pair} contact zone [{begin}, {end}] is not between the nodes in contact and "
                        f"the open ones next to them")
@@ -251,8 +263,15 @@ def steps_contacts(c):
             g = s["contacts"][pair]
             where = f"step {k} pair {pair}"
             n = g["position"].shape[0]
-            for name, shape in (("position", (n, 2)), ("normal", (n, 2)), ("segments", (max(n - 1, 0), 2))):
+            for name, shape in (("position", (n, 2)), ("normal", (n, 2))):
                 expect(g[name].shape == shape, f"{where} {name} has shape {g[name].shape}, expected {shape}")
+            # Consecutive nodes, and on a closed slave edge (n rows) the last back to the first.
+            segments = g["segments"][()]
+            closed = n > 2 and segments.shape == (n, 2)
+            expect(segments.shape == ((n, 2) if closed else (max(n - 1, 0), 2)),
+                   f"{where} segments has shape {segments.shape}, expected ({max(n - 1, 0)}, 2) or ({n}, 2)")
+            expect(segments.tolist() == [[j, (j + 1) % n] for j in range(segments.shape[0])],
+                   f"{where} segments do not join consecutive nodes")
             for name in ("node", "arc_length", "weight", "gap", "normal_gap", "pressure", "penetration", "active",
                          "status"):
                 expect(g[name].shape == (n,), f"{where} {name} has shape {g[name].shape}, expected ({n},)")

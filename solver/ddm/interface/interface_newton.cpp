@@ -51,6 +51,11 @@ InterfaceQp InterfaceNewton::make_qp(const SolverSettings& settings) const {
         if (pair.multiplier.size() == pair.n_rows()) qp.g[i] -= pair.theta * pair.area[r] * pair.multiplier[r];
       }
     }
+  // Each pair's rows are a line, ordered along the slave edge. A closed slave edge is the line cut at its start:
+  // the nested guess's coarse spaces keep its first and last row as a line's ends. Every other row still lies
+  // between two kept ones and the closing stretch between the last row and the first holds none, so it is a
+  // coarse space like an open line's (a loop of odd length keeps two neighbours there); it only seeds the first
+  // active set, and the solution is the same.
   qp.line.assign(static_cast<size_t>(m), -1);  // tangential rows lie on no line
   qp.position = Eigen::VectorXd::Zero(m);
   for (size_t k = 0; k < pairs.size(); ++k)

@@ -77,7 +77,9 @@ struct Mesh {
   std::vector<Point> nodes;
   std::vector<Cell> cells;                 // node indices, counter-clockwise
   std::vector<int> level;                  // refinement level per cell (0 = initial mesh)
-  // Boundary edge sets by name, each ordered along the edge (consecutive entries share a node).
+  // Boundary edge sets by name, each ordered along the edge (consecutive entries share a node), counter-clockwise
+  // along the boundary (the body on the left). An edge set is an open chain (two ends) or a closed loop (the last
+  // side ends where the first begins: a bore, a shaft's rim, the whole outline of a body); see edge_set_closed().
   std::map<std::string, std::vector<EdgeRef>> edge_sets;
   // True geometry of named edges that are curved (block edges); absent means straight.
   std::map<std::string, Curve> edge_curves;
@@ -100,8 +102,13 @@ struct Mesh {
     const auto& c = cells[static_cast<size_t>(e.cell)];
     return {c[static_cast<size_t>(e.side)], c[static_cast<size_t>((e.side + 1) % c.size())]};
   }
-  // Nodes of an edge set in order along the set (n_edges + 1 nodes for an open chain). Empty if unknown.
+  // Nodes of an edge set in order along the set: n_edges + 1 nodes for an open chain, n_edges for a closed loop
+  // (each node once, from the loop's start: the first node of its first side; the side from the last node back
+  // to the first closes it). Empty if unknown.
   std::vector<int> edge_set_nodes(const std::string& name) const;
+  // Whether an edge set is a closed loop: its last side ends at its first side's first node. Derived from the
+  // sides themselves, so refinement (which splits every side in place, in order) keeps it.
+  bool edge_set_closed(const std::string& name) const;
   // Area of a cell (shoelace formula; positive for counter-clockwise cells).
   double cell_area(int cell) const;
   Eigen::Vector2d bbox_min() const;
@@ -132,10 +139,12 @@ Mesh make_block(const BlockSpec& spec);
 std::optional<std::string> fit_curve(Curve& curve, const Point& p, const Point& q);
 
 // Adds a named edge set from node pairs (either orientation) of an explicit mesh: each pair must be a
-// boundary side of exactly one cell, and the pairs must form one open chain along the boundary (a set of several
-// pieces, or a closed loop, has no one order: it is an error). The set is stored in chain order, counter-clockwise
-// along the boundary (the body on the left). Returns an error message naming the offending pair (by its index in
-// `pairs`), or saying why the set is not one chain.
+// boundary side of exactly one cell, and the pairs must form one connected piece along the boundary: one open
+// chain, or one closed loop (around the body or a hole). A set of several pieces has no one order: it is an error.
+// The set is stored in chain order, counter-clockwise along the boundary (the body on the left); an open chain
+// from its one end, a closed loop from the first node (counter-clockwise) of the side given first, `pairs[0]`.
+// Returns an error message naming the offending pair (by its index in `pairs`), or saying why the set is not one
+// piece.
 std::optional<std::string> add_edge_set(Mesh& m, const std::string& name,
                                         const std::vector<std::array<int, 2>>& pairs);
 

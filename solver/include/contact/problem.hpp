@@ -102,7 +102,8 @@ struct ContactPair {
 
 // theta = c * length / E_pair unless theta is given. E_pair is the harmonic mean 2 E1 E2 / (E1 + E2) of the
 // pair's Young's moduli (E itself for equal bodies); length defaults to the smaller of the two bodies' extents
-// along the contact normal (the body height in the paper).
+// along the contact normal (the body height in the paper), the master edge's mean normal; a closed master edge
+// (a shaft's rim, a bore) has none, and a body's extent is then the smaller of its extents along x and y.
 struct PenaltySpec {
   std::optional<double> theta;
   double c = 0.05;
