@@ -8,7 +8,9 @@ steps (Newton steps or outer iterations) and MPRGP iterations, and the ratios th
 22 x 22 frictional wall in at most 1x the paper's test, within 1 GB; frictional / frictionless on the same wall at
 most 5x; 16 x 16 -> 22 x 22 growing at most 2.5x.
 
-    bench/bench_friction_walls.py [BUILD_DIR] [--quick]     (--quick: about a minute on two cores)"""
+Then the walls near the limit, H/V 0.5 (8 x 8 and 16 x 16; 22 x 22 without --quick), with the solver `auto` picks.
+
+    bench/bench_friction_walls.py [BUILD_DIR] [--quick]     (--quick: about two minutes on two cores)"""
 import json
 import os
 import subprocess
@@ -51,6 +53,14 @@ def main():
                     rows[(n, kind, solver)] = r
                     print_result(f"{n:>4}x{n:<2} {bodies:>6} {kind:>12} {solver:>9}", r, error,
                                  "{wall:>8.2f} {rss:>8.0f} {steps:>5} {iterations:>9}")
+        # Near the friction limit (issue 28's statics): the free course ends unload the heel, whose bricks slip on
+        # both bed joints (an indeterminate slip). Every step must converge, uncut.
+        print("\nnear the limit: head joints, mu 0.6, H/V 0.5, the solver `auto` picks", flush=True)
+        print(f"{'wall':>7} {'bodies':>6} {'time s':>8} {'peak MB':>8} {'steps':>5} {'MPRGP it.':>9} {'cuts':>4}", flush=True)
+        for n in [8, 16] if QUICK else [8, 16, 22]:
+            job, bodies = generated(n, ["--head-joints", "--friction", "0.6", "--shear", "0.5"], "auto", tmp)
+            r, error = run(job, 1, tmp)
+            print_result(f"{n:>4}x{n:<2} {bodies:>6}", r, error, "{wall:>8.2f} {rss:>8.0f} {steps:>5} {iterations:>9} {cuts:>4}")
         print("\nratios (same run):")
         for solver in ("direct", "iterative"):
             a, b = rows.get((22, "frictional", solver)), rows.get((16, "frictional", solver))

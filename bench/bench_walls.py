@@ -41,7 +41,9 @@ def run(job, ranks, tmp):
     iterations = int(m.group(1)) if m else 0
     m = re.search(r"stop: \S+ after (\d+)", r.stdout)
     steps = int(m.group(1)) if m else 0
-    return dict(wall=wall, rss=rss, iterations=iterations, steps=steps), ""
+    m = re.search(r"cut (\d+) times", r.stdout)  # a frictional load step cut into sub-steps (load_steps.cpp)
+    cuts = int(m.group(1)) if m else 0
+    return dict(wall=wall, rss=rss, iterations=iterations, steps=steps, cuts=cuts), ""
 
 
 def print_result(label, r, error, columns):
