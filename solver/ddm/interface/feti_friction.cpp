@@ -122,9 +122,11 @@ linalg::ActiveSetStep outer_step(int outer, const FrictionData& d, const ActiveS
 // Coulomb: the outer fixed point b <- mu z on Tresca problems. The first bounds are mu z0 (the previous load
 // step's or update's answer) or, without one (or if a floating body is not held on them), +inf: the tied problem,
 // well posed whatever holds the floating bodies. Each Tresca solve starts from the last answer and equality
-// multipliers and is solved to a hundredth of the bounds' last change (the first to 1e-2: its bounds are wrong by
-// far more; a cap of 1e-6 cost 1.5x the MPRGP iterations on sheared walls, 1819 against 1191 at 16 x 16, H/V 0.3,
-// and 2.4x at 12 x 12, H/V 0.5, 59506 against 24687, for the same answer), never below ten times the tolerance: a
+// multipliers and is solved to a hundredth of the bounds' last change (the first to 1e-3: its bounds are wrong by
+// far more; a cap of 1e-6 cost 1.4x the MPRGP iterations on sheared walls, 1819 against 1302 at 16 x 16, H/V 0.3,
+// and 2.4x at 12 x 12, H/V 0.5, 59506 against 24981, for the same answer; 1e-2 was too loose: the 8 x 8 wall's
+// take-over without a preconditioner at H/V 0.5 then failed its whole increment), never below ten times the
+// tolerance: a
 // warm-started solve near the answer meets the projected gradient's rounding floor there (measured on
 // roller_friction: ~1e-11 of the free response's penetration), and asking for less would stall SMALBE. Stops when the bounds moved by less than 1e3 x the tolerance and the Coulomb
 // complementarity is below that too, or the bounds have settled (below): reduced quantities only, so every process
@@ -139,7 +141,7 @@ void coulomb_outer(Smalbe& smalbe, const FrictionData& d, const Eigen::VectorXd*
   linalg::FrictionSets previous;
   double change = 1.0;
   int settled = 0;
-  how.tolerance = std::max(10 * tolerance, 0.01);
+  how.tolerance = std::max(10 * tolerance, 1e-3);
   // The bounds Anderson-mixed (linalg/anderson.hpp): where the stick and slip sets no longer change, z(b) is affine
   // in b and the mixing converges like a Krylov method on it, where the plain update contracts by a constant factor
   // (about 0.5 per outer iteration on a sheared brick wall).
