@@ -173,11 +173,23 @@ TEST(Masonry, A16x16WallWithFreeCourseEndsHoldsAShearOfHalfItsLoad) {
   // Statics at scale near the limit: mu = 0.6, H/V = 0.5, head joints and free course ends, the solver `auto`
   // picks (the iterative one). It failed in every solver until the indeterminate bricks took SMALBE's multipliers
   // (after 5 cuts: "the slip bounds settled, but the Coulomb complementarity stays at 0.00456"); now in one
-  // increment (about 45 s; the 22 x 22 wall is in bench/bench_friction_walls.py).
+  // increment (about 15 s).
   const json job = wall(16, 16, "--head-joints --friction 0.6 --shear 0.5");
   const Result r = run(job);
   EXPECT_EQ(r.message.find("cut"), std::string::npos) << r.message;
   EXPECT_GT(expect_wall_holds(job, r, 0.6, "16 x 16"), 0);
+}
+
+TEST(Masonry, A22x22WallWithFreeCourseEndsHoldsAShearOfHalfItsLoad) {
+  // The largest wall near the limit: 496 bodies, mu = 0.6, H/V = 0.5, head joints and free course ends.
+  // Every Tresca solve of its Coulomb outer iteration used to drive SMALBE's rho to 1e3-1e4 ||P H P||, and the
+  // increment ran out of the MPRGP budget and was cut (not solved in 26 minutes); with rho held at 10 ||P H P||
+  // unless the updates stall (smalbe.cpp) it holds in one increment (69 outer, ~81,000 MPRGP iterations: 2 to 3
+  // minutes, the longest test in the suite).
+  const json job = wall(22, 22, "--head-joints --friction 0.6 --shear 0.5");
+  const Result r = run(job);
+  EXPECT_EQ(r.message.find("cut"), std::string::npos) << r.message;
+  EXPECT_GT(expect_wall_holds(job, r, 0.6, "22 x 22"), 0);
 }
 
 TEST(Masonry, TheInterfaceSolverEqualsTheMonolithicReferenceOnFrictionalWalls) {
