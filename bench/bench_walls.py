@@ -17,6 +17,8 @@ import subprocess
 import sys
 import tempfile
 
+import h5py
+
 SRC = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
 args = [a for a in sys.argv[1:] if not a.startswith("--")]
 QUICK = "--quick" in sys.argv
@@ -37,8 +39,10 @@ def run(job, ranks, tmp):
         return None, f"failed: {r.stdout[-300:]} {r.stderr[-300:]}"
     wall = float(re.search(r"stop: \S+ after \d+ \S+, ([0-9.]+) s", r.stdout).group(1))
     rss = max(int(x) / 1024 for x in re.findall(r"maxrss_kb (\d+)", r.stderr))
-    m = re.search(r"(\d+) MPRGP iterations", r.stdout)
-    iterations = int(m.group(1)) if m else 0
+    # MPRGP iterations over the whole run (every load step and outer iteration: the products with F), from the
+    # result's provenance; the progress message gives the last step's only.
+    with h5py.File(out, "r") as f:
+        iterations = int(f["provenance"].attrs.get("interface_iterations", 0))
     m = re.search(r"stop: \S+ after (\d+)", r.stdout)
     steps = int(m.group(1)) if m else 0
     m = re.search(r"cut (\d+) times", r.stdout)  # a frictional load step cut into sub-steps (load_steps.cpp)
