@@ -61,9 +61,9 @@ TEST(ContactMarking, TheBandHoldsCellsAlongTheZoneToATighterDeltaAndTheGradingKe
     for (int k : m.cells[static_cast<size_t>(c)]) centre += 0.25 * m.nodes[static_cast<size_t>(k)];
     const double d = zones[0].distance(centre);
     // Within one cell size (0.5) of the zone the band's sqrt(l / h) with l = 0.75, h = 0.5, or the neighbourhood's 2
-    // if larger (it is); within two extents (1.5) the neighbourhood's 2; elsewhere 1.
+    // if larger (it is); within one extent (0.75) the neighbourhood's 2; elsewhere 1.
     const double band = d < 0.5 ? std::sqrt(0.75 / 0.5) : 1.0;
-    EXPECT_DOUBLE_EQ(rules.factor[static_cast<size_t>(c)], d < 1.5 ? std::max(band, 2.0) : 1.0) << c;
+    EXPECT_DOUBLE_EQ(rules.factor[static_cast<size_t>(c)], d < 0.75 ? std::max(band, 2.0) : 1.0) << c;
     // Cells smaller than 0.25 x their distance: h = 0.5 < 0.25 d where d > 2.
     EXPECT_EQ(rules.graded[static_cast<size_t>(c)], d > 2.0) << c;
   }

@@ -6,7 +6,7 @@
 //    extent: the cells that carry the pressure are held to delta sqrt(h / l) instead of delta, a tolerance that
 //    tightens as they shrink, so refinement follows the contact surface until its stress error falls faster than
 //    sqrt(h) (where the pressure is smooth) or the level limit is reached (at the zone's edges);
-//  * the neighbourhood (issue 30, item 1): a cell within two zone extents of a zone is held to delta / 2 (factor 2
+//  * the neighbourhood (issue 30, item 1): a cell within one zone extent l of a zone is held to delta / 2 (factor 2
 //    on its indicator, or the band's if larger). Why: the pressure, and above all the contact's width that its
 //    square-root edges follow, is set by the stiffness of the body under and around the zone (Saint-Venant: the
 //    stresses of a load of extent l are of its order within about l of it), not by the surface cells alone. With
