@@ -402,9 +402,10 @@ TEST(SeedLayersAdaptiveDefaults, TheLastStepIsWithinHalfAPercentWithTwentyTimesF
   ASSERT_TRUE(r.converged) << r.message;
   std::vector<double> errors;
   for (const auto& s : r.steps) errors.push_back(pressure_error(s.pairs.at(0), reference));
-  // No plateau: once below 1 %, every step lowers the error.
+  // No plateau: once below 1 %, every step lowers the error by a tenth at least (a step adds about half the
+  // unknowns again; the plateau's steps lowered it by 1-6 %).
   for (size_t k = 1; k < errors.size(); ++k)
-    if (errors[k - 1] < 0.01) EXPECT_LT(errors[k], errors[k - 1]) << "step " << k;
+    if (errors[k - 1] < 0.01) EXPECT_LT(errors[k], 0.9 * errors[k - 1]) << "step " << k;
   const double error = errors.back();
   const long dofs = unknowns(r, r.steps.back().iteration);
   EXPECT_LE(error, 0.005);
