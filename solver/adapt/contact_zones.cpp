@@ -13,9 +13,8 @@ namespace {
 // delta^1.7 (relative L2 0.39 %, 0.12 %, 0.04 % at delta 0.1, 0.05, 0.025 at the runs' last steps); half of delta
 // puts it below what the band and the contact edges reach in the steps the loop takes. One extent: the region
 // Saint-Venant's principle names. Measured on the paper's test with the job's defaults (last step against an
-// overkill solution): 0.5 extent 0.30 % at 2,678 unknowns, 1 extent 0.26 % at 3,024, 2 extents 0.165 % at 3,720
-// (and they refine the half x > 2 the paper never refines); on the two-cylinder example 1 extent ends at 236k
-// unknowns (180k without).
+// overkill solution): 0.5 extent 0.30 % at 2,678 unknowns, 1 extent 0.26 % at 3,024, 2 extents 0.165 % at 3,720;
+// on the two-cylinder example 1 extent ends at 236k unknowns, 2 at 252k (180k without).
 constexpr double kNeighbourhood = 1.0;
 constexpr double kNeighbourhoodFactor = 2.0;
 
