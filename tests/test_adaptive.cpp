@@ -6,11 +6,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 using namespace contact;
 using nlohmann::json;
@@ -43,10 +45,13 @@ TEST(SeedLayersAdaptive, RefinesAtTheContactEdgeNeverInTheRightHalfAndMatchesAFi
   const BodyField& upper = body(last, "upper");
   // Only body 2 adapts (the paper): the upper body keeps its 32 x 8 mesh.
   EXPECT_EQ(upper.mesh.num_cells(), 32 * 8);
-  // The right half of body 2 (x > 2), where there is no contact, is never refined: its 4 x 2 initial cells.
-  const auto right = cells_in(lower, 2.0, 4.0);
-  EXPECT_EQ(right.first, 8);
-  EXPECT_EQ(right.second, 0);
+  // The right half of body 2 (x > 2), where there is no contact, is never refined (the paper) beyond the
+  // neighbourhood of the contact zone (solver/adapt/contact_zones.hpp): x > 2.5 keeps its 3 x 2 initial cells, and
+  // the cells next to x = 2, within one zone extent of the coarse first steps' zones, are split once at most.
+  const auto right = cells_in(lower, 2.0, 4.0), far_right = cells_in(lower, 2.5, 4.0);
+  EXPECT_EQ(far_right.first, 6);
+  EXPECT_EQ(far_right.second, 0);
+  EXPECT_LE(right.second, 1);
   // Refinement concentrates on the contact zone, the finest cells at its edge (x about 1). The contact's interior
   // is refined too: the paper explains its own interior refinements by stress gradients "and in places the error
   // of the mortar method" - here the master (the adapted body) is loaded by the dual multipliers of the coarse
@@ -82,7 +87,9 @@ TEST(Adaptivity, ConvergeThenRefineWithBothIndicatorsRefinesTowardsTheContactAnd
     ASSERT_GE(r.steps.size(), 3u) << indicator;
     for (size_t k = 1; k < r.steps.size(); ++k)
       EXPECT_GT(body(r.steps[k], "lower").mesh.num_cells(), body(r.steps[k - 1], "lower").mesh.num_cells()) << indicator;
-    EXPECT_EQ(cells_in(body(r.steps.back(), "lower"), 2.0, 4.0).first, 8) << indicator;
+    // x > 2.5 is never refined; next to x = 2 the neighbourhood of the first steps' zones splits cells once at most.
+    EXPECT_EQ(cells_in(body(r.steps.back(), "lower"), 2.5, 4.0).first, 6) << indicator;
+    EXPECT_LE(cells_in(body(r.steps.back(), "lower"), 2.0, 4.0).second, 1) << indicator;
     // Each step's report says how many elements were refined.
     int refined = 0;
     for (const auto& it : r.history) refined += it.bodies[1].elements_refined;
@@ -305,4 +312,115 @@ TEST(AdaptiveLimits, RefinementStaysWithinTheJobsLimitOnUnknownsOverAllBodies) {
   bool said = false;
   for (const auto& r : reports) said = said || r.note.find("2500 unknowns over all bodies (--max-dofs) reached") != std::string::npos;
   EXPECT_TRUE(said) << "no report names the total limit";
+}
+
+namespace {
+
+// The pressure along a pair's slave edge, piecewise linear between its nodes (x sorted; no pressure: 0).
+struct PressureProfile {
+  std::vector<double> x, p;
+  explicit PressureProfile(const PairField& f) {
+    std::vector<std::pair<double, double>> v;
+    for (Eigen::Index j = 0; j < f.pressure.size(); ++j)
+      v.emplace_back(f.position(j, 0), std::isfinite(f.pressure[j]) ? f.pressure[j] : 0.0);
+    std::sort(v.begin(), v.end());
+    for (const auto& [xj, pj] : v) {
+      x.push_back(xj);
+      p.push_back(pj);
+    }
+  }
+  double at(double q) const {
+    const auto it = std::upper_bound(x.begin(), x.end(), q);
+    if (it == x.begin()) return p.front();
+    if (it == x.end()) return p.back();
+    const size_t i = static_cast<size_t>(it - x.begin()) - 1;
+    return p[i] + (p[i + 1] - p[i]) * (q - x[i]) / (x[i + 1] - x[i]);
+  }
+};
+
+// Relative L2 error of a pressure over 0 <= x <= 1.5 against a reference (trapezoidal rule on 15,000 intervals,
+// finer than any mesh compared), the measure of issue 30.
+double pressure_error(const PairField& f, const PressureProfile& reference) {
+  const PressureProfile mine(f);
+  double e2 = 0, r2 = 0;
+  const int n = 15000;
+  for (int i = 0; i <= n; ++i) {
+    const double x = 1.5 * i / n, w = (i == 0 || i == n) ? 0.5 : 1.0;
+    e2 += w * std::pow(mine.at(x) - reference.at(x), 2);
+    r2 += w * std::pow(reference.at(x), 2);
+  }
+  return std::sqrt(e2 / r2);
+}
+
+// seed_layers with the job's defaults (exact contact), both bodies nx x nx / 4.
+json seed_layers_defaults(int nx) {
+  json job = example("seed_layers.json");
+  job.erase("solver");
+  for (auto& b : job["bodies"]) {
+    b["mesh"]["block"]["nx"] = nx;
+    b["mesh"]["block"]["ny"] = nx / 4;
+  }
+  return job;
+}
+
+// The unknowns (after the constraints) of a step, from its last iteration report.
+long unknowns(const Result& r, int iteration) {
+  long dofs = 0;
+  for (const auto& it : r.history)
+    if (it.iteration == iteration) {
+      dofs = 0;
+      for (const auto& b : it.bodies) dofs += b.dofs;
+    }
+  return dofs;
+}
+
+}  // namespace
+
+TEST(SeedLayersAdaptiveDefaults, TheLastStepIsWithinHalfAPercentWithTwentyTimesFewerUnknownsThanUniform) {
+  // Issue 30, item 1: the paper's test with the job's defaults (exact contact, fem_bem, marking "contact", delta
+  // 0.1), both bodies adaptive from 8 x 2. Before the neighbourhood rule (solver/adapt/contact_zones.hpp) the
+  // error stalled at 0.45-0.5 % while the unknowns grew 4x. The reference is uniform 1024 x 256, not the issue's
+  // 512 x 128: that one's own error is ~0.2 % (the square-root edge on h = 1/128: docs/algorithm.md, "What the
+  // plateau was"), as large as what is measured here. Uniform meshes share the reference's nodes at the contact
+  // edge, which flatters them: the ratio below is a lower bound.
+  const auto t0 = std::chrono::steady_clock::now();
+  const Result fine = run(seed_layers_defaults(1024));
+  ASSERT_TRUE(fine.converged) << fine.message;
+  const PressureProfile reference(fine.steps.back().pairs.at(0));
+  std::vector<std::pair<long, double>> uniform;  // unknowns, error
+  for (int nx : {64, 128, 256, 512}) {
+    const Result r = run(seed_layers_defaults(nx));
+    ASSERT_TRUE(r.converged) << nx << ": " << r.message;
+    uniform.emplace_back(unknowns(r, r.iterations), pressure_error(r.steps.back().pairs.at(0), reference));
+  }
+  for (size_t i = 1; i < uniform.size(); ++i) ASSERT_LT(uniform[i].second, uniform[i - 1].second);  // converging
+
+  json job = seed_layers_defaults(8);
+  job["adaptivity"] = json::object();  // every adaptivity default
+  job["output"] = {{"steps", "all"}};
+  const Result r = run(job);
+  ASSERT_TRUE(r.converged) << r.message;
+  std::vector<double> errors;
+  for (const auto& s : r.steps) errors.push_back(pressure_error(s.pairs.at(0), reference));
+  // No plateau: once below 1 %, every step lowers the error by a tenth at least (a step adds about half the
+  // unknowns again; the plateau's steps lowered it by 1-6 %).
+  for (size_t k = 1; k < errors.size(); ++k)
+    if (errors[k - 1] < 0.01) EXPECT_LT(errors[k], 0.9 * errors[k - 1]) << "step " << k;
+  const double error = errors.back();
+  const long dofs = unknowns(r, r.steps.back().iteration);
+  EXPECT_LE(error, 0.005);
+  // The uniform unknowns for that error: log-log between the measured meshes around it; below the finest
+  // measured error, at least the finest mesh's.
+  double needed = static_cast<double>(uniform.back().first);
+  for (size_t i = 0; i + 1 < uniform.size(); ++i) {
+    const auto [n0, e0] = uniform[i];
+    const auto [n1, e1] = uniform[i + 1];
+    if (error <= e0 && error >= e1)
+      needed = n0 * std::exp(std::log(static_cast<double>(n1) / n0) * std::log(error / e0) / std::log(e1 / e0));
+  }
+  if (error > uniform.front().second) needed = 0;  // (not reached by the coarsest: no claim)
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::printf("  adaptive last step: %ld unknowns, pressure error %.3f %%; uniform needs %.0f: ratio %.1f (%.1f s)\n",
+              dofs, 100 * error, needed, needed / static_cast<double>(dofs), seconds);
+  EXPECT_GE(needed, 20.0 * static_cast<double>(dofs));
 }

@@ -1,5 +1,6 @@
 // The marking that serves the contact (solver/adapt/contact_zones.cpp; docs/algorithm.md, "Marking that serves
-// the contact"): the zones of a step's pairs, the band factor sqrt(l / h) and the grading, by hand on a block.
+// the contact"): the zones of a step's pairs, the band factor sqrt(l / h), the neighbourhood and the
+// grading, by hand on a block.
 #include "adapt/contact_zones.hpp"
 #include "adapt/indicator.hpp"
 #include "contact/mesh.hpp"
@@ -59,8 +60,10 @@ TEST(ContactMarking, TheBandHoldsCellsAlongTheZoneToATighterDeltaAndTheGradingKe
     Eigen::Vector2d centre = Eigen::Vector2d::Zero();
     for (int k : m.cells[static_cast<size_t>(c)]) centre += 0.25 * m.nodes[static_cast<size_t>(k)];
     const double d = zones[0].distance(centre);
-    // Within one cell size (0.5) of the zone: sqrt(l / h) with l = 0.75, h = 0.5; elsewhere 1.
-    EXPECT_DOUBLE_EQ(rules.factor[static_cast<size_t>(c)], d < 0.5 ? std::sqrt(0.75 / 0.5) : 1.0) << c;
+    // Within one cell size (0.5) of the zone the band's sqrt(l / h) with l = 0.75, h = 0.5, or the neighbourhood's 2
+    // if larger (it is); within one extent (0.75) the neighbourhood's 2; elsewhere 1.
+    const double band = d < 0.5 ? std::sqrt(0.75 / 0.5) : 1.0;
+    EXPECT_DOUBLE_EQ(rules.factor[static_cast<size_t>(c)], d < 0.75 ? std::max(band, 2.0) : 1.0) << c;
     // Cells smaller than 0.25 x their distance: h = 0.5 < 0.25 d where d > 2.
     EXPECT_EQ(rules.graded[static_cast<size_t>(c)], d > 2.0) << c;
   }
