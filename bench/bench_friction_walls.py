@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Friction on many bodies (issue 28): masonry walls held by friction alone (scripts/make_brick_wall.py
 --head-joints --friction 0.6 --shear 0.3: head and bed joints, no dowels, precompression then shear), 8 x 8 to
-22 x 22 (32 x 32 and 64 x 64 without --quick), each interface solver that takes them, against the frictionless
+22 x 22 (32 x 32 and 64 x 64 without --quick), each interface solver that takes them, on 1 rank (and 2 under
+mpirun without --quick; the ratios are the 1-rank runs'), against the frictionless
 dowelled twin of the same size (the generator's default wall), and in the same run the paper's test at 1024 x 256
 per body (1.05M unknowns, the default method) as the yardstick. Prints time, peak memory, the interface solver's
 steps (Newton steps or outer iterations) and MPRGP iterations (the whole run's), and the ratios the issue sets targets for: the
@@ -13,6 +14,7 @@ Then the walls near the limit, H/V 0.5 (8 x 8 and 16 x 16; 22 x 22 without --qui
     bench/bench_friction_walls.py [BUILD_DIR] [--quick]     (--quick: about two minutes on two cores)"""
 import json
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -35,24 +37,27 @@ def generated(n, options, solver, tmp):
 
 def main():
     sizes = [8, 16, 22] if QUICK else [8, 16, 22, 32, 64]
+    ranks_list = [1] if QUICK or not shutil.which("mpirun") else [1, 2]  # peak memory is per rank
     frictional = ["--head-joints", "--friction", "0.6", "--shear", "0.3"]
     rows = {}
     with tempfile.TemporaryDirectory() as tmp:
         seed, _ = run(seed_job(tmp), 1, tmp)
         print(f"paper's test 1024 x 256 per body (1.05M unknowns), defaults: {seed['wall']:.2f} s, {seed['rss']:.0f} MB",
               flush=True)
-        print(f"{'wall':>7} {'bodies':>6} {'kind':>12} {'solver':>9} {'time s':>8} {'peak MB':>8} {'steps':>5} "
-              f"{'MPRGP it.':>9}", flush=True)
+        print(f"{'wall':>7} {'bodies':>6} {'kind':>12} {'solver':>9} {'ranks':>5} {'time s':>8} {'peak MB':>8} "
+              f"{'steps':>5} {'MPRGP it.':>9}", flush=True)
         for n in sizes:
             for kind, options in (("frictionless", []), ("frictional", frictional)):
                 for solver in ("direct", "iterative"):
                     if solver == "direct" and n >= (64 if kind == "frictionless" else 32):
                         continue  # the direct solver's dense floating-body block, or its sets' LU, past memory/time
                     job, bodies = generated(n, options, solver, tmp)
-                    r, error = run(job, 1, tmp)
-                    rows[(n, kind, solver)] = r
-                    print_result(f"{n:>4}x{n:<2} {bodies:>6} {kind:>12} {solver:>9}", r, error,
-                                 "{wall:>8.2f} {rss:>8.0f} {steps:>5} {iterations:>9}")
+                    for ranks in ranks_list:
+                        r, error = run(job, ranks, tmp)
+                        if ranks == 1:
+                            rows[(n, kind, solver)] = r
+                        print_result(f"{n:>4}x{n:<2} {bodies:>6} {kind:>12} {solver:>9} {ranks:>5}", r, error,
+                                     "{wall:>8.2f} {rss:>8.0f} {steps:>5} {iterations:>9}")
         # Near the friction limit (issue 28's statics): the free course ends unload the heel, whose bricks slip on
         # both bed joints (an indeterminate slip). Every step must converge, uncut.
         print("\nnear the limit: head joints, mu 0.6, H/V 0.5, the solver `auto` picks", flush=True)
