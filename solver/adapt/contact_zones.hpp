@@ -1,7 +1,7 @@
 // Refinement that serves the contact (issue 20, item 2; docs/algorithm.md, "Marking that serves the contact").
 //
 // What an adaptive contact run is for is the contact pressure (and its resultant). Three rules on top of the
-// indicator, both relative to the contact zones (the boxes of the pairs' nodes with a positive pressure):
+// indicator, all relative to the contact zones (the boxes of the pairs' nodes with a positive pressure):
 //  * the band: a cell within its own size h of a zone has its indicator multiplied by sqrt(l / h), l the zone's
 //    extent: the cells that carry the pressure are held to delta sqrt(h / l) instead of delta, a tolerance that
 //    tightens as they shrink, so refinement follows the contact surface until its stress error falls faster than
