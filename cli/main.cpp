@@ -141,7 +141,7 @@ class ProgressPrinter final : public contact::Observer {
       for (const auto& b : r.bodies)
         bodies.push_back({{"name", b.name}, {"cells", b.elements}, {"unknowns", b.dofs}, {"refined", b.elements_refined}});
       const nlohmann::json line = {{"type", "adaptive_step"},       {"step", r.step},
-                                   {"bodies", bodies},              {"estimate", r.estimate},
+                                   {"bodies", bodies},              {"estimate", r.estimate}, {"pressure_estimate", r.pressure_estimate},
                                    {"force", r.force},              {"peak_pressure", r.peak_pressure},
                                    {"estimate_change", r.estimate_change}, {"force_change", r.force_change},
                                    {"peak_change", r.peak_change},  {"indicator_seconds", r.indicator_seconds},
@@ -163,6 +163,7 @@ class ProgressPrinter final : public contact::Observer {
     else
       std::printf("  | estimate %.3e (change %.2g %%)  force %.6g (%.2g %%)  p_max %.6g (%.2g %%)", r.estimate,
                   100 * r.estimate_change, r.force, 100 * r.force_change, r.peak_pressure, 100 * r.peak_change);
+    if (std::isfinite(r.pressure_estimate)) std::printf("  pressure error ~%.3g %%", 100 * r.pressure_estimate);
     std::printf("  | estimating %.2fs  %.2fs\n", r.indicator_seconds, r.elapsed_seconds);
     std::fflush(stdout);
   }

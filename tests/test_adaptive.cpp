@@ -2,6 +2,7 @@
 // transcript (deal.II style: the per-step elements, DOFs and iterations are compared with a checked-in file).
 #include "contact/job.hpp"
 #include "contact/solve.hpp"
+#include "adaptive_support.hpp"
 #include "support.hpp"
 
 #include <gtest/gtest.h>
@@ -317,67 +318,6 @@ TEST(AdaptiveLimits, RefinementStaysWithinTheJobsLimitOnUnknownsOverAllBodies) {
   EXPECT_TRUE(said) << "no report names the total limit";
 }
 
-namespace {
-
-// The pressure along a pair's slave edge, piecewise linear between its nodes (x sorted; no pressure: 0).
-struct PressureProfile {
-  std::vector<double> x, p;
-  explicit PressureProfile(const PairField& f) {
-    std::vector<std::pair<double, double>> v;
-    for (Eigen::Index j = 0; j < f.pressure.size(); ++j)
-      v.emplace_back(f.position(j, 0), std::isfinite(f.pressure[j]) ? f.pressure[j] : 0.0);
-    std::sort(v.begin(), v.end());
-    for (const auto& [xj, pj] : v) {
-      x.push_back(xj);
-      p.push_back(pj);
-    }
-  }
-  double at(double q) const {
-    const auto it = std::upper_bound(x.begin(), x.end(), q);
-    if (it == x.begin()) return p.front();
-    if (it == x.end()) return p.back();
-    const size_t i = static_cast<size_t>(it - x.begin()) - 1;
-    return p[i] + (p[i + 1] - p[i]) * (q - x[i]) / (x[i + 1] - x[i]);
-  }
-};
-
-// Relative L2 error of a pressure over 0 <= x <= 1.5 against a reference (trapezoidal rule on 15,000 intervals,
-// finer than any mesh compared), the measure of issue 30.
-double pressure_error(const PairField& f, const PressureProfile& reference) {
-  const PressureProfile mine(f);
-  double e2 = 0, r2 = 0;
-  const int n = 15000;
-  for (int i = 0; i <= n; ++i) {
-    const double x = 1.5 * i / n, w = (i == 0 || i == n) ? 0.5 : 1.0;
-    e2 += w * std::pow(mine.at(x) - reference.at(x), 2);
-    r2 += w * std::pow(reference.at(x), 2);
-  }
-  return std::sqrt(e2 / r2);
-}
-
-// seed_layers with the job's defaults (exact contact), both bodies nx x nx / 4.
-json seed_layers_defaults(int nx) {
-  json job = example("seed_layers.json");
-  job.erase("solver");
-  for (auto& b : job["bodies"]) {
-    b["mesh"]["block"]["nx"] = nx;
-    b["mesh"]["block"]["ny"] = nx / 4;
-  }
-  return job;
-}
-
-// The unknowns (after the constraints) of a step, from its last iteration report.
-long unknowns(const Result& r, int iteration) {
-  long dofs = 0;
-  for (const auto& it : r.history)
-    if (it.iteration == iteration) {
-      dofs = 0;
-      for (const auto& b : it.bodies) dofs += b.dofs;
-    }
-  return dofs;
-}
-
-}  // namespace
 
 TEST(SeedLayersAdaptiveDefaults, TheLastStepIsWithinHalfAPercentWithTwentyTimesFewerUnknownsThanUniform) {
   // Issue 30, item 1: the paper's test with the job's defaults (exact contact, fem_bem, marking "contact", delta

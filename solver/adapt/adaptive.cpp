@@ -3,6 +3,7 @@
 #include "../ddm/fixed_point.hpp"
 #include "contact_zones.hpp"
 #include "indicator.hpp"
+#include "pressure_estimate.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -31,6 +32,7 @@ std::vector<IndicatorResult> estimate(const Problem& problem, const ddm::Contact
                                p.put(out[a].error2);
                                p.put(out[a].reference2);
                                p.put(out[a].cancelled ? 1.0 : 0.0);
+                               p.put(out[a].bem_displacement);
                              },
                              [&](size_t a, parallel::Unpacker& in) {
                                out[a].eta = in.get_vector();
@@ -39,6 +41,7 @@ std::vector<IndicatorResult> estimate(const Problem& problem, const ddm::Contact
                                out[a].error2 = in.get_double();
                                out[a].reference2 = in.get_double();
                                out[a].cancelled = in.get_double() != 0.0;
+                               out[a].bem_displacement = in.get_vector();
                              }};
   runner.run_bodies(problem.bodies.size(), [&](size_t a) {
     if (!adapts(problem.adaptivity, a)) return;
@@ -65,6 +68,26 @@ void add_note(std::string& notes, const std::string& note) {
   if (note.empty()) return;
   if (!notes.empty()) notes += "; ";
   notes += note;
+}
+
+// Refines `cells` (largest indicator first), halving the list until the refined mesh stays within `allowed`
+// unknowns (2 x nodes): mark() keeps a margin for the 1-irregularity closure, which can still add more.
+mesh::RefinementResult refine_within(mesh::Mesh& mesh, std::vector<int> cells, int max_level, long allowed,
+                                     std::string& note, const std::string& body) {
+  // Far from the limit (a split and its closure add well under 60 unknowns per marked cell): in place.
+  if (2L * mesh.num_nodes() + 60L * static_cast<long>(cells.size()) <= allowed) return mesh::refine(mesh, cells, max_level);
+  for (;;) {
+    mesh::Mesh trial = mesh;
+    mesh::RefinementResult r = mesh::refine(trial, cells, max_level);
+    if (2L * trial.num_nodes() <= allowed) {
+      mesh = std::move(trial);
+      return r;
+    }
+    if (note.find("'" + body + "': max_dofs") == std::string::npos)
+      add_note(note, "body '" + body + "': max_dofs reached, refinement cut back");
+    if (cells.size() <= 1) return mesh::RefinementResult{};  // not even one split fits
+    cells.resize(cells.size() / 2);
+  }
 }
 
 // Marks and refines the adaptive bodies; `step` is the current mesh state (its contact zones for the grading);
@@ -109,7 +132,8 @@ RefineOutcome mark_and_refine(Problem& problem, const std::vector<IndicatorResul
     out.blocked = out.blocked || m.dof_limit_hit || m.level_limit_hit || m.graded_out > 0;
     add_note(out.note, eta[a].note);
     if (m.cells.empty()) continue;
-    out.refinements[a] = mesh::refine(mesh, m.cells, s.max_level);
+    out.refinements[a] = refine_within(mesh, m.cells, s.max_level, allowed, out.note, problem.bodies[a].name);
+    if (out.refinements[a].refined_cells == 0) out.blocked = true;  // not one marked split fits the limit
     total += 2L * mesh.num_nodes() - own;
     out.refined[a] = out.refinements[a].refined_cells;
     out.changed[a] = out.refined[a] > 0;
@@ -212,6 +236,57 @@ std::string stalled(const AdaptiveStepReport& r, double tolerance) {
   return os.str();
 }
 
+// The target test (adaptivity.target_error): the message when the step's pressure estimate meets it, else "".
+std::string target_met(const AdaptiveStepReport& r, const PressureEstimate& pe, double target) {
+  if (target <= 0.0 || !(pe.relative <= target)) return "";
+  std::ostringstream os;
+  os.precision(2);
+  os << "adaptive: target met after " << r.step << " refinement steps: the estimated pressure error "
+     << 100 * pe.relative << " % (boundary-element correction " << 100 * pe.defect << " %, contact edges "
+     << 100 * pe.edges << " %) is at most target_error = " << 100 * target << " %";
+  return os.str();
+}
+
+// What a stop other than the target says about the target, when the job set one.
+std::string target_missed(const PressureEstimate& pe, double target) {
+  if (target <= 0.0) return "";
+  std::ostringstream os;
+  os.precision(2);
+  os << "; target_error = " << 100 * target << " % not reached: ";
+  if (std::isfinite(pe.relative))
+    os << "the last step's estimated pressure error is " << 100 * pe.relative << " %";
+  else
+    os << pe.note;
+  return os.str();
+}
+
+// Marks and refines. With a target that is not met, delta is halved before the marking when the last step
+// lowered the pressure estimate by less than a quarter (`stalling`: the cells over delta are no longer where
+// the pressure's error is), and a marking that finds no cell over delta is repeated with delta halved, down to
+// the job's delta / 1024 (the note says where it ended).
+RefineOutcome refine_towards_target(Problem& working, const std::vector<IndicatorResult>& eta, const Step& step,
+                                    double kept_nodes, bool stalling, double job_delta) {
+  auto& s = working.adaptivity;
+  const double floor = job_delta / 1024;
+  bool lowered = false;
+  if (s.target_error > 0.0 && stalling && s.delta / 2 >= floor) {
+    s.delta /= 2;
+    lowered = true;
+  }
+  RefineOutcome r = mark_and_refine(working, eta, step, kept_nodes);
+  while (s.target_error > 0.0 && !r.any && !r.blocked && s.delta / 2 >= floor) {
+    s.delta /= 2;
+    lowered = true;
+    r = mark_and_refine(working, eta, step, kept_nodes);
+  }
+  if (lowered) {
+    std::ostringstream os;
+    os << "delta lowered to " << s.delta << " towards the target";
+    add_note(r.note, os.str());
+  }
+  return r;
+}
+
 bool any_cancelled(const std::vector<IndicatorResult>& eta) {
   for (const auto& e : eta)
     if (e.cancelled) return true;
@@ -226,7 +301,49 @@ const ddm::MethodOutcome& solve_step(ddm::ContactSystem& system, ddm::RunFrame& 
                       [&](ddm::RunFrame& inner) { ddm::run_enforced(system, inner, method); });
 }
 
-// Solve, estimate, report the step, and stop (stop test, max_steps, nothing refinable, cancellation) or refine.
+void mark_cancelled(ddm::MethodOutcome& total) {
+  total.stop_reason = StopReason::cancelled;
+  total.converged = false;
+}
+
+// The refined meshes take the solution (transferred) and are assembled and factorised; false, with the total's
+// stop and message set, if a cancel or an error ended that.
+bool rebuild_refined(Problem& working, ddm::ContactSystem& system, ddm::RunFrame& frame, ddm::ContactMethod& method,
+                     const RefineOutcome& r, int step, ddm::Displacements& warm) {
+  ddm::MethodOutcome& total = frame.outcome();
+  transfer(warm, working, r);
+  system.rebuild(r.changed, frame.stop_check());
+  method.reset();
+  if (system.cancelled()) {  // during the refined meshes' assembly or factorisation: they are not solved
+    mark_cancelled(total);
+    total.message = "cancelled during adaptive step " + std::to_string(step + 1) +
+                    " (assembling and factorising its refined meshes; the result holds step " +
+                    std::to_string(step) + "'s solution)";
+    return false;
+  }
+  if (!system.ok()) {
+    total.stop_reason = StopReason::error;
+    total.converged = false;
+    total.message = "adaptive: " + system.error();
+    return false;
+  }
+  return true;
+}
+
+// The stops after a converged step's estimate, in order: the target, the stop test, max_steps; "" to go on.
+std::string stop_after_estimate(const AdaptivitySettings& s, const AdaptiveStepReport& report,
+                                const PressureEstimate& pe, int step, const std::string& solve_message) {
+  if (std::string met = target_met(report, pe, s.target_error); !met.empty()) return met;
+  const std::string missed = target_missed(pe, s.target_error);
+  if (const std::string stop = stalled(report, s.stop_tolerance); !stop.empty()) return stop + missed;
+  if (step >= s.max_steps)
+    return "adaptive: max_steps = " + std::to_string(s.max_steps) + " refinement steps done" + missed + "; " +
+           solve_message;
+  return "";
+}
+
+// Solve, estimate, report the step, and stop (target, stop test, max_steps, nothing refinable, cancellation) or
+// refine.
 void converge_then_refine(Problem& working, ddm::ContactSystem& system, ddm::RunFrame& frame,
                           ddm::ContactMethod& method, ddm::StepLog& steps) {
   const auto& s = working.adaptivity;
@@ -234,6 +351,9 @@ void converge_then_refine(Problem& working, ddm::ContactSystem& system, ddm::Run
   std::vector<int> refined_last;
   ddm::Displacements warm;
   StepMeasures previous;
+  double previous_pressure_estimate = 0.0;
+  const double job_delta = s.delta;
+  const std::string cancelled_here = "cancelled during adaptive step ";
   for (int step = 0;; ++step) {
     const ddm::MethodOutcome& o = solve_step(system, frame, method, refined_last, warm);
     if (o.u.empty()) return;
@@ -241,8 +361,7 @@ void converge_then_refine(Problem& working, ddm::ContactSystem& system, ddm::Run
       Step reached = make_step(system, o.u, o.z, total.iterations, step, {});
       reached.converged = false;
       steps.push_back(std::move(reached));
-      total.stop_reason = StopReason::cancelled;
-      total.converged = false;
+      mark_cancelled(total);
       return;
     }
     const ddm::Displacements loads = o.z.empty() ? system.contact_loads(o.u) : system.loads_from_pressures(o.z);
@@ -261,50 +380,37 @@ void converge_then_refine(Problem& working, ddm::ContactSystem& system, ddm::Run
     };
     if (frame.stop_requested() || any_cancelled(eta)) {
       if (any_cancelled(eta)) report.estimate = report.estimate_change = std::nan("");  // only partly estimated
-      total.stop_reason = StopReason::cancelled;
-      total.converged = false;
-      return finish("cancelled during adaptive step " + std::to_string(step) +
-                    " (the result holds that step's solution)");
+      report.pressure_estimate = std::nan("");
+      mark_cancelled(total);
+      return finish(cancelled_here + std::to_string(step) + " (the result holds that step's solution)");
     }
+    const PressureEstimate pe =
+        pressure_estimate(system, o.u, o.z.empty() ? system.penalty_pressures(o.u) : o.z, eta);
+    report.pressure_estimate = pe.relative;
     if (!o.converged) return finish("");
-    if (const std::string stop = stalled(report, s.stop_tolerance); !stop.empty()) return finish(stop);
-    if (step >= s.max_steps)
-      return finish("adaptive: max_steps = " + std::to_string(s.max_steps) + " refinement steps done; " + o.message);
-    RefineOutcome r = mark_and_refine(working, eta, steps.back(), steps.committed_nodes());
+    if (const std::string stop = stop_after_estimate(s, report, pe, step, o.message); !stop.empty())
+      return finish(stop);
+    const bool stalling = step > 0 && !(pe.relative < 0.75 * previous_pressure_estimate);
+    previous_pressure_estimate = pe.relative;
+    RefineOutcome r =
+        refine_towards_target(working, eta, steps.back(), steps.committed_nodes(), stalling, job_delta);
     if (!r.any) {
       std::ostringstream os;
       os << "adaptive: " << (r.blocked ? "nothing marked can be refined" : "no cell marked") << " after " << step
-         << " refinement steps (" << (r.note.empty() ? "" : r.note + "; ") << "last solve: " << o.message << ")";
+         << " refinement steps (" << (r.note.empty() ? "" : r.note + "; ") << "last solve: " << o.message << ")"
+         << target_missed(pe, s.target_error);
       return finish(os.str());
     }
     if (frame.stop_requested()) {  // during the marking and refinement: the refined meshes are not solved
-      total.stop_reason = StopReason::cancelled;
-      total.converged = false;
-      return finish("cancelled during adaptive step " + std::to_string(step) +
-                    " (the result holds that step's solution)");
+      mark_cancelled(total);
+      return finish(cancelled_here + std::to_string(step) + " (the result holds that step's solution)");
     }
     for (size_t a = 0; a < report.bodies.size() && a < r.refined.size(); ++a)
       report.bodies[a].elements_refined = r.refined[a];
     frame.report(report);
     warm = o.u;
-    transfer(warm, working, r);
-    system.rebuild(r.changed, frame.stop_check());
-    method.reset();
     refined_last = r.refined;
-    if (system.cancelled()) {  // during the refined meshes' assembly or factorisation: they are not solved
-      total.stop_reason = StopReason::cancelled;
-      total.converged = false;
-      total.message = "cancelled during adaptive step " + std::to_string(step + 1) +
-                      " (assembling and factorising its refined meshes; the result holds step " +
-                      std::to_string(step) + "'s solution)";
-      return;
-    }
-    if (!system.ok()) {
-      total.stop_reason = StopReason::error;
-      total.converged = false;
-      total.message = "adaptive: " + system.error();
-      return;
-    }
+    if (!rebuild_refined(working, system, frame, method, r, step, warm)) return;
   }
 }
 

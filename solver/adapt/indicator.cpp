@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <array>
 #include <map>
 #include <numeric>
 #include <set>
@@ -234,12 +235,27 @@ bem::BoundaryProblem boundary_problem(const Body& body, const Model& model, cons
     if (!bc.vertex.empty() && bc.kind == BoundaryCondition::Kind::force)
       for (int node : condition_nodes(m, bc)) nodal_load.segment<2>(2 * node) += factor * bc.force;
   const size_t nb = loop.size();
-  // Nodal forces to tractions: lumped over the boundary sides that carry them.
+  // Nodal forces to tractions, lumped over the boundary sides next to their node. Where one of the two sides has
+  // a condition of its own and the other none (a contact edge meeting a symmetry line or a loaded edge), the
+  // force goes to the free side alone: spread over both, a contact force would push on the symmetry face, and
+  // the boundary-element solution would carry that spurious load at the corner (it set a mesh-independent
+  // pressure correction of -22 at the paper's test's symmetry corner; pressure_estimate.hpp).
+  auto side_free = [&](size_t i) {
+    return sides.condition.find(key(loop[i], loop[(i + 1) % nb])) == sides.condition.end();
+  };
   std::vector<double> half_length(nb, 0.0);
+  std::vector<std::array<bool, 2>> takes(nb, {true, true});  // side i takes the load of its start / end node
+  for (size_t i = 0; i < nb; ++i) {
+    const size_t before = (i + nb - 1) % nb;
+    if (side_free(i) != side_free(before)) {
+      takes[i][0] = side_free(i);
+      takes[before][1] = side_free(before);
+    }
+  }
   for (size_t i = 0; i < nb; ++i) {
     const double L = (m.nodes[static_cast<size_t>(loop[(i + 1) % nb])] - m.nodes[static_cast<size_t>(loop[i])]).norm();
-    half_length[i] += 0.5 * L;
-    half_length[(i + 1) % nb] += 0.5 * L;
+    if (takes[i][0]) half_length[i] += 0.5 * L;
+    if (takes[i][1]) half_length[(i + 1) % nb] += 0.5 * L;
   }
   bem::BoundaryProblem bp;
   bp.material = {body.material.E, body.material.nu, model.plane == Plane::strain};
@@ -266,8 +282,8 @@ bem::BoundaryProblem boundary_problem(const Body& body, const Model& model, cons
         el.value(comp, 1) = u[2 * b + comp];
       } else {
         // Contact forces are per thickness-weighted length: divide the lumped force by length x thickness.
-        const double ta = nodal_load[2 * a + comp] / (half_length[i] * thickness);
-        const double tb = nodal_load[2 * b + comp] / (half_length[(i + 1) % nb] * thickness);
+        const double ta = takes[i][0] ? nodal_load[2 * a + comp] / (half_length[i] * thickness) : 0.0;
+        const double tb = takes[i][1] ? nodal_load[2 * b + comp] / (half_length[(i + 1) % nb] * thickness) : 0.0;
         el.value(comp, 0) = traction[comp] + ta;
         el.value(comp, 1) = traction[comp] + tb;
       }
@@ -279,8 +295,8 @@ bem::BoundaryProblem boundary_problem(const Body& body, const Model& model, cons
 // Solves the boundary-element problem, evaluates its stresses at the cell centres and compares them with the FE
 // stresses there (a cancel gives a cancelled result; a failed solve the zz indicator).
 IndicatorResult compare_with_bem(const Body& body, const fem::BodySolver& solver, const Eigen::VectorXd& u,
-                                 const bem::BoundaryProblem& bp, Normalization normalization,
-                                 const std::function<bool()>& cancelled) {
+                                 const bem::BoundaryProblem& bp, const std::vector<int>& loop,
+                                 Normalization normalization, const std::function<bool()>& cancelled) {
   const auto& m = body.mesh;
   IndicatorResult r;
   try {
@@ -292,6 +308,9 @@ IndicatorResult compare_with_bem(const Body& body, const fem::BodySolver& solver
     evaluation.tolerance = kEvaluationTolerance;
     const Eigen::MatrixX3d sb = bem::interior_stresses_auto(bp, sol, centres, evaluation);
     r.eta = normalised(m, fe_point_stresses(body, solver, u), linear_fit_at_points(m, centres, sb), normalization, r);
+    r.bem_displacement = u;
+    for (size_t i = 0; i < loop.size(); ++i)
+      r.bem_displacement.segment<2>(2 * loop[i]) = sol.displacement.row(static_cast<Eigen::Index>(i)).transpose();
   } catch (const bem::Cancelled&) {
     r = IndicatorResult{};
     r.cancelled = true;
@@ -324,7 +343,7 @@ IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fe
     return r;
   }
   const bem::BoundaryProblem bp = boundary_problem(body, model, solver, u, contact_load, loop, sides);
-  IndicatorResult r = compare_with_bem(body, solver, u, bp, normalization, cancelled);
+  IndicatorResult r = compare_with_bem(body, solver, u, bp, loop, normalization, cancelled);
   r.seconds = seconds_since(t0);  // (r is replaced on the way: not a ScopedTimer)
   return r;
 }

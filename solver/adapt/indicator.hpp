@@ -29,6 +29,10 @@ struct IndicatorResult {
   double error2 = 0.0;      // ||sigma_R - sigma_F||^2 over the body (the global estimate's numerator)
   double reference2 = 0.0;  // ||sigma_R||^2 over the body
   bool cancelled = false;   // the estimate was stopped by `cancelled` (eta is then empty)
+  // fem_bem only: the FE displacements (all dofs) with the boundary nodes' replaced by the boundary-element
+  // solution's, the body's response to the same data without the FE interior (pressure_estimate.hpp); empty
+  // for zz and where fem_bem fell back to zz.
+  Eigen::VectorXd bem_displacement;
 };
 
 // Zienkiewicz-Zhu recovery indicator of body displacements u (all dofs).

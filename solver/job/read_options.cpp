@@ -149,7 +149,7 @@ void JobReader::resolve_method_defaults() {
 void JobReader::read_adaptivity(const json& value, const std::string& pointer) {
   Fields f(value, pointer, "adaptivity",
            {"indicator", "normalization", "delta", "marking", "grading", "bodies", "max_level", "max_dofs", "strategy",
-            "max_steps", "stop_tolerance"},
+            "max_steps", "stop_tolerance", "target_error"},
            errors_);
   if (!f.ok()) return;
   AdaptivitySettings& a = problem_.adaptivity;
@@ -189,7 +189,39 @@ void JobReader::read_adaptivity(const json& value, const std::string& pointer) {
         a.stop_tolerance = *x;
     }
   if (const json* b = f.find("bodies")) read_adaptive_bodies(*b, f.at("bodies"));
+  if (const json* t = f.find("target_error")) read_target_error(*t, f.at("target_error"), f.find("stop_tolerance"), out);
   write_adaptivity_defaults(out);
+}
+
+// "target_error": the estimated relative error of the contact pressure to reach (adapt/pressure_estimate.hpp).
+// The estimate takes the fem_bem indicator's boundary-element solutions, and the loop it ends is
+// converge_then_refine's; the stop test on the changes is off unless the job sets it (it would end the run at
+// the changes of 0.5 %, before a finer target).
+void JobReader::read_target_error(const json& value, const std::string& pointer, const json* stop_tolerance,
+                                  json& out) {
+  AdaptivitySettings& a = problem_.adaptivity;
+  const auto x = read::number(value, pointer, "target_error", errors_);
+  if (!x) return;
+  if (!(*x > 0.0 && *x < 1.0)) {
+    errors_.add(pointer, "target_error must lie in (0, 1): the relative error of the contact pressure to reach "
+                         "(0.001 is 0.1 %)");
+    return;
+  }
+  if (a.indicator != Indicator::fem_bem) {
+    errors_.add(pointer, "target_error needs the fem_bem indicator (the pressure estimate takes its "
+                         "boundary-element solutions); remove \"indicator\": \"zz\" or the target");
+    return;
+  }
+  if (a.strategy != AdaptStrategy::converge_then_refine) {
+    errors_.add(pointer, "target_error needs the strategy \"converge_then_refine\" (the paper's strategy refines "
+                         "before each solve has converged, so no step has a pressure to estimate)");
+    return;
+  }
+  a.target_error = *x;
+  if (!stop_tolerance) {
+    a.stop_tolerance = 0.0;
+    out["stop_tolerance"] = 0.0;
+  }
 }
 
 // "bodies": the names of the bodies to refine, as indices (each once).

@@ -234,6 +234,9 @@ struct AdaptivitySettings {
   // converge_then_refine stops once a step changed the total contact force, the peak contact pressure and the
   // global estimate each by less than this, relatively (0: never stop for that reason).
   double stop_tolerance = 0.005;
+  // converge_then_refine stops at the first step whose estimated relative error of the contact pressure
+  // (adapt/pressure_estimate.hpp) is at most this; where nothing is marked before, delta is halved (0: no target).
+  double target_error = 0.0;
 };
 
 // Load steps: every prescribed displacement, traction, force and body force is scaled by each factor in turn;

@@ -203,6 +203,9 @@ struct AdaptiveStepReport {
   double force = 0.0;      // total normal contact force, all pairs
   double peak_pressure = 0.0;  // largest contact pressure, all pairs
   double force_change = 0.0, peak_change = 0.0, estimate_change = 0.0;
+  // The estimated relative L2 error of the contact pressure over all pairs (adapt/pressure_estimate.hpp); NaN
+  // where it cannot be made (the zz indicator, a cancel).
+  double pressure_estimate = 0.0;
   double indicator_seconds = 0.0;  // this step's estimate (for fem_bem: the boundary-element work)
   double elapsed_seconds = 0.0;    // since solve() started
 };

@@ -1,0 +1,214 @@
+#include "pressure_estimate.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace contact::adapt {
+
+namespace {
+
+constexpr int kMaxIterations = 200;
+constexpr double kTolerance = 1e-3;  // relative residual of the correction: the estimate's third digit
+
+using ddm::Pressures;
+
+// Rows that carry pressure: the correction lives on them (the open rows' gaps are not closed by the exact
+// pressure either).
+std::vector<std::vector<char>> active_rows(const Pressures& z) {
+  std::vector<std::vector<char>> active(z.size());
+  for (size_t k = 0; k < z.size(); ++k) {
+    active[k].assign(static_cast<size_t>(z[k].size()), 0);
+    for (Eigen::Index r = 0; r < z[k].size(); ++r) active[k][static_cast<size_t>(r)] = z[k][r] > 0.0;
+  }
+  return active;
+}
+
+// The D-weighted inner product over the active rows.
+double dot(const ddm::ContactSystem& system, const std::vector<std::vector<char>>& active, const Pressures& a,
+           const Pressures& b) {
+  double s = 0.0;
+  for (size_t k = 0; k < a.size(); ++k)
+    for (Eigen::Index r = 0; r < a[k].size(); ++r)
+      if (active[k][static_cast<size_t>(r)]) s += system.pairs()[k].D[r] * a[k][r] * b[k][r];
+  return s;
+}
+
+void axpy(double alpha, const Pressures& x, Pressures& y) {
+  for (size_t k = 0; k < y.size(); ++k) y[k] += alpha * x[k];
+}
+
+// The FE bodies' contact compliance G: the change of the nodal gaps on the active rows from pressures v (zero on
+// the other rows), one solve per body; `free_gaps` are the gaps of the bodies' response to no contact force.
+class Compliance {
+ public:
+  Compliance(const ddm::ContactSystem& system, const std::vector<std::vector<char>>& active)
+      : system_(system), active_(active) {
+    ddm::Displacements none(system.n_bodies());
+    for (size_t a = 0; a < none.size(); ++a) none[a] = Eigen::VectorXd::Zero(system.body(a).n_dofs());
+    free_gaps_ = system.nodal_gaps(system.solve_bodies(none));
+  }
+  Pressures apply(const Pressures& v) const {
+    Pressures g = system_.nodal_gaps(system_.solve_bodies(system_.loads_from_pressures(v)));
+    for (size_t k = 0; k < g.size(); ++k) {
+      g[k] -= free_gaps_[k];
+      for (Eigen::Index r = 0; r < g[k].size(); ++r)
+        if (!active_[k][static_cast<size_t>(r)]) g[k][r] = 0.0;
+    }
+    return g;
+  }
+
+ private:
+  const ddm::ContactSystem& system_;
+  const std::vector<std::vector<char>>& active_;
+  Pressures free_gaps_;
+};
+
+// G dz = rhs on the active rows by conjugate gradients (D-weighted); returns the iterations, -1 if not converged.
+int solve_correction(const ddm::ContactSystem& system, const std::vector<std::vector<char>>& active,
+                     const Pressures& rhs, Pressures& dz) {
+  const Compliance G(system, active);
+  dz = rhs;
+  for (auto& v : dz) v.setZero();
+  Pressures r = rhs, p = rhs;
+  double rr = dot(system, active, r, r);
+  const double stop = kTolerance * kTolerance * rr;
+  if (rr == 0.0) return 0;
+  for (int it = 1; it <= kMaxIterations; ++it) {
+    const Pressures Gp = G.apply(p);
+    const double pGp = dot(system, active, p, Gp);
+    if (!(pGp > 0.0)) return -1;  // not positive on the active rows (a body free to move along them)
+    const double alpha = rr / pGp;
+    axpy(alpha, p, dz);
+    axpy(-alpha, Gp, r);
+    const double rr_new = dot(system, active, r, r);
+    if (rr_new <= stop) return it;
+    for (size_t k = 0; k < p.size(); ++k) p[k] = r[k] + (rr_new / rr) * p[k];
+    rr = rr_new;
+  }
+  return -1;
+}
+
+
+// The nodal pressure profile along a pair's slave edge (what the result shows: each slave node's value from the
+// rows, piecewise linear in the arc length between nodes).
+Eigen::VectorXd nodal_profile(const mortar::PairDiscretization& pair, const Eigen::VectorXd& z) {
+  Eigen::VectorXd p = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(pair.slave_nodes.size()));
+  for (size_t j = 0; j < pair.node_from_rows.size(); ++j)
+    for (const auto& [row, weight] : pair.node_from_rows[j]) p[static_cast<Eigen::Index>(j)] += weight * z[row];
+  return p;
+}
+
+// Integral over [a, b] of (m(t) - l(t))^2 with m the square-root model sqrt(max(0, c0 + c1 t)) and l linear
+// through (a, la) and (b, lb): Gauss-Legendre on pieces graded towards the model's zero, where it is not smooth.
+double squared_misfit(double a, double b, double la, double lb, double c0, double c1) {
+  static const double xg[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526};
+  static const double wg[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538};
+  const auto f = [&](double t) {
+    const double m = std::sqrt(std::max(0.0, c0 + c1 * t)), l = la + (lb - la) * (t - a) / (b - a);
+    return (m - l) * (m - l);
+  };
+  const double zero = c1 < 0.0 ? -c0 / c1 : b;  // where the model vanishes
+  double sum = 0.0;
+  const auto gauss = [&](double lo, double hi) {
+    for (int q = 0; q < 4; ++q) sum += 0.5 * (hi - lo) * wg[q] * f(0.5 * (lo + hi) + 0.5 * (hi - lo) * xg[q]);
+  };
+  const auto graded = [&](double lo, double hi, bool towards_hi) {  // 12 pieces halving towards one end
+    double len = hi - lo, pos = towards_hi ? hi : lo;
+    for (int piece = 0; piece < 12; ++piece) {
+      const double half = piece == 11 ? len : 0.5 * len;
+      gauss(towards_hi ? pos - len : pos + len - half, towards_hi ? pos - len + half : pos + len);
+      len -= half;
+    }
+  };
+  if (zero > a && zero < b) {
+    graded(a, zero, true);
+    graded(zero, b, false);
+  } else {
+    graded(a, b, zero <= a);
+  }
+  return sum;
+}
+
+// The contact edges' share of the error: where the pressure falls to zero at the end of a contact zone it
+// falls like the square root of the distance to the edge (a smooth contact: Hertz, the paper's test), which the
+// piecewise-linear profile cannot follow and whose position it misses by up to a segment. Each such end (an
+// active node i between a node with a larger pressure and an open one) gets the square-root model through
+// its last two nodes (p^2 linear in the arc length, as contact_extent.hpp extrapolates the zone's end) and the
+// integral of (model - profile)^2 over its last two segments. A zone whose pressure does not fall towards its
+// end (a punch's corner) has no such term.
+double edge_error2(const mortar::PairDiscretization& pair, const Eigen::VectorXd& z) {
+  const Eigen::VectorXd p = nodal_profile(pair, z);
+  const Eigen::Index n = p.size();
+  const auto neighbour = [&](Eigen::Index j, int step) -> Eigen::Index {
+    const Eigen::Index k = j + step;
+    if (k >= 0 && k < n) return k;
+    return pair.closed ? (k + n) % n : -1;
+  };
+  const auto distance = [&](Eigen::Index from, Eigen::Index to) {
+    double d = std::abs(pair.node_arc[to] - pair.node_arc[from]);
+    return pair.closed ? std::min(d, pair.loop_length - d) : d;
+  };
+  double sum = 0.0;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    if (!(p[j] > 0.0)) continue;
+    for (const int step : {1, -1}) {
+      const Eigen::Index open = neighbour(j, step), inner = neighbour(j, -step);
+      if (open < 0 || inner < 0 || p[open] != 0.0 || !(p[inner] > p[j])) continue;
+      const double h1 = distance(inner, j), h2 = distance(j, open);
+      if (!(h1 > 0.0) || !(h2 > 0.0)) continue;
+      // t from the inner node towards the open one: model^2 = p_j^2 + slope (t - h1).
+      const double slope = (p[j] * p[j] - p[inner] * p[inner]) / h1;
+      const double c0 = p[j] * p[j] - slope * h1;
+      sum += squared_misfit(0.0, h1, p[inner], p[j], c0, slope) + squared_misfit(h1, h1 + h2, p[j], 0.0, c0, slope);
+    }
+  }
+  return sum;
+}
+
+}  // namespace
+
+PressureEstimate pressure_estimate(const ddm::ContactSystem& system, const ddm::Displacements& u,
+                                   const Pressures& z, const std::vector<IndicatorResult>& eta) {
+  PressureEstimate out;
+  ddm::Displacements ub = u;
+  int replaced = 0;
+  for (size_t a = 0; a < ub.size() && a < eta.size(); ++a)
+    if (eta[a].bem_displacement.size() == u[a].size()) {
+      ub[a] = eta[a].bem_displacement;
+      ++replaced;
+    }
+  if (replaced == 0) {
+    out.relative = std::nan("");
+    out.note = "no pressure estimate: it needs the fem_bem indicator's boundary-element solutions";
+    return out;
+  }
+  const auto active = active_rows(z);
+  const double norm2 = dot(system, active, z, z);
+  if (!(norm2 > 0.0)) return out;  // no pressure, nothing to be wrong
+  // The right-hand side: the gaps the boundary-element bodies leave open (or overlapping) under z.
+  const Pressures gF = system.nodal_gaps(u), gB = system.nodal_gaps(ub);
+  Pressures rhs(z.size());
+  for (size_t k = 0; k < z.size(); ++k) {
+    rhs[k] = gF[k] - gB[k];
+    for (Eigen::Index r = 0; r < rhs[k].size(); ++r)
+      if (!active[k][static_cast<size_t>(r)]) rhs[k][r] = 0.0;
+  }
+  Pressures dz;
+  out.iterations = solve_correction(system, active, rhs, dz);
+  if (out.iterations < 0) {
+    out.relative = std::nan("");
+    out.note = "no pressure estimate: the correction's conjugate gradients did not converge";
+    out.iterations = kMaxIterations;
+    return out;
+  }
+  const Model& model = system.problem().model;
+  const double thickness = model.plane == Plane::stress ? model.thickness : 1.0;  // D is length x thickness
+  double edges2 = 0.0;
+  for (size_t k = 0; k < z.size(); ++k) edges2 += thickness * edge_error2(system.pairs()[k], z[k]);
+  out.defect = std::sqrt(dot(system, active, dz, dz) / norm2);
+  out.edges = std::sqrt(edges2 / norm2);
+  out.relative = std::sqrt(out.defect * out.defect + out.edges * out.edges);
+  return out;
+}
+
+}  // namespace contact::adapt
