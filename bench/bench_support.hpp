@@ -20,6 +20,7 @@ inline double now() {
 inline Problem parse_or_exit(const nlohmann::json& job) {
   job::Limits limits;
   limits.max_dofs = 10'000'000;
+  limits.mesh_directory = std::string(CONTACT_SOURCE_DIR) + "/api/examples";  // the examples' Gmsh files
   auto r = job::parse(job, limits);
   if (!r.ok()) {
     std::fprintf(stderr, "%s", job::format_errors(r.errors).c_str());

@@ -137,15 +137,8 @@ class ProgressPrinter final : public contact::Observer {
   // the estimate's own time and the elapsed time.
   void on_adaptive_step(const contact::AdaptiveStepReport& r) override {
     if (ndjson_) {
-      nlohmann::json bodies = nlohmann::json::array();
-      for (const auto& b : r.bodies)
-        bodies.push_back({{"name", b.name}, {"cells", b.elements}, {"unknowns", b.dofs}, {"refined", b.elements_refined}});
-      const nlohmann::json line = {{"type", "adaptive_step"},       {"step", r.step},
-                                   {"bodies", bodies},              {"estimate", r.estimate}, {"pressure_estimate", r.pressure_estimate},
-                                   {"force", r.force},              {"peak_pressure", r.peak_pressure},
-                                   {"estimate_change", r.estimate_change}, {"force_change", r.force_change},
-                                   {"peak_change", r.peak_change},  {"indicator_seconds", r.indicator_seconds},
-                                   {"elapsed_seconds", r.elapsed_seconds}};
+      nlohmann::json line = contact::io::adaptive_step_json(r);
+      line["type"] = "adaptive_step";
       std::printf("%s\n", line.dump().c_str());
       std::fflush(stdout);
       return;

@@ -183,3 +183,29 @@ TEST(ProgressJson, TheJobsProgressPairsAreCheckedAgainstItsPairNames) {
   ASSERT_EQ(r.errors.size(), 1u);
   EXPECT_EQ(r.errors[0].pointer, "/output/progress_pairs/0");
 }
+
+TEST(ProgressJson, AnAdaptiveStepCarriesItsEstimatesAndAnEstimateThatCouldNotBeMadeIsNull) {
+  contact::AdaptiveStepReport r;
+  r.step = 3;
+  r.bodies.resize(2);
+  r.bodies[0].name = "upper";
+  r.bodies[0].elements = 40;
+  r.bodies[0].dofs = 90;
+  r.bodies[0].elements_refined = 7;
+  r.estimate = 0.03;
+  r.pressure_estimate = 0.0012;
+  r.force = 150.5;
+  r.peak_pressure = 193.7;
+  const nlohmann::json j = contact::io::adaptive_step_json(r);
+  EXPECT_EQ(j["step"], 3);
+  EXPECT_EQ(j["bodies"][0]["name"], "upper");
+  EXPECT_EQ(j["bodies"][0]["cells"], 40);
+  EXPECT_EQ(j["bodies"][0]["unknowns"], 90);
+  EXPECT_EQ(j["bodies"][0]["refined"], 7);
+  EXPECT_EQ(j["pressure_estimate"], 0.0012);
+  EXPECT_EQ(j["estimate"], 0.03);
+  EXPECT_FALSE(j.contains("type"));  // the writer names it (contact-solve's line, contactd's event)
+  r.pressure_estimate = std::nan("");  // the zz indicator: no estimate
+  const nlohmann::json line = nlohmann::json::parse(contact::io::adaptive_step_json(r).dump());
+  EXPECT_TRUE(line["pressure_estimate"].is_null());
+}

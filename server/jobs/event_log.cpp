@@ -16,11 +16,11 @@ namespace contactd {
 
 namespace {
 
-const char* const kTypes[] = {"state", "iteration", "step", "end"};
+const char* const kTypes[] = {"state", "iteration", "step", "end", "adaptive_step"};
 constexpr std::uint64_t kUnwritten = ~std::uint64_t{0};
 
 std::uint8_t type_index(const std::string& type) {
-  for (std::uint8_t i = 0; i < 4; ++i)
+  for (std::uint8_t i = 0; i < sizeof kTypes / sizeof *kTypes; ++i)
     if (type == kTypes[i]) return i;
   return 0;
 }

@@ -28,7 +28,7 @@ namespace contactd {
 
 struct Event {
   std::int64_t seq = 0;
-  std::string type;  // "state", "iteration", "step" or "end"
+  std::string type;  // "state", "iteration", "adaptive_step", "step" or "end"
   std::string json;  // the whole event, one line without the newline
 };
 

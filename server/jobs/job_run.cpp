@@ -123,7 +123,11 @@ contact::Result JobRun::solve_on_ranks(ProgressObserver& observer) {
   JobStore& store = context_.store;
   mpi_ = run_mpi_job(
       settings.mpi, problem_->ranks, store.job_path(id_), store.result_path(id_), id_, settings.max_dofs,
-      [&](const nlohmann::json& j) { observer.on_iteration_json(j); }, job_->cancel);
+      [&](const std::string& type, const nlohmann::json& j) {
+        if (type == "iteration") observer.on_iteration_json(j);
+        if (type == "adaptive_step") observer.on_adaptive_step_json(j);
+      },
+      job_->cancel);
   contact::Result result;
   result.stop_reason = mpi_->stop_reason;
   result.message = public_message(mpi_->message, store.data_dir());

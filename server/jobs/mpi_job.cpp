@@ -52,9 +52,9 @@ namespace {
 // lines and its stderr kept for the message, a stop request forwarded, and its end read back as an outcome.
 class MpiRun {
  public:
-  MpiRun(const MpiSettings& settings, const std::function<void(const nlohmann::json&)>& on_iteration,
+  MpiRun(const MpiSettings& settings, const ProgressLine& on_progress,
          const contact::CancelToken& cancel)
-      : settings_(settings), on_iteration_(on_iteration), cancel_(cancel) {}
+      : settings_(settings), on_progress_(on_progress), cancel_(cancel) {}
 
   MpiOutcome run(std::vector<std::string> args) {
     start_ = std::chrono::steady_clock::now();
@@ -172,7 +172,7 @@ class MpiRun {
     if (err_.size() > 2 * kStderrTail) err_.erase(0, err_.size() - kStderrTail);
   }
 
-  // One progress line: an iteration (passed on) or the result.
+  // One progress line: an iteration or an adaptive step (passed on) or the result.
   void take_line() {
     if (line_.empty()) return;
     nlohmann::json j = nlohmann::json::parse(line_, nullptr, false);
@@ -187,8 +187,9 @@ class MpiRun {
       // The iterations done so far, also for a run that ends without its result object.
       if (j.contains("iteration") && j["iteration"].is_number_integer())
         outcome_.iterations = j["iteration"].get<int>();
-      on_iteration_(j);
+      on_progress_("iteration", j);
     }
+    if (type == "adaptive_step") on_progress_(type, j);
     if (type == "result") result_ = std::move(j);
   }
 
@@ -224,7 +225,7 @@ class MpiRun {
   }
 
   const MpiSettings& settings_;
-  const std::function<void(const nlohmann::json&)>& on_iteration_;
+  const ProgressLine& on_progress_;
   const contact::CancelToken& cancel_;
   MpiOutcome outcome_;
   std::chrono::steady_clock::time_point start_;
@@ -241,7 +242,7 @@ class MpiRun {
 
 MpiOutcome run_mpi_job(const MpiSettings& settings, int ranks, const std::string& job_file,
                        const std::string& result_path, const std::string& job_id, long max_dofs,
-                       const std::function<void(const nlohmann::json&)>& on_iteration,
+                       const ProgressLine& on_progress,
                        const contact::CancelToken& cancel) {
   std::vector<std::string> args;
   for (std::string a : settings.launcher) {
@@ -252,7 +253,7 @@ MpiOutcome run_mpi_job(const MpiSettings& settings, int ranks, const std::string
                                std::string("ndjson"), std::string("--progress-pairs"), std::string("all"), std::string("--job-id"), job_id, std::string("--max-dofs"),
                                std::to_string(max_dofs), std::string("--no-mesh-files")})
     args.push_back(a);
-  return MpiRun(settings, on_iteration, cancel).run(std::move(args));
+  return MpiRun(settings, on_progress, cancel).run(std::move(args));
 }
 
 }  // namespace contactd

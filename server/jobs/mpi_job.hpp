@@ -35,13 +35,15 @@ struct MpiOutcome {
   nlohmann::json steps = nlohmann::json::array();  // step events, as the child reported them
 };
 
+using ProgressLine = std::function<void(const std::string& type, const nlohmann::json& line)>;
+
 // Runs `launcher... solver job_file -o result_path --progress ndjson --job-id job_id --max-dofs max_dofs
 // --no-mesh-files` (a job of the server reads no files: its Gmsh meshes come as "data") and
-// waits for it; on_iteration receives every iteration object. Never throws for the child's failures (a launcher
+// waits for it; on_progress receives every progress line's type ("iteration", "adaptive_step") and object
+// (without "type"). Never throws for the child's failures (a launcher
 // that cannot start, a rank that dies): they come back as stop_reason error with the child's last words.
 MpiOutcome run_mpi_job(const MpiSettings& settings, int ranks, const std::string& job_file,
                        const std::string& result_path, const std::string& job_id, long max_dofs,
-                       const std::function<void(const nlohmann::json&)>& on_iteration,
-                       const contact::CancelToken& cancel);
+                       const ProgressLine& on_progress, const contact::CancelToken& cancel);
 
 }  // namespace contactd

@@ -30,4 +30,13 @@ void ProgressObserver::on_iteration_json(nlohmann::json full) {
   metrics_.iteration_done();
 }
 
+void ProgressObserver::on_adaptive_step(const contact::AdaptiveStepReport& report) {
+  on_adaptive_step_json(contact::io::adaptive_step_json(report));
+}
+
+void ProgressObserver::on_adaptive_step_json(nlohmann::json step) {
+  step.erase("type");
+  job_.events.append("adaptive_step", step);
+}
+
 }  // namespace contactd

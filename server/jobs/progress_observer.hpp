@@ -24,6 +24,10 @@ class ProgressObserver final : public contact::Observer {
   void on_iteration(const contact::IterationReport& report) override;
   // The same for an iteration as JSON with every pair (an MPI run's progress lines: contactd asks for all).
   void on_iteration_json(nlohmann::json full);
+  // An adaptive step (its estimates, cells and unknowns) as an "adaptive_step" event; the JSON form is an MPI
+  // run's progress line.
+  void on_adaptive_step(const contact::AdaptiveStepReport& report) override;
+  void on_adaptive_step_json(nlohmann::json step);
   // Where the job's steps go as they are reached: its result file (contact::io::ResultStream).
   void set_step_sink(contact::StepSink* sink) { sink_ = sink; }
   contact::StepSink* step_sink() override { return sink_; }

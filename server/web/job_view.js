@@ -173,6 +173,14 @@ export class JobView {
         this.log(`step ${e.step} at iteration ${e.iteration}: ${bodies}`);
         break;
       }
+      case "adaptive_step": {
+        const unknowns = (Array.isArray(e.bodies) ? e.bodies : []).reduce((n, b) => n + (b.unknowns || 0), 0);
+        const pressure = typeof e.pressure_estimate === "number"
+          ? `, pressure error ~${(100 * e.pressure_estimate).toPrecision(3)} %` : "";
+        this.log(`adaptive step ${e.step}: ${unknowns} unknowns, estimate ${Number(e.estimate).toPrecision(3)}` +
+                 `${pressure}`);
+        break;
+      }
       case "end":
         this.setState(e.state);
         this.log(`end ${e.state} (${e.stop_reason}) after ${e.iterations} iterations` +

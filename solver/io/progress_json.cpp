@@ -52,6 +52,23 @@ double number(const nlohmann::json& item, const char* key) {
 
 }  // namespace
 
+nlohmann::json adaptive_step_json(const AdaptiveStepReport& r) {
+  nlohmann::json bodies = nlohmann::json::array();
+  for (const auto& b : r.bodies)
+    bodies.push_back({{"name", b.name}, {"cells", b.elements}, {"unknowns", b.dofs}, {"refined", b.elements_refined}});
+  return {{"step", r.step},
+          {"bodies", std::move(bodies)},
+          {"estimate", r.estimate},
+          {"pressure_estimate", r.pressure_estimate},
+          {"force", r.force},
+          {"peak_pressure", r.peak_pressure},
+          {"estimate_change", r.estimate_change},
+          {"force_change", r.force_change},
+          {"peak_change", r.peak_change},
+          {"indicator_seconds", r.indicator_seconds},
+          {"elapsed_seconds", r.elapsed_seconds}};
+}
+
 nlohmann::json iteration_json(const IterationReport& report, bool profiles) {
   nlohmann::json bodies = nlohmann::json::array();
   for (const auto& b : report.bodies)

@@ -7,6 +7,8 @@
 - Issue 32, item 6: the roller example with the friction removed from its base contact ended SUCCEEDED after 2004
   Newton steps with a tensile contact force (-3865). It ends FAILED, and its message says that the last iterate
   pulls at a contact and is not an answer.
+- Issue 30, item 2: an adaptive job with adaptivity.target_error streams one adaptive_step event per step (its
+  pressure estimate, the last at most the target) and ends with the target met in its message.
 - Issue 31, item 4: a job over --max-bodies got its one real error followed by 200 that repeated it, one per
   contact naming a body. /v1/validate and a submission answer the one error.
 
@@ -139,6 +141,26 @@ with Server(args=["--workers", "1"]) as server:
                 check("the file holds step 1, converged", converged == [1] and "steps/0" in h, converged)
     else:
         check("the result downloads", False, r.status)
+
+    # --- an adaptive job with a target: each step's estimates as events, the stop in the message (issue 30) ----
+    job = example("seed_layers.json")
+    job.pop("solver", None)
+    for b in job["bodies"]:
+        b["mesh"]["block"].update(nx=8, ny=2)
+    job["adaptivity"] = {"target_error": 0.005}
+    job_id = server.submit_id(job)
+    final = server.wait_done(job_id, timeout=120)
+    steps = [e for e in read_all_events(server, job_id) if e["type"] == "adaptive_step"]
+    estimates = [e.get("pressure_estimate") for e in steps]
+    check("one adaptive_step event per step, numbered from 0",
+          [e["step"] for e in steps] == list(range(len(steps))) and len(steps) >= 2, [e.get("step") for e in steps])
+    check("each carries its pressure estimate, the last one at most the target, the others above",
+          all(isinstance(x, float) for x in estimates) and estimates[-1] <= 0.005 and
+          all(x > 0.005 for x in estimates[:-1]), estimates)
+    check("and the bodies' unknowns", all(len(e["bodies"]) == 2 and e["bodies"][0]["unknowns"] > 0 for e in steps),
+          steps[-1:])
+    check("the message names the target met", final.get("state") == "SUCCEEDED" and
+          "target met after" in (final.get("message") or ""), final.get("message"))
 
     # --- one error for one cause past a limit ------------------------------------------------------------------
     r = server.request("POST", "/v1/validate", json_body=row_of_blocks(589))

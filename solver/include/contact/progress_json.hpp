@@ -23,6 +23,12 @@ namespace contact::io {
 // tangential_tractions and stick) only with `profiles`.
 nlohmann::json iteration_json(const IterationReport& report, bool profiles = true);
 
+// One adaptive step (AdaptiveStepReport) as an object without "type": the step, the bodies' cells, unknowns and
+// cells refined after it, the global stress estimate, the estimated pressure error (null where it cannot be
+// made), force and peak pressure, their relative changes over the step, and the times. contact-solve's
+// --ndjson "adaptive_step" lines and contactd's "adaptive_step" events.
+nlohmann::json adaptive_step_json(const AdaptiveStepReport& report);
+
 // Which pairs a bounded progress object lists in full.
 struct ProgressSelection {
   std::vector<std::string> patterns;  // shell globs on pair names (fnmatch: * ? [..]); empty: the default
