@@ -1,6 +1,7 @@
 #include "adaptive.hpp"
 
 #include "../ddm/fixed_point.hpp"
+#include "../ddm/load_steps.hpp"
 #include "contact_zones.hpp"
 #include "indicator.hpp"
 #include "pressure_estimate.hpp"
@@ -163,8 +164,9 @@ void transfer(ddm::Displacements& u, const Problem& problem, const RefineOutcome
 }
 
 Step make_step(const ddm::ContactSystem& system, const ddm::Displacements& u, const ddm::Pressures& z, int iteration,
-               int index, const std::vector<IndicatorResult>& eta) {
-  Step st = z.empty() ? system.fields(u, iteration) : system.fields(u, z, iteration);
+               int index, const std::vector<IndicatorResult>& eta, const ddm::Pressures& q = {}) {
+  Step st = z.empty() ? system.fields(u, iteration)
+                      : system.fields(u, z, iteration, nullptr, q.empty() ? nullptr : &q);
   st.index = index;
   for (size_t a = 0; a < st.bodies.size() && a < eta.size(); ++a)
     if (eta[a].eta.size() == st.bodies[a].mesh.num_cells()) st.bodies[a].indicator_cell = eta[a].eta;
@@ -293,11 +295,22 @@ bool any_cancelled(const std::vector<IndicatorResult>& eta) {
   return false;
 }
 
-// One solve on the current meshes (run_enforced) in a frame nested in `frame` (its first report carries the
-// elements refined before it); returns the total, whose answer and stop are now this solve's.
+// One solve on the current meshes in a frame nested in `frame` (its first report carries the elements refined
+// before it); returns the total, whose answer and stop are now this solve's. With load steps (`path`: more than
+// one factor) the whole path is solved from rest on these meshes and the answer is its end's: friction depends on
+// the path, so each mesh state is the path's solution on that mesh, its history never transferred between
+// meshes (docs/algorithm.md, "Adaptivity with friction"); the path's steps before the end are not kept.
 const ddm::MethodOutcome& solve_step(ddm::ContactSystem& system, ddm::RunFrame& frame, ddm::ContactMethod& method,
-                                     std::vector<int>& refined_last, const ddm::Displacements& warm) {
-  return frame.nested(warm.empty() ? nullptr : &warm, ddm::InnerMarks{0, std::exchange(refined_last, {})},
+                                     std::vector<int>& refined_last, const ddm::Displacements& warm,
+                                     const std::vector<double>& path) {
+  const ddm::InnerMarks marks{0, std::exchange(refined_last, {})};
+  if (path.size() > 1) {
+    ddm::StepLog path_steps(StepOutput::last, false);
+    return frame.nested(nullptr, marks, [&](ddm::RunFrame& inner) {
+      ddm::run_load_steps(system, path, inner, method, path_steps);
+    });
+  }
+  return frame.nested(warm.empty() ? nullptr : &warm, marks,
                       [&](ddm::RunFrame& inner) { ddm::run_enforced(system, inner, method); });
 }
 
@@ -355,19 +368,21 @@ void converge_then_refine(Problem& working, ddm::ContactSystem& system, ddm::Run
   const double job_delta = s.delta;
   const std::string cancelled_here = "cancelled during adaptive step ";
   for (int step = 0;; ++step) {
-    const ddm::MethodOutcome& o = solve_step(system, frame, method, refined_last, warm);
+    const ddm::MethodOutcome& o = solve_step(system, frame, method, refined_last, warm, working.loading.factors);
     if (o.u.empty()) return;
     if (frame.stop_requested()) {  // stopped inside the solve: keep what it reached, skip the estimate
-      Step reached = make_step(system, o.u, o.z, total.iterations, step, {});
+      Step reached = make_step(system, o.u, o.z, total.iterations, step, {}, o.q);
       reached.converged = false;
       steps.push_back(std::move(reached));
       mark_cancelled(total);
       return;
     }
-    const ddm::Displacements loads = o.z.empty() ? system.contact_loads(o.u) : system.loads_from_pressures(o.z);
+    // The whole contact traction, the tangential one too where there is friction, is the bodies' Neumann data.
+    const ddm::Displacements loads = o.z.empty() ? system.contact_loads(o.u)
+                                                 : system.loads_from_pressures(o.z, o.q.empty() ? nullptr : &o.q);
     const auto eta = estimate(working, system, o.u, loads, frame.runner(), frame.stop_check());
     for (const auto& e : eta) total.indicator_seconds += e.seconds;
-    Step solved = make_step(system, o.u, o.z, total.iterations, step, eta);
+    Step solved = make_step(system, o.u, o.z, total.iterations, step, eta, o.q);
     solved.converged = o.converged;
     const StepMeasures now = measure(solved, eta);
     steps.push_back(std::move(solved));  // an unconverged one only if the job asks for its iterate (StepLog)

@@ -54,9 +54,10 @@ void JobReader::check_friction_and_histories() {
   for (const auto& in : inputs_)
     for (size_t j = 0; j < in.body.boundary.size() && j < in.condition_pointers.size(); ++j) {
       const auto& h = in.body.boundary[j].history;
-      if (!h.empty() && problem_.adaptivity.enabled)
+      if (!h.empty() && problem_.adaptivity.enabled && problem_.adaptivity.strategy == AdaptStrategy::paper)
         errors_.add(child(in.condition_pointers[j], "history"),
-                    "a load history needs load steps, which adaptivity does not take (it refines for one load)");
+                    "a load history needs load steps, which the adaptive strategy \"paper\" does not take (use "
+                    "\"converge_then_refine\")");
       else if (!h.empty() && h.size() != steps && loading_read_)  // else the number of steps is not known
         errors_.add(child(in.condition_pointers[j], "history"),
                     "history has " + std::to_string(h.size()) + " load factors but the job has " +
@@ -72,9 +73,9 @@ void JobReader::check_friction_and_histories() {
       errors_.add(at, conflict + (where.empty() ? "" : " at " + where));
       return;
     }
-    if (problem_.adaptivity.enabled) {
-      errors_.add(at, "friction with adaptivity is not supported: the error indicators take the normal contact "
-                      "tractions only; solve the frictional job on a fixed (e.g. previously refined) mesh");
+    if (problem_.adaptivity.enabled && problem_.adaptivity.strategy == AdaptStrategy::paper) {
+      errors_.add(at, "friction with the adaptive strategy \"paper\" is not supported (its penalty iteration is "
+                      "frictionless): use strategy \"converge_then_refine\"");
       return;
     }
   }

@@ -406,9 +406,9 @@ void JobReader::read_loading_steps(const json& value, const std::string& pointer
       if (auto x = positive((*list)[k], child(f.at("factors"), k), "load factor", errors_)) factors.push_back(*x);
   }
   if (factors.empty()) return;
-  if (problem_.adaptivity.enabled && factors.size() > 1)
-    errors_.add(pointer, "load steps and adaptivity together are not supported: refine for one load, or step a "
-                         "fixed mesh");
+  if (problem_.adaptivity.enabled && problem_.adaptivity.strategy == AdaptStrategy::paper && factors.size() > 1)
+    errors_.add(pointer, "load steps with the adaptive strategy \"paper\" are not supported (it refines inside one "
+                         "solve): use strategy \"converge_then_refine\", which solves the path on each mesh");
   problem_.loading.factors = std::move(factors);
 }
 

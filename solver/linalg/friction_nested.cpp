@@ -147,8 +147,12 @@ bool solve_sets_system(const SparseMatrix& F, const Equalities& eq, const Fricti
   // system is consistent and the solution with the least rigid motion along the free directions is as good an
   // answer as any: regularised, -eps I in the equilibrium block, and taken only if the equalities still hold (the
   // regularisation did not have to push), otherwise the sets are singular indeed (the body would slide away).
-  double gp2 = 0, f = 0;
-  for (Eigen::Index i = 0; i < GP.rows(); ++i) gp2 = std::max(gp2, GP.row(i).squaredNorm());
+  // The rows' squared norms by one pass over the columns (row(i) of a column-major sparse matrix is a strided
+  // view whose reductions Eigen does not support: it crashed on a Cattaneo-Mindlin job of 325 x 10 cells).
+  Eigen::VectorXd row2 = Eigen::VectorXd::Zero(GP.rows());
+  for (int col = 0; col < GP.outerSize(); ++col)
+    for (SparseMatrix::InnerIterator it(GP, col); it; ++it) row2[it.row()] += it.value() * it.value();
+  double gp2 = row2.size() ? row2.maxCoeff() : 0.0, f = 0;
   for (Eigen::Index i = 0; i < na; ++i) f = std::max(f, std::abs(RFP.coeff(i, i)));
   if (!(gp2 > 0) || !(f > 0)) return false;
   const double eps = 1e-10 * gp2 / f;
