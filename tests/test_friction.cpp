@@ -4,6 +4,7 @@
 // solving the same discrete problem in one system.
 #include "contact/job.hpp"
 #include "contact/solve.hpp"
+#include "adaptive_support.hpp"
 #include "support.hpp"
 
 #include <gtest/gtest.h>
@@ -165,16 +166,6 @@ json cattaneo_mesh(int nx, int ny, bool graded, double Q) {
   return job;
 }
 
-long unknowns_of(const Result& r, int iteration) {
-  long dofs = 0;
-  for (const auto& it : r.history)
-    if (it.iteration == iteration) {
-      dofs = 0;
-      for (const auto& b : it.bodies) dofs += b.dofs;
-    }
-  return dofs;
-}
-
 }  // namespace
 
 TEST(Friction, CattaneoMindlinAdaptsFromACoarseMeshAndEndsOnTheTheory) {
@@ -191,7 +182,7 @@ TEST(Friction, CattaneoMindlinAdaptsFromACoarseMeshAndEndsOnTheTheory) {
   long first_meeting = 0;
   for (const Step& s : r.steps) {
     const MindlinFit fit = mindlin_fit(pair_of(s, "block.top-cylinder.bottom"), Q);
-    const long dofs = unknowns_of(r, s.iteration);
+    const long dofs = unknowns(r, s.iteration);
     std::printf("  step %d: %ld unknowns, Q / (mu P) %.3f, c / a %.4f (theory %.4f), traction error %.3f\n", s.index,
                 dofs, fit.ratio, fit.c_over_a, fit.theory, fit.traction_error);
     if (!first_meeting && std::abs(fit.c_over_a - fit.theory) <= 0.03 && fit.traction_error < 0.05) first_meeting = dofs;
@@ -215,7 +206,7 @@ TEST(Friction, CattaneoMindlinAdaptsFromACoarseMeshAndEndsOnTheTheory) {
   EXPECT_TRUE(std::abs(coarse_fit.c_over_a - coarse_fit.theory) > 0.03 || coarse_fit.traction_error >= 0.05);
   EXPECT_LE(std::abs(graded_fit.c_over_a - graded_fit.theory), 0.03);
   EXPECT_LT(graded_fit.traction_error, 0.05);
-  const long graded_dofs = unknowns_of(graded, graded.iterations);
+  const long graded_dofs = unknowns(graded, graded.iterations);
   std::printf("  adaptive meets both at %ld unknowns; graded 650 x 20: %ld (ratio %.1f)\n", first_meeting, graded_dofs,
               static_cast<double>(graded_dofs) / static_cast<double>(first_meeting));
   ASSERT_GT(first_meeting, 0);
