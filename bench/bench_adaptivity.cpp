@@ -208,7 +208,7 @@ void two_cylinder_runs() {
   const std::vector<std::pair<const char*, json>> runs = {
       {"default (contact marking, delta 0.1, stop test)", json::object()},
       {"target_error 0.5 %", {{"target_error", 0.005}}},
-      {"target_error 0.2 %", {{"target_error", 0.002}}}};
+      {"target_error 0.3 %", {{"target_error", 0.003}}}};  // (0.2 %: not reached in 20 steps, 400 s; docs)
   for (const auto& [label, adaptivity] : runs) {
     Estimates estimates;
     t0 = now();

@@ -265,15 +265,22 @@ std::string target_missed(const PressureEstimate& pe, double target) {
 // Marks and refines. With a target that is not met, delta is halved before the marking when the last step
 // lowered the pressure estimate by less than a quarter (`stalling`: the cells over delta are no longer where
 // the pressure's error is), and a marking that finds no cell over delta is repeated with delta halved, down to
-// the job's delta / 1024 (the note says where it ended).
+// the job's delta / 1024 (the note says where it ended). From the second stalling step in a row the marking is
+// "plain": the contact marking's weights keep the refinement (and max_dofs) on the contact surface and its
+// neighbourhood, while the estimate says the error lies elsewhere (the two-cylinder example's far field, which
+// makes the bodies 0.23 % too stiff: the estimate sat at 0.29 % for 14 steps with the contact marking).
 RefineOutcome refine_towards_target(Problem& working, const std::vector<IndicatorResult>& eta, const Step& step,
-                                    double kept_nodes, bool stalling, double job_delta) {
+                                    double kept_nodes, int stalls, double job_delta) {
   auto& s = working.adaptivity;
   const double floor = job_delta / 1024;
-  bool lowered = false;
-  if (s.target_error > 0.0 && stalling && s.delta / 2 >= floor) {
+  bool lowered = false, plain = false;
+  if (s.target_error > 0.0 && stalls > 0 && s.delta / 2 >= floor) {
     s.delta /= 2;
     lowered = true;
+  }
+  if (s.target_error > 0.0 && stalls > 1 && s.marking == MarkingRule::contact) {
+    s.marking = MarkingRule::plain;
+    plain = true;
   }
   RefineOutcome r = mark_and_refine(working, eta, step, kept_nodes);
   while (s.target_error > 0.0 && !r.any && !r.blocked && s.delta / 2 >= floor) {
@@ -286,6 +293,7 @@ RefineOutcome refine_towards_target(Problem& working, const std::vector<Indicato
     os << "delta lowered to " << s.delta << " towards the target";
     add_note(r.note, os.str());
   }
+  if (plain) add_note(r.note, "marking \"plain\" from here: the contact marking no longer lowered the estimate");
   return r;
 }
 
@@ -365,6 +373,7 @@ void converge_then_refine(Problem& working, ddm::ContactSystem& system, ddm::Run
   ddm::Displacements warm;
   StepMeasures previous;
   double previous_pressure_estimate = 0.0;
+  int stalls = 0;  // steps in a row that lowered the pressure estimate by less than a quarter
   const double job_delta = s.delta;
   const std::string cancelled_here = "cancelled during adaptive step ";
   for (int step = 0;; ++step) {
@@ -405,10 +414,9 @@ void converge_then_refine(Problem& working, ddm::ContactSystem& system, ddm::Run
     if (!o.converged) return finish("");
     if (const std::string stop = stop_after_estimate(s, report, pe, step, o.message); !stop.empty())
       return finish(stop);
-    const bool stalling = step > 0 && !(pe.relative < 0.75 * previous_pressure_estimate);
+    stalls = step > 0 && !(pe.relative < 0.75 * previous_pressure_estimate) ? stalls + 1 : 0;
     previous_pressure_estimate = pe.relative;
-    RefineOutcome r =
-        refine_towards_target(working, eta, steps.back(), steps.committed_nodes(), stalling, job_delta);
+    RefineOutcome r = refine_towards_target(working, eta, steps.back(), steps.committed_nodes(), stalls, job_delta);
     if (!r.any) {
       std::ostringstream os;
       os << "adaptive: " << (r.blocked ? "nothing marked can be refined" : "no cell marked") << " after " << step
