@@ -1,6 +1,7 @@
 #include "pair.hpp"
 #include "../common/assert.hpp"
 
+#include "corners.hpp"
 #include "dual_basis.hpp"
 #include "segments.hpp"
 
@@ -27,112 +28,6 @@ double analytic_gap(const GapSpec& spec, const Eigen::Vector2d& x) {
   double d = spec.constant;
   if (spec.parabola_r0) d += *spec.parabola_r0 * (x.x() - spec.parabola_x0) * (x.x() - spec.parabola_x0);
   return d;
-}
-
-// Prescribed displacement components (x, y) of every node of a body.
-std::map<int, std::array<bool, 2>> prescribed_components(const Body& body) {
-  std::map<int, std::array<bool, 2>> out;
-  for (const auto& bc : body.boundary) {
-    if (!prescribes_displacement(bc)) continue;
-    for (int node : condition_nodes(body.mesh, bc)) {
-      auto& p = out[node];
-      p[0] = p[0] || bc.ux.has_value();
-      p[1] = p[1] || bc.uy.has_value();
-    }
-  }
-  return out;
-}
-
-// A crosspoint: the node's displacement along its normal is prescribed (both components, or the one component
-// within 10 degrees of the normal), so the slave side cannot move to open or close the contact there.
-bool normal_is_prescribed(const std::array<bool, 2>& p, const Eigen::Vector2d& n) {
-  if (p[0] && p[1]) return true;
-  const double cos10 = 0.984807753;
-  return (p[0] && std::abs(n.x()) >= cos10) || (p[1] && std::abs(n.y()) >= cos10);
-}
-
-// The end nodes of a slave edge where another contact edge of the same body meets it (a corner of the body where
-// its joints turn: a brick's bottom and right edge, or the top of a head joint under the bed joint of the course
-// above), with the other edge's unit tangent there, whether that edge is another pair's master edge facing a third
-// body, and whether friction is involved (this pair's or the other's).
-//
-// Why: where three bodies meet at one point, each pair ties two of them there, and with friction the ties close a
-// loop: at a brick's corner on a bed joint, the two bed joints' tangential rows and the head joint's normal row
-// all tie the x-displacements of the same three bodies at one point, the two bed joints' normal rows and the head
-// joint's tangential row their y-displacements. The multipliers are then redundant and the stick and slip systems
-// singular (or nearly: pressures of 1e7 that cancel). The pair therefore drops, at such a corner, its tangential
-// row (against another slave edge of the same body: the corner of the brick) or its multiplier altogether (against
-// a master edge facing a third body: the top of a head joint), the crosspoint treatment of the dual mortar
-// literature restricted to where friction makes it necessary. Frictionless contact has no such loop (its rows tie
-// along the normals only) and is left as it was.
-struct Corner {
-  Eigen::Vector2d tangent = Eigen::Vector2d::Zero();
-  bool third_body = false;  // the other edge is a master edge facing a body other than this pair's master
-  bool friction = false;
-};
-
-std::map<int, Corner> slave_corners(const Problem& problem, const ContactPair& pair, const std::vector<int>& nodes,
-                                    bool look_for_broken_loops = true);
-
-// Whether the pair between bodies a and b (either its slave) has a slave edge ending at x where that end drops its
-// multiplier altogether (a corner against a master edge facing a third body): the loop of three bodies at x is then
-// broken there, and the other two pairs keep all their rows.
-bool crosspoint_between(const Problem& problem, int a, int b, const Eigen::Vector2d& x, double tolerance) {
-  for (const auto& q : problem.contacts) {
-    if (!((q.slave_body == a && q.master_body == b) || (q.slave_body == b && q.master_body == a))) continue;
-    const auto& mesh = problem.bodies[static_cast<size_t>(q.slave_body)].mesh;
-    const std::vector<int> nodes = mesh.edge_set_nodes(q.slave_edge);
-    if (nodes.size() < 2 || mesh.edge_set_closed(q.slave_edge)) continue;  // a closed loop has no ends
-    for (int end : {nodes.front(), nodes.back()}) {
-      if ((mesh.nodes[static_cast<size_t>(end)] - x).norm() > tolerance) continue;
-      const auto corners = slave_corners(problem, q, nodes, false);
-      const auto c = corners.find(end);
-      if (c != corners.end() && c->second.third_body && c->second.friction) return true;
-    }
-  }
-  return false;
-}
-
-std::map<int, Corner> slave_corners(const Problem& problem, const ContactPair& pair, const std::vector<int>& nodes,
-                                    bool look_for_broken_loops) {
-  std::map<int, Corner> out;
-  const auto& mesh = problem.bodies[static_cast<size_t>(pair.slave_body)].mesh;
-  // A closed loop has no ends, so no corners: it meets another edge only where that edge ends on it, and there
-  // the boundary runs on along the loop.
-  if (nodes.size() < 2 || mesh.edge_set_closed(pair.slave_edge)) return out;
-  auto meet = [&](const std::string& edge, bool third_body, bool friction, int other_master) {
-    const std::vector<int> others = mesh.edge_set_nodes(edge);
-    if (others.size() < 2 || mesh.edge_set_closed(edge)) return;
-    for (size_t end : {size_t{0}, nodes.size() - 1})
-      for (size_t j : {size_t{0}, others.size() - 1}) {
-        if (others[j] != nodes[end]) continue;
-        const size_t next = j == 0 ? 1 : j - 1;
-        const Eigen::Vector2d x = mesh.nodes[static_cast<size_t>(others[j])];
-        const double h = (mesh.nodes[static_cast<size_t>(others[next])] - x).norm();
-        // Two slave edges of this body at a corner: the loop through the two masters is broken already where the
-        // pair between those masters drops its multiplier at this point (the top of a head joint seen from the
-        // brick on the other side: the brick's bed joint keeps its friction row at its toe, where the pressure is).
-        if (!third_body && look_for_broken_loops && other_master >= 0 &&
-            crosspoint_between(problem, pair.master_body, other_master, x, 1e-6 * h))
-          continue;
-        Corner& c = out[nodes[end]];
-        c.tangent = (mesh.nodes[static_cast<size_t>(others[next])] - x).normalized();
-        c.third_body = c.third_body || third_body;
-        c.friction = c.friction || friction || pair.friction.active();
-      }
-  };
-  for (const auto& other : problem.contacts) {
-    if (other.slave_body == pair.slave_body && other.slave_edge != pair.slave_edge)
-      meet(other.slave_edge, false, other.friction.active(), other.master_body);
-    if (other.master_body == pair.slave_body && other.master_edge != pair.slave_edge)
-      meet(other.master_edge, other.slave_body != pair.master_body, other.friction.active(), -1);
-  }
-  return out;
-}
-
-// Whether the other edge turns away from this one at the node (more than 10 degrees between the tangents).
-bool turns(const Eigen::Vector2d& own, const Eigen::Vector2d& other) {
-  return std::abs(own.x() * other.y() - own.y() * other.x()) > 0.17364817766;  // sin 10 degrees
 }
 
 // Three-point Gauss-Legendre on [0, 1]: exact to degree 5 (the products here are at most cubic).
