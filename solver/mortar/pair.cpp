@@ -3,6 +3,7 @@
 
 #include "corners.hpp"
 #include "dual_basis.hpp"
+#include "edge_curves.hpp"
 #include "segments.hpp"
 
 #include <algorithm>
@@ -222,6 +223,9 @@ class PairBuilder {
     const auto Mx = coordinates(master_.mesh, master_poly_);
     n_ = S_.size();
     segments_ = build_segment_mesh(S_, Mx);
+    slave_curves_ = EdgeCurves::of_edge(slave_.mesh, pair_.slave_edge, poly_);
+    master_curves_ = EdgeCurves::of_edge(master_.mesh, pair_.master_edge, master_poly_);
+    master_closed_ = master_.mesh.edge_set_closed(pair_.master_edge);
     const size_t n_segments = n_ < 2 ? 0 : n_ - 1;
     for (size_t j = 0; j + 1 < Mx.size(); ++j) master_length_.push_back((Mx[j + 1] - Mx[j]).norm());
     arc_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n_));
@@ -341,6 +345,42 @@ class PairBuilder {
     it->second += v;
   }
 
+  // A quadrature point of a mortar segment: the slave point x, the normal n the gap is measured along (and the
+  // pressure acts along), and the gap t to the master along n. Where neither side's segment has a curve, the
+  // chords' (x on the chord, n the chord's normal, t affine along the mortar segment: the arithmetic of the
+  // segment mesh, unchanged); else the curves' (edge_curves.hpp), the master's curve hit on the segment whose
+  // stretch the hit lies on (the mortar segment's, or a neighbour's where the normal leans across its end).
+  struct GapPoint {
+    Eigen::Vector2d x, normal;
+    double gap = 0.0;
+  };
+  GapPoint gap_point(const MortarSegment& s, size_t k, double u, double xi) const {
+    GapPoint p;
+    p.gap = s.gap0 + u * (s.gap1 - s.gap0);
+    const size_t j = static_cast<size_t>(s.master);
+    if (!slave_curves_.curved(k) && !master_curves_.curved(j)) {
+      p.x = S_[k] + xi * (S_[k + 1] - S_[k]);
+      p.normal = segments_.slave_normal[k];
+      return p;
+    }
+    const EdgeCurves::Frame f = slave_curves_.at(k, xi);
+    p.x = f.point;
+    p.normal = f.normal;
+    const size_t nm = master_curves_.segments();
+    const auto t = master_curves_.hit(j, p.x, p.normal);
+    if (!t) return p;  // the line misses the master's curve (grazing): the chords' gap
+    p.gap = *t;
+    const double eta = master_curves_.chord_parameter(j, p.x + *t * p.normal);
+    const bool before = eta < 0 && (j > 0 || master_closed_), after = eta > 1 && (j + 1 < nm || master_closed_);
+    if (!before && !after) return p;
+    const size_t other = before ? (j + nm - 1) % nm : (j + 1) % nm;
+    const auto t_other = master_curves_.hit(other, p.x, p.normal);
+    if (!t_other) return p;
+    const double eta_other = master_curves_.chord_parameter(other, p.x + *t_other * p.normal);
+    if (eta_other >= 0 && eta_other <= 1) p.gap = *t_other;
+    return p;
+  }
+
   // Integrals over every mortar segment of one run (three-point Gauss: the integrands are at most cubic in xi).
   void integrate_run(size_t m) {
     const size_t a = d_.multiplier_nodes[m], b_node = d_.multiplier_nodes[m + 1];
@@ -351,7 +391,6 @@ class PairBuilder {
     if (r1 < 0) b = drop_node(b, 1);
     const double Lrun = arc(b_node) - arc(a);
     for (size_t k = a; k < b_node; ++k) {
-      const Eigen::Vector2d nk = segments_.slave_normal[k];
       const double L = segments_.slave_length[k];
       for (const auto* s : on_segment_[k]) {
         const int m0 = master_poly_[static_cast<size_t>(s->master)], m1 = master_poly_[static_cast<size_t>(s->master) + 1];
@@ -361,10 +400,10 @@ class PairBuilder {
           const double xi = s->xi0 + u * (s->xi1 - s->xi0);
           const double w = kGaussW[q] * (s->xi1 - s->xi0) * L * thickness_;
           const double eta = s->eta0 + u * (s->eta1 - s->eta0);
-          const double t = s->gap0 + u * (s->gap1 - s->gap0);
           const double sr = (arc(k) + xi * L - arc(a)) / Lrun;  // parameter along the run
-          const Eigen::Vector2d x = S_[k] + xi * (S_[k + 1] - S_[k]);
-          const double gap = (pair_.gap.geometric ? t : 0.0) + analytic_gap(pair_.gap, x);
+          const GapPoint p = gap_point(*s, k, u, xi);
+          const Eigen::Vector2d& n = p.normal;
+          const double gap = (pair_.gap.geometric ? p.gap : 0.0) + analytic_gap(pair_.gap, p.x);
           const double Ns[2] = {1 - xi, xi}, Nm[2] = {1 - eta, eta}, Nrun[2] = {1 - sr, sr};
           for (int i = 0; i < 2; ++i) {
             const int r = i == 0 ? r0 : r1;
@@ -373,11 +412,11 @@ class PairBuilder {
             d_.gap0[r] += w * phi * gap;
             d_.D[r] += w * phi * Nrun[i];
             d_.area[r] += w * phi;
-            nu_[static_cast<size_t>(r)] += w * phi * nk;
+            nu_[static_cast<size_t>(r)] += w * phi * n;
             for (int l = 0; l < 2; ++l) {
-              add(gs_, {r, poly_[k + static_cast<size_t>(l)]}, w * phi * Ns[l] * nk);
+              add(gs_, {r, poly_[k + static_cast<size_t>(l)]}, w * phi * Ns[l] * n);
               ss_[{r, poly_[k + static_cast<size_t>(l)]}] += w * phi * Ns[l];
-              add(gm_, {r, l == 0 ? m0 : m1}, w * phi * Nm[l] * nk);
+              add(gm_, {r, l == 0 ? m0 : m1}, w * phi * Nm[l] * n);
               mm_[{r, (s->master + l) % n_master}] += w * phi * Nm[l];
             }
           }
@@ -454,6 +493,8 @@ class PairBuilder {
   std::set<size_t> tangential_dropped_;  // slave nodes whose friction row is dropped (slave_corners)
   size_t n_ = 0, n_runs_ = 0;
   SegmentMesh segments_;
+  EdgeCurves slave_curves_, master_curves_;  // the sides' true curves where the mesh knows them
+  bool master_closed_ = false;               // the master edge is a closed loop
   std::vector<double> master_length_;
   std::vector<std::vector<const MortarSegment*>> on_segment_;
   std::vector<std::optional<DualBasis>> basis_;

@@ -1,0 +1,97 @@
+// The contact geometry of curved edges (mortar/edge_curves.hpp): unit checks against the curves' own equations.
+#include "mortar/edge_curves.hpp"
+#include "mortar/segments.hpp"
+#include "support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+using namespace contact;
+using namespace contact::mortar;
+using namespace contact::testing;
+
+namespace {
+
+mesh::Curve arc(const Eigen::Vector2d& centre, double radius) {
+  mesh::Curve c;
+  c.kind = mesh::Curve::Kind::arc;
+  c.center = centre;
+  c.radius = radius;
+  return c;
+}
+
+}  // namespace
+
+TEST(EdgeCurves, AStraightSegmentIsItsOwnChordBitForBit) {
+  // No curve, or a line: the chord's point and the chord's normal exactly (the flat cases' arithmetic).
+  const std::vector<Eigen::Vector2d> points = {{0.1, 0.3}, {0.7, 0.9}, {1.9, 1.1}};
+  mesh::Curve line;
+  const EdgeCurves e(points, {std::nullopt, line});
+  for (size_t k = 0; k < 2; ++k) {
+    EXPECT_FALSE(e.curved(k));
+    for (double xi : {0.0, 0.2113248654051871, 0.5, 1.0}) {
+      const EdgeCurves::Frame f = e.at(k, xi);
+      const Eigen::Vector2d x = points[k] + xi * (points[k + 1] - points[k]);
+      EXPECT_EQ(f.point, x);
+      EXPECT_EQ(f.normal, outward_normal(points[k], points[k + 1]));
+    }
+  }
+  // The hit on a chord: x + t n on the chord's line.
+  const Eigen::Vector2d x(0.5, 0.2), n = Eigen::Vector2d(0.3, 1.0).normalized();
+  const double t = *e.hit(0, x, n);
+  EXPECT_NEAR(outward_normal(points[0], points[1]).dot(x + t * n - points[0]), 0.0, 1e-15);  // on the chord's line
+}
+
+TEST(EdgeCurves, ChordPointsOfAnArcStandForTheArcsPointsAndTheGapBetweenConcentricArcsIsTheirRadii) {
+  // A shaft's rim (convex, counter-clockwise) of radius 500 cut into 7 chords, and a bore (concave: the ring's
+  // boundary runs clockwise round the hole) of radius 500.5 cut into 11: every chord point's image lies on its
+  // circle with the radial normal pointing out of its body, and from the rim along that normal the bore is 0.5 away
+  // wherever the chords are, however differently the two sides cut the circle.
+  const Eigen::Vector2d c(3.0, -2.0);
+  const double a = 500.0, b = 500.5, pi = 3.14159265358979323846;
+  auto points = [&](double r, int n, bool ccw) {
+    std::vector<Eigen::Vector2d> p;
+    for (int j = 0; j <= n; ++j) {
+      const double t = 0.5 * pi * (ccw ? j : n - j) / n;
+      p.push_back(c + r * Eigen::Vector2d(std::cos(t), std::sin(t)));
+    }
+    return p;
+  };
+  const EdgeCurves rim(points(a, 7, true), std::vector<std::optional<mesh::Curve>>(7, arc(c, a)));
+  const EdgeCurves bore(points(b, 11, false), std::vector<std::optional<mesh::Curve>>(11, arc(c, b)));
+  for (size_t k = 0; k < 7; ++k)
+    for (double xi : {0.0, 0.1127016653792583, 0.5, 0.8872983346207417, 1.0}) {
+      const EdgeCurves::Frame f = rim.at(k, xi);
+      EXPECT_NEAR((f.point - c).norm(), a, 1e-12 * a);
+      EXPECT_NEAR(f.normal.dot((f.point - c) / a), 1.0, 1e-15);  // out of the shaft
+      size_t hits = 0;
+      for (size_t j = 0; j < 11; ++j) {
+        const auto t = bore.hit(j, f.point, f.normal);
+        ASSERT_TRUE(t.has_value());
+        EXPECT_NEAR(*t, b - a, 1e-9);
+        const double eta = bore.chord_parameter(j, f.point + *t * f.normal);
+        hits += eta >= -1e-9 && eta <= 1 + 1e-9 ? 1 : 0;
+      }
+      EXPECT_GE(hits, 1u);  // on some segment's stretch
+      const EdgeCurves::Frame g = bore.at(k, xi);
+      EXPECT_NEAR(g.normal.dot((g.point - c) / b), -1.0, 1e-15);  // out of the ring: towards the centre
+    }
+}
+
+TEST(EdgeCurves, TheGapToAParabolaIsTheRootOfTheLinesQuadratic) {
+  // y = 0.5 x^2 - x + 2 over [0, 2], the top of a body below it (so run from x = 2 to x = 0, the outward normal
+  // up); the line from (1, 0) straight up meets the parabola at y = 1.5.
+  mesh::Curve p;
+  p.kind = mesh::Curve::Kind::parabola;
+  p.a = 0.5;
+  p.b = -1.0;
+  p.c = 2.0;
+  const EdgeCurves e({{2.0, 2.0}, {0.0, 2.0}}, {p});
+  EXPECT_NEAR(*e.hit(0, Eigen::Vector2d(1.0, 0.0), Eigen::Vector2d(0.0, 1.0)), 1.5, 1e-15);
+  const EdgeCurves::Frame f = e.at(0, 0.75);  // x = 0.5: y = 1.625, slope -0.5, the normal along (0.5, 1)
+  EXPECT_NEAR(f.point.x(), 0.5, 1e-15);
+  EXPECT_NEAR(f.point.y(), 1.625, 1e-15);
+  EXPECT_NEAR(f.normal.dot(Eigen::Vector2d(0.5, 1.0).normalized()), 1.0, 1e-15);
+}
