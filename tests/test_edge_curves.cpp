@@ -1,4 +1,6 @@
-// The contact geometry of curved edges (mortar/edge_curves.hpp): unit checks against the curves' own equations.
+// The contact geometry of curved edges (mortar/edge_curves.hpp) and the arcs fitted to curves known only by their
+// nodes (mesh/curve_fit.hpp): unit checks against the curves' own equations.
+#include "mesh/curve_fit.hpp"
 #include "mortar/edge_curves.hpp"
 #include "mortar/segments.hpp"
 #include "support.hpp"
@@ -94,4 +96,48 @@ TEST(EdgeCurves, TheGapToAParabolaIsTheRootOfTheLinesQuadratic) {
   EXPECT_NEAR(f.point.x(), 0.5, 1e-15);
   EXPECT_NEAR(f.point.y(), 1.625, 1e-15);
   EXPECT_NEAR(f.normal.dot(Eigen::Vector2d(0.5, 1.0).normalized()), 1.0, 1e-15);
+}
+
+TEST(FittedArcs, OnAnEllipseTheyStrayFromTheCurveAsHCubedWhereTheChordsStrayAsHSquared) {
+  // The quarter ellipse x = 3 cos t, y = 2 sin t (an open chain) and the whole one (closed), N sides at equal steps
+  // of t: the largest distance from the ellipse of the points of each side's fitted arc (mesh/curve_fit.hpp) and of
+  // its chord, sampled at 9 points per side, the distance taken as |F| / |grad F| for F = x^2 / 9 + y^2 / 4 - 1
+  // (exact to second order in the distance). The orders between N and 2N: the chord's 2, the fitted arc's 3 (the
+  // printed measurements are those of docs/algorithm.md).
+  const double pi = 3.14159265358979323846;
+  auto distance = [](const mesh::Point& p) {
+    const double F = p.x() * p.x() / 9 + p.y() * p.y() / 4 - 1;
+    return std::abs(F) / mesh::Point(2 * p.x() / 9, p.y() / 2).norm();
+  };
+  for (const bool closed : {false, true}) {
+    double previous_fit = 0, previous_chord = 0;
+    for (int n : {16, 32, 64, 128}) {
+      std::vector<mesh::Point> nodes;
+      const double span = closed ? 2 * pi : 0.5 * pi;
+      for (int j = 0; j < (closed ? n : n + 1); ++j)
+        nodes.emplace_back(3 * std::cos(span * j / n), 2 * std::sin(span * j / n));
+      const auto arcs = mesh::fitted_arcs(nodes, closed);
+      ASSERT_EQ(arcs.size(), static_cast<size_t>(n));
+      double fit = 0, chord = 0;
+      for (int k = 0; k < n; ++k) {
+        const mesh::Point a = nodes[static_cast<size_t>(k)], b = nodes[static_cast<size_t>((k + 1) % nodes.size())];
+        ASSERT_TRUE(arcs[static_cast<size_t>(k)].has_value()) << k;
+        for (int s = 1; s < 10; ++s) {
+          fit = std::max(fit, distance(arcs[static_cast<size_t>(k)]->between(a, b, s / 10.0)));
+          chord = std::max(chord, distance(a + s / 10.0 * (b - a)));
+        }
+      }
+      if (previous_fit > 0) {
+        const double fit_order = std::log2(previous_fit / fit), chord_order = std::log2(previous_chord / chord);
+        std::printf(
+            "[ measured ] %s ellipse, %d -> %d sides: fitted arcs %.3g (order %.2f), chords %.3g (order %.2f)\n",
+            closed ? "closed" : "quarter", n / 2, n, fit, fit_order, chord, chord_order);
+        EXPECT_NEAR(chord_order, 2.0, 0.1);
+        EXPECT_GT(fit_order, 2.8);
+      }
+      EXPECT_LT(fit, chord / 10) << n;
+      previous_fit = fit;
+      previous_chord = chord;
+    }
+  }
 }
