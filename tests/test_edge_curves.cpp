@@ -1,7 +1,9 @@
-// The contact geometry of curved edges (mortar/edge_curves.hpp) and the arcs fitted to curves known only by their
-// nodes (mesh/curve_fit.hpp): unit checks against the curves' own equations.
+// The contact geometry of curved edges (mortar/edge_curves.hpp), the arcs fitted to curves known only by their
+// nodes (mesh/curve_fit.hpp) and the groups of pairs that share a contact surface (mortar/pair_group.hpp): unit
+// checks against the curves' own equations.
 #include "mesh/curve_fit.hpp"
 #include "mortar/edge_curves.hpp"
+#include "mortar/pair_group.hpp"
 #include "mortar/segments.hpp"
 #include "support.hpp"
 
@@ -96,6 +98,37 @@ TEST(EdgeCurves, TheGapToAParabolaIsTheRootOfTheLinesQuadratic) {
   EXPECT_NEAR(f.point.x(), 0.5, 1e-15);
   EXPECT_NEAR(f.point.y(), 1.625, 1e-15);
   EXPECT_NEAR(f.normal.dot(Eigen::Vector2d(0.5, 1.0).normalized()), 1.0, 1e-15);
+}
+
+TEST(PairGroups, TheQuarterFitsPairsShareOneSurfaceAndACornerDoesNot) {
+  // api/examples/shrink_fit.json: the bore against the shaft's two arcs, which chain at 45 degrees (the shaft's
+  // "right" ends where its "top" begins, tangentially): one group, the master chain right then top, 33 nodes.
+  const Problem fit = parse_or_fail(example("shrink_fit.json"));
+  for (int p : {0, 1}) {
+    const PairGroup g = pair_group(fit, p);
+    EXPECT_EQ(g.pairs, (std::vector<int>{0, 1}));
+    EXPECT_EQ(g.slave.edges, (std::vector<std::string>{"left"}));
+    EXPECT_EQ(g.master.edges, (std::vector<std::string>{"right", "top"}));
+    EXPECT_EQ(g.master.start, (std::vector<size_t>{0, 16}));
+    EXPECT_EQ(g.master.nodes.size(), 33u);
+    EXPECT_FALSE(g.master.closed);
+    EXPECT_EQ(g.pair_of(0, 0), 0);
+    EXPECT_EQ(g.pair_of(0, 1), 1);
+    EXPECT_EQ(g.master.edge_of_segment(15), 0u);
+    EXPECT_EQ(g.master.edge_of_segment(16), 1u);
+  }
+  // The shaft's bottom (a radius) turns into its right arc at (500, 0) through a right angle: a corner, where each
+  // edge keeps its own multiplier and normal, so the two pairs stay apart.
+  nlohmann::json corner = example("shrink_fit.json");
+  corner["contacts"] = nlohmann::json::array(
+      {{{"slave", "shaft.bottom"}, {"master", "ring.left"}}, {{"slave", "shaft.right"}, {"master", "ring.left"}}});
+  const Problem cornered = parse_or_fail(corner);
+  EXPECT_EQ(pair_group(cornered, 0).pairs, (std::vector<int>{0}));
+  EXPECT_EQ(pair_group(cornered, 1).pairs, (std::vector<int>{1}));
+  // The stack's pairs are between different bodies: each alone.
+  const Problem stack = parse_or_fail(example("stack3.json"));
+  for (int p = 0; p < static_cast<int>(stack.contacts.size()); ++p)
+    EXPECT_EQ(pair_group(stack, p).pairs, (std::vector<int>{p}));
 }
 
 TEST(FittedArcs, OnAnEllipseTheyStrayFromTheCurveAsHCubedWhereTheChordsStrayAsHSquared) {

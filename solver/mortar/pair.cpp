@@ -4,6 +4,7 @@
 #include "corners.hpp"
 #include "dual_basis.hpp"
 #include "edge_curves.hpp"
+#include "pair_group.hpp"
 #include "segments.hpp"
 
 #include <algorithm>
@@ -143,10 +144,12 @@ PenaltyChoice choose_penalty(const Problem& problem, int pair_index) {
 namespace {
 
 // The multiplier partition: the slave nodes that bound multiplier segments (positions in the slave polyline), the
-// first and the last always among them. Where the master is coarser than the slave, consecutive slave segments are
-// grouped until the group is as long as the longest master segment opposite, to the nearest slave segment;
-// elsewhere every slave node is a multiplier node (the plain dual mortar method).
-std::vector<size_t> multiplier_partition(const SegmentMesh& segments, const std::vector<double>& master_length) {
+// first and the last always among them, and the `breaks` (where one slave edge of a group ends and the next
+// begins). Where the master is coarser than the slave, consecutive slave segments are grouped until the group is
+// as long as the longest master segment opposite, to the nearest slave segment; elsewhere every slave node is a
+// multiplier node (the plain dual mortar method).
+std::vector<size_t> multiplier_partition(const SegmentMesh& segments, const std::vector<double>& master_length,
+                                         const std::vector<size_t>& breaks) {
   const size_t n_segments = segments.slave_length.size();
   std::vector<double> opposite(n_segments, 0.0);  // the longest master segment opposite each slave segment
   for (const auto& s : segments.segments)
@@ -157,7 +160,8 @@ std::vector<size_t> multiplier_partition(const SegmentMesh& segments, const std:
     run += segments.slave_length[k];
     longest = std::max(longest, opposite[k]);
     // Close the run when one more slave segment would take it further from the master length than it is now.
-    if (k + 1 == n_segments || run >= longest - 0.5 * segments.slave_length[k]) {
+    const bool at_break = std::find(breaks.begin(), breaks.end(), k + 1) != breaks.end();
+    if (k + 1 == n_segments || at_break || run >= longest - 0.5 * segments.slave_length[k]) {
       nodes.push_back(k + 1);
       run = longest = 0;
     }
@@ -179,7 +183,9 @@ class PairBuilder {
         pair_(problem.contacts[static_cast<size_t>(pair_index)]),
         slave_(problem.bodies[static_cast<size_t>(pair_.slave_body)]),
         master_(problem.bodies[static_cast<size_t>(pair_.master_body)]),
-        thickness_(problem.model.plane == Plane::stress ? problem.model.thickness : 1.0) {
+        thickness_(problem.model.plane == Plane::stress ? problem.model.thickness : 1.0),
+        pair_index_(pair_index),
+        group_(pair_group(problem, pair_index)) {
     d_.name = pair_.name;
     d_.slave_body = pair_.slave_body;
     d_.master_body = pair_.master_body;
@@ -191,10 +197,12 @@ class PairBuilder {
     cut_segments();
     dual_bases();
     classify_nodes();
+    assign_owners();
     number_rows();
     integrate();
     assemble_operators();
     close_loop();
+    keep_own_edge();
     return std::move(d_);
   }
 
@@ -211,21 +219,26 @@ class PairBuilder {
   }
 
   // The slave and master nodes, the segment mesh, arc lengths, and which mortar segments lie on each slave segment.
-  // The builder works on the slave polyline's positions 0 .. n_ - 1; on a closed slave edge position n_ - 1 is
-  // position 0 again (close_loop() folds it back once the operators are built).
+  // The builder works on the group's slave chain (pair_group.hpp: this pair's slave edge, or the edges it chains
+  // with) at positions 0 .. n_ - 1, against the group's master chain; on a closed chain position n_ - 1 is position
+  // 0 again (close_loop() folds it back once the operators are built), and keep_own_edge() cuts the pair's own
+  // slave edge out at the end. Pieces of a slave edge opposite a master edge the group does not pair it with are
+  // left out.
   void cut_segments() {
-    d_.slave_nodes = slave_.mesh.edge_set_nodes(pair_.slave_edge);
-    d_.master_nodes = master_.mesh.edge_set_nodes(pair_.master_edge);
-    closed_ = slave_.mesh.edge_set_closed(pair_.slave_edge);
+    d_.slave_nodes = group_.slave.nodes;
+    d_.master_nodes = group_.master.nodes;
+    closed_ = group_.slave.closed;
     poly_ = polyline(d_.slave_nodes, closed_);
-    master_poly_ = polyline(d_.master_nodes, master_.mesh.edge_set_closed(pair_.master_edge));
+    master_poly_ = polyline(d_.master_nodes, group_.master.closed);
     S_ = coordinates(slave_.mesh, poly_);
     const auto Mx = coordinates(master_.mesh, master_poly_);
     n_ = S_.size();
     segments_ = build_segment_mesh(S_, Mx);
-    slave_curves_ = EdgeCurves::of_edge(slave_.mesh, pair_.slave_edge, poly_);
-    master_curves_ = EdgeCurves::of_edge(master_.mesh, pair_.master_edge, master_poly_);
-    master_closed_ = master_.mesh.edge_set_closed(pair_.master_edge);
+    auto& pieces = segments_.segments;
+    pieces.erase(std::remove_if(pieces.begin(), pieces.end(), [&](const MortarSegment& s) { return pair_of(s) < 0; }),
+                 pieces.end());
+    slave_curves_ = EdgeCurves::of_sides(slave_.mesh, poly_, edge_names(group_.slave, poly_.size()));
+    master_curves_ = EdgeCurves::of_sides(master_.mesh, master_poly_, edge_names(group_.master, master_poly_.size()));
     const size_t n_segments = n_ < 2 ? 0 : n_ - 1;
     for (size_t j = 0; j + 1 < Mx.size(); ++j) master_length_.push_back((Mx[j + 1] - Mx[j]).norm());
     arc_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n_));
@@ -234,14 +247,29 @@ class PairBuilder {
     on_segment_.assign(n_segments, {});
     for (const auto& s : segments_.segments) {
       on_segment_[static_cast<size_t>(s.slave)].push_back(&s);
-      d_.covered_length += (s.xi1 - s.xi0) * segments_.slave_length[static_cast<size_t>(s.slave)];
+      if (pair_of(s) == pair_index_)
+        d_.covered_length += (s.xi1 - s.xi0) * segments_.slave_length[static_cast<size_t>(s.slave)];
     }
+  }
+
+  // The pair of the group a mortar segment belongs to (by its slave and master edges), or -1.
+  int pair_of(const MortarSegment& s) const {
+    return group_.pair_of(group_.slave.edge_of_segment(static_cast<size_t>(s.slave)),
+                          group_.master.edge_of_segment(static_cast<size_t>(s.master)));
+  }
+
+  // The edge name of every segment of a chain's polyline of `points` positions.
+  static std::vector<std::string> edge_names(const Chain& chain, size_t points) {
+    std::vector<std::string> out;
+    for (size_t k = 0; k + 1 < points; ++k) out.push_back(chain.edges[chain.edge_of_segment(k)]);
+    return out;
   }
 
   // Multiplier segments (runs of slave segments between consecutive multiplier nodes), each with its dual basis
   // on its covered part, in the arc-length parameter s of the run.
   void dual_bases() {
-    d_.multiplier_nodes = on_segment_.empty() ? std::vector<size_t>{} : multiplier_partition(segments_, master_length_);
+    d_.multiplier_nodes = on_segment_.empty() ? std::vector<size_t>{}
+                                              : multiplier_partition(segments_, master_length_, group_.slave.start);
     n_runs_ = d_.multiplier_nodes.empty() ? 0 : d_.multiplier_nodes.size() - 1;
     basis_.assign(n_runs_, std::nullopt);
     for (size_t m = 0; m < n_runs_; ++m) {
@@ -262,7 +290,7 @@ class PairBuilder {
   void classify_nodes() {
     d_.status.assign(n_, NodeStatus::inner);
     const auto prescribed = prescribed_components(slave_);
-    const auto corners = slave_corners(problem_, pair_, d_.slave_nodes);
+    const auto corners = slave_corners(problem_, pair_, slave_.mesh.edge_set_nodes(pair_.slave_edge));
     for (size_t m = 0; m <= n_runs_ && n_runs_ > 0; ++m) {
       const size_t i = d_.multiplier_nodes[m];
       double support = 0, covered = 0;
@@ -302,6 +330,30 @@ class PairBuilder {
     const auto c = corners.find(poly_[i]);
     if (c == corners.end() || !c->second.friction || !(nu.norm() > 0)) return nullptr;
     return turns(Eigen::Vector2d(-nu.y(), nu.x()).normalized(), c->second.tangent) ? &c->second : nullptr;
+  }
+
+  // Which pair of the group carries each contact node's multiplier: of the pairs whose pieces touch the node (else
+  // whose pieces lie on its two segments), the first in the job's order. The others mark it carried elsewhere.
+  void assign_owners() {
+    if (group_.pairs.size() < 2) return;
+    const size_t n_segments = on_segment_.size();
+    for (size_t m = 0; m <= n_runs_ && n_runs_ > 0; ++m) {
+      const size_t i = d_.multiplier_nodes[m];
+      if (d_.status[i] != NodeStatus::contact) continue;
+      int touching = -1, near = -1;
+      auto consider = [](int& best, int pair) { best = best < 0 ? pair : std::min(best, pair); };
+      // The segments before and after node i (on a closed chain position 0 follows the closing segment).
+      const size_t before = i > 0 ? i - 1 : (closed_ ? n_segments - 1 : n_segments);
+      for (const auto& [k, end] : {std::pair{before, 1.0}, std::pair{i, 0.0}}) {
+        if (k >= n_segments) continue;
+        for (const auto* s : on_segment_[k]) {
+          consider(near, pair_of(*s));
+          if (std::abs((end == 0.0 ? s->xi0 : s->xi1) - end) < 1e-9) consider(touching, pair_of(*s));
+        }
+      }
+      const int owner = touching >= 0 ? touching : near;
+      if (owner != pair_index_) d_.status[i] = NodeStatus::other_pair;
+    }
   }
 
   // One row per contact node; every slave node's value from the rows: a multiplier node's own; inside a run the
@@ -386,9 +438,10 @@ class PairBuilder {
     const size_t a = d_.multiplier_nodes[m], b_node = d_.multiplier_nodes[m + 1];
     const int r0 = d_.row_of_node[a], r1 = d_.row_of_node[b_node];
     if (r0 < 0 && r1 < 0) return;
+    // A node without a row drops its function into the other's, unless another pair of the group carries it.
     DualBasis b = *basis_[m];
-    if (r0 < 0) b = drop_node(b, 0);
-    if (r1 < 0) b = drop_node(b, 1);
+    if (r0 < 0 && d_.status[a] != NodeStatus::other_pair) b = drop_node(b, 0);
+    if (r1 < 0 && d_.status[b_node] != NodeStatus::other_pair) b = drop_node(b, 1);
     const double Lrun = arc(b_node) - arc(a);
     for (size_t k = a; k < b_node; ++k) {
       const double L = segments_.slave_length[k];
@@ -470,6 +523,34 @@ class PairBuilder {
     d_.node_from_rows.resize(n);
   }
 
+  // A pair whose group chains several slave edges: its own edge's stretch of the per-node results (positions
+  // first .. last of the chain), its arc lengths from its own first node.
+  void keep_own_edge() {
+    if (group_.slave.edges.size() < 2) return;
+    const size_t own = group_.slave.index(pair_.slave_edge);
+    const size_t first = group_.slave.start[own];
+    const size_t last = first + slave_.mesh.edge_set_nodes(pair_.slave_edge).size() - 1;  // on poly_
+    const auto from = static_cast<std::ptrdiff_t>(first), to = static_cast<std::ptrdiff_t>(last) + 1;
+    d_.slave_nodes.assign(poly_.begin() + from, poly_.begin() + to);
+    auto slice = [&](auto& v) { v = std::decay_t<decltype(v)>(v.begin() + from, v.begin() + to); };
+    if (d_.status.size() < n_) {  // close_loop() folded the start back: unfold for the slicing
+      d_.status.push_back(d_.status.front());
+      d_.row_of_node.push_back(d_.row_of_node.front());
+      d_.node_from_rows.push_back(d_.node_from_rows.front());
+    }
+    slice(d_.status);
+    slice(d_.row_of_node);
+    slice(d_.node_from_rows);
+    d_.node_arc = arc_.segment(from, to - from).array() - arc(first);
+    std::vector<size_t> multipliers;
+    for (size_t i : d_.multiplier_nodes)
+      if (i >= first && i <= last) multipliers.push_back(i - first);
+    d_.multiplier_nodes = multipliers;
+    d_.closed = false;
+    d_.loop_length = 0.0;
+    for (size_t r = 0; r < d_.node_of_row.size(); ++r) d_.node_of_row[r] -= static_cast<int>(first);
+  }
+
   // Ts and Tm: the scalar mortar integrals of the slave and the master times the row's tangent.
   void tangential_operators() {
     VectorEntries ts, tm;
@@ -485,6 +566,8 @@ class PairBuilder {
   const Body& slave_;
   const Body& master_;
   const double thickness_;
+  const int pair_index_;
+  const PairGroup group_;  // the pairs sharing this pair's contact surface (itself alone, mostly)
   PairDiscretization d_;
   std::vector<int> poly_, master_poly_;  // the slave's and the master's nodes as polylines (polyline())
   bool closed_ = false;                  // the slave edge is a closed loop
