@@ -7,6 +7,7 @@
 // Lame (plane strain): p = E' delta / (2 a) (1 - a^2 / b^2) = 109.89, E' = E / (1 - nu^2), uniform round the bore.
 #include "contact/job.hpp"
 #include "contact/solve.hpp"
+#include "polar_meshes.hpp"
 #include "support.hpp"
 
 #include <gtest/gtest.h>
@@ -206,3 +207,47 @@ TEST_P(CurvedJunction, WhereTheShaftsArcsMeetInsideARingSegmentAUniformPressureS
 
 INSTANTIATE_TEST_SUITE_P(RingOrShaftSlave, CurvedJunction, ::testing::Values(true, false),
                          [](const auto& info) { return info.param ? "ring_slave" : "shaft_slave"; });
+
+TEST(CurvedGroups, AClosedCurveCutIntoFourPairsIsTheClosedCurvesOnePairAgain) {
+  // The full shrink fit of test_closed_curves.cpp on matching polar meshes (64 nodes round), the shaft's rim cut
+  // into its four quarters, each its own pair with the ring's bore: four slave edges chained into a loop against one
+  // closed master (the rim the slave), or one closed slave against four master edges (the bore the slave). Grouped
+  // (mortar/pair_group.hpp) they are the closed pair's discrete problem again: the same pressure at every node, to
+  // the solver's tolerance, each node's multiplier in one of the four pairs.
+  const FullShrinkFit fit;
+  for (const bool ring_slave : {true, false}) {
+    const Result whole = solve_quietly(fit.problem(64, 64, ring_slave));
+    ASSERT_TRUE(whole.converged) << whole.message;
+    Problem quarters = fit.problem(64, 64, ring_slave);
+    auto& rim = quarters.bodies[0].mesh.edge_sets;
+    const auto sides = rim.at("rim");
+    const ContactPair one = quarters.contacts[0];
+    quarters.contacts.clear();
+    for (int q = 0; q < 4; ++q) {
+      const std::string name = "rim" + std::to_string(q);
+      rim[name].assign(sides.begin() + 16 * q, sides.begin() + 16 * (q + 1));
+      ContactPair c = one;
+      (ring_slave ? c.master_edge : c.slave_edge) = name;
+      c.name = one.name + "." + name;
+      quarters.contacts.push_back(c);
+    }
+    const Result cut = solve_quietly(quarters);
+    ASSERT_TRUE(cut.converged) << cut.message;
+    std::map<int, double> expected, got;
+    std::map<int, int> pairs_of_node;
+    const PairField& single = whole.steps.back().pairs.at(0);
+    for (Eigen::Index i = 0; i < single.pressure.size(); ++i)
+      if (single.status[i] == 0) expected[single.node[i]] = single.pressure[i];
+    for (const PairField& pair : cut.steps.back().pairs)
+      for (Eigen::Index i = 0; i < pair.pressure.size(); ++i)
+        if (pair.status[i] == 0) {
+          got[pair.node[i]] = pair.pressure[i];
+          ++pairs_of_node[pair.node[i]];
+        }
+    ASSERT_EQ(got.size(), expected.size()) << (ring_slave ? "ring" : "shaft") << " slave";
+    for (const auto& [node, p] : expected) {
+      EXPECT_NEAR(got[node], p, 1e-6 * p) << "node " << node;
+      EXPECT_EQ(pairs_of_node[node], 1) << "node " << node;
+    }
+  }
+}

@@ -333,13 +333,14 @@ class PairBuilder {
   }
 
   // Which pair of the group carries each contact node's multiplier: of the pairs whose pieces touch the node (else
-  // whose pieces lie on its two segments), the first in the job's order. The others mark it carried elsewhere.
+  // whose pieces lie on its two segments), the first in the job's order. The others mark it carried elsewhere. On a
+  // closed chain the last position is the start again and takes the start's answer.
   void assign_owners() {
     if (group_.pairs.size() < 2) return;
     const size_t n_segments = on_segment_.size();
     for (size_t m = 0; m <= n_runs_ && n_runs_ > 0; ++m) {
       const size_t i = d_.multiplier_nodes[m];
-      if (d_.status[i] != NodeStatus::contact) continue;
+      if (d_.status[i] != NodeStatus::contact || (closed_ && i + 1 == n_)) continue;
       int touching = -1, near = -1;
       auto consider = [](int& best, int pair) { best = best < 0 ? pair : std::min(best, pair); };
       // The segments before and after node i (on a closed chain position 0 follows the closing segment).
@@ -354,6 +355,7 @@ class PairBuilder {
       const int owner = touching >= 0 ? touching : near;
       if (owner != pair_index_) d_.status[i] = NodeStatus::other_pair;
     }
+    if (closed_ && n_ > 0) d_.status[n_ - 1] = d_.status[0];
   }
 
   // One row per contact node; every slave node's value from the rows: a multiplier node's own; inside a run the
@@ -548,7 +550,11 @@ class PairBuilder {
     d_.multiplier_nodes = multipliers;
     d_.closed = false;
     d_.loop_length = 0.0;
-    for (size_t r = 0; r < d_.node_of_row.size(); ++r) d_.node_of_row[r] -= static_cast<int>(first);
+    // A row at the chain's start belongs to an edge ending there when the chain closes (position n_ - 1 again).
+    for (int& i : d_.node_of_row) {
+      if (i < static_cast<int>(first)) i = static_cast<int>(n_) - 1;
+      i -= static_cast<int>(first);
+    }
   }
 
   // Ts and Tm: the scalar mortar integrals of the slave and the master times the row's tangent.
