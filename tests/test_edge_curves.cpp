@@ -2,6 +2,7 @@
 // nodes (mesh/curve_fit.hpp) and the groups of pairs that share a contact surface (mortar/pair_group.hpp): unit
 // checks against the curves' own equations.
 #include "mesh/curve_fit.hpp"
+#include "mesh/gmsh.hpp"
 #include "mortar/edge_curves.hpp"
 #include "mortar/pair_group.hpp"
 #include "mortar/segments.hpp"
@@ -9,8 +10,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 
 using namespace contact;
 using namespace contact::mortar;
@@ -173,4 +177,43 @@ TEST(FittedArcs, OnAnEllipseTheyStrayFromTheCurveAsHCubedWhereTheChordsStrayAsHS
       previous_chord = chord;
     }
   }
+}
+
+TEST(FittedArcs, AGmshEllipseGetsThemOnEverySideAndRefinementPutsItsNewNodesOnThem) {
+  // tests/data/half_ellipse_gmsh.msh: the half ellipse x^2 / 9 + y^2 / 4 <= 1, y >= 0, its curved side two Gmsh
+  // Ellipse curves of 12 sides each. Every side of the rim gets a fitted arc through its two nodes, the straight base
+  // none; each arc's midpoint lies nearer the ellipse than its chord's, the farthest 10 times nearer than the
+  // farthest chord's (the two Ellipse curves are fitted each on its own, so their ends use one-sided triples), and a
+  // uniform refinement puts the rim's new nodes on the arcs.
+  std::ifstream in(std::string(CONTACT_SOURCE_DIR) + "/tests/data/half_ellipse_gmsh.msh");
+  std::stringstream text;
+  text << in.rdbuf();
+  auto s = mesh::gmsh::surface(mesh::gmsh::parse(text.str(), 1'000'000), "plate");
+  ASSERT_TRUE(s.errors.empty()) << s.errors[0];
+  auto distance = [](const mesh::Point& p) {
+    const double F = p.x() * p.x() / 9 + p.y() * p.y() / 4 - 1;
+    return std::abs(F) / mesh::Point(2 * p.x() / 9, p.y() / 2).norm();
+  };
+  const std::vector<int> rim = s.mesh.edge_set_nodes("rim");
+  ASSERT_EQ(rim.size(), 25u);
+  EXPECT_EQ(s.mesh.side_curves.size(), 24u);  // the rim's sides, none of the base's
+  double arc_worst = 0, chord_worst = 0;
+  for (size_t k = 0; k + 1 < rim.size(); ++k) {
+    const mesh::Point a = s.mesh.nodes[static_cast<size_t>(rim[k])], b = s.mesh.nodes[static_cast<size_t>(rim[k + 1])];
+    const auto c = s.mesh.side_curves.find(std::minmax(rim[k], rim[k + 1]));
+    ASSERT_NE(c, s.mesh.side_curves.end()) << k;
+    EXPECT_EQ(c->second.kind, mesh::Curve::Kind::arc);
+    for (const mesh::Point& p : {a, b}) EXPECT_NEAR((p - c->second.center).norm(), c->second.radius, 1e-9);
+    const double on_arc = distance(c->second.between(a, b, 0.5)), on_chord = distance(0.5 * (a + b));
+    EXPECT_LT(on_arc, on_chord) << k;
+    arc_worst = std::max(arc_worst, on_arc);
+    chord_worst = std::max(chord_worst, on_chord);
+  }
+  EXPECT_LT(arc_worst, 0.1 * chord_worst);
+  std::printf("[ measured ] Gmsh ellipse, 24 sides: midpoints at most %.2g from it on the arcs, %.2g on the chords\n",
+              arc_worst, chord_worst);
+  mesh::refine_uniform(s.mesh);
+  const std::vector<int> refined = s.mesh.edge_set_nodes("rim");
+  ASSERT_EQ(refined.size(), 49u);
+  for (int n : refined) EXPECT_LE(distance(s.mesh.nodes[static_cast<size_t>(n)]), arc_worst + 1e-12) << n;
 }
