@@ -124,11 +124,13 @@ TEST(ClosedCurves, NonMatchingLoopsRunPeriodicallyAndCarryTheFitTheirChordsLeave
   // 192 nodes round the shaft against 256 round the ring and the converse, either side the slave. Both meshes are
   // unchanged by a rotation through 2 pi / 64, so the pressures repeat every 256 / 64 (or 192 / 64) slave nodes
   // all round the loop, across its start too: a loop has no ends. (They do oscillate within the period where the
-  // slave is the finer side: the two polygons cut the circle differently, issue 29, item 3, not solved here.)
-  // The gap is measured between the two polygons' chords, which lie inside the circle by h^2 / (12 a) on average
-  // (h = 2 a sin(pi / N) a side): the fit's interference is in effect delta - (h_shaft^2 - h_ring^2) / (12 a), and
-  // the force-averaged pressure is Lame's for it, within the discretisation's 0.5 % and the dual mortar's
-  // averaging of the kinked gap (measured: within 0.4 %; asserted 1 %). It is within 3.2 % of Lame's own.
+  // slave is the finer side: the two polygons cut the circle differently.) Polar meshes built in code carry no
+  // curve, so their chords are their geometry (mortar/edge_curves.hpp; test_curved_contact.cpp has the same fit on
+  // Gmsh's circles, measured on the circle): the gap is measured between the two polygons' chords, which lie
+  // inside the circle by h^2 / (12 a) on average (h = 2 a sin(pi / N) a side): the fit's interference is in effect
+  // delta - (h_shaft^2 - h_ring^2) / (12 a), and the force-averaged pressure is Lame's for it, within the
+  // discretisation's 0.5 % and the dual mortar's averaging of the kinked gap (measured: within 0.4 %; asserted
+  // 1 %). It is within 3.2 % of Lame's own.
   const FullShrinkFit fit;
   const double pi = 3.14159265358979323846;
   for (const auto& [shaft_nt, ring_nt] : {std::pair{192, 256}, std::pair{256, 192}})

@@ -8,7 +8,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 using namespace contact;
@@ -130,13 +132,18 @@ TEST(MortarShrinkFit, AnInterferenceGivesLamesUniformPressureOnMatchingArcs) {
     ASSERT_TRUE(r.converged) << r.message;
     const double p = lame(a);
     int nodes = 0;
+    double lo = 1e300, hi = -1e300;
     for (const PairField& pair : r.steps.back().pairs)
       for (Eigen::Index i = 0; i < pair.pressure.size(); ++i) {
         if (pair.status[i] != 0) continue;
         ++nodes;
+        lo = std::min(lo, pair.pressure[i]);
+        hi = std::max(hi, pair.pressure[i]);
         EXPECT_NEAR(pair.pressure[i], p, 0.005 * p) << pair.name << " node " << i << (overlapping ? " (overlap)" : "");
       }
     EXPECT_GE(nodes, 32);
+    std::printf("[ measured ] %s: %d nodes, %.3f to %.3f (Lame %.3f)\n",
+                overlapping ? "overlapping geometry" : "gap.constant", nodes, lo, hi, p);
     for (const BodyField& body : r.steps.back().bodies)
       if (body.name == "shaft") EXPECT_NEAR(body.reaction_total.y(), p * a, 0.005 * p * a);
   }

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -239,11 +240,15 @@ TEST(SeedLayers, PaperParametersStopByThePapersCriterionWithContactNearTheOrigin
   EXPECT_LT(edge, 1.5);
 }
 
-TEST(SeedLayers, CurvedBodyAndAnalyticGapAgreeUpToADifferenceThatShrinksLikeHSquared) {
+TEST(SeedLayers, CurvedBodyAndAnalyticGapAgreeOnceTheGapIsMeasuredOnTheCurve) {
   // ../shared/design/TEST_PROBLEMS.md section 1: the linearised theory treats y = r0 x^2 as a gap function on a
-  // flat surface; the really curved body with the projected gap must give nearly the same contact. The two
-  // discretisations differ by the chord error of the curved edge, r0 h^2 / 8 per element, which the stiff penalty
-  // turns into a pressure difference of order r0 h^2 / theta: it must fall by about 4 when h halves.
+  // flat surface; the really curved body with the projected gap must give nearly the same contact. Measured on the
+  // chords of the curved edge, the two differed by the chord error r0 h^2 / 8 per element, which the stiff penalty
+  // turned into a pressure difference of order r0 h^2 / theta, falling by about 4 when h halved. The gap is now
+  // measured on the block's parabola itself (mortar/edge_curves.hpp), so no chord error is left: what remains is the
+  // linearisation's (the curved body's normals lean by the slope 2 r0 x, at most 0.008 here, where the analytic gap
+  // is vertical), of order slope^2 and the same at every h. Measured: peak pressures 1.7e-6 and 6.1e-6 apart at 32
+  // and 64 elements; asserted 1e-4, and the forces 1e-3.
   auto pressure_gap = [](int nx, double& force_difference) {
     json flat = load_example("seed_layers.json");
     json curved = load_example("seed_layers_curved.json");
@@ -259,12 +264,13 @@ TEST(SeedLayers, CurvedBodyAndAnalyticGapAgreeUpToADifferenceThatShrinksLikeHSqu
     force_difference = std::abs(pb.force - pa.force) / pa.force;
     return std::abs(pb.pressure.maxCoeff() - pa.pressure.maxCoeff()) / pa.pressure.maxCoeff();
   };
-  double df32 = 0, df64 = 0;
-  const double d32 = pressure_gap(32, df32), d64 = pressure_gap(64, df64);
-  EXPECT_LT(df32, 0.01);
-  EXPECT_LT(d32, 0.1);
-  EXPECT_LT(d64, 0.35 * d32);
-  EXPECT_LT(df64, 0.01);
+  for (int nx : {32, 64}) {
+    double df = 0;
+    const double d = pressure_gap(nx, df);
+    EXPECT_LT(d, 1e-4) << nx;
+    EXPECT_LT(df, 1e-3) << nx;
+    std::printf("[ measured ] %d elements: peak pressures %.2g apart, forces %.2g\n", nx, d, df);
+  }
 }
 
 TEST(PaperScheme, NodalMortarPenaltyReproducesTheRemovedGaussPointSchemeOnMatchingMeshes) {

@@ -33,13 +33,14 @@ def _spread(n, k):
 
 
 def _node_values(c, key):
-    """A pair's dataset `key` per slave node, NaN where the node takes no part in the contact (status 1 to 3: not
-    opposite the master, a crosspoint, barely covered; docs/results-format.md), so curves break there."""
+    """A pair's dataset `key` per slave node, NaN where the node takes no part in the pair's contact (status 1 to 3:
+    not opposite the master, a crosspoint, barely covered; 5: carried by another pair of its group;
+    docs/results-format.md), so curves break there."""
     import numpy as np
     v = np.asarray(c[key], dtype=float).copy()
     status = c.get("status")
     if status is not None and len(status) == len(v):
-        v[np.isin(np.asarray(status), (1, 2, 3))] = np.nan
+        v[np.isin(np.asarray(status), (1, 2, 3, 5))] = np.nan
     return v
 
 

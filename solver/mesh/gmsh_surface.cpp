@@ -1,6 +1,8 @@
 // gmsh::surface: one physical surface of a parsed MSH file -> a body's Mesh with its physical curves as edges.
 #include "gmsh.hpp"
 
+#include "curve_fit.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -265,9 +267,51 @@ void add_points(const File& f, const std::unordered_map<std::size_t, int>& local
   }
 }
 
+// A curve entity's lines in order along it (node tags, the first again at the end of a closed curve), or empty
+// where they do not form one chain.
+std::vector<std::size_t> in_order(const std::vector<std::array<std::size_t, 2>>& segments) {
+  std::map<std::size_t, std::size_t> next;
+  std::set<std::size_t> ends;
+  for (const auto& s : segments)
+    if (!next.emplace(s[0], s[1]).second) return {};  // a fork
+  for (const auto& s : segments) ends.insert(s[1]);
+  std::size_t first = segments.front()[0];
+  for (const auto& s : segments)
+    if (!ends.count(s[0])) first = s[0];
+  std::vector<std::size_t> out = {first};
+  while (out.size() <= segments.size()) {
+    const auto n = next.find(out.back());
+    if (n == next.end()) break;
+    out.push_back(n->second);
+    if (n->second == first) break;
+  }
+  return out.size() == segments.size() + 1 ? out : std::vector<std::size_t>{};
+}
+
+// The boundary sides of a curve entity that is neither straight nor a circle (a spline, an ellipse) get the local
+// arcs of mesh/curve_fit.hpp, a smooth description for the contact's gaps and normals and for refinement's new nodes.
+void add_fitted_arcs(const File& f, const std::vector<std::array<std::size_t, 2>>& segments,
+                     const std::unordered_map<std::size_t, int>& local,
+                     const std::map<std::pair<int, int>, int>& side_count, Mesh& m) {
+  std::vector<std::size_t> tags = in_order(segments);
+  if (tags.empty()) return;
+  const bool closed = tags.front() == tags.back();
+  if (closed) tags.pop_back();
+  std::vector<Point> x;
+  for (std::size_t tag : tags) x.push_back(f.nodes[f.node_index.at(tag)].xy);
+  const auto arcs = fitted_arcs(x, closed);
+  for (size_t k = 0; k < arcs.size(); ++k) {
+    auto i = local.find(tags[k]), j = local.find(tags[(k + 1) % tags.size()]);
+    if (!arcs[k] || i == local.end() || j == local.end()) continue;
+    auto side = side_count.find(key(i->second, j->second));
+    if (side != side_count.end() && side->second == 1) m.side_curves[key(i->second, j->second)] = *arcs[k];
+  }
+}
+
 // The circle through all the nodes of each curve entity's lines, where there is one (Gmsh's Circle and
 // Ellipse arcs with equal axes): the boundary sides on it get it as their true geometry, so that refinement puts
-// new nodes on the arc rather than on the chord. Straight and other curves are left to their chords.
+// new nodes on the arc rather than on the chord, and the contact measures its gaps and normals on it. Other curves
+// get fitted local arcs (add_fitted_arcs); straight ones are left to their chords.
 void add_arcs(const File& f, const std::unordered_map<std::size_t, int>& local,
               const std::map<std::pair<int, int>, int>& side_count, Mesh& m) {
   std::map<int, std::vector<std::array<std::size_t, 2>>> lines;  // curve entity -> its lines' end nodes
@@ -298,8 +342,11 @@ void add_arcs(const File& f, const std::unordered_map<std::size_t, int>& local,
     const Point centre = a + Point(ac.y() * ab.squaredNorm() - ab.y() * ac.squaredNorm(),
                                    ab.x() * ac.squaredNorm() - ac.x() * ab.squaredNorm()) / det;
     const double radius = (a - centre).norm();
-    if (!std::all_of(x.begin(), x.end(), [&](const Point& p) { return std::abs((p - centre).norm() - radius) <= 1e-8 * radius; }))
-      continue;  // not a circle
+    if (!std::all_of(x.begin(), x.end(),
+                     [&](const Point& p) { return std::abs((p - centre).norm() - radius) <= 1e-8 * radius; })) {
+      add_fitted_arcs(f, segments, local, side_count, m);  // not a circle
+      continue;
+    }
     Curve arc;
     arc.kind = Curve::Kind::arc;
     arc.center = centre;

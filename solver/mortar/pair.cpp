@@ -1,7 +1,10 @@
 #include "pair.hpp"
 #include "../common/assert.hpp"
 
+#include "corners.hpp"
 #include "dual_basis.hpp"
+#include "edge_curves.hpp"
+#include "pair_group.hpp"
 #include "segments.hpp"
 
 #include <algorithm>
@@ -27,112 +30,6 @@ double analytic_gap(const GapSpec& spec, const Eigen::Vector2d& x) {
   double d = spec.constant;
   if (spec.parabola_r0) d += *spec.parabola_r0 * (x.x() - spec.parabola_x0) * (x.x() - spec.parabola_x0);
   return d;
-}
-
-// Prescribed displacement components (x, y) of every node of a body.
-std::map<int, std::array<bool, 2>> prescribed_components(const Body& body) {
-  std::map<int, std::array<bool, 2>> out;
-  for (const auto& bc : body.boundary) {
-    if (!prescribes_displacement(bc)) continue;
-    for (int node : condition_nodes(body.mesh, bc)) {
-      auto& p = out[node];
-      p[0] = p[0] || bc.ux.has_value();
-      p[1] = p[1] || bc.uy.has_value();
-    }
-  }
-  return out;
-}
-
-// A crosspoint: the node's displacement along its normal is prescribed (both components, or the one component
-// within 10 degrees of the normal), so the slave side cannot move to open or close the contact there.
-bool normal_is_prescribed(const std::array<bool, 2>& p, const Eigen::Vector2d& n) {
-  if (p[0] && p[1]) return true;
-  const double cos10 = 0.984807753;
-  return (p[0] && std::abs(n.x()) >= cos10) || (p[1] && std::abs(n.y()) >= cos10);
-}
-
-// The end nodes of a slave edge where another contact edge of the same body meets it (a corner of the body where
-// its joints turn: a brick's bottom and right edge, or the top of a head joint under the bed joint of the course
-// above), with the other edge's unit tangent there, whether that edge is another pair's master edge facing a third
-// body, and whether friction is involved (this pair's or the other's).
-//
-// Why: where three bodies meet at one point, each pair ties two of them there, and with friction the ties close a
-// loop: at a brick's corner on a bed joint, the two bed joints' tangential rows and the head joint's normal row
-// all tie the x-displacements of the same three bodies at one point, the two bed joints' normal rows and the head
-// joint's tangential row their y-displacements. The multipliers are then redundant and the stick and slip systems
-// singular (or nearly: pressures of 1e7 that cancel). The pair therefore drops, at such a corner, its tangential
-// row (against another slave edge of the same body: the corner of the brick) or its multiplier altogether (against
-// a master edge facing a third body: the top of a head joint), the crosspoint treatment of the dual mortar
-// literature restricted to where friction makes it necessary. Frictionless contact has no such loop (its rows tie
-// along the normals only) and is left as it was.
-struct Corner {
-  Eigen::Vector2d tangent = Eigen::Vector2d::Zero();
-  bool third_body = false;  // the other edge is a master edge facing a body other than this pair's master
-  bool friction = false;
-};
-
-std::map<int, Corner> slave_corners(const Problem& problem, const ContactPair& pair, const std::vector<int>& nodes,
-                                    bool look_for_broken_loops = true);
-
-// Whether the pair between bodies a and b (either its slave) has a slave edge ending at x where that end drops its
-// multiplier altogether (a corner against a master edge facing a third body): the loop of three bodies at x is then
-// broken there, and the other two pairs keep all their rows.
-bool crosspoint_between(const Problem& problem, int a, int b, const Eigen::Vector2d& x, double tolerance) {
-  for (const auto& q : problem.contacts) {
-    if (!((q.slave_body == a && q.master_body == b) || (q.slave_body == b && q.master_body == a))) continue;
-    const auto& mesh = problem.bodies[static_cast<size_t>(q.slave_body)].mesh;
-    const std::vector<int> nodes = mesh.edge_set_nodes(q.slave_edge);
-    if (nodes.size() < 2 || mesh.edge_set_closed(q.slave_edge)) continue;  // a closed loop has no ends
-    for (int end : {nodes.front(), nodes.back()}) {
-      if ((mesh.nodes[static_cast<size_t>(end)] - x).norm() > tolerance) continue;
-      const auto corners = slave_corners(problem, q, nodes, false);
-      const auto c = corners.find(end);
-      if (c != corners.end() && c->second.third_body && c->second.friction) return true;
-    }
-  }
-  return false;
-}
-
-std::map<int, Corner> slave_corners(const Problem& problem, const ContactPair& pair, const std::vector<int>& nodes,
-                                    bool look_for_broken_loops) {
-  std::map<int, Corner> out;
-  const auto& mesh = problem.bodies[static_cast<size_t>(pair.slave_body)].mesh;
-  // A closed loop has no ends, so no corners: it meets another edge only where that edge ends on it, and there
-  // the boundary runs on along the loop.
-  if (nodes.size() < 2 || mesh.edge_set_closed(pair.slave_edge)) return out;
-  auto meet = [&](const std::string& edge, bool third_body, bool friction, int other_master) {
-    const std::vector<int> others = mesh.edge_set_nodes(edge);
-    if (others.size() < 2 || mesh.edge_set_closed(edge)) return;
-    for (size_t end : {size_t{0}, nodes.size() - 1})
-      for (size_t j : {size_t{0}, others.size() - 1}) {
-        if (others[j] != nodes[end]) continue;
-        const size_t next = j == 0 ? 1 : j - 1;
-        const Eigen::Vector2d x = mesh.nodes[static_cast<size_t>(others[j])];
-        const double h = (mesh.nodes[static_cast<size_t>(others[next])] - x).norm();
-        // Two slave edges of this body at a corner: the loop through the two masters is broken already where the
-        // pair between those masters drops its multiplier at this point (the top of a head joint seen from the
-        // brick on the other side: the brick's bed joint keeps its friction row at its toe, where the pressure is).
-        if (!third_body && look_for_broken_loops && other_master >= 0 &&
-            crosspoint_between(problem, pair.master_body, other_master, x, 1e-6 * h))
-          continue;
-        Corner& c = out[nodes[end]];
-        c.tangent = (mesh.nodes[static_cast<size_t>(others[next])] - x).normalized();
-        c.third_body = c.third_body || third_body;
-        c.friction = c.friction || friction || pair.friction.active();
-      }
-  };
-  for (const auto& other : problem.contacts) {
-    if (other.slave_body == pair.slave_body && other.slave_edge != pair.slave_edge)
-      meet(other.slave_edge, false, other.friction.active(), other.master_body);
-    if (other.master_body == pair.slave_body && other.master_edge != pair.slave_edge)
-      meet(other.master_edge, other.slave_body != pair.master_body, other.friction.active(), -1);
-  }
-  return out;
-}
-
-// Whether the other edge turns away from this one at the node (more than 10 degrees between the tangents).
-bool turns(const Eigen::Vector2d& own, const Eigen::Vector2d& other) {
-  return std::abs(own.x() * other.y() - own.y() * other.x()) > 0.17364817766;  // sin 10 degrees
 }
 
 // Three-point Gauss-Legendre on [0, 1]: exact to degree 5 (the products here are at most cubic).
@@ -247,10 +144,12 @@ PenaltyChoice choose_penalty(const Problem& problem, int pair_index) {
 namespace {
 
 // The multiplier partition: the slave nodes that bound multiplier segments (positions in the slave polyline), the
-// first and the last always among them. Where the master is coarser than the slave, consecutive slave segments are
-// grouped until the group is as long as the longest master segment opposite, to the nearest slave segment;
-// elsewhere every slave node is a multiplier node (the plain dual mortar method).
-std::vector<size_t> multiplier_partition(const SegmentMesh& segments, const std::vector<double>& master_length) {
+// first and the last always among them, and the `breaks` (where one slave edge of a group ends and the next
+// begins). Where the master is coarser than the slave, consecutive slave segments are grouped until the group is
+// as long as the longest master segment opposite, to the nearest slave segment; elsewhere every slave node is a
+// multiplier node (the plain dual mortar method).
+std::vector<size_t> multiplier_partition(const SegmentMesh& segments, const std::vector<double>& master_length,
+                                         const std::vector<size_t>& breaks) {
   const size_t n_segments = segments.slave_length.size();
   std::vector<double> opposite(n_segments, 0.0);  // the longest master segment opposite each slave segment
   for (const auto& s : segments.segments)
@@ -261,7 +160,8 @@ std::vector<size_t> multiplier_partition(const SegmentMesh& segments, const std:
     run += segments.slave_length[k];
     longest = std::max(longest, opposite[k]);
     // Close the run when one more slave segment would take it further from the master length than it is now.
-    if (k + 1 == n_segments || run >= longest - 0.5 * segments.slave_length[k]) {
+    const bool at_break = std::find(breaks.begin(), breaks.end(), k + 1) != breaks.end();
+    if (k + 1 == n_segments || at_break || run >= longest - 0.5 * segments.slave_length[k]) {
       nodes.push_back(k + 1);
       run = longest = 0;
     }
@@ -283,7 +183,9 @@ class PairBuilder {
         pair_(problem.contacts[static_cast<size_t>(pair_index)]),
         slave_(problem.bodies[static_cast<size_t>(pair_.slave_body)]),
         master_(problem.bodies[static_cast<size_t>(pair_.master_body)]),
-        thickness_(problem.model.plane == Plane::stress ? problem.model.thickness : 1.0) {
+        thickness_(problem.model.plane == Plane::stress ? problem.model.thickness : 1.0),
+        pair_index_(pair_index),
+        group_(pair_group(problem, pair_index)) {
     d_.name = pair_.name;
     d_.slave_body = pair_.slave_body;
     d_.master_body = pair_.master_body;
@@ -295,10 +197,12 @@ class PairBuilder {
     cut_segments();
     dual_bases();
     classify_nodes();
+    assign_owners();
     number_rows();
     integrate();
     assemble_operators();
     close_loop();
+    keep_own_edge();
     return std::move(d_);
   }
 
@@ -315,18 +219,26 @@ class PairBuilder {
   }
 
   // The slave and master nodes, the segment mesh, arc lengths, and which mortar segments lie on each slave segment.
-  // The builder works on the slave polyline's positions 0 .. n_ - 1; on a closed slave edge position n_ - 1 is
-  // position 0 again (close_loop() folds it back once the operators are built).
+  // The builder works on the group's slave chain (pair_group.hpp: this pair's slave edge, or the edges it chains
+  // with) at positions 0 .. n_ - 1, against the group's master chain; on a closed chain position n_ - 1 is position
+  // 0 again (close_loop() folds it back once the operators are built), and keep_own_edge() cuts the pair's own
+  // slave edge out at the end. Pieces of a slave edge opposite a master edge the group does not pair it with are
+  // left out.
   void cut_segments() {
-    d_.slave_nodes = slave_.mesh.edge_set_nodes(pair_.slave_edge);
-    d_.master_nodes = master_.mesh.edge_set_nodes(pair_.master_edge);
-    closed_ = slave_.mesh.edge_set_closed(pair_.slave_edge);
+    d_.slave_nodes = group_.slave.nodes;
+    d_.master_nodes = group_.master.nodes;
+    closed_ = group_.slave.closed;
     poly_ = polyline(d_.slave_nodes, closed_);
-    master_poly_ = polyline(d_.master_nodes, master_.mesh.edge_set_closed(pair_.master_edge));
+    master_poly_ = polyline(d_.master_nodes, group_.master.closed);
     S_ = coordinates(slave_.mesh, poly_);
     const auto Mx = coordinates(master_.mesh, master_poly_);
     n_ = S_.size();
     segments_ = build_segment_mesh(S_, Mx);
+    auto& pieces = segments_.segments;
+    pieces.erase(std::remove_if(pieces.begin(), pieces.end(), [&](const MortarSegment& s) { return pair_of(s) < 0; }),
+                 pieces.end());
+    slave_curves_ = EdgeCurves::of_sides(slave_.mesh, poly_, edge_names(group_.slave, poly_.size()));
+    master_curves_ = EdgeCurves::of_sides(master_.mesh, master_poly_, edge_names(group_.master, master_poly_.size()));
     const size_t n_segments = n_ < 2 ? 0 : n_ - 1;
     for (size_t j = 0; j + 1 < Mx.size(); ++j) master_length_.push_back((Mx[j + 1] - Mx[j]).norm());
     arc_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n_));
@@ -335,14 +247,29 @@ class PairBuilder {
     on_segment_.assign(n_segments, {});
     for (const auto& s : segments_.segments) {
       on_segment_[static_cast<size_t>(s.slave)].push_back(&s);
-      d_.covered_length += (s.xi1 - s.xi0) * segments_.slave_length[static_cast<size_t>(s.slave)];
+      if (pair_of(s) == pair_index_)
+        d_.covered_length += (s.xi1 - s.xi0) * segments_.slave_length[static_cast<size_t>(s.slave)];
     }
+  }
+
+  // The pair of the group a mortar segment belongs to (by its slave and master edges), or -1.
+  int pair_of(const MortarSegment& s) const {
+    return group_.pair_of(group_.slave.edge_of_segment(static_cast<size_t>(s.slave)),
+                          group_.master.edge_of_segment(static_cast<size_t>(s.master)));
+  }
+
+  // The edge name of every segment of a chain's polyline of `points` positions.
+  static std::vector<std::string> edge_names(const Chain& chain, size_t points) {
+    std::vector<std::string> out;
+    for (size_t k = 0; k + 1 < points; ++k) out.push_back(chain.edges[chain.edge_of_segment(k)]);
+    return out;
   }
 
   // Multiplier segments (runs of slave segments between consecutive multiplier nodes), each with its dual basis
   // on its covered part, in the arc-length parameter s of the run.
   void dual_bases() {
-    d_.multiplier_nodes = on_segment_.empty() ? std::vector<size_t>{} : multiplier_partition(segments_, master_length_);
+    d_.multiplier_nodes = on_segment_.empty() ? std::vector<size_t>{}
+                                              : multiplier_partition(segments_, master_length_, group_.slave.start);
     n_runs_ = d_.multiplier_nodes.empty() ? 0 : d_.multiplier_nodes.size() - 1;
     basis_.assign(n_runs_, std::nullopt);
     for (size_t m = 0; m < n_runs_; ++m) {
@@ -363,7 +290,7 @@ class PairBuilder {
   void classify_nodes() {
     d_.status.assign(n_, NodeStatus::inner);
     const auto prescribed = prescribed_components(slave_);
-    const auto corners = slave_corners(problem_, pair_, d_.slave_nodes);
+    const auto corners = slave_corners(problem_, pair_, slave_.mesh.edge_set_nodes(pair_.slave_edge));
     for (size_t m = 0; m <= n_runs_ && n_runs_ > 0; ++m) {
       const size_t i = d_.multiplier_nodes[m];
       double support = 0, covered = 0;
@@ -403,6 +330,32 @@ class PairBuilder {
     const auto c = corners.find(poly_[i]);
     if (c == corners.end() || !c->second.friction || !(nu.norm() > 0)) return nullptr;
     return turns(Eigen::Vector2d(-nu.y(), nu.x()).normalized(), c->second.tangent) ? &c->second : nullptr;
+  }
+
+  // Which pair of the group carries each contact node's multiplier: of the pairs whose pieces touch the node (else
+  // whose pieces lie on its two segments), the first in the job's order. The others mark it carried elsewhere. On a
+  // closed chain the last position is the start again and takes the start's answer.
+  void assign_owners() {
+    if (group_.pairs.size() < 2) return;
+    const size_t n_segments = on_segment_.size();
+    for (size_t m = 0; m <= n_runs_ && n_runs_ > 0; ++m) {
+      const size_t i = d_.multiplier_nodes[m];
+      if (d_.status[i] != NodeStatus::contact || (closed_ && i + 1 == n_)) continue;
+      int touching = -1, near = -1;
+      auto consider = [](int& best, int pair) { best = best < 0 ? pair : std::min(best, pair); };
+      // The segments before and after node i (on a closed chain position 0 follows the closing segment).
+      const size_t before = i > 0 ? i - 1 : (closed_ ? n_segments - 1 : n_segments);
+      for (const auto& [k, end] : {std::pair{before, 1.0}, std::pair{i, 0.0}}) {
+        if (k >= n_segments) continue;
+        for (const auto* s : on_segment_[k]) {
+          consider(near, pair_of(*s));
+          if (std::abs((end == 0.0 ? s->xi0 : s->xi1) - end) < 1e-9) consider(touching, pair_of(*s));
+        }
+      }
+      const int owner = touching >= 0 ? touching : near;
+      if (owner != pair_index_) d_.status[i] = NodeStatus::other_pair;
+    }
+    if (closed_ && n_ > 0) d_.status[n_ - 1] = d_.status[0];
   }
 
   // One row per contact node; every slave node's value from the rows: a multiplier node's own; inside a run the
@@ -446,17 +399,53 @@ class PairBuilder {
     it->second += v;
   }
 
+  // A quadrature point of a mortar segment: the slave point x, the normal n the gap is measured along (and the
+  // pressure acts along), and the gap t to the master along n. Where neither side's segment has a curve, the
+  // chords' (x on the chord, n the chord's normal, t affine along the mortar segment: the arithmetic of the
+  // segment mesh, unchanged); else the curves' (edge_curves.hpp), the master's curve hit on the segment whose
+  // stretch the hit lies on (the mortar segment's, or a neighbour's where the normal leans across its end).
+  struct GapPoint {
+    Eigen::Vector2d x, normal;
+    double gap = 0.0;
+  };
+  GapPoint gap_point(const MortarSegment& s, size_t k, double u, double xi) const {
+    GapPoint p;
+    p.gap = s.gap0 + u * (s.gap1 - s.gap0);
+    const size_t j = static_cast<size_t>(s.master);
+    if (!slave_curves_.curved(k) && !master_curves_.curved(j)) {
+      p.x = S_[k] + xi * (S_[k + 1] - S_[k]);
+      p.normal = segments_.slave_normal[k];
+      return p;
+    }
+    const EdgeCurves::Frame f = slave_curves_.at(k, xi);
+    p.x = f.point;
+    p.normal = f.normal;
+    const size_t nm = master_curves_.segments();
+    const auto t = master_curves_.hit(j, p.x, p.normal);
+    if (!t) return p;  // the line misses the master's curve (grazing): the chords' gap
+    p.gap = *t;
+    const double eta = master_curves_.chord_parameter(j, p.x + *t * p.normal);
+    const bool before = eta < 0 && (j > 0 || master_closed_), after = eta > 1 && (j + 1 < nm || master_closed_);
+    if (!before && !after) return p;
+    const size_t other = before ? (j + nm - 1) % nm : (j + 1) % nm;
+    const auto t_other = master_curves_.hit(other, p.x, p.normal);
+    if (!t_other) return p;
+    const double eta_other = master_curves_.chord_parameter(other, p.x + *t_other * p.normal);
+    if (eta_other >= 0 && eta_other <= 1) p.gap = *t_other;
+    return p;
+  }
+
   // Integrals over every mortar segment of one run (three-point Gauss: the integrands are at most cubic in xi).
   void integrate_run(size_t m) {
     const size_t a = d_.multiplier_nodes[m], b_node = d_.multiplier_nodes[m + 1];
     const int r0 = d_.row_of_node[a], r1 = d_.row_of_node[b_node];
     if (r0 < 0 && r1 < 0) return;
+    // A node without a row drops its function into the other's, unless another pair of the group carries it.
     DualBasis b = *basis_[m];
-    if (r0 < 0) b = drop_node(b, 0);
-    if (r1 < 0) b = drop_node(b, 1);
+    if (r0 < 0 && d_.status[a] != NodeStatus::other_pair) b = drop_node(b, 0);
+    if (r1 < 0 && d_.status[b_node] != NodeStatus::other_pair) b = drop_node(b, 1);
     const double Lrun = arc(b_node) - arc(a);
     for (size_t k = a; k < b_node; ++k) {
-      const Eigen::Vector2d nk = segments_.slave_normal[k];
       const double L = segments_.slave_length[k];
       for (const auto* s : on_segment_[k]) {
         const int m0 = master_poly_[static_cast<size_t>(s->master)], m1 = master_poly_[static_cast<size_t>(s->master) + 1];
@@ -466,10 +455,10 @@ class PairBuilder {
           const double xi = s->xi0 + u * (s->xi1 - s->xi0);
           const double w = kGaussW[q] * (s->xi1 - s->xi0) * L * thickness_;
           const double eta = s->eta0 + u * (s->eta1 - s->eta0);
-          const double t = s->gap0 + u * (s->gap1 - s->gap0);
           const double sr = (arc(k) + xi * L - arc(a)) / Lrun;  // parameter along the run
-          const Eigen::Vector2d x = S_[k] + xi * (S_[k + 1] - S_[k]);
-          const double gap = (pair_.gap.geometric ? t : 0.0) + analytic_gap(pair_.gap, x);
+          const GapPoint p = gap_point(*s, k, u, xi);
+          const Eigen::Vector2d& n = p.normal;
+          const double gap = (pair_.gap.geometric ? p.gap : 0.0) + analytic_gap(pair_.gap, p.x);
           const double Ns[2] = {1 - xi, xi}, Nm[2] = {1 - eta, eta}, Nrun[2] = {1 - sr, sr};
           for (int i = 0; i < 2; ++i) {
             const int r = i == 0 ? r0 : r1;
@@ -478,11 +467,11 @@ class PairBuilder {
             d_.gap0[r] += w * phi * gap;
             d_.D[r] += w * phi * Nrun[i];
             d_.area[r] += w * phi;
-            nu_[static_cast<size_t>(r)] += w * phi * nk;
+            nu_[static_cast<size_t>(r)] += w * phi * n;
             for (int l = 0; l < 2; ++l) {
-              add(gs_, {r, poly_[k + static_cast<size_t>(l)]}, w * phi * Ns[l] * nk);
+              add(gs_, {r, poly_[k + static_cast<size_t>(l)]}, w * phi * Ns[l] * n);
               ss_[{r, poly_[k + static_cast<size_t>(l)]}] += w * phi * Ns[l];
-              add(gm_, {r, l == 0 ? m0 : m1}, w * phi * Nm[l] * nk);
+              add(gm_, {r, l == 0 ? m0 : m1}, w * phi * Nm[l] * n);
               mm_[{r, (s->master + l) % n_master}] += w * phi * Nm[l];
             }
           }
@@ -536,6 +525,38 @@ class PairBuilder {
     d_.node_from_rows.resize(n);
   }
 
+  // A pair whose group chains several slave edges: its own edge's stretch of the per-node results (positions
+  // first .. last of the chain), its arc lengths from its own first node.
+  void keep_own_edge() {
+    if (group_.slave.edges.size() < 2) return;
+    const size_t own = group_.slave.index(pair_.slave_edge);
+    const size_t first = group_.slave.start[own];
+    const size_t last = first + slave_.mesh.edge_set_nodes(pair_.slave_edge).size() - 1;  // on poly_
+    const auto from = static_cast<std::ptrdiff_t>(first), to = static_cast<std::ptrdiff_t>(last) + 1;
+    d_.slave_nodes.assign(poly_.begin() + from, poly_.begin() + to);
+    auto slice = [&](auto& v) { v = std::decay_t<decltype(v)>(v.begin() + from, v.begin() + to); };
+    if (d_.status.size() < n_) {  // close_loop() folded the start back: unfold for the slicing
+      d_.status.push_back(d_.status.front());
+      d_.row_of_node.push_back(d_.row_of_node.front());
+      d_.node_from_rows.push_back(d_.node_from_rows.front());
+    }
+    slice(d_.status);
+    slice(d_.row_of_node);
+    slice(d_.node_from_rows);
+    d_.node_arc = arc_.segment(from, to - from).array() - arc(first);
+    std::vector<size_t> multipliers;
+    for (size_t i : d_.multiplier_nodes)
+      if (i >= first && i <= last) multipliers.push_back(i - first);
+    d_.multiplier_nodes = multipliers;
+    d_.closed = false;
+    d_.loop_length = 0.0;
+    // A row at the chain's start belongs to an edge ending there when the chain closes (position n_ - 1 again).
+    for (int& i : d_.node_of_row) {
+      if (i < static_cast<int>(first)) i = static_cast<int>(n_) - 1;
+      i -= static_cast<int>(first);
+    }
+  }
+
   // Ts and Tm: the scalar mortar integrals of the slave and the master times the row's tangent.
   void tangential_operators() {
     VectorEntries ts, tm;
@@ -551,6 +572,8 @@ class PairBuilder {
   const Body& slave_;
   const Body& master_;
   const double thickness_;
+  const int pair_index_;
+  const PairGroup group_;  // the pairs sharing this pair's contact surface (itself alone, mostly)
   PairDiscretization d_;
   std::vector<int> poly_, master_poly_;  // the slave's and the master's nodes as polylines (polyline())
   bool closed_ = false;                  // the slave edge is a closed loop
@@ -559,6 +582,8 @@ class PairBuilder {
   std::set<size_t> tangential_dropped_;  // slave nodes whose friction row is dropped (slave_corners)
   size_t n_ = 0, n_runs_ = 0;
   SegmentMesh segments_;
+  EdgeCurves slave_curves_, master_curves_;  // the sides' true curves where the mesh knows them
+  bool master_closed_ = false;               // the master edge is a closed loop
   std::vector<double> master_length_;
   std::vector<std::vector<const MortarSegment*>> on_segment_;
   std::vector<std::optional<DualBasis>> basis_;

@@ -38,9 +38,10 @@ namespace contact::mortar {
 using SparseRows = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 
 // Whether a slave node carries a multiplier, and why not: not opposite the master, a crosspoint (its normal
-// displacement prescribed), barely covered by the master, or inside a multiplier segment (coarse-grained
-// multipliers: the slave is finer than the master there).
-enum class NodeStatus { contact = 0, uncovered = 1, crosspoint = 2, barely_covered = 3, inner = 4 };
+// displacement prescribed), barely covered by the master, inside a multiplier segment (coarse-grained
+// multipliers: the slave is finer than the master there), or carried by another pair of its group (pair_group.hpp:
+// the node lies opposite the other pair's master edge, or at the end its slave edge shares with the other's).
+enum class NodeStatus { contact = 0, uncovered = 1, crosspoint = 2, barely_covered = 3, inner = 4, other_pair = 5 };
 
 struct PairDiscretization {
   std::string name;
@@ -73,9 +74,10 @@ struct PairDiscretization {
   std::vector<Eigen::Vector2d> normal;  // unit normal of row r (direction of D_r nu_r): for reports
   SparseRows Gs;                    // rows x slave dofs
   SparseRows Gm;                    // rows x master dofs
-  std::vector<int> master_nodes;    // the master edge's nodes in order (a closed one's each once, from its start)
-  SparseRows M;                     // rows x master edge nodes (scalar mortar matrix, summed over segments)
-  double covered_length = 0.0;      // length of the slave edge opposite the master edge
+  std::vector<int> master_nodes;    // the master edge's nodes in order (a closed one's each once, from its start);
+                                    // in a group of pairs (pair_group.hpp) the group's master chain, all its edges
+  SparseRows M;                     // rows x master_nodes (scalar mortar matrix, summed over segments)
+  double covered_length = 0.0;      // length of the slave edge opposite the master edge (this pair's pieces)
 
   // Augmented-Lagrangian multipliers per row (empty: none). The pressure is then max(0, lambda - g / theta).
   Eigen::VectorXd multiplier;

@@ -112,7 +112,8 @@ struct PairField {
   Eigen::VectorXd pressure;      // the nodal multiplier z (exact) or max(0, lambda - normal_gap / theta)
   Eigen::VectorXd penetration;   // max(0, -normal_gap) (0 where no multiplier)
   Eigen::VectorXi active;        // 1 where the pressure is positive
-  Eigen::VectorXi status;        // 0 contact node, 1 not opposite the master, 2 crosspoint, 3 barely covered
+  Eigen::VectorXi status;        // 0 contact node, 1 not opposite the master, 2 crosspoint, 3 barely covered,
+                                 // 4 inside a multiplier segment, 5 carried by another pair of its group
   double force = 0.0;            // sum of weight x pressure: the total normal force (a scalar sum of normal
                                  // pressures: on a curved slave more than the load it carries)
   // The resultant contact force vector on the slave body (the master exerts it; the master receives its
