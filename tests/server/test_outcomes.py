@@ -14,6 +14,7 @@
 
 Standard library and Debian's python3-h5py; exits non-zero on any failure."""
 import json
+import math
 import os
 import subprocess
 import sys
@@ -39,7 +40,12 @@ def result_attributes(server, job_id):
             steps = h["history/steps"]
             names = [n.decode() if isinstance(n, bytes) else str(n) for n in steps.attrs["pair_names"]]
             forces = dict(zip(names, steps["force"][-1])) if len(steps["force"]) else {}
-            return {"converged": h.attrs["converged"], "stop_reason": h.attrs["stop_reason"], "forces": forces}
+            # solve.cpp's scale of a pulling force (tensile_pairs): the largest sum of |weight x pressure| of a pair
+            last = h["steps"][str(len(h["steps"]) - 1)]["contacts"] if len(h["steps"]) else {}
+            scale = max([sum(abs(w * q) for w, q in zip(c["weight"][()], c["pressure"][()]) if math.isfinite(w * q))
+                         for c in last.values()] or [0.0])
+            return {"converged": h.attrs["converged"], "stop_reason": h.attrs["stop_reason"], "forces": forces,
+                    "scale": scale}
 
 
 def ends_failed_not_converged(server, job_id, what, reason):
@@ -110,7 +116,9 @@ with Server(args=["--workers", "1"]) as server:
     if final.get("stop_reason") in ("max_iterations", "stagnation"):
         ends_failed_not_converged(server, job_id, "roller on a frictionless base", final["stop_reason"])
     attrs = result_attributes(server, job_id) if final.get("result_available") else None
-    pulling = [name for name, force in (attrs or {}).get("forces", {}).items() if force < 0]
+    # Pulling beyond rounding (solve.cpp's rule): on the curve's own geometry the roller's top contact ends at
+    # -0.0016 against 164,000, a contact that carries nothing.
+    pulling = [name for name, force in (attrs or {}).get("forces", {}).items() if force < -1e-6 * attrs["scale"]]
     check("roller on a frictionless base: each pulling contact is said to be no answer",
           all(f"'{name}' (force " in message for name in pulling)
           and (not pulling or "the last iterate is not an answer: contact '" in message), (attrs, message[:400]))
