@@ -409,7 +409,7 @@ void converge_then_refine(Problem& working, ddm::ContactSystem& system, ddm::Run
       return finish(cancelled_here + std::to_string(step) + " (the result holds that step's solution)");
     }
     const PressureEstimate pe =
-        pressure_estimate(system, o.u, o.z.empty() ? system.penalty_pressures(o.u) : o.z, eta);
+        pressure_estimate(system, o.u, o.z.empty() ? system.penalty_pressures(o.u) : o.z, eta, frame.stop_check());
     report.pressure_estimate = pe.relative;
     if (!o.converged) return finish("");
     if (const std::string stop = stop_after_estimate(s, report, pe, step, o.message); !stop.empty())

@@ -63,17 +63,19 @@ class Compliance {
   Pressures free_gaps_;
 };
 
-// G dz = rhs on the active rows by conjugate gradients (D-weighted); returns the iterations, -1 if not converged.
+// G dz = rhs on the active rows by conjugate gradients (D-weighted); returns the iterations, -1 if not converged,
+// -2 if stopped.
 int solve_correction(const ddm::ContactSystem& system, const std::vector<std::vector<char>>& active,
-                     const Pressures& rhs, Pressures& dz) {
+                     const Pressures& rhs, Pressures& dz, const std::function<bool()>& stop) {
   const Compliance G(system, active);
   dz = rhs;
   for (auto& v : dz) v.setZero();
   Pressures r = rhs, p = rhs;
   double rr = dot(system, active, r, r);
-  const double stop = kTolerance * kTolerance * rr;
+  const double small = kTolerance * kTolerance * rr;
   if (rr == 0.0) return 0;
   for (int it = 1; it <= kMaxIterations; ++it) {
+    if (stop && stop()) return -2;
     const Pressures Gp = G.apply(p);
     const double pGp = dot(system, active, p, Gp);
     if (!(pGp > 0.0)) return -1;  // not positive on the active rows (a body free to move along them)
@@ -81,7 +83,7 @@ int solve_correction(const ddm::ContactSystem& system, const std::vector<std::ve
     axpy(alpha, p, dz);
     axpy(-alpha, Gp, r);
     const double rr_new = dot(system, active, r, r);
-    if (rr_new <= stop) return it;
+    if (rr_new <= small) return it;
     for (size_t k = 0; k < p.size(); ++k) p[k] = r[k] + (rr_new / rr) * p[k];
     rr = rr_new;
   }
@@ -168,7 +170,8 @@ double edge_error2(const mortar::PairDiscretization& pair, const Eigen::VectorXd
 }  // namespace
 
 PressureEstimate pressure_estimate(const ddm::ContactSystem& system, const ddm::Displacements& u,
-                                   const Pressures& z, const std::vector<IndicatorResult>& eta) {
+                                   const Pressures& z, const std::vector<IndicatorResult>& eta,
+                                   const std::function<bool()>& stop) {
   PressureEstimate out;
   ddm::Displacements ub = u;
   int replaced = 0;
@@ -194,10 +197,11 @@ PressureEstimate pressure_estimate(const ddm::ContactSystem& system, const ddm::
       if (!active[k][static_cast<size_t>(r)]) rhs[k][r] = 0.0;
   }
   Pressures dz;
-  out.iterations = solve_correction(system, active, rhs, dz);
+  out.iterations = solve_correction(system, active, rhs, dz, stop);
   if (out.iterations < 0) {
     out.relative = std::nan("");
-    out.note = "no pressure estimate: the correction's conjugate gradients did not converge";
+    out.note = out.iterations == -2 ? "no pressure estimate: cancelled"
+                                    : "no pressure estimate: the correction's conjugate gradients did not converge";
     out.iterations = kMaxIterations;
     return out;
   }

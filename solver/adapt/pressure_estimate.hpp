@@ -14,6 +14,7 @@
 #include "../ddm/contact_system.hpp"
 #include "indicator.hpp"
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -29,7 +30,9 @@ struct PressureEstimate {
 
 // z: the pressures the solve reached (per pair, per row); eta: the estimate's per-body results (bodies without
 // bem_displacement keep their FE displacements: they are not estimated).
+// `stop` is polled before each conjugate-gradient iteration (one solve per body): true ends it, the estimate NaN.
 PressureEstimate pressure_estimate(const ddm::ContactSystem& system, const ddm::Displacements& u,
-                                   const ddm::Pressures& z, const std::vector<IndicatorResult>& eta);
+                                   const ddm::Pressures& z, const std::vector<IndicatorResult>& eta,
+                                   const std::function<bool()>& stop = {});
 
 }  // namespace contact::adapt
