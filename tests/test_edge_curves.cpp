@@ -217,3 +217,62 @@ TEST(FittedArcs, AGmshEllipseGetsThemOnEverySideAndRefinementPutsItsNewNodesOnTh
   ASSERT_EQ(refined.size(), 49u);
   for (int n : refined) EXPECT_LE(distance(s.mesh.nodes[static_cast<size_t>(n)]), arc_worst + 1e-12) << n;
 }
+
+TEST(FittedArcs, CornersSplitAChainSoNoArcRoundsACornerOffAndStraightPiecesKeepTheirChords) {
+  // An L of straight sides (an explicit edge round two sides of a punch): one corner, no arc anywhere, so a flat
+  // edge computes exactly what it did.
+  const std::vector<mesh::Point> l = {{0, 0}, {1, 0}, {2, 0}, {2, 1}, {2, 2}};
+  EXPECT_EQ(mesh::chain_corners(l, false), (std::vector<bool>{false, false, true, false, false}));
+  for (const auto& a : mesh::fitted_arcs(l, false)) EXPECT_FALSE(a.has_value());
+  // A quarter circle of radius 2 in 8 sides (11.25 degrees each) from (2, 0) to (0, 2), then straight down the y
+  // axis to the centre: the corner at (0, 2) turns through 84.4 degrees. The arc's sides get the circle itself
+  // (every triple on it, the piece's ends one-sided), the straight ones none.
+  const double pi = 3.14159265358979323846;
+  std::vector<mesh::Point> d;
+  for (int j = 0; j <= 8; ++j) d.emplace_back(2 * std::cos(0.5 * pi * j / 8), 2 * std::sin(0.5 * pi * j / 8));
+  d.emplace_back(0, 1);
+  d.emplace_back(0, 0);
+  const auto corners = mesh::chain_corners(d, false);
+  for (size_t i = 0; i < d.size(); ++i) EXPECT_EQ(corners[i], i == 8) << i;
+  const auto arcs = mesh::fitted_arcs(d, false);
+  ASSERT_EQ(arcs.size(), 10u);
+  for (size_t k = 0; k < 8; ++k) {
+    ASSERT_TRUE(arcs[k].has_value()) << k;
+    EXPECT_NEAR(arcs[k]->radius, 2.0, 1e-12) << k;
+    EXPECT_NEAR(arcs[k]->center.norm(), 0.0, 1e-12) << k;
+  }
+  EXPECT_FALSE(arcs[8].has_value());
+  EXPECT_FALSE(arcs[9].has_value());
+  // Closed: the same piece closed back to (2, 0) has corners at (0, 2), the centre... (0, 0) turns 90 degrees
+  // too, and (2, 0) 95.6: three corners, the arc's sides fitted as before.
+  const auto closed = mesh::fitted_arcs(d, true);
+  ASSERT_EQ(closed.size(), 11u);
+  for (size_t k = 0; k < 8; ++k) ASSERT_TRUE(closed[k].has_value() && std::abs(closed[k]->radius - 2) < 1e-12) << k;
+  for (size_t k = 8; k < 11; ++k) EXPECT_FALSE(closed[k].has_value()) << k;
+}
+
+TEST(FittedArcs, ASmoothCurveHasNoCornersEvenCoarseOrGradedButAKinkInItIsOne) {
+  const double pi = 3.14159265358979323846;
+  // A 12-gon (30 degrees at every node) and a circle graded by 1.5 from side to side: no corner.
+  std::vector<mesh::Point> twelve, graded;
+  for (int j = 0; j < 12; ++j) twelve.emplace_back(std::cos(pi * j / 6), std::sin(pi * j / 6));
+  double t = 0, step = 0.02;
+  for (int j = 0; j < 8; ++j, t += step, step *= 1.5) graded.emplace_back(std::cos(t), std::sin(t));
+  for (bool c : mesh::chain_corners(twelve, true)) EXPECT_FALSE(c);
+  for (bool c : mesh::chain_corners(graded, false)) EXPECT_FALSE(c);
+  // Two straight lines meeting at 10 degrees, and the same kink in the middle of a circle's chain (the circle
+  // turning 2 degrees per node): each a corner.
+  const std::vector<mesh::Point> kink = {{-2, 0}, {-1, 0}, {0, 0}, {std::cos(pi / 18), std::sin(pi / 18)},
+                                         {2 * std::cos(pi / 18), 2 * std::sin(pi / 18)}};
+  EXPECT_EQ(mesh::chain_corners(kink, false), (std::vector<bool>{false, false, true, false, false}));
+  std::vector<mesh::Point> bent;
+  double angle = 0;
+  mesh::Point x(0, 0);
+  for (int j = 0; j < 9; ++j) {
+    bent.push_back(x);
+    angle += (j == 4 ? 12.0 : 2.0) * pi / 180;
+    x += mesh::Point(std::cos(angle), std::sin(angle));
+  }
+  const auto corners = mesh::chain_corners(bent, false);
+  for (size_t i = 0; i < bent.size(); ++i) EXPECT_EQ(corners[i], i == 4) << i;
+}

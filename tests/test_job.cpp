@@ -382,6 +382,17 @@ std::vector<BadJob> bad_jobs() {
        {replace("/bodies/0/mesh/edges/base", {{0, 1}, {1, 4}}),  // 1-4 is shared by both quads
         replace("/contacts/0/slave", "upper.cap")},
        "/bodies/0/mesh/edges/base", "interior side"},
+      {"ExplicitCurveOfAnUnknownEdgeListsTheMeshsEdges", upper_explicit,
+       {add("/bodies/0/mesh/curves", {{"bse", "chords"}})},
+       "/bodies/0/mesh/curves/bse", "'bse' is not an edge of this mesh; its edges are base, cap, side and wall"},
+      {"ExplicitCurveOfAnUnknownKindNamesTheFourKinds", upper_explicit,
+       {add("/bodies/0/mesh/curves", {{"base", "smooth"}})},
+       "/bodies/0/mesh/curves/base", "unknown curve \"smooth\": give \"fitted\""},
+      {"ExplicitArcOffTheEdgesNodesNamesTheSide", upper_explicit,
+       {add("/bodies/0/mesh/curves", {{"cap", {{"arc", {{"center", {1, -5}}, {"radius", 6}}}}}})},
+       "/bodies/0/mesh/curves/cap/arc", "edge 'cap': side [5, 4]: the edge's end corners are at distances"},
+      {"ExplicitCurvesMustBeAnObject", upper_explicit, {add("/bodies/0/mesh/curves", "fitted")},
+       "/bodies/0/mesh/curves", "curves must be an object"},
 
       // Boundary conditions.
       {"UnknownEdgeInBoundaryListsTheEdgesTheBodyHas", small_job, {replace("/bodies/1/boundary/1/edge", "botom")},

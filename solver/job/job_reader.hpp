@@ -18,6 +18,7 @@
 #include <cstddef>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -64,6 +65,8 @@ struct MeshInput {
   std::vector<mesh::Cell> quads;
   std::vector<std::pair<std::string, std::vector<std::array<int, 2>>>> edge_pairs;
   std::map<std::string, int> vertices;  // named vertices of an explicit mesh: name -> node
+  std::map<std::string, mesh::Curve> edge_curves;  // "curves" given as an arc or a parabola, by edge
+  std::set<std::string> chord_edges;               // "curves" given as "chords"
   // gmsh: the surface's mesh, built while reading (gmsh_input.hpp)
   std::optional<GmshBody> gmsh;
 };
@@ -153,7 +156,10 @@ class JobReader {
   void fit_block_curves(MeshInput& m);
   void read_gmsh(const json& value, const std::string& pointer, MeshInput& m, json& out);
   std::optional<long long> read_count(const json& value, const std::string& pointer, const std::string& what);
-  void read_curve(const json& value, const std::string& pointer, const std::string& edge, MeshInput& m);
+  std::optional<mesh::Curve> read_curve(const json& value, const std::string& pointer, const std::string& edge,
+                                        MeshInput& m);
+  void read_edge_curves(const Fields& f, MeshInput& m, json& out);
+  void fit_explicit_curves(const MeshInput& m, const std::string& pointer, mesh::Mesh& mesh);
   void read_arrays(const json& value, const std::string& pointer, MeshInput& m, json& out);
   size_t read_nodes(const json& nodes, const std::string& pointer, MeshInput& m);
   void read_quads(const json& quads, const std::string& pointer, const NodeIndex& index, MeshInput& m);

@@ -2,6 +2,8 @@
 // surface (gmsh_input.hpp). Read in phase 1 (sizes and edge names known), built and checked in phase 3.
 #include "job_reader.hpp"
 
+#include "mesh/curve_fit.hpp"
+
 #include <algorithm>
 #include <array>
 #include <limits>
@@ -52,7 +54,7 @@ void JobReader::read_mesh(const json& value, const std::string& pointer, MeshInp
   const bool arrays =
       value.contains("nodes") || value.contains("quads") || value.contains("edges") || value.contains("vertices");
   if (block == arrays) {
-    Fields f(value, pointer, "mesh", {"block", "nodes", "quads", "edges", "vertices"}, errors_);
+    Fields f(value, pointer, "mesh", {"block", "nodes", "quads", "edges", "vertices", "curves"}, errors_);
     errors_.add(pointer, block ? "give either a block or explicit nodes and quads, not both"
                                : "give either {\"block\": {...}} or explicit \"nodes\" and \"quads\"");
     return;
@@ -80,7 +82,8 @@ void JobReader::read_block(const json& value, const std::string& pointer, MeshIn
   if (const json* e = f.find("edges")) {
     Fields edges(*e, f.at("edges"), "block edges", {"bottom", "right", "top", "left"}, errors_);
     for (const char* name : kBlockEdges)
-      if (const json* c = edges.find(name)) read_curve(*c, edges.at(name), name, m);
+      if (const json* c = edges.find(name))
+        if (auto curve = read_curve(*c, edges.at(name), name, m)) m.block.curves[name] = *curve;
   }
   if (const json* g = f.find("grading")) read_block_grading(*g, f.at("grading"), m.block);
   if (corners_ok) fit_block_curves(m);
@@ -203,12 +206,13 @@ std::optional<long long> JobReader::read_count(const json& value, const std::str
   return n;
 }
 
-void JobReader::read_curve(const json& value, const std::string& pointer, const std::string& edge, MeshInput& m) {
+std::optional<mesh::Curve> JobReader::read_curve(const json& value, const std::string& pointer,
+                                                 const std::string& edge, MeshInput& m) {
   Fields f(value, pointer, "the curve of edge " + edge, {"parabola", "arc"}, errors_);
-  if (!f.ok()) return;
+  if (!f.ok()) return std::nullopt;
   if (f.has("parabola") == f.has("arc")) {
     errors_.add(pointer, "give exactly one of parabola {\"a\": ...} or arc {\"center\": [x, y], \"radius\": R}");
-    return;
+    return std::nullopt;
   }
   mesh::Curve curve;
   if (const json* p = f.find("parabola")) {
@@ -216,9 +220,9 @@ void JobReader::read_curve(const json& value, const std::string& pointer, const 
     m.curve_pointers[edge] = f.at("parabola");
     curve.kind = mesh::Curve::Kind::parabola;
     const json* a = pf.require("a", "the coefficient a of y = a x^2 + b x + c (b and c follow from the corners)");
-    if (!a) return;
+    if (!a) return std::nullopt;
     auto x = read::number(*a, pf.at("a"), "a", errors_);
-    if (!x) return;
+    if (!x) return std::nullopt;
     curve.a = *x;
   } else {
     const json* arc = f.find("arc");
@@ -227,14 +231,14 @@ void JobReader::read_curve(const json& value, const std::string& pointer, const 
     curve.kind = mesh::Curve::Kind::arc;
     const json* c = af.require("center", "the circle's centre [x, y]");
     const json* r = af.require("radius", "the circle's radius, a positive number");
-    if (!c || !r) return;
+    if (!c || !r) return std::nullopt;
     auto centre = read::pair(*c, af.at("center"), "center", errors_);
     auto radius = positive(*r, af.at("radius"), "radius", errors_);
-    if (!centre || !radius) return;
+    if (!centre || !radius) return std::nullopt;
     curve.center = *centre;
     curve.radius = *radius;
   }
-  m.block.curves[edge] = curve;
+  return curve;
 }
 
 // A side listed twice in one edge set (in either direction) would carry its load twice: an error at the
@@ -303,7 +307,7 @@ std::optional<int> NodeIndex::operator()(const json& v, const std::string& ptr, 
 void JobReader::read_arrays(const json& value, const std::string& pointer, MeshInput& m, json& out) {
   m.kind = MeshInput::Kind::arrays;
   const size_t before = errors_.size();
-  Fields f(value, pointer, "mesh", {"nodes", "quads", "edges", "vertices"}, errors_);
+  Fields f(value, pointer, "mesh", {"nodes", "quads", "edges", "vertices", "curves"}, errors_);
   const json* nodes = f.require("nodes", "an array of points [[x, y], ...], or use {\"block\": {...}}");
   const json* quads = f.require("quads", "an array of quads [[i, j, k, l], ...] (node indices, counter-clockwise)");
   const size_t before_nodes = errors_.size();
@@ -314,6 +318,7 @@ void JobReader::read_arrays(const json& value, const std::string& pointer, MeshI
   if (quads && nodes_ok) read_quads(*quads, f.at("quads"), index, m);
   read_named_edges(f, nodes_ok, index, m, out);
   read_named_vertices(f, nodes_ok, index, m, out);
+  read_edge_curves(f, m, out);
   m.valid = errors_.size() == before && nodes_ok && !m.quads.empty();
 }
 
@@ -386,6 +391,42 @@ void JobReader::read_named_edges(const Fields& f, bool nodes_ok, const NodeIndex
     read_edge_set(item.key(), item.value(), child(f.at("edges"), item.key()), nodes_ok, index, m);
 }
 
+// An explicit mesh's "curves" {"edge": "fitted" | "chords" | {"arc": {...}} | {"parabola": {...}}}: the geometry
+// its contacts measure gaps and normals on and refinement puts new boundary nodes on (docs/job-format.md). An
+// edge not listed is "fitted" (mesh/curve_fit.hpp), and the normalized job says so.
+void JobReader::read_edge_curves(const Fields& f, MeshInput& m, json& out) {
+  const json* c = f.find("curves");
+  if (c && !c->is_object()) {
+    errors_.add(f.at("curves"), "curves must be an object {\"edge\": \"fitted\" | \"chords\" | {\"arc\": ...} | "
+                                "{\"parabola\": ...}}, got " + read::type_name(*c));
+    return;
+  }
+  json& normalized = sub_object(out, "curves");
+  if (c)
+    for (const auto& item : c->items()) {
+      const std::string pointer = child(f.at("curves"), item.key());
+      if (!has_edge(m, item.key())) {
+        errors_.add(pointer, "'" + item.key() + "' is not an edge of this mesh" +
+                                 (m.edge_names.empty() ? std::string(" (it names no edges)")
+                                                       : "; its edges are " + join_names(m.edge_names)));
+        continue;
+      }
+      const json& v = item.value();
+      if (v.is_string()) {
+        const std::string how = v.get<std::string>();
+        if (how == "chords") m.chord_edges.insert(item.key());
+        else if (how != "fitted")
+          errors_.add(pointer, "unknown curve \"" + how + "\": give \"fitted\" (a smooth curve through the edge's nodes), "
+                               "\"chords\" (the straight sides as they are), {\"arc\": {\"center\": [x, y], \"radius\": R}} "
+                               "or {\"parabola\": {\"a\": a}}");
+      } else if (auto curve = read_curve(v, pointer, item.key(), m)) {
+        m.edge_curves[item.key()] = *curve;
+      }
+    }
+  for (const auto& name : m.edge_names)
+    if (!normalized.contains(name)) normalized[name] = "fitted";
+}
+
 // An explicit mesh's named vertices {"name": node index}: where point loads and point supports go (default: none).
 void JobReader::read_named_vertices(const Fields& f, bool nodes_ok, const NodeIndex& index, MeshInput& m, json& out) {
   const json* v = f.find("vertices");
@@ -426,6 +467,7 @@ void JobReader::build_mesh(BodyInput& in) {
       for (const auto& [name, pairs] : m.edge_pairs)
         if (auto message = mesh::add_edge_set(mesh, name, pairs))
           errors_.add(child(child(mp, "edges"), name), "edge '" + name + "': " + *message);
+    fit_explicit_curves(m, mp, mesh);
     mesh.vertices = std::move(m.vertices);
     check_arrays(mesh, mp);
   }
@@ -435,6 +477,20 @@ void JobReader::build_mesh(BodyInput& in) {
   for (size_t k = 0; k < std::min(problems.size(), kShown); ++k) errors_.add(mp, problems[k]);
   if (problems.size() > kShown)
     errors_.add(mp, "and " + std::to_string(problems.size() - kShown) + " more cells with the same kinds of problem");
+}
+
+// Explicit meshes: each named edge's geometry, as its "curves" entry says (read_edge_curves).
+void JobReader::fit_explicit_curves(const MeshInput& m, const std::string& pointer, mesh::Mesh& mesh) {
+  for (const auto& [name, sides] : mesh.edge_sets) {
+    if (m.chord_edges.count(name)) continue;
+    const auto given = m.edge_curves.find(name);
+    if (given == m.edge_curves.end()) {
+      mesh::fit_edge_curves(mesh, name);
+    } else if (auto message = mesh::set_edge_curve(mesh, name, given->second)) {
+      errors_.add(m.curve_pointers.count(name) ? m.curve_pointers.at(name) : child(child(pointer, "curves"), name),
+                  "edge '" + name + "': " + *message);
+    }
+  }
 }
 
 // Explicit meshes only (a block is one piece by construction): every node belongs to a quad, and the quads

@@ -8,8 +8,10 @@
 // the distance along it to the master's curve. Two discretisations of one circle then see the same circle, however
 // each cuts it, instead of two polygons whose sags h^2 / (8 R) differ.
 //
-// A segment without a curve (a straight edge, or an edge given only by its nodes: an explicit mesh, a Gmsh curve
-// that is not a circle) keeps its chord, and the pair takes exactly the chord-based arithmetic there (pair.cpp).
+// Where the mesh knows only the nodes (an explicit mesh's edges, a Gmsh spline), mesh/curve_fit.hpp gives the
+// sides fitted arcs as their side curves. A segment without a curve (a straight edge, an explicit edge given
+// "chords", a mesh built in code) keeps its chord, and the pair takes exactly the chord-based arithmetic there
+// (pair.cpp).
 #pragma once
 
 #include "contact/mesh.hpp"
