@@ -252,6 +252,35 @@ TEST(JobExplicitMesh, ArraysBecomeAMeshWithOrderedEdgeSetsAndConditions) {
   EXPECT_EQ(r.problem->contacts[0].slave_edge, "base");
 }
 
+TEST(JobExplicitMesh, StraightEdgesAndCornersGetNoCurveSoAFlatExplicitMeshIsItsChords) {
+  // Every edge fitted by default (mesh.curves): straight runs keep their chords, and an edge round the whole
+  // outline (a closed loop with four corners) is fitted piecewise between them, so no side of a flat mesh gets
+  // an arc and it computes what it did before the fit existed.
+  json job = small_job();
+  job["bodies"][0]["mesh"] = explicit_mesh();
+  job["bodies"][0]["mesh"]["edges"]["outline"] = json::parse("[[0, 1], [1, 2], [2, 5], [5, 4], [4, 3], [3, 0]]");
+  job["bodies"][0]["boundary"] = {{{"edge", "wall"}, {"displacement", {{"x", 0}, {"y", 0}}}}};
+  job["contacts"][0]["slave"] = "upper.base";
+  const ParseResult r = parse(job);
+  ASSERT_TRUE(r.ok()) << listing(r);
+  const auto& mesh = r.problem->bodies[0].mesh;
+  EXPECT_TRUE(mesh.edge_set_closed("outline"));
+  EXPECT_TRUE(mesh.side_curves.empty());
+  EXPECT_EQ(r.problem->normalized["bodies"][0]["mesh"]["curves"],
+            json({{"base", "fitted"}, {"cap", "fitted"}, {"outline", "fitted"}, {"side", "fitted"}, {"wall", "fitted"}}));
+  // A curve given for an edge is set on each of its sides, b and c from each side's ends: "cap" (nodes 5, 4, 3,
+  // all at y = 1) as the parabola of a = 0 is y = 1 on both its sides.
+  job["bodies"][0]["mesh"]["curves"] = {{"cap", {{"parabola", {{"a", 0.0}}}}}};
+  const ParseResult p = parse(job);
+  ASSERT_TRUE(p.ok()) << listing(p);
+  EXPECT_EQ(p.problem->bodies[0].mesh.side_curves.size(), 2u);
+  for (const auto& [side, curve] : p.problem->bodies[0].mesh.side_curves) {
+    EXPECT_EQ(curve.kind, mesh::Curve::Kind::parabola);
+    EXPECT_DOUBLE_EQ(curve.b, 0.0);
+    EXPECT_DOUBLE_EQ(curve.c, 1.0);
+  }
+}
+
 TEST(JobRobustness, NonObjectDocumentsAreErrorsNotExceptions) {
   for (const json& doc : {json(nullptr), json(3), json("job"), json::array()}) {
     const ParseResult r = parse(doc);
