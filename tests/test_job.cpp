@@ -275,7 +275,7 @@ TEST(JobExplicitMesh, StraightEdgesAndCornersGetNoCurveSoAFlatExplicitMeshIsItsC
   ASSERT_TRUE(p.ok()) << listing(p);
   EXPECT_EQ(p.problem->bodies[0].mesh.side_curves.size(), 2u);
   for (const auto& [side, curve] : p.problem->bodies[0].mesh.side_curves) {
-    EXPECT_EQ(curve.kind, mesh::Curve::Kind::parabola);
+    EXPECT_EQ(curve.kind, contact::mesh::Curve::Kind::parabola);
     EXPECT_DOUBLE_EQ(curve.b, 0.0);
     EXPECT_DOUBLE_EQ(curve.c, 1.0);
   }
