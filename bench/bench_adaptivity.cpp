@@ -12,10 +12,12 @@
 // its error against the finer reference
 // (log-log interpolation between the two measured uniform meshes around it; ">N" below the finest measured) and
 // their ratio; then, per run, the measured ratio at 0.5 % (the reference): the unknowns of the first
-// uniform mesh at or below 0.5 % over those of the first adaptive step at or below 0.5 %.
+// uniform mesh at or below 0.5 % over those of the first adaptive step at or below 0.5 %. Then Cattaneo-Mindlin
+// (cattaneo_mindlin_runs) and, without --quick, two cylinders (two_cylinder_runs).
 #include "contact/job.hpp"
 #include "contact/solve.hpp"
 #include "bench_support.hpp"
+#include "../tests/cattaneo_mindlin.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -231,6 +233,51 @@ void two_cylinder_runs() {
   }
 }
 
+// Cattaneo-Mindlin (tests/cattaneo_mindlin.hpp: R 60, mu 0.3, Q / (mu P) = 0.5) adaptive from 20 x 4 uniform cells
+// per body, with the defaults and with grading 0.5: every step's pressure error against Hertz at its own force,
+// the pressure estimate and its effectivity, c / a against sqrt(1 - Q / (mu P)) and the tangential traction's
+// error against Mindlin's; then meshes graded towards the contact, the smallest found to meet c / a within 0.03
+// and the traction within 5 % (400 x 12) and a finer one (650 x 20).
+void cattaneo_mindlin_runs() {
+  const double Q = 0.5 * 0.3 * 2194.0;
+  auto meets = [](const testing::MindlinFit& f) {
+    return std::abs(f.c_over_a - f.theory) <= 0.03 && f.traction_error < 0.05;
+  };
+  for (const auto& [label, adaptivity] : std::vector<std::pair<const char*, json>>{
+           {"defaults", json::object()}, {"grading 0.5", {{"grading", 0.5}}}}) {
+    json job = testing::cattaneo_mesh(20, 4, false, Q);
+    job["adaptivity"] = adaptivity;
+    job["output"] = {{"steps", "all"}};
+    Estimates estimates;
+    const double t0 = now();
+    const Result r = run(job, &estimates);
+    const double wall = now() - t0;
+    std::printf("\nCattaneo-Mindlin, %s: wall %.1f s (%.2f s a step)\n", label, wall,
+                wall / static_cast<double>(r.steps.size()));
+    std::printf("  %4s %9s %10s %10s %6s %8s %8s %9s %s\n", "step", "unknowns", "p err", "estimate", "effect", "c/a",
+                "theory", "t err", "");
+    for (size_t k = 0; k < r.steps.size(); ++k) {
+      const PairField& p = r.steps[k].pairs.at(0);
+      const testing::MindlinFit fit = testing::mindlin_fit(p, Q);
+      const double error = testing::hertz_pressure_error(p);
+      const double estimate = k < estimates.pressure.size() ? estimates.pressure[k] : std::nan("");
+      std::printf("  %4zu %9ld %9.3f%% %9.3f%% %6.2f %8.4f %8.4f %8.2f%% %s\n", k, total_dofs(r, r.steps[k].iteration),
+                  100 * error, 100 * estimate, estimate / error, fit.c_over_a, fit.theory, 100 * fit.traction_error,
+                  meets(fit) ? "meets" : "");
+    }
+    std::printf("  stop: %s\n", r.message.c_str());
+  }
+  std::printf("\nCattaneo-Mindlin, meshes graded towards the contact (grading 60)\n");
+  for (const auto& [nx, ny] : {std::pair{400, 12}, std::pair{650, 20}}) {
+    const double t0 = now();
+    const Result r = run(testing::cattaneo_mesh(nx, ny, true, Q));
+    const testing::MindlinFit fit = testing::mindlin_fit(r.steps.back().pairs.at(0), Q);
+    std::printf("  %3d x %-3d %9ld unknowns, %.1f s: p err %.3f%%, c/a %.4f (theory %.4f), t err %.2f%% %s\n", nx, ny,
+                total_dofs(r, r.iterations), now() - t0, 100 * testing::hertz_pressure_error(r.steps.back().pairs.at(0)),
+                fit.c_over_a, fit.theory, 100 * fit.traction_error, meets(fit) ? "meets" : "");
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -289,6 +336,7 @@ int main(int argc, char** argv) {
     std::snprintf(label, sizeof label, "FEM-BEM, target_error %.1f %%", 100 * target);
     adaptive_run(label, {{"target_error", target}}, refs);
   }
+  cattaneo_mindlin_runs();
   if (!quick) two_cylinder_runs();  // (minutes: the reference alone reaches ~400k unknowns)
   return 0;
 }

@@ -5,6 +5,7 @@
 #include "contact/job.hpp"
 #include "contact/solve.hpp"
 #include "adaptive_support.hpp"
+#include "cattaneo_mindlin.hpp"
 #include "support.hpp"
 
 #include <gtest/gtest.h>
@@ -31,80 +32,9 @@ double relative(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   return scale > 0 ? (a - b).norm() / scale : 0.0;
 }
 
-// A cylinder (radius R = 60, arc from x = -30 to 30) on a block of the same material, both 60 wide and 30 deep,
-// mirror images as nearly as a cylinder and a block can be, so that pressing them together makes no tangential
-// traction (a half-space pair of one material does not slip under normal load; bodies of different shapes
-// would). The cylinder's top is held at y = -0.05 (its rotation too); the tangential load is two point loads at
-// its top corners, scaled per step by their history. The block's slave nodes (spacing 0.046) are as coarse as
-// the cylinder's (0.041), so that every slave node carries a multiplier.
-json cattaneo_job(const std::vector<double>& tangential) {
-  const double y0 = 60 - std::sqrt(3600.0 - 900.0);
-  json job = json::parse(R"({
-    "name": "cattaneo",
-    "bodies": [
-      {"name": "block", "material": {"E": 2.1e5, "nu": 0.3},
-       "mesh": {"block": {"corners": [[-30, -30], [30, -30], [30, 0], [-30, 0]], "nx": 1300, "ny": 40,
-                          "grading": {"top": 60}}},
-       "boundary": [{"edge": "bottom", "displacement": {"y": 0}}, {"vertex": "bottom_left", "displacement": {"x": 0}}]},
-      {"name": "cylinder", "material": {"E": 2.1e5, "nu": 0.3},
-       "mesh": {"block": {"nx": 1500, "ny": 40, "edges": {"bottom": {"arc": {"center": [0, 60], "radius": 60}}},
-                          "grading": {"bottom": 60}}},
-       "boundary": [{"edge": "top", "displacement": {"y": -0.05}},
-                    {"vertex": "top_left", "force": [0.5, 0]}, {"vertex": "top_right", "force": [0.5, 0]}]}
-    ],
-    "contacts": [{"slave": "block.top", "master": "cylinder.bottom", "friction": {"coefficient": 0.3}}]
-  })");
-  job["bodies"][1]["mesh"]["block"]["corners"] = {{-30, y0}, {30, y0}, {30, 30}, {-30, 30}};
-  job["loading"] = {{"factors", std::vector<double>(tangential.size(), 1.0)}};
-  job["bodies"][1]["boundary"][1]["history"] = tangential;
-  job["bodies"][1]["boundary"][2]["history"] = tangential;
-  return job;
-}
-
-// Half the length of the stick zone: from the middle of the last sticking and the first slipping node on each side.
-double stick_half_width(const PairField& p) {
-  std::vector<std::pair<double, int>> nodes;
-  for (Eigen::Index j = 0; j < p.position.rows(); ++j) nodes.emplace_back(p.position(j, 0), p.stick[j]);
-  std::sort(nodes.begin(), nodes.end());
-  size_t lo = nodes.size(), hi = 0;
-  for (size_t j = 0; j < nodes.size(); ++j)
-    if (nodes[j].second) lo = std::min(lo, j), hi = std::max(hi, j);
-  if (lo > hi || lo == 0 || hi + 1 >= nodes.size()) return 0.0;
-  return 0.25 * (nodes[hi].first + nodes[hi + 1].first - nodes[lo].first - nodes[lo - 1].first);
-}
-
 }  // namespace
 
 namespace {
-
-// A Cattaneo-Mindlin step against the theory, with the step's own normal force P and tangential load Q: the stick
-// zone's half-width c over a (c / a = sqrt(1 - Q / (mu P))) and the relative L2 error of the tangential traction
-// against Mindlin's (mu p(x) less the stick zone's mu p0 (c / a) sqrt(1 - x^2 / c^2)), over the slave nodes.
-struct MindlinFit {
-  double ratio = 0, c_over_a = 0, theory = 0, traction_error = 0;
-};
-
-MindlinFit mindlin_fit(const PairField& p, double Q) {
-  const double mu = 0.3, R = 60, E = 2.1e5, nu = 0.3;
-  const double E_star = E / (2 * (1 - nu * nu));  // plane strain, both bodies alike
-  MindlinFit fit;
-  const double P = p.force;
-  fit.ratio = Q / (mu * P);
-  const double a = std::sqrt(4 * P * R / (M_PI * E_star)), p0 = 2 * P / (M_PI * a);
-  const double c = a * std::sqrt(1 - fit.ratio);
-  fit.c_over_a = stick_half_width(p) / a;
-  fit.theory = c / a;
-  double error = 0, norm = 0;
-  for (Eigen::Index j = 0; j < p.position.rows(); ++j) {
-    const double x = p.position(j, 0);
-    double q = mu * p0 * std::sqrt(std::max(0.0, 1 - x * x / (a * a)));
-    if (std::abs(x) < c) q -= mu * p0 * (c / a) * std::sqrt(1 - x * x / (c * c));
-    error += std::pow(-p.tangential_traction[j] - q, 2);
-    norm += q * q;
-  }
-  fit.traction_error = std::sqrt(error / norm);
-  return fit;
-}
 
 // Cattaneo-Mindlin by the given interface solver ("direct" or "iterative"): the stick zone's half-width c and the
 // tangential traction against the theory, equilibrium to 1e-8, Coulomb at every node.
@@ -151,22 +81,6 @@ void check_cattaneo_mindlin(const std::string& interface_solver) {
 
 TEST(Friction, CattaneoMindlinStickZoneAndTractionFollowTheTheory) { check_cattaneo_mindlin("direct"); }
 
-namespace {
-
-// The Cattaneo-Mindlin job on nx x ny cells per body (the cylinder's nx scaled by 15/13 as in cattaneo_job), graded
-// towards the contact as cattaneo_job's or uniform, with the tangential load Q in a second load step.
-json cattaneo_mesh(int nx, int ny, bool graded, double Q) {
-  json job = cattaneo_job({0.0, Q});
-  for (int b = 0; b < 2; ++b) {
-    auto& block = job["bodies"][b]["mesh"]["block"];
-    block["nx"] = b == 0 ? nx : nx * 15 / 13;
-    block["ny"] = ny;
-    if (!graded) block.erase("grading");
-  }
-  return job;
-}
-
-}  // namespace
 
 TEST(Friction, CattaneoMindlinAdaptsFromACoarseMeshAndEndsOnTheTheory) {
   // Issue 30, item 3: friction with adaptivity. The load path (press, then Q = half of what friction holds) is
@@ -174,17 +88,41 @@ TEST(Friction, CattaneoMindlinAdaptsFromACoarseMeshAndEndsOnTheTheory) {
   // indicators take the whole contact traction as the bodies' Neumann data. From 20 x 4 uniform cells per body.
   const double Q = 0.5 * 0.3 * 2194.0;  // P is 2194 to 0.1 % on fine meshes (the held top sets it)
   json job = cattaneo_mesh(20, 4, false, Q);
-  job["adaptivity"] = json::object();
+  // Refinement graded towards the contact: a cell smaller than half its distance from the contact zone is not
+  // refined, so the stress singularities of the cylinder's point loads and the block's held corner, far from
+  // the contact, do not take the unknowns (with the default grading 0 the run meets the theory at 54,077
+  // unknowns, 1.06x fewer than the graded mesh below; docs/algorithm.md, "Adaptivity with friction").
+  job["adaptivity"] = {{"grading", 0.5}};
   job["output"] = {{"steps", "all"}};
-  const Result r = run(job);
+  struct Estimates : Observer {
+    std::vector<double> of_step;
+    void on_adaptive_step(const AdaptiveStepReport& report) override { of_step.push_back(report.pressure_estimate); }
+  } estimates;
+  CancelToken cancel;
+  const Result r = solve(parse_or_fail(job), estimates, cancel);
   ASSERT_TRUE(r.converged) << r.message;
   ASSERT_GE(r.steps.size(), 4u);
+  ASSERT_EQ(estimates.of_step.size(), r.steps.size());
   long first_meeting = 0;
-  for (const Step& s : r.steps) {
-    const MindlinFit fit = mindlin_fit(pair_of(s, "block.top-cylinder.bottom"), Q);
+  for (size_t k = 0; k < r.steps.size(); ++k) {
+    const Step& s = r.steps[k];
+    const PairField& pair = pair_of(s, "block.top-cylinder.bottom");
+    const MindlinFit fit = mindlin_fit(pair, Q);
     const long dofs = unknowns(r, s.iteration);
-    std::printf("  step %d: %ld unknowns, Q / (mu P) %.3f, c / a %.4f (theory %.4f), traction error %.3f\n", s.index,
-                dofs, fit.ratio, fit.c_over_a, fit.theory, fit.traction_error);
+    // The pressure estimate (issue 30, item 2) against the pressure's true error: Hertz's at the step's force
+    // (the bodies are 25 half-widths deep: their departure from half-spaces is far below these errors).
+    const double truth = hertz_pressure_error(pair), effectivity = estimates.of_step[k] / truth;
+    std::printf("  step %d: %ld unknowns, Q / (mu P) %.3f, c / a %.4f (theory %.4f), traction error %.3f, pressure "
+                "error %.3f %%, estimate %.3f %% (effectivity %.2f)\n",
+                s.index, dofs, fit.ratio, fit.c_over_a, fit.theory, fit.traction_error, 100 * truth,
+                100 * estimates.of_step[k], effectivity);
+    // Calibrated: within a factor of 3 either way (the paper's test and two cylinders measure 0.9 to 2.1;
+    // docs/algorithm.md, "The pressure estimate") wherever the contact has nodes enough to be resolved at all
+    // (6 in contact: at 3 the profile is three values and its error mostly the zone it cannot draw).
+    if ((pair.pressure.array() > 0).count() >= 6) {
+      EXPECT_GT(effectivity, 1.0 / 3) << "step " << k;
+      EXPECT_LT(effectivity, 3.0) << "step " << k;
+    }
     if (!first_meeting && std::abs(fit.c_over_a - fit.theory) <= 0.03 && fit.traction_error < 0.05) first_meeting = dofs;
   }
   // The last step, what the user receives: Cattaneo-Mindlin, Coulomb at every node, Q carried.
@@ -196,10 +134,13 @@ TEST(Friction, CattaneoMindlinAdaptsFromACoarseMeshAndEndsOnTheTheory) {
   EXPECT_NEAR(-p.weight.dot(p.tangential_traction), Q, 1e-8 * Q);
   for (Eigen::Index j = 0; j < p.position.rows(); ++j)
     if (p.pressure[j] > 0) EXPECT_LE(std::abs(p.tangential_traction[j]), 0.3 * p.pressure[j] * (1 + 1e-9));
-  // Against meshes graded towards the contact (cattaneo_job's grading): 325 x 10 misses (c / a 0.058 off, the
-  // traction 8 % off), 650 x 20 (58,884 unknowns) meets both. The adaptive run meets both with fewer unknowns.
-  const Result coarse = run(cattaneo_mesh(325, 10, true, Q)), graded = run(cattaneo_mesh(650, 20, true, Q));
-  ASSERT_TRUE(coarse.converged) << coarse.message;  // (it crashed in the sets' regularised solve before)
+  // Against meshes graded towards the contact (cattaneo_job's grading 60 in both bodies): the family is noisy in
+  // c / a (the stick zone's end is read between nodes h = 60 / nx apart, 0.06 a at nx = 400): 350 x 11 and 375 x
+  // 11 miss it (c / a 0.07 and 0.046 off), 400 x 12 (22,438 unknowns) meets both, 500 x 15 misses the traction
+  // (5.9 %), 650 x 20 (57,480) meets both. The adaptive run meets both with at most a quarter of the smallest
+  // graded mesh found to meet them (measured 4.4x; against 650 x 20, 11x; docs/algorithm.md).
+  const Result coarse = run(cattaneo_mesh(375, 11, true, Q)), graded = run(cattaneo_mesh(400, 12, true, Q));
+  ASSERT_TRUE(coarse.converged) << coarse.message;
   ASSERT_TRUE(graded.converged) << graded.message;
   const MindlinFit coarse_fit = mindlin_fit(pair_of(coarse.steps.back(), "block.top-cylinder.bottom"), Q);
   const MindlinFit graded_fit = mindlin_fit(pair_of(graded.steps.back(), "block.top-cylinder.bottom"), Q);
@@ -207,10 +148,10 @@ TEST(Friction, CattaneoMindlinAdaptsFromACoarseMeshAndEndsOnTheTheory) {
   EXPECT_LE(std::abs(graded_fit.c_over_a - graded_fit.theory), 0.03);
   EXPECT_LT(graded_fit.traction_error, 0.05);
   const long graded_dofs = unknowns(graded, graded.iterations);
-  std::printf("  adaptive meets both at %ld unknowns; graded 650 x 20: %ld (ratio %.1f)\n", first_meeting, graded_dofs,
+  std::printf("  adaptive meets both at %ld unknowns; graded 400 x 12: %ld (ratio %.1f)\n", first_meeting, graded_dofs,
               static_cast<double>(graded_dofs) / static_cast<double>(first_meeting));
   ASSERT_GT(first_meeting, 0);
-  EXPECT_LT(first_meeting, graded_dofs);
+  EXPECT_LE(4 * first_meeting, graded_dofs);
 }
 
 TEST(Friction, CattaneoMindlinByTheIterativeSolverFollowsTheTheoryToo) { check_cattaneo_mindlin("iterative"); }

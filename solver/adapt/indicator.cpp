@@ -3,6 +3,7 @@
 #include "../common/scoped_timer.hpp"
 
 #include "../bem/bem.hpp"
+#include "../bem/boundary.hpp"
 #include "../fem/element.hpp"
 
 #include <Eigen/LU>
@@ -196,12 +197,11 @@ IndicatorResult zz_indicator(const Body& body, const fem::BodySolver& solver, co
 
 namespace {
 
-// The body's edge conditions per boundary side (vertex conditions hold no side), each condition's edge length
-// (for a total force spread over its edge), and whether any edge prescribes a displacement.
+// The body's edge conditions per boundary side (vertex conditions hold no side) and each condition's edge length
+// (for a total force spread over its edge).
 struct SideConditions {
   std::map<std::pair<int, int>, const BoundaryCondition*> condition;
   std::map<const BoundaryCondition*, double> edge_length;
-  bool any_support = false;
 };
 
 SideConditions side_conditions(const Body& body) {
@@ -211,7 +211,6 @@ SideConditions side_conditions(const Body& body) {
     if (!bc.vertex.empty()) continue;
     auto it = m.edge_sets.find(bc.edge);
     if (it == m.edge_sets.end()) continue;
-    out.any_support = out.any_support || prescribes_displacement(bc);
     for (const auto& e : it->second) {
       const auto n = m.edge_nodes(e);
       out.condition[key(n[0], n[1])] = &bc;
@@ -228,12 +227,12 @@ bem::BoundaryProblem boundary_problem(const Body& body, const Model& model, cons
                                       const Eigen::VectorXd& u, const Eigen::VectorXd& contact_load,
                                       const std::vector<int>& loop, SideConditions& sides) {
   const auto& m = body.mesh;
-  const double factor = solver.load_factor();
+  // Each condition at its own factor now: the loading's, or its history's (BoundaryCondition::history).
   // Point loads join the contact forces: both are nodal forces, lumped over the sides next to their node.
   Eigen::VectorXd nodal_load = contact_load.size() ? contact_load : Eigen::VectorXd::Zero(2 * m.num_nodes());
   for (const auto& bc : body.boundary)
     if (!bc.vertex.empty() && bc.kind == BoundaryCondition::Kind::force)
-      for (int node : condition_nodes(m, bc)) nodal_load.segment<2>(2 * node) += factor * bc.force;
+      for (int node : condition_nodes(m, bc)) nodal_load.segment<2>(2 * node) += solver.condition_factor(bc) * bc.force;
   const size_t nb = loop.size();
   // Nodal forces to tractions, lumped over the boundary sides next to their node. Where one of the two sides has
   // a condition of its own and the other none (a contact edge meeting a symmetry line or a loaded edge), the
@@ -273,7 +272,7 @@ bem::BoundaryProblem boundary_problem(const Body& body, const Model& model, cons
     if (bc && bc->kind == BoundaryCondition::Kind::traction)
       traction = bc->normal_pressure ? Eigen::Vector2d(-bc->pressure * outward.normalized()) : bc->traction;
     if (bc && bc->kind == BoundaryCondition::Kind::force) traction = bc->force / (sides.edge_length[bc] * thickness);
-    traction *= factor;
+    if (bc) traction *= solver.condition_factor(*bc);
     for (int comp = 0; comp < 2; ++comp) {
       const bool prescribed = bc && (comp == 0 ? bc->ux : bc->uy);
       el.displacement_prescribed[static_cast<size_t>(comp)] = prescribed;
@@ -290,6 +289,53 @@ bem::BoundaryProblem boundary_problem(const Body& body, const Model& model, cons
     }
   }
   return bp;
+}
+
+// Where the body's edge conditions leave the boundary-element problem a rigid motion (a body held at a vertex, or
+// only by its contacts' friction, or floating), the FE solution fixes it as the FE problem fixed it: the sides at
+// each vertex support take the FE displacement in the components the vertex prescribes, and if motion is still
+// free, the side farthest from the contact takes the FE displacement in both. A pinned side gives up its traction
+// data (zero on a free side; that side then carries the FE's reaction, zero in equilibrium, as a boundary-element
+// traction), so the comparison is the same problem's, not a different one's.
+void pin_rigid_motions(const Body& body, const Eigen::VectorXd& u, const Eigen::VectorXd& contact_load,
+                       const std::vector<int>& loop, bem::BoundaryProblem& bp) {
+  if (bem::free_rigid_motions(bp).empty()) return;
+  const auto& m = body.mesh;
+  const size_t nb = loop.size();
+  auto prescribe = [&](size_t i, int comp) {
+    auto& el = bp.elements[i];
+    el.displacement_prescribed[static_cast<size_t>(comp)] = true;
+    el.value(comp, 0) = u[2 * loop[i] + comp];
+    el.value(comp, 1) = u[2 * loop[(i + 1) % nb] + comp];
+  };
+  std::unordered_map<int, size_t> at;
+  for (size_t i = 0; i < nb; ++i) at[loop[i]] = i;
+  for (const auto& bc : body.boundary) {
+    if (bc.vertex.empty() || !prescribes_displacement(bc)) continue;
+    for (int node : condition_nodes(m, bc)) {
+      const auto it = at.find(node);
+      if (it == at.end()) continue;
+      for (int comp = 0; comp < 2; ++comp)
+        if (comp == 0 ? bc.ux.has_value() : bc.uy.has_value()) {
+          prescribe(it->second, comp);
+          prescribe((it->second + nb - 1) % nb, comp);
+        }
+    }
+  }
+  if (bem::free_rigid_motions(bp).empty()) return;
+  std::vector<Eigen::Vector2d> contact;
+  for (int n : loop)
+    if (contact_load.size() && contact_load.segment<2>(2 * n).squaredNorm() > 0.0) contact.push_back(m.nodes[static_cast<size_t>(n)]);
+  size_t farthest = 0;
+  double best = -1.0;
+  for (size_t i = 0; i < nb; ++i) {
+    const Eigen::Vector2d mid = 0.5 * (bp.nodes[i] + bp.nodes[(i + 1) % nb]);
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const auto& c : contact) nearest = std::min(nearest, (mid - c).norm());
+    if (nearest > best) best = nearest, farthest = i;
+  }
+  prescribe(farthest, 0);
+  prescribe(farthest, 1);
 }
 
 // Solves the boundary-element problem, evaluates its stresses at the cell centres and compares them with the FE
@@ -335,14 +381,8 @@ IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fe
     return r;
   }
   SideConditions sides = side_conditions(body);
-  if (!sides.any_support) {
-    // Tractions all round (a floating body, or one held at vertices only): the boundary-element problem is
-    // determined only up to a rigid motion, which this collocation does not remove.
-    IndicatorResult r = zz_indicator(body, solver, u, normalization);
-    r.note = "body '" + body.name + "': no edge with a prescribed displacement; zz indicator used instead of fem_bem";
-    return r;
-  }
-  const bem::BoundaryProblem bp = boundary_problem(body, model, solver, u, contact_load, loop, sides);
+  bem::BoundaryProblem bp = boundary_problem(body, model, solver, u, contact_load, loop, sides);
+  pin_rigid_motions(body, u, contact_load, loop, bp);
   IndicatorResult r = compare_with_bem(body, solver, u, bp, loop, normalization, cancelled);
   r.seconds = seconds_since(t0);  // (r is replaced on the way: not a ScopedTimer)
   return r;

@@ -1,5 +1,7 @@
 #include "boundary.hpp"
 
+#include <limits>
+
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
@@ -202,7 +204,7 @@ void check_interior_point(const BoundaryGeometry& geometry, const Eigen::Vector2
   if (!inside) fail("the point " + point_text(x) + " is not inside the body");
 }
 
-void check_rigid_motions(const BoundaryProblem& problem, const BoundaryGeometry& geometry) {
+std::vector<std::string> free_rigid_motions(const BoundaryProblem& problem) {
   // The three rigid modes about the bounding-box centre, the rotation scaled to unit size at the farthest node,
   // evaluated at every prescribed displacement component; their null space holds the free motions.
   const std::size_t n = problem.nodes.size();
@@ -212,7 +214,7 @@ void check_rigid_motions(const BoundaryProblem& problem, const BoundaryGeometry&
     hi = hi.cwiseMax(p);
   }
   const Eigen::Vector2d centre = 0.5 * (lo + hi);
-  const double radius = 0.5 * geometry.diameter;
+  const double radius = std::max(0.5 * (hi - lo).norm(), std::numeric_limits<double>::min());
   std::vector<Eigen::RowVector3d> rows;
   for (std::size_t i = 0; i < n; ++i) {
     const ElementData& before = problem.elements[(i + n - 1) % n];
@@ -222,10 +224,7 @@ void check_rigid_motions(const BoundaryProblem& problem, const BoundaryGeometry&
       if (before.displacement_prescribed[c] || after.displacement_prescribed[c])
         rows.push_back(c == 0 ? Eigen::RowVector3d(1.0, 0.0, -d.y()) : Eigen::RowVector3d(0.0, 1.0, d.x()));
   }
-  if (rows.empty())
-    fail(
-        "no displacement is prescribed, so the body is free to translate and rotate: prescribe displacement "
-        "components that restrain both translations and the rotation (a traction-only body is not supported)");
+  if (rows.empty()) return {"translation in x", "translation in y", "rotation"};
   // At least three rows, so that the SVD has three singular values.
   Eigen::MatrixX3d modes = Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(std::max<std::size_t>(rows.size(), 3)), 3);
   for (std::size_t k = 0; k < rows.size(); ++k) modes.row(static_cast<Eigen::Index>(k)) = rows[k];
@@ -245,6 +244,17 @@ void check_rigid_motions(const BoundaryProblem& problem, const BoundaryGeometry&
       free.push_back("rotation about " + point_text(pivot));
     }
   }
+  return free;
+}
+
+void check_rigid_motions(const BoundaryProblem& problem, const BoundaryGeometry&) {
+  const std::vector<std::string> free = free_rigid_motions(problem);
+  bool any_prescribed = false;
+  for (const auto& e : problem.elements) any_prescribed = any_prescribed || e.displacement_prescribed[0] || e.displacement_prescribed[1];
+  if (!any_prescribed)
+    fail(
+        "no displacement is prescribed, so the body is free to translate and rotate: prescribe displacement "
+        "components that restrain both translations and the rotation (a traction-only body is not supported)");
   if (!free.empty()) {
     std::string list;
     for (const auto& f : free) list += (list.empty() ? "" : ", ") + f;

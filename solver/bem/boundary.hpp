@@ -1,6 +1,9 @@
 // The boundary polygon of a BoundaryProblem: element geometry, input checks, and point location.
 #pragma once
 
+#include <string>
+#include <vector>
+
 #include <Eigen/Core>
 #include <vector>
 
@@ -38,6 +41,11 @@ void check_solution(const BoundaryProblem& problem, const BoundarySolution& solu
 
 // Throws std::invalid_argument unless `x` lies inside the polygon, farther than 1e-12 x diameter from it.
 void check_interior_point(const BoundaryGeometry& geometry, const Eigen::Vector2d& x);
+
+// The rigid motions the prescribed displacement components of `problem` leave free, by name ("translation in x",
+// "rotation about (x, y)"); empty when they restrain both translations and the rotation. `problem` has at least
+// one node and one element per node.
+std::vector<std::string> free_rigid_motions(const BoundaryProblem& problem);
 
 // Throws std::invalid_argument, naming the free motions, unless the prescribed displacement components of
 // `problem` restrain both translations and the rotation.

@@ -185,6 +185,12 @@ void BodySolver::set_load_between(size_t step, double previous_factor, double fa
   }
 }
 
+double BodySolver::condition_factor(const BoundaryCondition& bc) const {
+  for (const auto& group : groups_)
+    if (group.condition == &bc) return group.factor;
+  return load_factor_;
+}
+
 Eigen::VectorXd BodySolver::scaled(const Eigen::VectorXd& base, Eigen::VectorXd LoadGroup::*part) const {
   Eigen::VectorXd out = load_factor_ * base;
   for (const auto& group : groups_)

@@ -90,6 +90,8 @@ class BodySolver {
   void set_load_between(size_t step, double previous_factor, double factor, double t);
   bool has_histories() const { return !groups_.empty(); }
   double load_factor() const { return load_factor_; }
+  // The factor a condition of this body is at now: its own history's where it has one, else load_factor().
+  double condition_factor(const BoundaryCondition& bc) const;
   Eigen::VectorXd external_load() const;   // all dofs: tractions, forces, body force
   Eigen::VectorXd reduced_rhs() const;     // T^T (f_ext - K g)
   Eigen::VectorXd prescribed() const;      // g: the prescribed values (and 0 elsewhere), all dofs
