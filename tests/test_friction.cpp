@@ -136,9 +136,9 @@ TEST(Friction, CattaneoMindlinAdaptsFromACoarseMeshAndEndsOnTheTheory) {
     if (p.pressure[j] > 0) EXPECT_LE(std::abs(p.tangential_traction[j]), 0.3 * p.pressure[j] * (1 + 1e-9));
   // Against meshes graded towards the contact (cattaneo_job's grading 60 in both bodies): the family is noisy in
   // c / a (the stick zone's end is read between nodes h = 60 / nx apart, 0.06 a at nx = 400): 350 x 11 and 375 x
-  // 11 miss it (c / a 0.07 and 0.046 off), 400 x 12 (22,438 unknowns) meets both, 500 x 15 misses the traction
+  // 11 miss it (c / a 0.07 and 0.046 off), 400 x 12 (21,573 unknowns) meets both, 500 x 15 misses the traction
   // (5.9 %), 650 x 20 (57,480) meets both. The adaptive run meets both with at most a quarter of the smallest
-  // graded mesh found to meet them (measured 4.4x; against 650 x 20, 11x; docs/algorithm.md).
+  // graded mesh found to meet them (measured 5.1x; against 650 x 20, 13.5x; docs/algorithm.md).
   const Result coarse = run(cattaneo_mesh(375, 11, true, Q)), graded = run(cattaneo_mesh(400, 12, true, Q));
   ASSERT_TRUE(coarse.converged) << coarse.message;
   ASSERT_TRUE(graded.converged) << graded.message;
