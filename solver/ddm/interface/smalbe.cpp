@@ -252,7 +252,8 @@ bool Smalbe::update_multipliers(const Eigen::VectorXd& x, const linalg::MprgpRes
   // down more than the updates gain: on a sheared wall (16 x 16 bricks with head joints, mu 0.6, H/V = 0.5) every
   // Coulomb outer iteration's Tresca solve climbed to 1e3-1e4 ||P H P|| (thousands of CG steps per update) and the
   // step took 52,688 MPRGP iterations, against 13,456 with this rule and the same answer; at 22 x 22 the step did
-  // not settle within the 100,000 of interface.max_iterations and was cut 3 times, and now holds uncut (80,913).
+  // not settle within 100,000 MPRGP iterations (the budget then) and was cut 3 times, and now holds uncut (80,913;
+  // 121,364 on another machine's rounding, which is why interface.max_iterations is now 300,000).
   // Without the stall rule the tolerance's last decades crawled there (hundreds of updates of 23 iterations).
   const size_t k = violation.size();
   const auto fell_little = [&](size_t i, double factor) { return violation[i] > factor * violation[i - 1]; };

@@ -157,7 +157,7 @@ struct InterfaceSolverSettings {
   InterfaceSolverKind solver = InterfaceSolverKind::automatic;
   InterfacePreconditioner preconditioner = InterfacePreconditioner::dirichlet;  // iterative only
   double tolerance = 1e-12;        // iterative: projected gradient and equilibrium, relative
-  long max_iterations = 100000;    // iterative: products with the interface operator, in all
+  long max_iterations = 300000;    // iterative: products with the interface operator, in all
 };
 
 // Defaults: exact contact by interface Newton. The job parser fills the defaults that depend on the method
