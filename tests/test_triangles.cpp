@@ -273,3 +273,35 @@ TEST(TriangleIndicators, BothIndicatorsVanishForTheExactUniformStateAndFindALoca
     EXPECT_LT((centre - Eigen::Vector2d(3.0, 2.0)).norm(), 0.75) << "largest eta at " << centre.transpose();
   }
 }
+
+TEST(TriangleIndicators, FemBemOnABodyHeldAtVerticesOnlyPinsItsRigidMotionInsteadOfFallingBackToZz) {
+  // The uniform traction state with tractions on all four sides and the body held at two vertices only (bottom
+  // left in x and y, bottom right in y: supports that carry nothing in this state). The edge conditions alone leave
+  // the boundary-element problem free to translate and rotate; the FE displacement pins that (indicator.cpp,
+  // pin_rigid_motions), so fem_bem runs (no fallback note), its stresses match the exact FE ones to the BEM's own
+  // error, and its boundary displacements are the FE ones (exact here) to the same accuracy. Before, such a body
+  // fell back to zz and had no boundary-element displacements (no pressure estimate).
+  Body body = contact::testing::uniform_traction_body(block(6, 4), false);
+  body.boundary.resize(2);  // right and top tractions below; left and bottom become tractions too
+  BoundaryCondition left{"left", BoundaryCondition::Kind::traction}, bottom{"bottom", BoundaryCondition::Kind::traction};
+  left.traction = Eigen::Vector2d(-contact::testing::kPatchSxx, 0);
+  bottom.traction = Eigen::Vector2d(0, -contact::testing::kPatchSyy);
+  BoundaryCondition right{"right", BoundaryCondition::Kind::traction}, top{"top", BoundaryCondition::Kind::traction};
+  right.traction = Eigen::Vector2d(contact::testing::kPatchSxx, 0);
+  top.traction = Eigen::Vector2d(0, contact::testing::kPatchSyy);
+  BoundaryCondition pin{"", BoundaryCondition::Kind::displacement}, roller{"", BoundaryCondition::Kind::displacement};
+  pin.vertex = "bottom_left";
+  pin.ux = pin.uy = 0.0;
+  roller.vertex = "bottom_right";
+  roller.uy = 0.0;
+  body.boundary = {left, bottom, right, top, pin, roller};
+  fem::BodySolver solver(body, Model{});
+  ASSERT_TRUE(solver.ok()) << solver.error();
+  const Eigen::VectorXd u = solver.solve(Eigen::VectorXd());
+  const auto fb = adapt::fem_bem_indicator(body, Model{}, solver, u, Eigen::VectorXd::Zero(u.size()));
+  EXPECT_TRUE(fb.note.empty()) << fb.note;
+  ASSERT_EQ(fb.eta.size(), body.mesh.num_cells());
+  EXPECT_LE(fb.eta.maxCoeff(), 0.02);
+  ASSERT_EQ(fb.bem_displacement.size(), u.size());
+  EXPECT_LE((fb.bem_displacement - u).cwiseAbs().maxCoeff(), 0.01 * u.cwiseAbs().maxCoeff());
+}
