@@ -48,7 +48,8 @@ struct NameTable<InterfaceSolverKind> {
 };
 template <>
 struct NameTable<InterfacePreconditioner> {
-  static constexpr Entries<InterfacePreconditioner, 3> entries{{{InterfacePreconditioner::none, "none"},
+  static constexpr Entries<InterfacePreconditioner, 4> entries{{{InterfacePreconditioner::automatic, "auto"},
+                                                                {InterfacePreconditioner::none, "none"},
                                                                 {InterfacePreconditioner::lumped, "lumped"},
                                                                 {InterfacePreconditioner::dirichlet, "dirichlet"}}};
 };

@@ -86,6 +86,13 @@ void InterfaceNewton::solve(RunFrame& frame) {
   const Eigen::VectorXd shift = qp.g - ip.free_gap();     // -theta area lambda
   const std::string* solver_note = nullptr;  // what the solver says of its start (coarse solves), on the first report
   std::string solver_name = solver_->name();
+  // The iterative solver's preconditioner, as `auto` resolved it (names.hpp's word).
+  const std::string preconditioner_note =
+      kind_ == InterfaceSolverKind::iterative
+          ? std::string(", preconditioner ") + (settings_.preconditioner == InterfacePreconditioner::none       ? "none"
+                                                : settings_.preconditioner == InterfacePreconditioner::lumped ? "lumped"
+                                                                                                              : "dirichlet")
+          : std::string();
   const linalg::StepCallback on_step = [&](const Eigen::VectorXd& z, const Eigen::VectorXd& h, const linalg::ActiveSetStep& step) {
     // The reported gaps are the physical ones: h without the penalty's theta area z and the multipliers' shift.
     const Eigen::VectorXd gap = h - penalty_diagonal.cwiseProduct(z) - shift;
@@ -95,7 +102,8 @@ void InterfaceNewton::solve(RunFrame& frame) {
     r.complementarity = step.complementarity;
     r.active_set_changes = step.changes;
     if (step.step == 1)
-      r.note = std::string("interface solver ") + solver_name + (solver_note->empty() ? "" : "; ") + *solver_note;
+      r.note = std::string("interface solver ") + solver_name + preconditioner_note +
+               (solver_note->empty() ? "" : "; ") + *solver_note;
     frame.report(std::move(r));
     return frame.stop_requested();
   };
@@ -118,7 +126,7 @@ void InterfaceNewton::solve(RunFrame& frame) {
     // convex Tresca problems cannot cycle that way, and gives the same answer where both converge. It takes the
     // step over before the step is cut (on the blocks this problem holds, without a preconditioner: the direct
     // solver's problem has none).
-    InterfaceSolverSettings iterative = settings.interface;
+    InterfaceSolverSettings iterative = settings_;
     iterative.preconditioner = InterfacePreconditioner::none;
     const int direct_steps = result.steps;
     solver_name = "iterative (the direct solver's friction Newton did not settle)";

@@ -20,9 +20,10 @@ class InterfaceNewton {
  public:
   InterfaceNewton(const ContactSystem& system, const SolverSettings& settings, parallel::TaskRunner& runner)
       : system_(system),
-        kind_(choose_interface_solver(settings.interface, system, runner)),
-        problem_(system, runner, interface_options(kind_, settings.interface, system.has_friction())),
-        solver_(make_interface_solver(kind_, settings.interface, system.has_friction())) {}
+        settings_(resolved_settings(settings.interface, system)),
+        kind_(choose_interface_solver(settings_, system, runner)),
+        problem_(system, runner, interface_options(kind_, settings_, system.has_friction())),
+        solver_(make_interface_solver(kind_, settings_, system.has_friction())) {}
   // Solves with the frame's enforcement on the pairs' current multipliers, building the frame's outcome; reports
   // every active-set step.
   void solve(RunFrame& frame);
@@ -39,6 +40,7 @@ class InterfaceNewton {
   InterfaceQp make_qp(const SolverSettings& settings) const;
 
   const ContactSystem& system_;
+  InterfaceSolverSettings settings_;  // the job's, `auto` preconditioner resolved
   InterfaceSolverKind kind_;
   InterfaceProblem problem_;
   std::unique_ptr<InterfaceSolver> solver_;

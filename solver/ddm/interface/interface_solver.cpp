@@ -14,7 +14,22 @@ namespace {
 constexpr Eigen::Index max_direct_floating_rows = 256;
 constexpr Eigen::Index max_direct_rows = 40000;
 
+
+Eigen::Index floating_rows(const ContactSystem& system) {
+  Eigen::Index rows = 0;
+  for (size_t a = 0; a < system.n_bodies(); ++a) rows += system.body(a).rigid_modes().cols();
+  return rows;
+}
+
 }  // namespace
+
+InterfaceSolverSettings resolved_settings(const InterfaceSolverSettings& settings, const ContactSystem& system) {
+  InterfaceSolverSettings out = settings;
+  if (out.preconditioner == InterfacePreconditioner::automatic)
+    out.preconditioner = floating_rows(system) > max_direct_floating_rows ? InterfacePreconditioner::none
+                                                                          : InterfacePreconditioner::dirichlet;
+  return out;
+}
 
 InterfaceSolverKind choose_interface_solver(const InterfaceSolverSettings& settings, const ContactSystem& system,
                                             const parallel::TaskRunner& runner) {
@@ -22,11 +37,10 @@ InterfaceSolverKind choose_interface_solver(const InterfaceSolverSettings& setti
   // its answer does not depend on them (the direct solver runs replicated on every rank; docs/parallel.md).
   (void)runner;
   if (settings.solver != InterfaceSolverKind::automatic) return settings.solver;
-  Eigen::Index rows = 0, floating_rows = 0;
+  Eigen::Index rows = 0;
   for (const auto& pair : system.pairs()) rows += pair.n_rows();
-  for (size_t a = 0; a < system.n_bodies(); ++a) floating_rows += system.body(a).rigid_modes().cols();
-  return floating_rows > max_direct_floating_rows || rows > max_direct_rows ? InterfaceSolverKind::iterative
-                                                                            : InterfaceSolverKind::direct;
+  return floating_rows(system) > max_direct_floating_rows || rows > max_direct_rows ? InterfaceSolverKind::iterative
+                                                                                    : InterfaceSolverKind::direct;
 }
 
 InterfaceProblem::Options interface_options(InterfaceSolverKind kind, const InterfaceSolverSettings& settings,

@@ -152,10 +152,12 @@ struct AugmentedLagrangianSettings {
 // MPRGP with SMALBE for the floating bodies' equilibrium, each process applying its own bodies' blocks; automatic
 // picks by size. Both give the same discrete solution.
 enum class InterfaceSolverKind { automatic, direct, iterative };
-enum class InterfacePreconditioner { none, lumped, dirichlet };
+// automatic: none on many floating bodies (the iterative solver's many-body case), dirichlet otherwise
+// (interface_solver.cpp, resolved_settings).
+enum class InterfacePreconditioner { none, lumped, dirichlet, automatic };
 struct InterfaceSolverSettings {
   InterfaceSolverKind solver = InterfaceSolverKind::automatic;
-  InterfacePreconditioner preconditioner = InterfacePreconditioner::dirichlet;  // iterative only
+  InterfacePreconditioner preconditioner = InterfacePreconditioner::automatic;  // iterative only
   double tolerance = 1e-12;        // iterative: projected gradient and equilibrium, relative
   long max_iterations = 300000;    // iterative: products with the interface operator, in all
 };
