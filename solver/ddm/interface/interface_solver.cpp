@@ -13,6 +13,8 @@ namespace {
 // active-set step refactorises the active block.
 constexpr Eigen::Index max_direct_floating_rows = 256;
 constexpr Eigen::Index max_direct_rows = 40000;
+// Beyond this many floating-body rows (ten floating bodies) the `auto` preconditioner is none (resolved_settings).
+constexpr Eigen::Index max_dirichlet_floating_rows = 30;
 
 
 Eigen::Index floating_rows(const ContactSystem& system) {
@@ -26,8 +28,8 @@ Eigen::Index floating_rows(const ContactSystem& system) {
 InterfaceSolverSettings resolved_settings(const InterfaceSolverSettings& settings, const ContactSystem& system) {
   InterfaceSolverSettings out = settings;
   if (out.preconditioner == InterfacePreconditioner::automatic)
-    out.preconditioner = floating_rows(system) > max_direct_floating_rows ? InterfacePreconditioner::none
-                                                                          : InterfacePreconditioner::dirichlet;
+    out.preconditioner = floating_rows(system) > max_dirichlet_floating_rows ? InterfacePreconditioner::none
+                                                                             : InterfacePreconditioner::dirichlet;
   return out;
 }
 

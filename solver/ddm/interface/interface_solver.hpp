@@ -76,11 +76,11 @@ class InterfaceSolver {
 InterfaceSolverKind choose_interface_solver(const InterfaceSolverSettings& settings, const ContactSystem& system,
                                             const parallel::TaskRunner& runner);
 // The settings with the preconditioner `auto` resolved, by size alone (the same on any number of processes): with
-// more than 256 floating-body rows (the many-body case, where `auto` takes the iterative solver) none, else
-// dirichlet. Why: on walls of floating bricks the coarse space carries the global coupling, Dirichlet cuts the
-// MPRGP iterations by 5-35 % only, and each iteration costs a second dense product per body: none is 1.15-1.8x
-// faster (16 x 16 frictional walls of 4 to 16 cells per brick; 106 s against 150 s at 64 x 64). On two finely
-// meshed bodies it cuts them 1.6-2.6x (docs/algorithm.md, "The interface solvers").
+// more than 30 floating-body rows (ten floating bodies) none, else dirichlet. Why: on walls of floating bricks the
+// coarse space carries the global coupling, Dirichlet cuts the MPRGP iterations by 5-35 % only (on dowelled
+// frictionless walls it adds to them), and each iteration costs a second dense product per body: none is as fast
+// or faster from 19 bodies up (1.15-1.8x on 16 x 16 frictional walls of 4 to 16 cells per brick; 106 s against
+// 150 s at 64 x 64). On two or three finely meshed bodies it cuts them 1.6-2.6x (docs/friction.md).
 InterfaceSolverSettings resolved_settings(const InterfaceSolverSettings& settings, const ContactSystem& system);
 // How the interface problem must be built for that solver (blocks replicated or not, preconditioner, tangential
 // rows for friction).
