@@ -190,6 +190,27 @@ TEST(InterfaceSolvers, TheAutomaticChoiceTakesTheDirectSolverForFewBodiesAndTheI
   EXPECT_NE(r.history.front().note.find("interface solver iterative"), std::string::npos) << r.history.front().note;
 }
 
+TEST(InterfaceSolvers, TheAutomaticPreconditionerIsDirichletForFewBodiesAndNoneForMany) {
+  // preconditioner "auto" (the default; interface_solver.cpp, resolved_settings): three bodies keep Dirichlet, a
+  // wall of 265 floating bricks runs without it. The iterative solver forced on both; the first step's note says
+  // which ran, and an explicit choice is kept.
+  json few = with_solver(example("stack3.json"), "iterative");
+  const Result f = run(few);
+  ASSERT_TRUE(f.converged) << f.message;
+  ASSERT_FALSE(f.history.empty());
+  EXPECT_NE(f.history.front().note.find("interface solver iterative, preconditioner dirichlet"), std::string::npos)
+      << f.history.front().note;
+  json many = with_solver(wall(16, 16, 2, false), "iterative");
+  const Result m = run(many);
+  ASSERT_TRUE(m.converged) << m.message;
+  EXPECT_NE(m.history.front().note.find("interface solver iterative, preconditioner none"), std::string::npos)
+      << m.history.front().note;
+  many["solver"]["interface"]["preconditioner"] = "dirichlet";
+  const Result d = run(many);
+  ASSERT_TRUE(d.converged) << d.message;
+  EXPECT_NE(d.history.front().note.find("preconditioner dirichlet"), std::string::npos) << d.history.front().note;
+}
+
 TEST(InterfaceSolvers, IterationsOfTheIterativeSolverDoNotGrowWithTheNumberOfBricks) {
   // The same bricks (same H/h) in walls of 69 to 4,129 bodies: FETI's iterations are bounded by H/h.
   std::vector<long> iterations;
