@@ -5,6 +5,7 @@
 // With friction the iterative solver (MPRGP on the box, Coulomb's outer iteration) gives the direct friction
 // solver's discrete solution (semismooth Newton, an independent method) under Coulomb and Tresca.
 #include "contact/result_file.hpp"
+#include "ddm/interface/interface_problem.hpp"
 #include "linalg/active_set.hpp"
 #include "linalg/mprgp.hpp"
 #include "support.hpp"
@@ -134,7 +135,7 @@ TEST(Mprgp, SolvesBoundConstrainedQpsLikeTheActiveSetQpMethod) {
       linalg::MprgpSettings settings;
       settings.alpha_bar = 1.9 / H.eigenvalues().real().maxCoeff();
       const auto r = linalg::solve_mprgp(qp, Eigen::VectorXd::Zero(n), settings,
-                                         [&](const Eigen::VectorXd&, const Eigen::VectorXd&, double gp) { return gp <= 1e-12 * g.norm(); });
+                                         [&](const linalg::MprgpResult& state) { return state.projected_gradient <= 1e-12 * g.norm(); });
       ASSERT_TRUE(r.converged) << trial;
       EXPECT_GE(r.x.minCoeff(), 0.0);
       EXPECT_LE((r.x - reference).cwiseAbs().maxCoeff(), 1e-9 * std::max(1.0, reference.cwiseAbs().maxCoeff()))
@@ -231,6 +232,30 @@ TEST(InterfaceSolvers, IterationsOfTheIterativeSolverDoNotGrowWithTheNumberOfBri
   EXPECT_LE(static_cast<double>(iterations.back()), 1.5 * static_cast<double>(iterations.front()))
       << iterations[0] << ", " << iterations[1] << ", " << iterations[2] << ", " << iterations[3];
   for (long k : iterations) EXPECT_GT(k, 0);
+}
+
+TEST(InterfaceSolvers, TheProductWithFIsTheSameOnOneTwoAndThreeThreads) {
+  // The iterative solver's product with F splits the bodies' blocks over the process's threads, each summing into
+  // a vector of its own: against the assembled sparse F, on a wall of 265 bodies (enough blocks for three threads).
+  const auto parsed = job::parse(with_solver(wall(16, 16, 4, false), "iterative"));
+  ASSERT_TRUE(parsed.ok());
+  parallel::ThreadTaskRunner one(1);
+  ddm::ContactSystem system(*parsed.problem, one, ddm::ContactSystem::Factorization::interface);
+  ASSERT_TRUE(system.ok()) << system.error();
+  const ddm::InterfaceProblem interface(system, one);
+  const linalg::SparseMatrix F = interface.assemble();
+  std::mt19937 rng(3);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Eigen::VectorXd x(interface.size());
+  for (Eigen::Index i = 0; i < x.size(); ++i) x[i] = normal(rng);
+  const Eigen::VectorXd expected = F * x;
+  for (unsigned threads : {1u, 2u, 3u}) {
+    parallel::ThreadTaskRunner runner(threads);
+    Eigen::VectorXd y;
+    EXPECT_FALSE(interface.apply(x, y, runner));
+    ASSERT_EQ(y.size(), expected.size());
+    EXPECT_LE((y - expected).cwiseAbs().maxCoeff(), 1e-13 * expected.cwiseAbs().maxCoeff()) << threads << " threads";
+  }
 }
 
 TEST(InterfaceSolvers, AnUnheldFloatingBodyIsNamedByTheIterativeSolverToo) {

@@ -114,7 +114,7 @@ linalg::MprgpResult solve(const BoxProblem& p, bool jacobi, bool with_upper, con
   settings.alpha_bar = 1.9 / p.A.selfadjointView<Eigen::Lower>().eigenvalues().maxCoeff();
   const double scale = p.b.norm();
   return linalg::solve_mprgp(qp, x0, settings,
-                             [&](const Eigen::VectorXd&, const Eigen::VectorXd&, double gp) { return gp <= 1e-13 * scale; });
+                             [&](const linalg::MprgpResult& state) { return state.projected_gradient <= 1e-13 * scale; });
 }
 
 }  // namespace
@@ -186,5 +186,48 @@ TEST(MprgpBox, AnAbsentOrInfiniteUpperBoundIsTheOneSidedMethod) {
       const auto r = solve(small, false, false, Eigen::VectorXd::Zero(7));
       EXPECT_LE((r.x - reference).cwiseAbs().maxCoeff(), 1e-9 * std::max(1.0, reference.cwiseAbs().maxCoeff()));
     }
+  }
+}
+
+TEST(MprgpBox, CarriesTheImageOfItsIterateUnderTheCallersLinearMap) {
+  // The problem's `image` hands over L v of every vector `apply` took; MPRGP must then carry L x through its CG,
+  // expansion and proportioning steps. Checked against L x itself at every stopping test, on problems whose
+  // answers sit on both bounds (so every kind of step is taken), and the iterates must be those without it.
+  std::mt19937 rng(29);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (int n : {12, 60}) {
+    const BoxProblem p = random_problem(n, rng);
+    Eigen::MatrixXd L(3, n);
+    for (Eigen::Index i = 0; i < L.size(); ++i) L.data()[i] = normal(rng);
+    Eigen::VectorXd last;
+    linalg::BoundQp qp;
+    qp.apply = [&](const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+      y = p.A * x;
+      last = L * x;
+      return false;
+    };
+    qp.image = [&]() -> const Eigen::VectorXd& { return last; };
+    qp.b = p.b;
+    qp.lower = p.l;
+    qp.upper = p.u;
+    linalg::MprgpSettings settings;
+    settings.alpha_bar = 1.9 / p.A.selfadjointView<Eigen::Lower>().eigenvalues().maxCoeff();
+    const double scale = p.b.norm();
+    double worst = 0.0;
+    int tests = 0;
+    const auto r = linalg::solve_mprgp(qp, Eigen::VectorXd::Zero(n), settings, [&](const linalg::MprgpResult& s) {
+      const Eigen::VectorXd exact = L * s.x;
+      worst = std::max(worst, (s.image - exact).norm() / std::max(1.0, L.norm() * s.x.norm()));
+      ++tests;
+      return s.projected_gradient <= 1e-13 * scale;
+    });
+    ASSERT_TRUE(r.converged) << n;
+    EXPECT_GT(r.cg_steps, 0);
+    EXPECT_GT(r.expansion_steps + r.proportioning_steps, 0) << n;
+    EXPECT_EQ(tests, r.cg_steps + r.expansion_steps + r.proportioning_steps + 1);
+    EXPECT_LE(worst, 1e-12) << n;
+    const auto plain = solve(p, false, true, Eigen::VectorXd::Zero(n));
+    EXPECT_EQ(plain.iterations, r.iterations) << n;
+    EXPECT_EQ((plain.x - r.x).cwiseAbs().maxCoeff(), 0.0) << n;
   }
 }

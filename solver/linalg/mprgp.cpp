@@ -71,16 +71,27 @@ class Mprgp {
     return stop;
   }
 
+  // A v, and L v in Lv_ when the problem tracks an image.
   bool product(const Eigen::VectorXd& v, Eigen::VectorXd& Av) {
     ++out_.iterations;
-    return qp_.apply(v, Av);
+    const bool stop = qp_.apply(v, Av);
+    if (qp_.image) Lv_ = qp_.image();
+    return stop;
   }
 
-  // Restart: the gradient from scratch and the direction from the free gradient.
+  // x -= alpha d and g -= alpha A d, with L x alongside (Lv_ = L d, from d's product).
+  void step(double alpha, const Eigen::VectorXd& d, const Eigen::VectorXd& Ad) {
+    out_.x -= alpha * d;
+    out_.gradient -= alpha * Ad;
+    if (qp_.image) out_.image -= alpha * Lv_;
+  }
+
+  // Restart: the gradient (and the image) from scratch and the direction from the free gradient.
   bool restart() {
     Eigen::VectorXd Ax;
     if (product(out_.x, Ax)) return true;
     out_.gradient = Ax - qp_.b;
+    if (qp_.image) out_.image = Lv_;
     return search_direction(p_);
   }
 
@@ -95,8 +106,7 @@ class Mprgp {
     const double alpha_f = feasible_step(out_.x, p_, box_, blocking);
     if (alpha_cg <= alpha_f) {
       ++out_.cg_steps;
-      out_.x -= alpha_cg * p_;
-      out_.gradient -= alpha_cg * Ap;
+      step(alpha_cg, p_, Ap);
       Eigen::VectorXd z;
       if (search_direction(z)) return true;
       const double beta = z.dot(Ap) / pAp;
@@ -105,7 +115,7 @@ class Mprgp {
     }
     ++out_.expansion_steps;
     out_.x -= alpha_f * p_;
-    out_.gradient -= alpha_f * Ap;
+    out_.gradient -= alpha_f * Ap;  // x's image: from the restart's product below
     // The blocking unknown lands on its bound exactly (the step's rounding could leave it a hair inside, free).
     out_.x[blocking] = p_[blocking] > 0 ? qp_.lower[blocking] : box_.u[blocking];
     const Eigen::VectorXd phi = free_gradient(out_.x, out_.gradient, box_);
@@ -124,9 +134,9 @@ class Mprgp {
     Eigen::Index blocking = -1;
     const double alpha_f = feasible_step(out_.x, beta, box_, blocking);
     const double alpha = std::min(out_.gradient.dot(beta) / dAd, alpha_f);
-    out_.x -= alpha * beta;
+    step(alpha, beta, Ad);
+    // (The blocking unknown set exactly on its bound moves it by rounding only: the image stays as it is.)
     if (alpha == alpha_f) out_.x[blocking] = beta[blocking] > 0 ? qp_.lower[blocking] : box_.u[blocking];
-    out_.gradient -= alpha * Ad;
     return search_direction(p_);
   }
 
@@ -145,6 +155,7 @@ class Mprgp {
   MprgpResult& out_;
   const Box box_;
   Eigen::VectorXd p_;
+  Eigen::VectorXd Lv_;  // the image of the vector of the last product
 };
 
 }  // namespace
@@ -156,7 +167,7 @@ Eigen::VectorXd projected_gradient(const Eigen::VectorXd& x, const Eigen::Vector
 }
 
 MprgpResult solve_mprgp(const BoundQp& qp, const Eigen::VectorXd& x0, const MprgpSettings& settings,
-                        const std::function<bool(const Eigen::VectorXd&, const Eigen::VectorXd&, double)>& done) {
+                        const std::function<bool(const MprgpResult& state)>& done) {
   MprgpResult out;
   Mprgp method(qp, settings, out);
   out.x = method.box().project(x0);
@@ -167,7 +178,7 @@ MprgpResult solve_mprgp(const BoundQp& qp, const Eigen::VectorXd& x0, const Mprg
   for (;;) {
     const Box& box = method.box();
     out.projected_gradient = (free_gradient(out.x, out.gradient, box) + chopped_gradient(out.x, out.gradient, box)).norm();
-    if (done(out.x, out.gradient, out.projected_gradient)) {
+    if (done(out)) {
       out.converged = true;
       return out;
     }

@@ -36,6 +36,11 @@ struct BoundQp {
   std::function<bool(const Eigen::VectorXd& r, Eigen::VectorXd& y)> precondition;
   Eigen::VectorXd b, lower;
   Eigen::VectorXd upper;  // empty: no upper bounds (+inf); entries may be +inf
+  // Optional: the image L v, under a linear map L that `apply` computes on its way, of the vector last passed to
+  // `apply` (SMALBE: the range part Q v, which its stopping test needs of every iterate). MPRGP then carries
+  // L x along with x through its steps (MprgpResult::image: exact after a restart, updated like x in between, so
+  // off by rounding only), and the stopping test costs no application of L of its own.
+  std::function<const Eigen::VectorXd&()> image;
 };
 
 struct MprgpSettings {
@@ -46,16 +51,17 @@ struct MprgpSettings {
 
 struct MprgpResult {
   Eigen::VectorXd x, gradient;  // the last iterate and its gradient A x - b
+  Eigen::VectorXd image;            // L x when the problem gives `image`, else empty
   double projected_gradient = 0.0;  // ||g^P(x)||
   long iterations = 0;          // products with A
   long cg_steps = 0, expansion_steps = 0, proportioning_steps = 0;
   bool converged = false, cancelled = false;
 };
 
-// Starts from x0 (projected onto the box) and stops when `done(x, g, ||g^P||)` says so (converged), after
-// max_iterations, or when a product asks to stop.
+// Starts from x0 (projected onto the box) and stops when `done(state)` says so (converged), after max_iterations,
+// or when a product asks to stop. `done` sees the current x, gradient, projected gradient's norm and image.
 MprgpResult solve_mprgp(const BoundQp& qp, const Eigen::VectorXd& x0, const MprgpSettings& settings,
-                        const std::function<bool(const Eigen::VectorXd& x, const Eigen::VectorXd& g, double norm_gp)>& done);
+                        const std::function<bool(const MprgpResult& state)>& done);
 
 // The projected gradient g^P of x (free gradient plus chopped gradient); `upper` empty: no upper bounds.
 Eigen::VectorXd projected_gradient(const Eigen::VectorXd& x, const Eigen::VectorXd& g, const Eigen::VectorXd& lower,

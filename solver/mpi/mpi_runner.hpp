@@ -29,6 +29,7 @@ class MpiTaskRunner final : public parallel::TaskRunner {
   void run_bodies(const std::vector<size_t>& bodies, const std::function<void(size_t)>& task,
                   const parallel::BodyShare& share) override;
   using parallel::TaskRunner::run_bodies;
+  unsigned concurrency() const override { return local_.concurrency(); }
   bool owns(size_t body) const override { return owner_.at(body) == rank_; }
   bool distributed() const override { return size_ > 1; }
   bool is_root() const override { return rank_ == 0; }

@@ -27,6 +27,9 @@ class TaskRunner {
                           const BodyShare& share);
   void run_bodies(size_t n_bodies, const std::function<void(size_t)>& task, const BodyShare& share);
 
+  // How many tasks of one run() this process runs at once (its threads).
+  virtual unsigned concurrency() const { return 1; }
+
   // Whether this process owns body a (holds its matrices, runs its tasks).
   virtual bool owns(size_t /*body*/) const { return true; }
   // Whether other processes take part (bodies they own have no matrices here).
@@ -54,6 +57,7 @@ class ThreadTaskRunner final : public TaskRunner {
   ThreadTaskRunner& operator=(const ThreadTaskRunner&) = delete;
   void run(size_t n, const std::function<void(size_t)>& task) override;
   unsigned threads() const { return static_cast<unsigned>(workers_.size()) + 1; }
+  unsigned concurrency() const override { return threads(); }
 
  private:
   void work_loop();

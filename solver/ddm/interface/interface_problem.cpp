@@ -1,6 +1,7 @@
 #include "interface_problem.hpp"
 #include "../../common/assert.hpp"
 
+#include <numeric>
 #include <stdexcept>
 
 namespace contact::ddm {
@@ -205,18 +206,45 @@ SparseMatrix InterfaceProblem::assemble() const {
 
 bool InterfaceProblem::apply_blocks(const Eigen::VectorXd& x, Eigen::VectorXd& y, parallel::TaskRunner& runner,
                                     bool preconditioner) const {
-  y = Eigen::VectorXd::Zero(size());
-  Eigen::VectorXd local, product;
+  const auto matrix = [&](size_t a) -> const Eigen::MatrixXd& {
+    return preconditioner ? blocks_[a].preconditioner : blocks_[a].F;
+  };
+  std::vector<size_t> mine;  // the blocks this process applies, and their cost (entries read)
+  std::vector<double> cost;
   for (size_t a = 0; a < blocks_.size(); ++a) {
-    const Block& b = blocks_[a];
-    const Eigen::MatrixXd& X = preconditioner ? b.preconditioner : b.F;
-    if (X.rows() == 0 || (!options_.replicate_blocks && !runner.owns(a))) continue;
-    const Eigen::Index k = static_cast<Eigen::Index>(b.rows.size());
-    local.resize(k);
-    for (Eigen::Index i = 0; i < k; ++i) local[i] = x[b.rows[static_cast<size_t>(i)]];
-    product.noalias() = X.selfadjointView<Eigen::Lower>() * local;
-    for (Eigen::Index i = 0; i < k; ++i) y[b.rows[static_cast<size_t>(i)]] += product[i];
+    if (matrix(a).rows() == 0 || (!options_.replicate_blocks && !runner.owns(a))) continue;
+    mine.push_back(a);
+    cost.push_back(0.5 * static_cast<double>(matrix(a).rows() * matrix(a).rows()));
   }
+  // Each of the process's threads applies a contiguous run of blocks of about equal cost into a vector of its own
+  // (blocks share rows: a contact row belongs to its slave's and its master's block); the vectors are summed. On a
+  // wall of thousands of bricks this product is a third of the iterative solver's time, and reading the blocks is
+  // what costs (26 MB at 64 x 64 bricks), so 64 blocks (about 0.1 ms of work) per thread is the least worth a thread's wake-up.
+  const size_t chunks = std::max<size_t>(1, std::min<size_t>(runner.concurrency(), mine.size() / 64));
+  std::vector<size_t> first(chunks + 1, mine.size());
+  first[0] = 0;
+  const double total = std::accumulate(cost.begin(), cost.end(), 0.0);
+  double sum = 0.0;
+  for (size_t i = 0, c = 1; i < mine.size() && c < chunks; ++i) {
+    sum += cost[i];
+    while (c < chunks && sum >= total * static_cast<double>(c) / static_cast<double>(chunks)) first[c++] = i + 1;
+  }
+  std::vector<Eigen::VectorXd> part(chunks);
+  runner.run(chunks, [&](size_t c) {
+    Eigen::VectorXd& out = part[c];
+    out = Eigen::VectorXd::Zero(size());
+    Eigen::VectorXd local, product;
+    for (size_t i = first[c]; i < first[c + 1]; ++i) {
+      const Block& b = blocks_[mine[i]];
+      const Eigen::Index k = static_cast<Eigen::Index>(b.rows.size());
+      local.resize(k);
+      for (Eigen::Index j = 0; j < k; ++j) local[j] = x[b.rows[static_cast<size_t>(j)]];
+      product.noalias() = matrix(mine[i]).selfadjointView<Eigen::Lower>() * local;
+      for (Eigen::Index j = 0; j < k; ++j) out[b.rows[static_cast<size_t>(j)]] += product[j];
+    }
+  });
+  y = std::move(part[0]);
+  for (size_t c = 1; c < chunks; ++c) y += part[c];
   // Replicated blocks: every process has the whole product already (the sum would count it once per process);
   // the sum still runs, on zeros, to carry the cancel requests at the same point on every process.
   if (options_.replicate_blocks && runner.distributed()) {

@@ -63,6 +63,7 @@ class Smalbe {
   CoarseSpace coarse_;
   const Eigen::Index m_;
   Eigen::VectorXd z_I_, Pc_, diagonal_, nu_, last_z_;
+  Eigen::VectorXd range_;  // Q x of the last x apply_A took
   double rho_ = 1.0, norm_A_ = 1.0, norm_PHP_ = 1.0;
   double seconds_F_ = 0.0, seconds_coarse_ = 0.0;  // products with F (and their sum over processes), P and Q
   bool ready_ = false;
