@@ -14,6 +14,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <system_error>
 
 namespace contact::io {
 
@@ -471,10 +472,25 @@ struct ResultStream::Open {
 ResultStream::ResultStream(std::string path, std::string xmf_path, std::string hdf_name_in_xmf)
     : path_(std::move(path)), xmf_path_(std::move(xmf_path)), xmf_hdf_name_(std::move(hdf_name_in_xmf)) {}
 
-ResultStream::~ResultStream() = default;  // an unfinished file is removed (PendingFile)
+ResultStream::~ResultStream() { wait(); }  // then an unfinished file is removed (PendingFile)
+
+void ResultStream::wait() {
+  if (writer_.joinable()) writer_.join();
+}
 
 void ResultStream::take(const Step& step) {
+  wait();
   if (!error_.empty() || finished_) return;  // already failed: the error is thrown by finish
+  // The writer's own copy: the run moves on (and replaces its step) while the copy is written.
+  auto copy = std::make_shared<const Step>(step);
+  try {
+    writer_ = std::thread([this, copy] { write_taken(*copy); });
+  } catch (const std::system_error&) {  // no thread to be had: write it here
+    write_taken(*copy);
+  }
+}
+
+void ResultStream::write_taken(const Step& step) {
   try {
     h5::QuietErrors quiet;
     if (!open_) {
@@ -488,10 +504,14 @@ void ResultStream::take(const Step& step) {
   } catch (const std::exception& e) {
     error_ = "cannot write result file '" + path_ + "': " + e.what();
     open_.reset();  // removes the partial file: the space it took may be what the disk lacks
+  } catch (...) {
+    error_ = "cannot write result file '" + path_ + "': an unknown error";
+    open_.reset();
   }
 }
 
 void ResultStream::finish(const Problem& problem, const Result& result, const WriteInfo& info) {
+  wait();
   if (finished_) throw std::runtime_error("result file '" + path_ + "' finished twice");
   finished_ = true;
   if (!error_.empty()) throw std::runtime_error(error_);
@@ -521,6 +541,7 @@ void ResultStream::finish(const Problem& problem, const Result& result, const Wr
 }
 
 void ResultStream::abandon() {
+  wait();
   finished_ = true;
   open_.reset();
 }

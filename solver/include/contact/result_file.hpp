@@ -17,6 +17,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace contact::io {
@@ -50,6 +51,12 @@ void write_xdmf(const std::string& xmf_path, const std::string& hdf_file_name, c
 // Result::streamed_steps); finish() writes the rest when the run ends. The file is built under "<path>.tmp" and
 // renamed over `path` by finish() only: a crash, an error or abandon() (and destruction before finish) never leave
 // a partial file under the final name. Not thread safe: one run feeds it, from one thread.
+//
+// A step is written on a thread of the stream's own while the run goes on to the next step (the HDF5 calls are
+// serialised by the library): on a wall of thousands of bricks a step's 200,000 small datasets take seconds,
+// as long as a load step's solve. One write at a time: take() first waits for the previous one, so at most one
+// step besides the run's current one is in memory; finish(), abandon(), steps_taken() and the destructor wait for
+// the write in flight.
 class ResultStream : public StepSink {
  public:
   // `hdf_name_in_xmf`: the result file as the sidecar names it (normally its bare file name).
@@ -68,10 +75,16 @@ class ResultStream : public StepSink {
   void finish(const Problem& problem, const Result& result, const WriteInfo& info = {});
   // No result after all (nothing held, the run refused): the partial file is removed.
   void abandon();
-  std::size_t steps_taken() const { return taken_; }
+  std::size_t steps_taken() {
+    wait();
+    return taken_;
+  }
 
  private:
   struct Open;
+  void wait();                          // for the write in flight
+  void write_taken(const Step& step);  // on the writer thread (or here when no thread can be started)
+  std::thread writer_;
   std::string path_, xmf_path_, xmf_hdf_name_;
   std::unique_ptr<Open> open_;
   std::size_t taken_ = 0;
