@@ -47,7 +47,7 @@ void write_xdmf(const std::string& xmf_path, const std::string& hdf_file_name, c
 
 // The result file and its XDMF sidecar written as the run goes: handed to solve() as the observer's StepSink
 // (Observer::step_sink), it writes each step's fields (/steps/<k>) when the solver reaches it, so that a job
-// that keeps every step holds one step in memory, not all (solve() then returns the last step only,
+// that keeps every step holds one step in memory (two while one is written, below), not all (solve() then returns the last step only,
 // Result::streamed_steps); finish() writes the rest when the run ends. The file is built under "<path>.tmp" and
 // renamed over `path` by finish() only: a crash, an error or abandon() (and destruction before finish) never leave
 // a partial file under the final name. Not thread safe: one run feeds it, from one thread.
