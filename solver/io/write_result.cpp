@@ -14,6 +14,8 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <memory>
+#include <new>
 #include <system_error>
 
 namespace contact::io {
@@ -482,7 +484,13 @@ void ResultStream::take(const Step& step) {
   wait();
   if (!error_.empty() || finished_) return;  // already failed: the error is thrown by finish
   // The writer's own copy: the run moves on (and replaces its step) while the copy is written.
-  auto copy = std::make_shared<const Step>(step);
+  std::shared_ptr<const Step> copy;
+  try {
+    copy = std::make_shared<const Step>(step);
+  } catch (const std::bad_alloc&) {  // no memory for a copy: write the run's step here, as before the thread
+    write_taken(step);
+    return;
+  }
   try {
     writer_ = std::thread([this, copy] { write_taken(*copy); });
   } catch (const std::system_error&) {  // no thread to be had: write it here
