@@ -204,47 +204,56 @@ SparseMatrix InterfaceProblem::assemble() const {
   return F;
 }
 
-bool InterfaceProblem::apply_blocks(const Eigen::VectorXd& x, Eigen::VectorXd& y, parallel::TaskRunner& runner,
-                                    bool preconditioner) const {
+InterfaceProblem::Split& InterfaceProblem::split(parallel::TaskRunner& runner, bool preconditioner) const {
+  Split& s = split_[preconditioner ? 1 : 0];
+  if (s.runner == &runner && s.concurrency == runner.concurrency()) return s;
   const auto matrix = [&](size_t a) -> const Eigen::MatrixXd& {
     return preconditioner ? blocks_[a].preconditioner : blocks_[a].F;
   };
-  std::vector<size_t> mine;  // the blocks this process applies, and their cost (entries read)
-  std::vector<double> cost;
+  s = Split{&runner, runner.concurrency(), {}, {}, {}};
+  std::vector<double> cost;  // entries read
   for (size_t a = 0; a < blocks_.size(); ++a) {
     if (matrix(a).rows() == 0 || (!options_.replicate_blocks && !runner.owns(a))) continue;
-    mine.push_back(a);
+    s.blocks.push_back(a);
     cost.push_back(0.5 * static_cast<double>(matrix(a).rows() * matrix(a).rows()));
   }
   // Each of the process's threads applies a contiguous run of blocks of about equal cost into a vector of its own
   // (blocks share rows: a contact row belongs to its slave's and its master's block); the vectors are summed. On a
   // wall of thousands of bricks this product is a third of the iterative solver's time, and reading the blocks is
-  // what costs (26 MB at 64 x 64 bricks), so 64 blocks (about 0.1 ms of work) per thread is the least worth a thread's wake-up.
-  const size_t chunks = std::max<size_t>(1, std::min<size_t>(runner.concurrency(), mine.size() / 64));
-  std::vector<size_t> first(chunks + 1, mine.size());
-  first[0] = 0;
+  // what costs (26 MB at 64 x 64 bricks), so 64 blocks (about 0.1 ms of work) per thread is the least worth a
+  // thread's wake-up.
+  const size_t chunks = std::max<size_t>(1, std::min<size_t>(runner.concurrency(), s.blocks.size() / 64));
+  s.first.assign(chunks + 1, s.blocks.size());
+  s.first[0] = 0;
   const double total = std::accumulate(cost.begin(), cost.end(), 0.0);
   double sum = 0.0;
-  for (size_t i = 0, c = 1; i < mine.size() && c < chunks; ++i) {
+  for (size_t i = 0, c = 1; i < s.blocks.size() && c < chunks; ++i) {
     sum += cost[i];
-    while (c < chunks && sum >= total * static_cast<double>(c) / static_cast<double>(chunks)) first[c++] = i + 1;
+    while (c < chunks && sum >= total * static_cast<double>(c) / static_cast<double>(chunks)) s.first[c++] = i + 1;
   }
-  std::vector<Eigen::VectorXd> part(chunks);
-  runner.run(chunks, [&](size_t c) {
-    Eigen::VectorXd& out = part[c];
-    out = Eigen::VectorXd::Zero(size());
+  s.parts.assign(chunks, Eigen::VectorXd(size()));
+  return s;
+}
+
+bool InterfaceProblem::apply_blocks(const Eigen::VectorXd& x, Eigen::VectorXd& y, parallel::TaskRunner& runner,
+                                    bool preconditioner) const {
+  Split& s = split(runner, preconditioner);
+  runner.run(s.parts.size(), [&](size_t c) {
+    Eigen::VectorXd& out = s.parts[c];
+    out.setZero();
     Eigen::VectorXd local, product;
-    for (size_t i = first[c]; i < first[c + 1]; ++i) {
-      const Block& b = blocks_[mine[i]];
+    for (size_t i = s.first[c]; i < s.first[c + 1]; ++i) {
+      const Block& b = blocks_[s.blocks[i]];
+      const Eigen::MatrixXd& X = preconditioner ? b.preconditioner : b.F;
       const Eigen::Index k = static_cast<Eigen::Index>(b.rows.size());
       local.resize(k);
       for (Eigen::Index j = 0; j < k; ++j) local[j] = x[b.rows[static_cast<size_t>(j)]];
-      product.noalias() = matrix(mine[i]).selfadjointView<Eigen::Lower>() * local;
+      product.noalias() = X.selfadjointView<Eigen::Lower>() * local;
       for (Eigen::Index j = 0; j < k; ++j) out[b.rows[static_cast<size_t>(j)]] += product[j];
     }
   });
-  y = std::move(part[0]);
-  for (size_t c = 1; c < chunks; ++c) y += part[c];
+  y = s.parts[0];
+  for (size_t c = 1; c < s.parts.size(); ++c) y += s.parts[c];
   // Replicated blocks: every process has the whole product already (the sum would count it once per process);
   // the sum still runs, on zeros, to carry the cancel requests at the same point on every process.
   if (options_.replicate_blocks && runner.distributed()) {

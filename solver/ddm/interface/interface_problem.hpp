@@ -108,6 +108,17 @@ class InterfaceProblem {
   void compute_body(size_t a, BodyParts& out) const;
   void assemble_equilibrium(const std::vector<BodyParts>& parts);
   bool apply_blocks(const Eigen::VectorXd& x, Eigen::VectorXd& y, parallel::TaskRunner& runner, bool preconditioner) const;
+  // apply_blocks' split of the blocks this process applies over its threads: runs [first[c], first[c + 1]) of
+  // `blocks`, and a vector per run to sum into. Made at the first product with a runner and kept (the products are
+  // the iterative solver's hot path: thousands per solve); one per kind (F, preconditioner). The products of one
+  // problem are not made concurrently (one solve drives them), so the cache needs no lock.
+  struct Split {
+    const parallel::TaskRunner* runner = nullptr;  // made for this runner with this many threads
+    unsigned concurrency = 0;
+    std::vector<size_t> blocks, first;
+    std::vector<Eigen::VectorXd> parts;
+  };
+  Split& split(parallel::TaskRunner& runner, bool preconditioner) const;
 
   const ContactSystem& system_;
   Options options_;
@@ -118,6 +129,7 @@ class InterfaceProblem {
   double factor_ = 1.0;
   std::vector<Floating> floating_;
   Equalities equilibrium_;
+  mutable Split split_[2];  // [0]: F, [1]: the preconditioner
 };
 
 }  // namespace contact::ddm
