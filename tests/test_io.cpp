@@ -13,6 +13,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <numeric>
 #include <regex>
 #include <sstream>
@@ -122,7 +123,7 @@ IterationReport report(int iteration, const Step& s) {
     PairReport pr;
     pr.name = p.name;
     pr.force = p.force * iteration;
-    pr.max_pressure = p.pressure.maxCoeff();
+    pr.max_pressure = p.pressure.size() > 0 ? p.pressure.maxCoeff() : 0.0;
     pr.extent_begin = 0.5;
     pr.extent_end = 1.5 + iteration;
     pr.active_nodes = p.active.sum();
@@ -275,7 +276,7 @@ TEST(ResultFile, ReadBackEqualsWhatWasWritten) {
 
   const io::ResultFile r = io::read_result(path.string());
   EXPECT_EQ(r.format, "contact-ddm-result");
-  EXPECT_EQ(r.format_version, 2);
+  EXPECT_EQ(r.format_version, 3);
   EXPECT_EQ(r.solver_version, CONTACT_VERSION);
   EXPECT_EQ(r.job_id, info.job_id);
   EXPECT_EQ(r.job_name, "fake");
@@ -605,6 +606,157 @@ TEST(ResultFile, ConcurrentWritersOfDifferentFilesDoNotInterfere) {
   for (const auto& e : errors) EXPECT_EQ(e, "");
 }
 
+TEST(ResultFile, PairsOfEveryKindRoundTripThroughTheStepsContactTables) {
+  // Three pairs in each step: the fixture's frictionless one, a Tresca pair on the same slave nodes with its own
+  // tangential fields, and a pair with no slave node at all. The tables (format version 3) hold them one after the
+  // other: the offsets count each pair's rows, `pair` names each row's pair, the segments index the tables' rows,
+  // and read_result gives back every pair's fields as written (a frictionless pair's friction fields empty).
+  Fixture f = make_fixture();
+  for (auto& s : f.result.steps) {
+    PairField tresca = s.pairs[0];
+    tresca.name = "tresca";
+    tresca.friction = "tresca";
+    tresca.friction_bound = 0.125;
+    const Eigen::Index n = tresca.position.rows();
+    tresca.tangent = Eigen::MatrixX2d(n, 2);
+    tresca.tangent.col(0).setConstant(1.0);
+    tresca.tangent.col(1).setZero();
+    tresca.tangential_traction = Eigen::VectorXd::LinSpaced(n, -0.125, 0.125);
+    tresca.slip = Eigen::VectorXd::LinSpaced(n, 0.0, 1e-3);
+    tresca.slip[0] = std::numeric_limits<double>::quiet_NaN();  // the crosspoint (status 2)
+    tresca.stick = Eigen::VectorXi::Ones(n);
+    tresca.stick[n - 1] = 0;
+    tresca.tangential_force = 0.0625;
+    tresca.resultant = Eigen::Vector2d(0.0625, tresca.force);
+    PairField empty = pair_field(s.bodies[0], 0.05);
+    empty.name = "empty";
+    for (auto* v : {&empty.arc_length, &empty.weight, &empty.gap, &empty.normal_gap, &empty.pressure, &empty.penetration})
+      v->resize(0);
+    empty.node.resize(0);
+    empty.active.resize(0);
+    empty.status.resize(0);
+    empty.position.resize(0, 2);
+    empty.normal.resize(0, 2);
+    empty.force = 0.0;
+    s.pairs.push_back(tresca);
+    s.pairs.push_back(empty);
+  }
+  f.result.history = {report(1, f.result.steps[0]), report(2, f.result.steps[1])};
+  const fs::path path = output_dir() / "pair_tables.hdf";
+  io::write_result(path.string(), f.problem, f.result);
+
+  const Eigen::Index n = f.result.steps[1].pairs[0].position.rows();
+  {
+    io::h5::Handle file = io::h5::open_file(path.string());
+    io::h5::Handle g = io::h5::open_group(file, "steps/1/contacts");
+    EXPECT_EQ(io::h5::read_vector<std::int64_t>(g, "offsets"), (std::vector<std::int64_t>{0, n, 2 * n, 2 * n}));
+    EXPECT_EQ(io::h5::read_vector<std::int64_t>(g, "segment_offsets"),
+              (std::vector<std::int64_t>{0, n - 1, 2 * n - 2, 2 * n - 2}));
+    const auto pair = io::h5::read_vector<std::int32_t>(g, "pair");
+    ASSERT_EQ(pair.size(), static_cast<size_t>(2 * n));
+    for (Eigen::Index j = 0; j < 2 * n; ++j) EXPECT_EQ(pair[static_cast<size_t>(j)], j < n ? 0 : 1);
+    std::vector<hsize_t> dims;
+    const auto segments = io::h5::read_dataset<std::int64_t>(g, "segments", 2, dims);
+    ASSERT_EQ(dims, (std::vector<hsize_t>{static_cast<hsize_t>(2 * n - 2), 2}));
+    EXPECT_EQ(segments[static_cast<size_t>(2 * (n - 1))], n);  // the Tresca pair's first segment: its own rows
+    EXPECT_EQ(io::h5::read_strings_dataset(g, "friction"), (std::vector<std::string>{"none", "tresca", "none"}));
+    // A frictionless pair's rows: no traction, no slip measured, not sticking.
+    const auto slip = io::h5::read_vector<double>(g, "slip");
+    EXPECT_TRUE(std::isnan(slip[1]));
+    EXPECT_EQ(io::h5::read_vector<double>(g, "tangential_traction")[1], 0.0);
+  }
+
+  const io::ResultFile r = io::read_result(path.string());
+  ASSERT_EQ(r.steps.size(), 2u);
+  for (size_t k = 0; k < 2; ++k) {
+    ASSERT_EQ(r.steps[k].pairs.size(), 3u);
+    for (size_t p = 0; p < 3; ++p) {
+      const PairField& g = r.steps[k].pairs[p];
+      const PairField& w = f.result.steps[k].pairs[p];
+      const std::string at = "step " + std::to_string(k) + " pair " + w.name + " ";
+      EXPECT_EQ(g.name, w.name);
+      EXPECT_EQ(g.slave_body + g.slave_edge + g.master_body + g.master_edge + g.enforcement,
+                w.slave_body + w.slave_edge + w.master_body + w.master_edge + w.enforcement);
+      EXPECT_EQ(g.theta, w.theta);
+      EXPECT_EQ(g.force, w.force);
+      EXPECT_EQ(g.resultant, w.resultant);
+      expect_same(g.node, w.node, at + "node");
+      expect_same(g.position, w.position, at + "position");
+      expect_same(g.normal, w.normal, at + "normal");
+      expect_same(g.arc_length, w.arc_length, at + "arc_length");
+      expect_same(g.weight, w.weight, at + "weight");
+      expect_same(g.status, w.status, at + "status");
+      expect_same(g.pressure, w.pressure, at + "pressure");
+      expect_same(g.active, w.active, at + "active");
+      EXPECT_EQ(g.friction, w.friction);
+      EXPECT_EQ(g.friction_bound, w.friction_bound);
+      EXPECT_EQ(g.tangential_force, w.tangential_force);
+      expect_same(g.tangent, w.tangent, at + "tangent");
+      expect_same(g.tangential_traction, w.tangential_traction, at + "tangential_traction");
+      expect_same(g.stick, w.stick, at + "stick");
+      ASSERT_EQ(g.slip.size(), w.slip.size()) << at;
+      EXPECT_TRUE(((g.slip.array() == w.slip.array()) || (g.slip.array().isNaN() && w.slip.array().isNaN())).all())
+          << at;
+    }
+  }
+}
+
+TEST(ResultFile, AVersion2FileReadsAsTheSameJobSolvedAndWrittenNow) {
+  // tests/data/result_format_v2.hdf: tests/data/result_format_v2.json (stack3 coarsened, Coulomb on one pair, the
+  // other frictionless, two load steps, the last kept) solved and written by commit 68ed5ab, the last writer of
+  // format version 2 (a group per pair). read_result reads it into what the same job gives now through the
+  // version 3 tables: the same pairs, the friction fields on the Coulomb pair only, the same values.
+  const std::string dir = std::string(CONTACT_SOURCE_DIR) + "/tests/data/";
+  const io::ResultFile old = io::read_result(dir + "result_format_v2.hdf");
+  EXPECT_EQ(old.format_version, 2);
+  std::ifstream in(dir + "result_format_v2.json");
+  const auto parsed = job::parse(nlohmann::json::parse(in));
+  ASSERT_TRUE(parsed.ok()) << job::format_errors(parsed.errors);
+  Observer quiet;
+  CancelToken cancel;
+  Result result = solve(*parsed.problem, quiet, cancel);
+  ASSERT_TRUE(result.converged) << result.message;
+  const fs::path hdf = output_dir() / "version3.hdf";
+  io::write_result(hdf.string(), *parsed.problem, result);
+  const io::ResultFile now = io::read_result(hdf.string());
+  ASSERT_EQ(old.steps.size(), 1u);
+  ASSERT_EQ(now.steps.size(), 1u);
+  const auto& a = old.steps[0].pairs;
+  const auto& b = now.steps[0].pairs;
+  ASSERT_EQ(a.size(), 2u);
+  ASSERT_EQ(b.size(), 2u);
+  auto close = [](const auto& x, const auto& y) {
+    return x.rows() == y.rows() && x.cols() == y.cols() &&
+           (x.size() == 0 || (x - y).cwiseAbs().maxCoeff() <= 1e-6 * std::max(1.0, y.cwiseAbs().maxCoeff()));
+  };
+  for (size_t p = 0; p < 2; ++p) {
+    const std::string at = "pair " + b[p].name;
+    EXPECT_EQ(a[p].name, b[p].name);
+    EXPECT_EQ(a[p].slave_body + a[p].slave_edge + a[p].master_body + a[p].master_edge,
+              b[p].slave_body + b[p].slave_edge + b[p].master_body + b[p].master_edge);
+    EXPECT_EQ(a[p].friction, b[p].friction) << at;
+    EXPECT_EQ(a[p].node, b[p].node) << at;
+    EXPECT_EQ(a[p].status, b[p].status) << at;
+    EXPECT_EQ(a[p].active, b[p].active) << at;
+    EXPECT_TRUE(close(a[p].position, b[p].position)) << at;
+    EXPECT_TRUE(close(a[p].weight, b[p].weight)) << at;
+    EXPECT_TRUE(close(a[p].pressure, b[p].pressure)) << at;
+    EXPECT_NEAR(a[p].force, b[p].force, 1e-6 * std::abs(b[p].force)) << at;
+    EXPECT_TRUE(close(a[p].resultant, b[p].resultant)) << at;
+    EXPECT_TRUE(close(a[p].tangential_traction, b[p].tangential_traction)) << at;
+    EXPECT_EQ(a[p].stick, b[p].stick) << at;
+    EXPECT_EQ(a[p].tangent.rows(), b[p].tangent.rows()) << at;
+  }
+  // One pair of each kind: the frictionless one's friction fields empty, the Coulomb one's present and sticking
+  // somewhere.
+  const PairField& coulomb = a[0].friction == "coulomb" ? a[0] : a[1];
+  const PairField& plain = a[0].friction == "coulomb" ? a[1] : a[0];
+  EXPECT_EQ(plain.friction, "none");
+  EXPECT_EQ(plain.tangential_traction.size(), 0);
+  EXPECT_EQ(coulomb.friction_coefficient, 0.3);
+  EXPECT_GT(coulomb.stick.sum(), 0);
+}
+
 TEST(Xdmf, SidecarIsWellFormedAndNamesEveryStepBodyAndContactSurface) {
   const Fixture f = make_fixture();
   const fs::path hdf = output_dir() / "sidecar.hdf";
@@ -628,14 +780,13 @@ TEST(Xdmf, SidecarIsWellFormedAndNamesEveryStepBodyAndContactSurface) {
       EXPECT_NE(text.find(base + "/von_mises</DataItem>"), std::string::npos) << base;
       EXPECT_NE(text.find(base + "/level</DataItem>"), std::string::npos) << base;
     }
-    // The contact surface of every pair: the slave polyline with pressure, gap and active.
-    for (const auto& p : f.result.steps[k].pairs) {
-      const std::string base = "sidecar.hdf:/steps/" + std::to_string(k) + "/contacts/" + p.name;
-      for (const char* array : {"/segments", "/position", "/pressure", "/normal_gap", "/active"})
-        EXPECT_NE(text.find(base + array + "</DataItem>"), std::string::npos) << base << array;
-    }
+    // The contact surfaces of all pairs as one grid: the slave polylines with pressure, gap, active and the pair.
+    const std::string base = "sidecar.hdf:/steps/" + std::to_string(k) + "/contacts";
+    for (const char* array : {"/segments", "/position", "/pressure", "/normal_gap", "/active", "/pair"})
+      EXPECT_NE(text.find(base + array + "</DataItem>"), std::string::npos) << base << array;
   }
   EXPECT_EQ(count(text, "TopologyType=\"Polyline\""), f.result.steps.size());
+  EXPECT_EQ(count(text, "<Grid Name=\"contacts\""), f.result.steps.size());
   EXPECT_EQ(count(text, "<Grid Name=\"upper\""), f.result.steps.size());
   EXPECT_EQ(count(text, "<Grid Name=\"lower\""), f.result.steps.size());
   EXPECT_EQ(count(text, "/indicator</DataItem>"), f.result.steps.size());  // lower body only

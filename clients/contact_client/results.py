@@ -5,7 +5,16 @@ import os
 
 from .errors import BadInput
 
-RESULT_FORMAT_VERSION = 2  # docs/results-format.md; 2: mortar contact (per-node multipliers, contact surfaces)
+RESULT_FORMAT_VERSION = 3  # docs/results-format.md; 2: mortar contact (per-node multipliers, contact surfaces);
+#                             3: a step's contact pairs as tables (/steps/<k>/contacts), read here into the same dicts
+
+# Format version 3's contact tables (/steps/<k>/contacts): per pair (P rows) and per slave node (N rows, the pairs'
+# nodes one after the other from offsets[p]); `segments` holds rows of the node tables. The friction columns of a
+# frictionless pair are not returned, as version 2 had none.
+_PAIR_COLUMNS = ("slave_body", "slave_edge", "master_body", "master_edge", "enforcement", "friction", "theta", "force",
+                 "resultant", "friction_coefficient", "friction_bound", "tangential_force")
+_FRICTION_ONLY = {"friction_coefficient", "friction_bound", "tangential_force", "tangent", "tangential_traction",
+                  "slip", "stick"}
 
 
 def _attr(value):
@@ -33,9 +42,10 @@ def _dataset(item):
 
 
 class ResultFile:
-    """A result file (docs/results-format.md) open for reading only what is asked: a wall of 496 bodies and 946
-    pairs kept for 2 steps holds some 45 000 datasets, and h5py takes about 0.25 ms for each, so reading all of
-    them (read_result) takes 11 s where a plot needs a tenth of them. Use it as a context manager:
+    """A result file (docs/results-format.md) open for reading only what is asked: a wall of 496 bodies kept for 2
+    steps holds some 13 000 body datasets, and h5py takes about 0.25 ms for each, where a plot needs a tenth of
+    them. A step's contact tables (format version 3) are read once each and sliced per pair. Use it as a context
+    manager:
 
         with ResultFile("wall.hdf") as f:
             last = f.step(f.count - 1)                       # {"step", "iteration", "load_factor", "body_names",
@@ -47,7 +57,9 @@ class ResultFile:
 
     def __init__(self, path):
         import h5py
+        self._h5py = h5py
         self.path = os.fspath(path)
+        self._tables, self._pair_index = {}, {}
         self._f = h5py.File(self.path, "r")
         try:
             self.attrs = {k: _attr(v) for k, v in self._f.attrs.items()}
@@ -99,12 +111,55 @@ class ResultFile:
 
     def pair(self, k, name, keys=None):
         """Pair `name` of step group k: {dataset: array} for the datasets `keys` it has (None: all), its
-        attributes under "attrs", and "x" (the slave nodes' x) when "position" is read."""
-        g = self._group(k)["contacts"][name]
-        out = {key: _dataset(g[key]) for key in (g.keys() if keys is None else keys) if key in g}
-        out["attrs"] = {a: _attr(v) for a, v in g.attrs.items()}
+        attributes under "attrs", and "x" (the slave nodes' x) when "position" is read. The same dict from a
+        version 3 file (the step's contact tables: `segments` then count the pair's own rows, as in version 2) as
+        from a version 2 file (a group per pair)."""
+        contacts = self._group(k)["contacts"]
+        if "offsets" in contacts and isinstance(contacts["offsets"], self._h5py.Dataset):
+            out = self._table_pair(k, contacts, name, keys)
+        else:
+            g = contacts[name]
+            out = {key: _dataset(g[key]) for key in (g.keys() if keys is None else keys) if key in g}
+            out["attrs"] = {a: _attr(v) for a, v in g.attrs.items()}
         if "position" in out and len(out["position"]):
             out["x"] = out["position"][:, 0]
+        return out
+
+    def _table(self, k, contacts, key):
+        """A whole table of step group k's contacts, read once (a plot of every pair reads each table once)."""
+        cache = self._tables.setdefault(k, {})
+        if key not in cache:
+            cache[key] = _dataset(contacts[key])
+        return cache[key]
+
+    def _table_pair(self, k, contacts, name, keys):
+        names = self._pair_index.get(k)
+        if names is None:
+            names = self._pair_index[k] = {n: p for p, n in enumerate(self.step(k)["pair_names"])}
+        if name not in names:
+            raise KeyError(f"step {k} has no contact pair {name!r}")
+        p = names[name]
+        frictional = self._table(k, contacts, "friction")[p] != "none"
+        attrs = {}
+        for key in _PAIR_COLUMNS:
+            if key in contacts and (frictional or key not in _FRICTION_ONLY):
+                v = self._table(k, contacts, key)[p]
+                attrs[key] = v if isinstance(v, str) else _attr(v)
+        offsets = self._table(k, contacts, "offsets")
+        begin, end = int(offsets[p]), int(offsets[p + 1])
+        per_node = [key for key, item in contacts.items()
+                    if isinstance(item, self._h5py.Dataset) and key not in _PAIR_COLUMNS
+                    and key not in ("offsets", "segment_offsets", "pair")]
+        out = {}
+        for key in (per_node if keys is None else keys):
+            if key not in per_node or (key in _FRICTION_ONLY and not frictional):
+                continue
+            if key == "segments":
+                s_off = self._table(k, contacts, "segment_offsets")
+                out[key] = self._table(k, contacts, key)[int(s_off[p]):int(s_off[p + 1])] - begin
+            else:
+                out[key] = self._table(k, contacts, key)[begin:end]
+        out["attrs"] = attrs
         return out
 
     def history(self, name):

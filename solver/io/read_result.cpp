@@ -1,6 +1,7 @@
 // read_result: HDF5 result file -> ResultFile (the inverse of write_result, for tests and tools).
 #include "contact/result_file.hpp"
 
+#include "contact_tables.hpp"
 #include "h5.hpp"
 
 #include <stdexcept>
@@ -179,45 +180,6 @@ BodyField read_body(hid_t bodies, const std::string& name) {
   return b;
 }
 
-PairField read_pair(hid_t contacts, const std::string& name) {
-  Handle g = h5::open_group(contacts, name);
-  PairField p;
-  p.name = name;
-  p.slave_body = h5::read_string_attribute(g, "slave_body");
-  p.slave_edge = h5::read_string_attribute(g, "slave_edge");
-  p.master_body = h5::read_string_attribute(g, "master_body");
-  p.master_edge = h5::read_string_attribute(g, "master_edge");
-  p.enforcement = h5::read_string_attribute(g, "enforcement");
-  p.theta = h5::read_attribute<double>(g, "theta");
-  p.force = h5::read_attribute<double>(g, "force");
-  if (h5::has_attribute(g, "resultant")) {
-    const auto r = h5::read_attribute_array<double>(g, "resultant");
-    if (r.size() == 2) p.resultant = Eigen::Vector2d(r[0], r[1]);
-  }
-  p.node = read_column<int>(g, "node");
-  p.position = read_matrix<double>(g, "position", 2);
-  p.normal = read_matrix<double>(g, "normal", 2);
-  p.arc_length = read_column<double>(g, "arc_length");
-  p.weight = read_column<double>(g, "weight");
-  p.gap = read_column<double>(g, "gap");
-  p.normal_gap = read_column<double>(g, "normal_gap");
-  p.pressure = read_column<double>(g, "pressure");
-  p.penetration = read_column<double>(g, "penetration");
-  p.active = read_column<int>(g, "active");
-  p.status = read_column<int>(g, "status");
-  if (h5::has_attribute(g, "friction")) p.friction = h5::read_string_attribute(g, "friction");  // (older files: none)
-  if (p.friction != "none") {
-    p.friction_coefficient = h5::read_attribute<double>(g, "friction_coefficient");
-    p.friction_bound = h5::read_attribute<double>(g, "friction_bound");
-    p.tangential_force = h5::read_attribute<double>(g, "tangential_force");
-    p.tangent = read_matrix<double>(g, "tangent", 2);
-    p.tangential_traction = read_column<double>(g, "tangential_traction");
-    p.slip = read_column<double>(g, "slip");
-    p.stick = read_column<int>(g, "stick");
-  }
-  return p;
-}
-
 void read_steps(hid_t file, ResultFile& r) {
   Handle steps = h5::open_group(file, "steps");
   const int count = h5::read_attribute<std::int32_t>(steps, "count");
@@ -231,7 +193,7 @@ void read_steps(hid_t file, ResultFile& r) {
     Handle bodies = h5::open_group(g, "bodies");
     for (const auto& name : h5::read_strings_attribute(g, "body_names")) s.bodies.push_back(read_body(bodies, name));
     Handle contacts = h5::open_group(g, "contacts");
-    for (const auto& name : h5::read_strings_attribute(g, "pair_names")) s.pairs.push_back(read_pair(contacts, name));
+    s.pairs = read_contact_tables(contacts, h5::read_strings_attribute(g, "pair_names"), r.format_version);
     r.steps.push_back(std::move(s));
   }
 }

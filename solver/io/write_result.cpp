@@ -9,6 +9,7 @@
 #include "contact/files.hpp"
 #include "h5.hpp"
 #include "h5_eigen.hpp"
+#include "contact_tables.hpp"
 #include "vtkhdf.hpp"
 
 #include <cmath>
@@ -332,67 +333,6 @@ void write_body(hid_t bodies, const BodyField& b, const std::string& where) {
   }
 }
 
-void write_pair(hid_t contacts, const PairField& p, bool closed, const std::string& where) {
-  check_link_name("contact pair", p.name);
-  const Eigen::Index n = p.position.rows();
-  const std::string at = where + " pair '" + p.name + "': ";
-  auto same = [&](const std::string& what, Eigen::Index rows) {
-    if (rows != n)
-      throw std::runtime_error(at + what + " has " + rows_text(rows) + " rows, position has " + rows_text(n));
-  };
-  same("node", p.node.rows());
-  same("normal", p.normal.rows());
-  same("arc_length", p.arc_length.rows());
-  same("weight", p.weight.rows());
-  same("gap", p.gap.rows());
-  same("normal_gap", p.normal_gap.rows());
-  same("pressure", p.pressure.rows());
-  same("penetration", p.penetration.rows());
-  same("active", p.active.rows());
-  same("status", p.status.rows());
-  const bool friction = p.friction != "none";
-  if (friction) {
-    same("tangent", p.tangent.rows());
-    same("tangential_traction", p.tangential_traction.rows());
-    same("slip", p.slip.rows());
-    same("stick", p.stick.rows());
-  }
-
-  Handle g = h5::create_group(contacts, p.name);
-  h5::write_attribute(g, "slave_body", p.slave_body);
-  h5::write_attribute(g, "slave_edge", p.slave_edge);
-  h5::write_attribute(g, "master_body", p.master_body);
-  h5::write_attribute(g, "master_edge", p.master_edge);
-  h5::write_attribute(g, "enforcement", p.enforcement);
-  h5::write_attribute<double>(g, "theta", p.theta);
-  h5::write_attribute<double>(g, "force", p.force);
-  h5::write_attribute_array<double>(g, "resultant", {p.resultant.x(), p.resultant.y()});
-  write_column(g, "node", p.node.cast<std::int64_t>().eval());
-  write_matrix(g, "position", p.position);
-  write_matrix(g, "normal", p.normal);
-  write_column(g, "arc_length", p.arc_length);
-  write_column(g, "weight", p.weight);
-  write_column(g, "gap", p.gap);
-  write_column(g, "normal_gap", p.normal_gap);
-  write_column(g, "pressure", p.pressure);
-  write_column(g, "penetration", p.penetration);
-  write_column(g, "active", p.active.cast<std::int8_t>().eval());
-  write_column(g, "status", p.status.cast<std::int8_t>().eval());
-  h5::write_attribute(g, "friction", p.friction);
-  if (friction) {
-    h5::write_attribute<double>(g, "friction_coefficient", p.friction_coefficient);
-    h5::write_attribute<double>(g, "friction_bound", p.friction_bound);
-    h5::write_attribute<double>(g, "tangential_force", p.tangential_force);
-    write_matrix(g, "tangent", p.tangent);
-    write_column(g, "tangential_traction", p.tangential_traction);
-    write_column(g, "slip", p.slip);
-    write_column(g, "stick", p.stick.cast<std::int8_t>().eval());
-  }
-  // The slave polyline as line cells (rows of position), for the XDMF view of the contact surface; a closed
-  // slave edge's closes the loop.
-  write_matrix(g, "segments", pair_segments(n, closed));
-}
-
 // One step's fields as /steps/<k>; `row` is its row in /history/steps.
 void write_step(hid_t steps, const Step& s, size_t k, size_t row) {
   const std::string where = "step " + std::to_string(k);
@@ -405,8 +345,7 @@ void write_step(hid_t steps, const Step& s, size_t k, size_t row) {
   h5::write_attribute(g, "pair_names", pair_names_of(s));
   Handle bodies = h5::create_group(g, "bodies");
   for (const auto& b : s.bodies) write_body(bodies, b, where);
-  Handle contacts = h5::create_group(g, "contacts");
-  for (const auto& p : s.pairs) write_pair(contacts, p, slave_is_closed(s, p), where);
+  write_contact_tables(g, s, where);
 }
 
 void check_kept_steps(std::size_t kept, std::size_t history_rows) {

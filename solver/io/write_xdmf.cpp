@@ -1,5 +1,5 @@
 // write_xdmf: the XDMF 3 sidecar that lets ParaView step through /steps/<k> of a result file: per step one grid
-// per body and one per contact pair (the slave polyline with pressure, gap and active).
+// per body and one for the contact surfaces of all pairs (the slave polylines with pressure, gap and active).
 //
 // Every attribute references a stored dataset whole: XDMF has no 2-component "Vector" (it means 3), so the
 // multi-component arrays are declared "Matrix" (rows x components), which both of ParaView 5.11's XDMF readers
@@ -91,15 +91,22 @@ struct Writer {
     out << "      </Grid>\n";
   }
 
-  // The contact surface of one pair: its slave polyline with the nodal pressure, gap and active flag (and with
-  // friction its tangential traction, slip, stick flag and tangent).
-  void pair(const std::string& step_path, const PairField& p, bool closed) {
-    const Eigen::Index n = p.position.rows();
-    if (n < 2) return;
-    const Eigen::Index segments = pair_segments(n, closed).rows();
-    const std::string base = step_path + "/contacts/" + p.name;
+  // The contact surfaces of all pairs as one grid (the step's contact tables, contact_tables.hpp): the slave
+  // polylines with the nodal pressure, gap, active flag and the pair's index in the step's pair_names (and with
+  // friction the tangential traction, slip, stick flag and tangent). One grid, not one per pair: a wall of 4,129
+  // bricks has 12,192 pairs, and whole datasets are all the Xdmf3 reader takes (no HyperSlab, above).
+  void contacts(const std::string& step_path, const Step& s) {
+    Eigen::Index n = 0, segments = 0;
+    bool friction = false;
+    for (const auto& p : s.pairs) {
+      n += p.position.rows();
+      segments += pair_segments(p.position.rows(), slave_is_closed(s, p)).rows();
+      friction = friction || p.friction != "none";
+    }
+    if (segments == 0) return;
+    const std::string base = step_path + "/contacts";
     const std::string in = "        ";
-    out << "      <Grid Name=\"" << xml_escape(p.name) << "\" GridType=\"Uniform\">\n";
+    out << "      <Grid Name=\"contacts\" GridType=\"Uniform\">\n";
     out << in << "<Topology TopologyType=\"Polyline\" NodesPerElement=\"2\" NumberOfElements=\"" << segments << "\">\n";
     data_item(in + "  ", base + "/segments", segments, 2, "Int", 8);
     out << in << "</Topology>\n";
@@ -109,7 +116,8 @@ struct Writer {
     attribute(in, "pressure", "Node", base + "/pressure", n, 0);
     attribute(in, "gap", "Node", base + "/normal_gap", n, 0);
     attribute(in, "active", "Node", base + "/active", n, 0, "Int", 1);
-    if (p.friction != "none") {  // friction: the tangential traction, the accumulated slip, stick and the tangent
+    attribute(in, "pair", "Node", base + "/pair", n, 0, "Int", 4);
+    if (friction) {  // friction: the tangential traction, the accumulated slip, stick and the tangent
       attribute(in, "tangential_traction", "Node", base + "/tangential_traction", n, 0);
       attribute(in, "slip", "Node", base + "/slip", n, 0);
       attribute(in, "stick", "Node", base + "/stick", n, 0, "Int", 1);
@@ -137,7 +145,7 @@ void XdmfSeries::add(const Step& step) {
   w.hdf = hdf_;
   const std::string path = "/steps/" + std::to_string(grids_.size());
   for (const auto& b : step.bodies) w.body(path, b);
-  for (const auto& p : step.pairs) w.pair(path, p, slave_is_closed(step, p));
+  w.contacts(path, step);
   grids_.push_back(w.out.str());
   load_factors_.push_back(step.load_factor);
 }

@@ -246,23 +246,43 @@ def test_frictionless(path, events):
           cc.format_iteration(iteration))
 
 
-def test_older_file(path, tmp):
-    """A friction result stripped of everything friction added: it reads and plots as frictionless."""
-    old = os.path.join(tmp, "before_friction.hdf")
-    shutil.copy(path, old)
-    with h5py.File(old, "r+") as f:
+def as_version_2_before_friction(path, out):
+    """A copy of result file `path` in the layout of format version 2 as it was before friction
+    (docs/results-format.md, "Version 3"): a group per pair under /steps/<k>/contacts with its scalars as
+    attributes, no friction attribute and no tangential datasets."""
+    shutil.copy(path, out)
+    with h5py.File(out, "r+") as f:
+        f.attrs["format_version"] = np.int32(2)
         for k in f["steps"]:
-            for c in f["steps"][k]["contacts"].values():
-                for a in ("friction", "friction_coefficient", "friction_bound", "tangential_force"):
-                    if a in c.attrs:
-                        del c.attrs[a]
-                for d in ("tangent", "tangential_traction", "slip", "stick"):
-                    if d in c:
-                        del c[d]
+            step = f["steps"][k]
+            t = {key: item[()] for key, item in step["contacts"].items()}
+            del step["contacts"]
+            contacts = step.create_group("contacts")
+            for p, name in enumerate(step.attrs["pair_names"]):
+                name = name.decode() if isinstance(name, bytes) else str(name)
+                rows = slice(int(t["offsets"][p]), int(t["offsets"][p + 1]))
+                segs = slice(int(t["segment_offsets"][p]), int(t["segment_offsets"][p + 1]))
+                g = contacts.create_group(name)
+                for a in ("slave_body", "slave_edge", "master_body", "master_edge", "enforcement"):
+                    g.attrs[a] = t[a][p].decode()
+                g.attrs["theta"], g.attrs["force"], g.attrs["resultant"] = t["theta"][p], t["force"][p], t["resultant"][p]
+                for d in ("node", "position", "normal", "arc_length", "weight", "gap", "normal_gap", "pressure",
+                          "penetration", "active", "status"):
+                    g[d] = t[d][rows]
+                g["segments"] = t["segments"][segs] - rows.start
         del f["history/steps/tangential_force"]
+    return out
+
+
+def test_older_file(path, tmp):
+    """A friction result as a file written before friction (format version 2): it reads and plots as
+    frictionless."""
+    old = as_version_2_before_friction(path, os.path.join(tmp, "before_friction.hdf"))
     result = cc.read_result(old)
     c = result["steps"][-1]["contacts"]["c"]
     check("older file: pair_friction is None", cc.results.pair_friction(c) is None, c["attrs"])
+    check("older file: the pair's nodes read as in the file it came from",
+          np.array_equal(c["pressure"], cc.read_result(path)["steps"][-1]["contacts"]["c"]["pressure"]))
     drawn = cc.plot_result(result, os.path.join(tmp, "before_friction.png"))
     check("older file: plotted without a tangential panel", not panels(drawn["figure"])[1]
           and drawn["friction"] == {}, drawn["friction"])

@@ -113,13 +113,15 @@ def test_wall_command(hdf, tmp):
 def file_counts(f):
     """Slave nodes per state over every pair of the final step, from the file's arrays."""
     counts = dict.fromkeys(("outside", "open", "stick", "slip", "contact"), 0)
-    for c in final_group(f)["contacts"].values():
-        status, active, stick = c["status"][()], c["active"][()] == 1, c["stick"][()] == 1
-        outside = np.isin(status, (1, 2, 3))
-        counts["outside"] += int(outside.sum())
-        counts["open"] += int((~outside & ~active).sum())
-        counts["stick"] += int((~outside & active & stick).sum())
-        counts["slip"] += int((~outside & active & ~stick).sum())
+    c = final_group(f)["contacts"]  # every pair's nodes in one table; `pair` is each row's pair
+    status, active, stick = c["status"][()], c["active"][()] == 1, c["stick"][()] == 1
+    frictional = (c["friction"].asstr()[()] != "none")[c["pair"][()]]
+    outside = np.isin(status, (1, 2, 3))
+    counts["outside"] += int(outside.sum())
+    counts["open"] += int((~outside & ~active).sum())
+    counts["stick"] += int((~outside & active & frictional & stick).sum())
+    counts["slip"] += int((~outside & active & frictional & ~stick).sum())
+    counts["contact"] += int((~outside & active & ~frictional).sum())
     return counts
 
 
@@ -141,7 +143,7 @@ def test_wall_module(hdf, tmp):
     with h5py.File(hdf, "r") as f:
         last = final_group(f)
         names = [str(n) for n in last.attrs["pair_names"]]
-        slave_of = {n: last["contacts"][n].attrs["slave_body"] for n in names}
+        slave_of = dict(zip(names, last["contacts/slave_body"].asstr()[()]))  # a row per pair
         counts = file_counts(f)
         rows = len(f["history/steps/load_factor"])
     patterns = ["b0_3.bottom-base.*", "b21_0"]  # a pair by its name, a brick by its name

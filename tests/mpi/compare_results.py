@@ -14,10 +14,16 @@ def _fields(path):
             step = f["steps"][k]
             for name, body in step["bodies"].items():
                 out[f"{k}/{name}/displacement"] = body["displacement"][()]
-            for name, pair in step["contacts"].items():
-                out[f"{k}/{name}/pressure"] = pair["pressure"][()]
-                if "tangential_traction" in pair:
-                    out[f"{k}/{name}/tangential_traction"] = pair["tangential_traction"][()]
+            # The pairs' rows of the contact tables (docs/results-format.md): pair p's from offsets[p].
+            t = step["contacts"]
+            offsets, friction = t["offsets"][()], t["friction"].asstr()[()]
+            pressure, traction = t["pressure"][()], t["tangential_traction"][()]
+            for p, name in enumerate(step.attrs["pair_names"]):
+                name = name.decode() if isinstance(name, bytes) else str(name)
+                rows = slice(int(offsets[p]), int(offsets[p + 1]))
+                out[f"{k}/{name}/pressure"] = pressure[rows]
+                if friction[p] != "none":
+                    out[f"{k}/{name}/tangential_traction"] = traction[rows]
     return out
 
 

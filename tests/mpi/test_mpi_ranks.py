@@ -83,11 +83,12 @@ with tempfile.TemporaryDirectory() as tmp:
     width = sum(b["mesh"]["block"]["corners"][1][0] - b["mesh"]["block"]["corners"][0][0] for b in top_bricks)
     pressure = top_bricks[0]["boundary"][-1]["traction"]["normal"]
     with h5py.File(os.path.join(tmp, "brick_wall.3.hdf"), "r") as f:
-        last = f["steps"][str(len(f["steps"]) - 1)]["contacts"]
+        last = f["steps"][str(len(f["steps"]) - 1)]
         per_course = {}
-        for name, pair in last.items():
+        for name, force in zip(last.attrs["pair_names"], last["contacts/force"][()]):  # a row per pair
+            name = name.decode() if isinstance(name, bytes) else str(name)
             course = name.split("_")[0]  # "b3" from "b3_1.bottom-b2_0.top"
-            per_course[course] = per_course.get(course, 0.0) + float(pair.attrs["force"])
+            per_course[course] = per_course.get(course, 0.0) + float(force)
     expected = pressure * width
     worst = max(abs(v - expected) / expected for v in per_course.values())
     check("every course of the wall carries pressure x width (1e-10)", len(per_course) == 8 and worst < 1e-10,

@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """What ParaView shows of a result (issue 13, item 5), checked with ParaView's own readers through pvpython:
 contact-solve on api/examples/hertz_cylinder_gmsh.json (triangles, and a block mixing them with quadrilaterals),
-then the sidecar opened as ./name.xmf with the Xdmf3 Reader has one block per body and per contact pair, named
-after them, with every cell; the stresses' components are named XX, YY, ZZ, XY (and YZ, XZ) in the sidecar and
+then the sidecar opened as ./name.xmf with the Xdmf3 Reader has one block per body, named after it, and one
+named "contacts" for the pairs' slave polylines (format version 3: the contact tables), with every cell; the stresses' components are named XX, YY, ZZ, XY (and YZ, XZ) in the sidecar and
 in the .hdf's /VTKHDF grid, whose cells are the bodies' triangles and quadrilaterals and the pair's segments.
 ParaView is not a dependency of the project: exits 77 (CTest: skipped) saying so when pvpython is absent."""
 import json
@@ -32,7 +32,12 @@ blocks = {}
 it = data.NewIterator()
 it.InitTraversal()
 while not it.IsDoneWithTraversal():
-    blocks[it.GetCurrentMetaData().Get(data.NAME())] = it.GetCurrentDataObject().GetNumberOfCells()
+    name, block = it.GetCurrentMetaData().Get(data.NAME()), it.GetCurrentDataObject()
+    blocks[name] = block.GetNumberOfCells()
+    if name == "contacts":
+        pd = block.GetPointData()
+        out["xmf_contact_arrays"] = sorted(pd.GetArrayName(i) for i in range(pd.GetNumberOfArrays()))
+        out["xmf_contact_points"] = block.GetNumberOfPoints()
     it.GoToNextItem()
 out["xmf_blocks"] = blocks
 out["xmf_stress_node"] = [xmf.PointData["stress_node"].GetComponentName(i) for i in range(6)]
@@ -74,11 +79,16 @@ def main():
         with h5py.File(os.path.join(tmp, "result.hdf")) as h:
             last = h["steps"][str(h["steps"].attrs["count"] - 1)]
             bodies = {name: last["bodies"][name]["cells"].shape[0] for name in last.attrs["body_names"]}
-            pairs = {name: last["contacts"][name]["segments"].shape[0] for name in last.attrs["pair_names"]}
+            pairs = {"contacts": last["contacts/segments"].shape[0]}  # every pair's segments, one block
+            contact_points = last["contacts/position"].shape[0]
             triangles = sum(int((last["bodies"][n]["cell_types"][()] == 5).sum()) for n in bodies)
     names = ["XX", "YY", "ZZ", "XY", "YZ", "XZ"]
-    check("the sidecar's blocks are named after the bodies and the pair, with all their cells",
-          seen["xmf_blocks"] == {**bodies, **pairs}, (seen["xmf_blocks"], bodies, pairs))
+    check("the sidecar's blocks are named after the bodies, and 'contacts' holds the pairs' segments, with all "
+          "their cells", seen["xmf_blocks"] == {**bodies, **pairs}, (seen["xmf_blocks"], bodies, pairs))
+    check("the contact block has every slave node with pressure, gap, active and each node's pair",
+          seen.get("xmf_contact_points") == contact_points
+          and {"pressure", "gap", "active", "pair"} <= set(seen.get("xmf_contact_arrays", [])),
+          (seen.get("xmf_contact_points"), contact_points, seen.get("xmf_contact_arrays")))
     for key in ("xmf_stress_node", "xmf_stress_cell", "hdf_stress_point", "hdf_stress_cell"):
         check(f"{key}: the stress components are named {names}", seen[key] == names, seen[key])
     types = seen["hdf_cell_types"]

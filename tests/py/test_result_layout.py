@@ -66,7 +66,7 @@ class Context:
 def root_attributes(c):
     a = c.f.attrs
     expect(text(a["format"]) == "contact-ddm-result", f"format is {a['format']!r}")
-    expect(int(a["format_version"]) == 2 and np.issubdtype(np.asarray(a["format_version"]).dtype, np.integer),
+    expect(int(a["format_version"]) == 3 and np.issubdtype(np.asarray(a["format_version"]).dtype, np.integer),
            f"format_version is {a['format_version']!r}")
     expect(text(a["solver_version"]) != "", "solver_version is empty")
     text(a["job_id"])  # may be empty for the CLI
@@ -139,6 +139,30 @@ def iteration_history(c):
         expect(int(c.f.attrs["iterations"]) == n, f"iterations = {c.f.attrs['iterations']} but {n} history rows")
 
 
+PAIR_STRINGS = ("slave_body", "slave_edge", "master_body", "master_edge", "enforcement", "friction")
+PAIR_REALS = ("theta", "force", "friction_coefficient", "friction_bound", "tangential_force")
+NODE_COLUMNS = ("node", "arc_length", "status", "weight", "gap", "normal_gap", "pressure", "penetration", "active",
+                "tangential_traction", "slip", "stick", "pair")
+NODE_PAIRS = ("position", "normal", "tangent")
+
+
+def pair_rows(contacts, p):
+    """Pair p of a step's contact tables as docs/results-format.md says to read it: its node rows
+    offsets[p]..offsets[p+1] of every node table, its scalars row p of the pair tables, its segments rows
+    segment_offsets[p]..segment_offsets[p+1] (rows of the node tables)."""
+    offsets, s_off = contacts["offsets"][()], contacts["segment_offsets"][()]
+    rows = slice(int(offsets[p]), int(offsets[p + 1]))
+    out = {key: contacts[key][rows] for key in NODE_COLUMNS + NODE_PAIRS}
+    out["segments"] = contacts["segments"][int(s_off[p]):int(s_off[p + 1])]
+    out["first"] = int(offsets[p])
+    for key in PAIR_STRINGS:
+        out[key] = text(contacts[key].asstr()[p])
+    for key in PAIR_REALS:
+        out[key] = float(contacts[key][p])
+    out["resultant"] = contacts["resultant"][p]
+    return out
+
+
 @check
 def step_history(c):
     g = c.f["history/steps"]
@@ -157,14 +181,14 @@ def step_history(c):
         st = c.f["steps"][str(k)]
         expect(float(st.attrs["load_factor"]) == float(g["load_factor"][k]), f"step {k} load_factor attribute")
         for p, pair in enumerate(pairs):
-            group = st["contacts"][pair]
-            expect(float(g["force"][k, p]) == float(group.attrs["force"]), f"step {k} pair {pair} force vs attribute")
-            arc, active = group["arc_length"][()], group["active"][()]
+            group = pair_rows(st["contacts"], p)
+            expect(float(g["force"][k, p]) == group["force"], f"step {k} pair {pair} force vs the contact table")
+            arc, active = group["arc_length"], group["active"]
             begin, end = g["contact_begin"][k, p], g["contact_end"][k, p]
             if len(arc) > 2 and group["segments"].shape[0] == len(arc):
                 # A closed slave edge: the zone is the loop less its longest open stretch, across the start where
                 # begin > end, [0, the loop's length] all round.
-                position = group["position"][()]
+                position = group["position"]
                 length = arc[-1] + float(np.hypot(*(position[0] - position[-1])))
                 if active.all():
                     expect(begin == 0 and abs(end - length) <= 1e-9 * length,
@@ -256,63 +280,83 @@ def steps_contacts(c):
     for k in range(int(steps.attrs["count"])):
         s = steps[str(k)]
         pair_names = names(s.attrs["pair_names"])
-        expect(sorted(pair_names) == sorted(s["contacts"].keys()), f"step {k} pair_names vs groups")
+        t = s["contacts"]
+        P = len(pair_names)
         if c.job_path:
-            expect(len(pair_names) >= 1, f"step {k} has no contact pair")
-        for pair in pair_names:
-            g = s["contacts"][pair]
+            expect(P >= 1, f"step {k} has no contact pair")
+        # The tables: P + 1 offsets from 0, N rows per node table, P per pair table, segments within the nodes.
+        offsets, s_off = t["offsets"][()], t["segment_offsets"][()]
+        expect(offsets.shape == (P + 1,) and offsets[0] == 0 and np.all(np.diff(offsets) >= 0),
+               f"step {k} offsets {offsets} do not rise from 0 in P + 1 = {P + 1} entries")
+        expect(s_off.shape == (P + 1,) and s_off[0] == 0 and np.all(np.diff(s_off) >= 0), f"step {k} segment_offsets")
+        expect(offsets.dtype == np.int64 and s_off.dtype == np.int64, f"step {k} offsets dtype")
+        n_all = int(offsets[-1])
+        for name in NODE_COLUMNS:
+            expect(t[name].shape == (n_all,), f"step {k} contacts/{name} has shape {t[name].shape}, expected ({n_all},)")
+        for name in NODE_PAIRS:
+            expect(t[name].shape == (n_all, 2), f"step {k} contacts/{name} has shape {t[name].shape}")
+        for name in PAIR_STRINGS + PAIR_REALS:
+            expect(t[name].shape == (P,), f"step {k} contacts/{name} has shape {t[name].shape}, expected ({P},)")
+        expect(t["resultant"].shape == (P, 2), f"step {k} contacts/resultant shape")
+        expect(t["segments"].shape == (int(s_off[-1]), 2) and t["segments"].dtype == np.int64, f"step {k} segments")
+        for name in ("active", "status", "stick"):
+            expect(t[name].dtype == np.int8, f"step {k} contacts/{name} dtype {t[name].dtype}")
+        expect(np.array_equal(t["pair"][()], np.repeat(np.arange(P), np.diff(offsets))),
+               f"step {k} contacts/pair is not each node's pair index")
+        for p, pair in enumerate(pair_names):
+            g = pair_rows(t, p)
             where = f"step {k} pair {pair}"
-            n = g["position"].shape[0]
-            for name, shape in (("position", (n, 2)), ("normal", (n, 2))):
-                expect(g[name].shape == shape, f"{where} {name} has shape {g[name].shape}, expected {shape}")
-            # Consecutive nodes, and on a closed slave edge (n rows) the last back to the first.
-            segments = g["segments"][()]
+            n, first = len(g["node"]), g["first"]
+            # Consecutive nodes of the pair, and on a closed slave edge (n rows) the last back to the first.
+            segments = g["segments"] - first
             closed = n > 2 and segments.shape == (n, 2)
             expect(segments.shape == ((n, 2) if closed else (max(n - 1, 0), 2)),
                    f"{where} segments has shape {segments.shape}, expected ({max(n - 1, 0)}, 2) or ({n}, 2)")
             expect(segments.tolist() == [[j, (j + 1) % n] for j in range(segments.shape[0])],
-                   f"{where} segments do not join consecutive nodes")
-            for name in ("node", "arc_length", "weight", "gap", "normal_gap", "pressure", "penetration", "active",
-                         "status"):
-                expect(g[name].shape == (n,), f"{where} {name} has shape {g[name].shape}, expected ({n},)")
-            for name in ("active", "status"):
-                expect(g[name].dtype == np.int8, f"{where} {name} dtype {g[name].dtype}")
-            expect(set(np.unique(g["active"][()]).tolist()) <= {0, 1}, f"{where} active is not 0/1")
-            status = g["status"][()]
+                   f"{where} segments do not join consecutive nodes of the pair's rows")
+            expect(set(np.unique(g["active"]).tolist()) <= {0, 1}, f"{where} active is not 0/1")
+            status = g["status"]
             expect(set(np.unique(status).tolist()) <= {0, 1, 2, 3, 4, 5}, f"{where} status outside 0..5")
-            pressure = g["pressure"][()]
+            pressure = g["pressure"]
             expect(np.all(np.isfinite(pressure)) and np.all(pressure >= 0),
                    f"{where} pressure must be >= 0 (positive in compression)")
             # multiplier nodes without a multiplier in this pair (5: another pair of its group carries it)
             dropped = ((status >= 1) & (status <= 3)) | (status == 5)
             expect(np.all(pressure[dropped] == 0), f"{where} a node without multiplier carries pressure")
-            weight = g["weight"][()]
+            weight = g["weight"]
             expect(np.all(weight[status == 0] > 0) and np.all(weight[status != 0] == 0), f"{where} weight vs status")
-            expect(abs(float(np.dot(weight, pressure)) - float(g.attrs["force"])) <= 1e-9 * max(1.0, float(g.attrs["force"])),
+            expect(abs(float(np.dot(weight, pressure)) - g["force"]) <= 1e-9 * max(1.0, g["force"]),
                    f"{where} force is not sum(weight * pressure)")
             # Gaps are defined (finite) at the nodes that carry a multiplier, NaN at the dropped ones.
             for name in ("gap", "normal_gap"):
-                v = g[name][()]
+                v = g[name]
                 expect(np.all(np.isfinite(v[status == 0])) and np.all(np.isnan(v[dropped])), f"{where} {name} NaNs")
-            normal = g["normal"][()]
-            expect(np.allclose(np.linalg.norm(normal, axis=1), 1.0), f"{where} normals are not unit vectors")
-            expect(np.all(g["penetration"][()] >= 0), f"{where} penetration < 0")
-            expect(np.all(np.diff(g["arc_length"][()]) > 0), f"{where} arc_length does not increase")
+            expect(np.allclose(np.linalg.norm(g["normal"], axis=1), 1.0), f"{where} normals are not unit vectors")
+            expect(np.allclose(g["tangent"], np.column_stack([-g["normal"][:, 1], g["normal"][:, 0]])),
+                   f"{where} tangent is not the normal turned a quarter anticlockwise")
+            expect(np.all(g["penetration"] >= 0), f"{where} penetration < 0")
+            expect(np.all(np.diff(g["arc_length"]) > 0), f"{where} arc_length does not increase")
             for key in ("slave_body", "slave_edge", "master_body", "master_edge"):
-                expect(text(g.attrs[key]) != "", f"{where} attribute {key} empty")
-            expect(text(g.attrs["enforcement"]) in ENFORCEMENTS, f"{where} enforcement {g.attrs['enforcement']!r}")
+                expect(g[key] != "", f"{where} {key} empty")
+            expect(g["enforcement"] in ENFORCEMENTS, f"{where} enforcement {g['enforcement']!r}")
+            expect(g["friction"] in ("none", "coulomb", "tresca"), f"{where} friction {g['friction']!r}")
+            if g["friction"] == "none":  # no friction: no traction, no slip, nothing sticks
+                expect(np.all(g["tangential_traction"] == 0) and np.all(np.isnan(g["slip"]))
+                       and np.all(g["stick"] == 0) and g["tangential_force"] == 0,
+                       f"{where} a frictionless pair with friction values")
             body_names = names(s.attrs["body_names"])
-            expect(text(g.attrs["slave_body"]) in body_names and text(g.attrs["master_body"]) in body_names,
+            expect(g["slave_body"] in body_names and g["master_body"] in body_names,
                    f"{where} names a body that is not in the step")
-            slave = s["bodies"][text(g.attrs["slave_body"])]
-            node = g["node"][()]
-            expect(node.min() >= 0 and node.max() < slave["points"].shape[0], f"{where} node outside the slave mesh")
-            expect(np.array_equal(slave["points"][()][node], g["position"][()]), f"{where} position != slave points")
-            if text(g.attrs["enforcement"]) == "exact":
-                expect(float(g.attrs["theta"]) == 0, f"{where} theta != 0 for exact contact")
+            slave = s["bodies"][g["slave_body"]]
+            node = g["node"]
+            if n:
+                expect(node.min() >= 0 and node.max() < slave["points"].shape[0], f"{where} node outside the slave mesh")
+            expect(np.array_equal(slave["points"][()][node], g["position"]), f"{where} position != slave points")
+            if g["enforcement"] == "exact":
+                expect(g["theta"] == 0, f"{where} theta != 0 for exact contact")
             else:
-                expect(float(g.attrs["theta"]) > 0, f"{where} theta <= 0")
-            expect(float(g.attrs["force"]) >= 0, f"{where} force < 0")
+                expect(g["theta"] > 0, f"{where} theta <= 0")
+            expect(g["force"] >= 0, f"{where} force < 0")
 
 
 @check
@@ -383,12 +427,13 @@ def xdmf_sidecar(c):
         expect(time == (factors[k] if by_load else k), f"step {k} has Time {time}")
         grids = {g.get("Name"): g for g in step.findall("Grid")}
         st = c.f["steps"][str(k)]
-        expect(sorted(grids) == sorted(names(st.attrs["body_names"]) + names(st.attrs["pair_names"])),
-               f"step {k} grids: one per body and one per contact pair")
-        for pair in names(st.attrs["pair_names"]):
-            expect(grids[pair].find("Topology").get("TopologyType") == "Polyline", f"step {k} pair {pair} topology")
-            attributes = {a.get("Name") for a in grids[pair].findall("Attribute")}
-            expect({"pressure", "gap", "active"} <= attributes, f"step {k} pair {pair} attributes {attributes}")
+        surfaces = ["contacts"] if st["contacts"]["segments"].shape[0] > 0 else []
+        expect(sorted(grids) == sorted(names(st.attrs["body_names"]) + surfaces),
+               f"step {k} grids: one per body and one for the contact surfaces")
+        if surfaces:
+            expect(grids["contacts"].find("Topology").get("TopologyType") == "Polyline", f"step {k} contacts topology")
+            attributes = {a.get("Name") for a in grids["contacts"].findall("Attribute")}
+            expect({"pressure", "gap", "active", "pair"} <= attributes, f"step {k} contacts attributes {attributes}")
         for item in step.iter("DataItem"):
             if item.get("Format") != "HDF":
                 continue

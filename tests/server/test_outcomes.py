@@ -21,6 +21,7 @@ import sys
 import tempfile
 
 import h5py
+import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))  # tests/
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -41,9 +42,12 @@ def result_attributes(server, job_id):
             names = [n.decode() if isinstance(n, bytes) else str(n) for n in steps.attrs["pair_names"]]
             forces = dict(zip(names, steps["force"][-1])) if len(steps["force"]) else {}
             # solve.cpp's scale of a pulling force (tensile_pairs): the largest sum of |weight x pressure| of a pair
-            last = h["steps"][str(len(h["steps"]) - 1)]["contacts"] if len(h["steps"]) else {}
-            scale = max([sum(abs(w * q) for w, q in zip(c["weight"][()], c["pressure"][()]) if math.isfinite(w * q))
-                         for c in last.values()] or [0.0])
+            scale = 0.0
+            if len(h["steps"]):  # the pairs' rows in one table (results-format.md); `pair` is each row's pair
+                last = h["steps"][str(len(h["steps"]) - 1)]["contacts"]
+                terms = np.abs(last["weight"][()] * last["pressure"][()])
+                terms[~np.isfinite(terms)] = 0
+                scale = float(np.bincount(last["pair"][()], weights=terms).max()) if len(terms) else 0.0
             return {"converged": h.attrs["converged"], "stop_reason": h.attrs["stop_reason"], "forces": forces,
                     "scale": scale}
 

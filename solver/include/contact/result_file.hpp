@@ -23,7 +23,7 @@
 namespace contact::io {
 
 inline constexpr const char* kFormatName = "contact-ddm-result";
-inline constexpr int kFormatVersion = 2;  // 2: mortar contact (per-node multipliers, contact surfaces)
+inline constexpr int kFormatVersion = 3;  // 2: mortar contact (per-node multipliers, contact surfaces); 3: contact tables
 
 struct WriteInfo {
   std::string job_id;   // "" for the CLI
