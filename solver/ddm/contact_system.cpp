@@ -85,14 +85,18 @@ parallel::BodyShare ContactSystem::body_outcome_share() {
 }
 
 void ContactSystem::discretize_pairs() {
-  pairs_.clear();
-  penalties_.clear();
-  for (int k = 0; k < static_cast<int>(problem_.contacts.size()); ++k) {
-    penalties_.push_back(mortar::choose_penalty(problem_, k));
-    pairs_.push_back(mortar::discretize_pair(problem_, k, penalties_.back().theta));
-    if (!(penalties_.back().theta > 0))
-      append_error(error_, "contact '" + pairs_.back().name + "': the penalty theta is not positive");
-  }
+  // Each pair from the problem alone (its two bodies' meshes, read only), so on the process's threads: a wall of
+  // 12,192 pairs took a second on one. Every process discretizes every pair.
+  const size_t n = problem_.contacts.size();
+  pairs_.assign(n, mortar::PairDiscretization{});
+  penalties_.assign(n, mortar::PenaltyChoice{});
+  runner_.run(n, [&](size_t k) {
+    penalties_[k] = mortar::choose_penalty(problem_, static_cast<int>(k));
+    pairs_[k] = mortar::discretize_pair(problem_, static_cast<int>(k), penalties_[k].theta);
+  });
+  for (size_t k = 0; k < n; ++k)
+    if (!(penalties_[k].theta > 0))
+      append_error(error_, "contact '" + pairs_[k].name + "': the penalty theta is not positive");
 }
 
 bool ContactSystem::may_float(size_t a) const {
