@@ -355,13 +355,15 @@ void JobReader::check_floating_bodies() {
   // whether a body floats is then not known, and its error would only repeat the contacts'.
   if (!contacts_complete_) return;
   const Method method = problem_.solver.method;
+  std::vector<char> touches(inputs_.size(), 0);
+  for (const auto& c : problem_.contacts)
+    for (const int b : {c.slave_body, c.master_body})
+      if (b >= 0 && static_cast<size_t>(b) < touches.size()) touches[static_cast<size_t>(b)] = 1;
   for (size_t i = 0; i < inputs_.size(); ++i) {
     const BodyInput& in = inputs_[i];
     if (in.free_motions.empty()) continue;
     const std::string free = join_names(in.free_motions) + (in.free_motions.size() == 1 ? " is" : " are") + " free";
-    bool in_contact = false;
-    for (const auto& c : problem_.contacts)
-      in_contact = in_contact || c.slave_body == static_cast<int>(i) || c.master_body == static_cast<int>(i);
+    const bool in_contact = touches[i];
     if (!in_contact) {
       errors_.add(child(in.pointer, "boundary"),
                   "body '" + in.body.name + "' is not restrained against rigid motion (" + free +

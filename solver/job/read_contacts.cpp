@@ -26,19 +26,24 @@ std::optional<JobReader::EdgeRef> JobReader::resolve(const json& value, const st
     return std::nullopt;
   }
   const std::string body = s->substr(0, dot), edge = s->substr(dot + 1);
-  std::vector<std::string> names;
-  for (size_t b = 0; b < inputs_.size(); ++b) {
-    if (inputs_[b].has_name) names.push_back(inputs_[b].body.name);
-    if (inputs_[b].has_name && inputs_[b].body.name == body) {
-      const MeshInput& m = inputs_[b].mesh;
-      if (m.edges_known && !has_edge(m, edge)) {
-        errors_.add(pointer, gmsh_elsewhere(m, edge).value_or("body '" + body + "' has no edge '" + read::shown(edge) +
-                                                               "'; its edges are " + join_names(m.edge_names)));
-        return std::nullopt;
-      }
-      return EdgeRef{static_cast<int>(b), edge};
-    }
+  if (!body_index_made_) {
+    for (size_t b = 0; b < inputs_.size(); ++b)
+      if (inputs_[b].has_name) body_index_.emplace(inputs_[b].body.name, b);
+    body_index_made_ = true;
   }
+  if (const auto found = body_index_.find(body); found != body_index_.end()) {
+    const size_t b = found->second;
+    const MeshInput& m = inputs_[b].mesh;
+    if (m.edges_known && !has_edge(m, edge)) {
+      errors_.add(pointer, gmsh_elsewhere(m, edge).value_or("body '" + body + "' has no edge '" + read::shown(edge) +
+                                                             "'; its edges are " + join_names(m.edge_names)));
+      return std::nullopt;
+    }
+    return EdgeRef{static_cast<int>(b), edge};
+  }
+  std::vector<std::string> names;
+  for (const auto& input : inputs_)
+    if (input.has_name) names.push_back(input.body.name);
   if (bodies_listed_ && bodies_all_named())
     errors_.add(pointer, "there is no body named '" + read::shown(body) + "'; the bodies are " + join_names(names));
   return std::nullopt;
