@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """Many bodies (issue 19): brick walls of 8 x 8 to 64 x 64 bricks (scripts/make_brick_wall.py --cells 16, the
-job's defaults otherwise) solved with each interface solver on 1 and 2 MPI ranks: time, peak memory per rank,
+job's defaults otherwise) solved with each interface solver on 1 and 2 MPI ranks: time (the whole command, result
+file included), peak memory per rank,
 MPRGP iterations; and, in the same run, the paper's test at 1024 x 256 elements per body (1.05M unknowns, the
 default method) as the yardstick of the targets: the 22 x 22 wall in at most 0.5x its time and within 1 GB, time
 from 16 x 16 to 22 x 22 growing at most 2.5x.
@@ -30,14 +31,17 @@ ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIR
 
 def run(job, ranks, tmp):
     out = os.path.join(tmp, "out.hdf")
-    cmd = ["/usr/bin/time", "-f", "maxrss_kb %M", CLI, job, "-o", out, "-q"]
+    cmd = ["/usr/bin/time", "-f", "maxrss_kb %M elapsed %e", CLI, job, "-o", out, "-q"]
     if ranks > 1:
-        cmd = ["mpirun", "-n", str(ranks), "/usr/bin/time", "-f", "maxrss_kb %M", CLI, job, "-o", out, "-q",
-               "--threads", "1"]
+        cmd = ["mpirun", "-n", str(ranks), "/usr/bin/time", "-f", "maxrss_kb %M elapsed %e", CLI, job, "-o", out,
+               "-q", "--threads", "1"]
     r = subprocess.run(cmd, capture_output=True, text=True, env=ENV, timeout=3600)
     if r.returncode != 0:
         return None, f"failed: {r.stdout[-300:]} {r.stderr[-300:]}"
-    wall = float(re.search(r"stop: \S+ after \d+ \S+, ([0-9.]+) s", r.stdout).group(1))
+    # wall: what the user waits for, the whole command (reading the job, setting up, solving, writing the result;
+    # the slowest rank's); solve: the solver's own figure in its stop line.
+    wall = max(float(x) for x in re.findall(r"elapsed ([0-9.]+)", r.stderr))
+    solve = float(re.search(r"stop: \S+ after \d+ \S+, ([0-9.]+) s", r.stdout).group(1))
     rss = max(int(x) / 1024 for x in re.findall(r"maxrss_kb (\d+)", r.stderr))
     # MPRGP iterations over the whole run (every load step and outer iteration: the products with F), from the
     # result's provenance; the progress message gives the last step's only.
@@ -47,7 +51,7 @@ def run(job, ranks, tmp):
     steps = int(m.group(1)) if m else 0
     m = re.search(r"cut (\d+) times", r.stdout)  # a frictional load step cut into sub-steps (load_steps.cpp)
     cuts = int(m.group(1)) if m else 0
-    return dict(wall=wall, rss=rss, iterations=iterations, steps=steps, cuts=cuts), ""
+    return dict(wall=wall, solve=solve, rss=rss, iterations=iterations, steps=steps, cuts=cuts), ""
 
 
 def print_result(label, r, error, columns):

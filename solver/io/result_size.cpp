@@ -3,7 +3,7 @@
 namespace contact::io {
 
 namespace {
-constexpr double kPerNode = 280, kPerBody = 25e3, kPerPair = 5e3;  // bytes a step (result_file.hpp)
+constexpr double kPerNode = 280, kPerBody = 25e3, kPerPair = 2e3;  // bytes a step (result_file.hpp)
 }
 
 double estimated_result_bytes(double nodes, double bodies, double pairs, double kept_steps) {

@@ -98,8 +98,11 @@ std::string xdmf_path_for(const std::string& hdf_path);
 // About how many bytes the result file of a job takes (its steps are streamed to it, ResultStream, so this bounds
 // the disk, not the memory): `kept_steps` steps' fields (and the final step's copy for ParaView, /VTKHDF) over `nodes` mesh nodes,
 // `bodies` bodies and `pairs` contact pairs. Measured (format version 2): 270-280 bytes a node and step on two
-// 40 x 40 to 80 x 80 blocks, and some 25 kB a body and 5 kB a pair and step in metadata and small datasets (a
-// 22 x 22 brick wall, 496 bodies: 30 MB for 2 steps). Job admission compares it with Limits::max_result_bytes.
+// 40 x 40 to 80 x 80 blocks, and some 25 kB a body and step in metadata and small datasets (a 22 x 22 brick wall,
+// 496 bodies: 30 MB for 2 steps). A pair (format version 3, the contact tables) is 770 bytes a step on the 64 x 64
+// wall, and its columns of the iteration history 2 kB over the run's 32 iterations: 2 kB a pair and step keeps
+// the estimate above the file (160 MB for 2 steps of 4,129 bodies and 12,192 pairs; 5 kB a pair in version 2).
+// Job admission compares it with Limits::max_result_bytes.
 double estimated_result_bytes(double nodes, double bodies, double pairs, double kept_steps);
 // The other way round: the nodes, summed over up to `kept_steps` kept steps, that keep the result within `bytes`
 // (the final step's copy counted as large as all of them; 0 when even the metadata does not fit).
