@@ -90,9 +90,10 @@ void ContactSystem::discretize_pairs() {
   const size_t n = problem_.contacts.size();
   pairs_.assign(n, mortar::PairDiscretization{});
   penalties_.assign(n, mortar::PenaltyChoice{});
+  const mortar::ContactIndex index(problem_);
   runner_.run(n, [&](size_t k) {
     penalties_[k] = mortar::choose_penalty(problem_, static_cast<int>(k));
-    pairs_[k] = mortar::discretize_pair(problem_, static_cast<int>(k), penalties_[k].theta);
+    pairs_[k] = mortar::discretize_pair(problem_, static_cast<int>(k), penalties_[k].theta, &index);
   });
   for (size_t k = 0; k < n; ++k)
     if (!(penalties_[k].theta > 0))

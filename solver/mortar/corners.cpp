@@ -10,15 +10,17 @@ namespace {
 // Whether the pair between bodies a and b (either its slave) has a slave edge ending at x where that end drops its
 // multiplier altogether (a corner against a master edge facing a third body): the loop of three bodies at x is then
 // broken there, and the other two pairs keep all their rows.
-bool crosspoint_between(const Problem& problem, int a, int b, const Eigen::Vector2d& x, double tolerance) {
-  for (const auto& q : problem.contacts) {
+bool crosspoint_between(const Problem& problem, const ContactIndex& index, int a, int b, const Eigen::Vector2d& x,
+                        double tolerance) {
+  for (const int k : index.touching(a, b)) {
+    const ContactPair& q = problem.contacts[static_cast<size_t>(k)];
     if (!((q.slave_body == a && q.master_body == b) || (q.slave_body == b && q.master_body == a))) continue;
     const auto& mesh = problem.bodies[static_cast<size_t>(q.slave_body)].mesh;
     const std::vector<int> nodes = mesh.edge_set_nodes(q.slave_edge);
     if (nodes.size() < 2 || mesh.edge_set_closed(q.slave_edge)) continue;  // a closed loop has no ends
     for (int end : {nodes.front(), nodes.back()}) {
       if ((mesh.nodes[static_cast<size_t>(end)] - x).norm() > tolerance) continue;
-      const auto corners = slave_corners(problem, q, nodes, false);
+      const auto corners = slave_corners(problem, index, q, nodes, false);
       const auto c = corners.find(end);
       if (c != corners.end() && c->second.third_body && c->second.friction) return true;
     }
@@ -47,8 +49,8 @@ bool normal_is_prescribed(const std::array<bool, 2>& p, const Eigen::Vector2d& n
   return (p[0] && std::abs(n.x()) >= cos10) || (p[1] && std::abs(n.y()) >= cos10);
 }
 
-std::map<int, Corner> slave_corners(const Problem& problem, const ContactPair& pair, const std::vector<int>& nodes,
-                                    bool look_for_broken_loops) {
+std::map<int, Corner> slave_corners(const Problem& problem, const ContactIndex& index, const ContactPair& pair,
+                                    const std::vector<int>& nodes, bool look_for_broken_loops) {
   std::map<int, Corner> out;
   const auto& mesh = problem.bodies[static_cast<size_t>(pair.slave_body)].mesh;
   // A closed loop has no ends, so no corners: it meets another edge only where that edge ends on it, and there
@@ -67,7 +69,7 @@ std::map<int, Corner> slave_corners(const Problem& problem, const ContactPair& p
         // pair between those masters drops its multiplier at this point (the top of a head joint seen from the
         // brick on the other side: the brick's bed joint keeps its friction row at its toe, where the pressure is).
         if (!third_body && look_for_broken_loops && other_master >= 0 &&
-            crosspoint_between(problem, pair.master_body, other_master, x, 1e-6 * h))
+            crosspoint_between(problem, index, pair.master_body, other_master, x, 1e-6 * h))
           continue;
         Corner& c = out[nodes[end]];
         c.tangent = (mesh.nodes[static_cast<size_t>(others[next])] - x).normalized();
@@ -75,7 +77,9 @@ std::map<int, Corner> slave_corners(const Problem& problem, const ContactPair& p
         c.friction = c.friction || friction || pair.friction.active();
       }
   };
-  for (const auto& other : problem.contacts) {
+  // The pairs with this slave body on either side, in the job's order (as every pair was asked before the index).
+  for (const int k : index.touching(pair.slave_body, pair.slave_body)) {
+    const ContactPair& other = problem.contacts[static_cast<size_t>(k)];
     if (other.slave_body == pair.slave_body && other.slave_edge != pair.slave_edge)
       meet(other.slave_edge, false, other.friction.active(), other.master_body);
     if (other.master_body == pair.slave_body && other.master_edge != pair.slave_edge)

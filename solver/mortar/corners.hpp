@@ -5,6 +5,7 @@
 #pragma once
 
 #include "contact/problem.hpp"
+#include "contact_index.hpp"
 
 #include <Eigen/Core>
 
@@ -41,9 +42,10 @@ struct Corner {
   bool friction = false;
 };
 
-// The corners at the ends of the slave edge `nodes` (its nodes in order) of `pair`.
-std::map<int, Corner> slave_corners(const Problem& problem, const ContactPair& pair, const std::vector<int>& nodes,
-                                    bool look_for_broken_loops = true);
+// The corners at the ends of the slave edge `nodes` (its nodes in order) of `pair`; `index`: the problem's pairs
+// by body.
+std::map<int, Corner> slave_corners(const Problem& problem, const ContactIndex& index, const ContactPair& pair,
+                                    const std::vector<int>& nodes, bool look_for_broken_loops = true);
 
 // Whether the other edge turns away from this one at the node (more than 10 degrees between the tangents).
 bool turns(const Eigen::Vector2d& own, const Eigen::Vector2d& other);

@@ -178,14 +178,15 @@ namespace {
 // nodes, number the rows, integrate over the mortar segments, assemble the sparse operators.
 class PairBuilder {
  public:
-  PairBuilder(const Problem& problem, int pair_index, double theta)
+  PairBuilder(const Problem& problem, const ContactIndex& index, int pair_index, double theta)
       : problem_(problem),
+        index_(index),
         pair_(problem.contacts[static_cast<size_t>(pair_index)]),
         slave_(problem.bodies[static_cast<size_t>(pair_.slave_body)]),
         master_(problem.bodies[static_cast<size_t>(pair_.master_body)]),
         thickness_(problem.model.plane == Plane::stress ? problem.model.thickness : 1.0),
         pair_index_(pair_index),
-        group_(pair_group(problem, pair_index)) {
+        group_(pair_group(problem, pair_index, &index)) {
     d_.name = pair_.name;
     d_.slave_body = pair_.slave_body;
     d_.master_body = pair_.master_body;
@@ -290,7 +291,7 @@ class PairBuilder {
   void classify_nodes() {
     d_.status.assign(n_, NodeStatus::inner);
     const auto prescribed = prescribed_components(slave_);
-    const auto corners = slave_corners(problem_, pair_, slave_.mesh.edge_set_nodes(pair_.slave_edge));
+    const auto corners = slave_corners(problem_, index_, pair_, slave_.mesh.edge_set_nodes(pair_.slave_edge));
     for (size_t m = 0; m <= n_runs_ && n_runs_ > 0; ++m) {
       const size_t i = d_.multiplier_nodes[m];
       double support = 0, covered = 0;
@@ -568,6 +569,7 @@ class PairBuilder {
   }
 
   const Problem& problem_;
+  const ContactIndex& index_;  // the problem's pairs by body
   const ContactPair& pair_;
   const Body& slave_;
   const Body& master_;
@@ -595,8 +597,10 @@ class PairBuilder {
 
 }  // namespace
 
-PairDiscretization discretize_pair(const Problem& problem, int pair_index, double theta) {
-  return PairBuilder(problem, pair_index, theta).build();
+PairDiscretization discretize_pair(const Problem& problem, int pair_index, double theta, const ContactIndex* index) {
+  if (index) return PairBuilder(problem, *index, pair_index, theta).build();
+  const ContactIndex own(problem);
+  return PairBuilder(problem, own, pair_index, theta).build();
 }
 
 }  // namespace contact::mortar

@@ -27,6 +27,7 @@
 #pragma once
 
 #include "contact/problem.hpp"
+#include "contact_index.hpp"
 
 #include <Eigen/SparseCore>
 
@@ -140,7 +141,9 @@ PenaltyChoice choose_penalty(const Problem& problem, int pair_index);
 constexpr double kDropCoverage = 1e-3;
 
 
-// Builds the mortar discretisation of pair `pair_index` on the bodies' current meshes.
-PairDiscretization discretize_pair(const Problem& problem, int pair_index, double theta);
+// Builds the mortar discretisation of pair `pair_index` on the bodies' current meshes. `index`: the problem's pairs
+// by body (made here when null; a caller discretizing every pair makes it once).
+PairDiscretization discretize_pair(const Problem& problem, int pair_index, double theta,
+                                   const ContactIndex* index = nullptr);
 
 }  // namespace contact::mortar

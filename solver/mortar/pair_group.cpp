@@ -97,16 +97,21 @@ int PairGroup::pair_of(size_t s, size_t m) const {
   return s < by_edges.size() && m < by_edges[s].size() ? by_edges[s][m] : -1;
 }
 
-PairGroup pair_group(const Problem& problem, int pair_index) {
+PairGroup pair_group(const Problem& problem, int pair_index, const ContactIndex* index) {
+  const ContactIndex own = index ? ContactIndex{} : ContactIndex(problem);
+  const ContactIndex& by_body = index ? *index : own;
   const ContactPair& pair = problem.contacts[static_cast<size_t>(pair_index)];
   const mesh::Mesh& slave = problem.bodies[static_cast<size_t>(pair.slave_body)].mesh;
   const mesh::Mesh& master = problem.bodies[static_cast<size_t>(pair.master_body)].mesh;
+  // The pairs between the same two bodies, slave to slave, in the job's order.
+  std::vector<int> between;
+  for (const int q : by_body.as_slave[static_cast<size_t>(pair.slave_body)])
+    if (problem.contacts[static_cast<size_t>(q)].master_body == pair.master_body) between.push_back(q);
   std::set<std::string> slave_edges, master_edges;
-  for (const auto& q : problem.contacts)
-    if (q.slave_body == pair.slave_body && q.master_body == pair.master_body) {
-      slave_edges.insert(q.slave_edge);
-      master_edges.insert(q.master_edge);
-    }
+  for (const int q : between) {
+    slave_edges.insert(problem.contacts[static_cast<size_t>(q)].slave_edge);
+    master_edges.insert(problem.contacts[static_cast<size_t>(q)].master_edge);
+  }
   const auto s = chain(slave, connected(slave, pair.slave_edge, slave_edges));
   const auto m = chain(master, connected(master, pair.master_edge, master_edges));
   PairGroup g;
@@ -117,11 +122,10 @@ PairGroup pair_group(const Problem& problem, int pair_index) {
   } else {
     g.slave = *s;
     g.master = *m;
-    for (size_t q = 0; q < problem.contacts.size(); ++q) {
-      const ContactPair& c = problem.contacts[q];
-      if (c.slave_body == pair.slave_body && c.master_body == pair.master_body &&
-          g.slave.index(c.slave_edge) < g.slave.edges.size() && g.master.index(c.master_edge) < g.master.edges.size())
-        g.pairs.push_back(static_cast<int>(q));
+    for (const int q : between) {
+      const ContactPair& c = problem.contacts[static_cast<size_t>(q)];
+      if (g.slave.index(c.slave_edge) < g.slave.edges.size() && g.master.index(c.master_edge) < g.master.edges.size())
+        g.pairs.push_back(q);
     }
   }
   g.by_edges.assign(g.slave.edges.size(), std::vector<int>(g.master.edges.size(), -1));

@@ -15,6 +15,7 @@
 #pragma once
 
 #include "contact/problem.hpp"
+#include "contact_index.hpp"
 
 #include <string>
 #include <vector>
@@ -45,6 +46,7 @@ struct PairGroup {
 
 // The group of pair `pair_index`. Edges that do not chain into one polyline per side (they meet at no end, or
 // fork) leave the pair alone in its group.
-PairGroup pair_group(const Problem& problem, int pair_index);
+// `index`: the problem's pairs by body (made here when null).
+PairGroup pair_group(const Problem& problem, int pair_index, const ContactIndex* index = nullptr);
 
 }  // namespace contact::mortar
