@@ -98,13 +98,19 @@ void ContactSystem::discretize_pairs() {
   for (size_t k = 0; k < n; ++k)
     if (!(penalties_[k].theta > 0))
       append_error(error_, "contact '" + pairs_[k].name + "': the penalty theta is not positive");
+  // Each body's pairs: what a body asks of the pairs (its interface unknowns, its rows of G) without going over
+  // every pair of the job (a wall of 4,129 bricks has 12,192).
+  pairs_of_body_.assign(problem_.bodies.size(), {});
+  for (size_t k = 0; k < n; ++k) {
+    const auto s = static_cast<size_t>(pairs_[k].slave_body), m = static_cast<size_t>(pairs_[k].master_body);
+    pairs_of_body_[s].push_back(k);
+    if (m != s) pairs_of_body_[m].push_back(k);
+  }
 }
 
 bool ContactSystem::may_float(size_t a) const {
   if (factorization_ == Factorization::plain) return false;  // the fixed-point schemes solve every body alone
-  for (const auto& c : problem_.contacts)
-    if (static_cast<size_t>(c.slave_body) == a || static_cast<size_t>(c.master_body) == a) return true;
-  return false;
+  return !pairs_of_body_[a].empty();
 }
 
 std::vector<int> ContactSystem::interface_dofs(size_t a) const {
@@ -114,7 +120,8 @@ std::vector<int> ContactSystem::interface_dofs(size_t a) const {
     for (int r = 0; r < G.outerSize(); ++r)
       for (mortar::SparseRows::InnerIterator it(G, r); it; ++it) dofs.push_back(static_cast<int>(it.col()));
   };
-  for (const auto& pair : pairs_) {
+  for (const size_t k : pairs_of_body_[a]) {
+    const auto& pair = pairs_[k];
     if (static_cast<size_t>(pair.slave_body) == a) collect(pair.Gs);
     if (static_cast<size_t>(pair.master_body) == a) collect(pair.Gm);
     if (pair.has_friction() && static_cast<size_t>(pair.slave_body) == a) collect(pair.Ts);

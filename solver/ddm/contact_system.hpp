@@ -54,6 +54,8 @@ class ContactSystem {
   const fem::BodySolver& body(size_t a) const { return *bodies_[a]; }
   const std::vector<mortar::PairDiscretization>& pairs() const { return pairs_; }
   const std::vector<mortar::PenaltyChoice>& penalties() const { return penalties_; }
+  // The pairs body a is the slave or the master of (indices into pairs(), in order, each once).
+  const std::vector<size_t>& pairs_of(size_t a) const { return pairs_of_body_[a]; }
   double setup_seconds() const { return setup_seconds_; }
   double factorization_seconds() const { return factorization_seconds_; }  // summed over bodies
 
@@ -152,6 +154,7 @@ class ContactSystem {
   std::vector<std::unique_ptr<fem::BodySolver>> bodies_;
   std::vector<mortar::PairDiscretization> pairs_;
   std::vector<mortar::PenaltyChoice> penalties_;
+  std::vector<std::vector<size_t>> pairs_of_body_;  // pairs_of(a)
   std::string error_;
   bool cancelled_ = false;
   double setup_seconds_ = 0.0, factorization_seconds_ = 0.0;

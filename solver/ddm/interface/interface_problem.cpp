@@ -14,24 +14,13 @@ struct BodyRows {
   std::vector<std::vector<std::pair<int, double>>> entries;
 };
 
-// Per body, the pairs it is the slave or the master of, in order (each once).
-std::vector<std::vector<size_t>> pairs_of_bodies(const ContactSystem& system) {
-  std::vector<std::vector<size_t>> out(system.n_bodies());
-  const auto& pairs = system.pairs();
-  for (size_t k = 0; k < pairs.size(); ++k) {
-    out[static_cast<size_t>(pairs[k].slave_body)].push_back(k);
-    if (pairs[k].master_body != pairs[k].slave_body) out[static_cast<size_t>(pairs[k].master_body)].push_back(k);
-  }
-  return out;
-}
-
-// Body a's rows of G and T over its own pairs (`pairs_of_a`: pairs_of_bodies' list for it; a wall of 4,129 bricks
-// asked every one of its 12,192 pairs for each body).
-BodyRows body_rows(const ContactSystem& system, size_t a, const std::vector<size_t>& pairs_of_a,
-                   const std::vector<Eigen::Index>& offset, const std::vector<Eigen::Index>& tangential_offset) {
+// Body a's rows of G and T over its own pairs (ContactSystem::pairs_of: a wall of 4,129 bricks asked every one of
+// its 12,192 pairs for each body).
+BodyRows body_rows(const ContactSystem& system, size_t a, const std::vector<Eigen::Index>& offset,
+                   const std::vector<Eigen::Index>& tangential_offset) {
   BodyRows out;
   const auto& pairs = system.pairs();
-  for (const size_t k : pairs_of_a) {
+  for (const size_t k : system.pairs_of(a)) {
     const auto& pair = pairs[k];
     auto add = [&](const mortar::SparseRows& G, double sign, Eigen::Index first) {
       for (int r = 0; r < G.outerSize(); ++r) {
@@ -145,8 +134,7 @@ InterfaceProblem::InterfaceProblem(const ContactSystem& system, parallel::TaskRu
   inverse_weight_ = (2.0 * D_.cwiseAbs2()).cwiseInverse();
   const size_t n_bodies = system.n_bodies();
   std::vector<BodyParts> parts(n_bodies);
-  const auto pairs_of = pairs_of_bodies(system);
-  for (size_t a = 0; a < n_bodies; ++a) parts[a].rows = body_rows(system, a, pairs_of[a], offset_, tangential_offset_);
+  for (size_t a = 0; a < n_bodies; ++a) parts[a].rows = body_rows(system, a, offset_, tangential_offset_);
   // Each body's part on its owner; the blocks move to every process only when they are replicated.
   const bool replicate = options_.replicate_blocks;
   const parallel::BodyShare share{[&](size_t a, parallel::Packer& out) {
@@ -310,8 +298,7 @@ void InterfaceProblem::refresh_loads(parallel::TaskRunner& runner) {
                           e[a] = in.get_vector();
                         }};
   std::vector<BodyRows> rows(n_bodies);
-  const auto pairs_of = pairs_of_bodies(system_);
-  for (size_t a = 0; a < n_bodies; ++a) rows[a] = body_rows(system_, a, pairs_of[a], offset_, tangential_offset_);
+  for (size_t a = 0; a < n_bodies; ++a) rows[a] = body_rows(system_, a, offset_, tangential_offset_);
   runner.run_bodies(n_bodies, [&](size_t a) {
     const auto& body = system_.body(a);
     const Eigen::VectorXd u_free = body.solve(Eigen::VectorXd());
