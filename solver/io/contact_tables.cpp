@@ -2,6 +2,7 @@
 #include "contact_tables.hpp"
 
 #include "h5.hpp"
+#include "h5_eigen.hpp"
 #include "view_layout.hpp"
 
 #include <cstdint>
@@ -13,6 +14,8 @@ namespace contact::io {
 namespace {
 
 using h5::Handle;
+using h5::read_column;
+using h5::read_matrix;
 
 std::string rows_text(Eigen::Index n) { return std::to_string(static_cast<long long>(n)); }
 
@@ -203,21 +206,6 @@ std::vector<PairField> read_tables(hid_t g, const std::vector<std::string>& name
   return out;
 }
 
-template <class T>
-Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> read_matrix(hid_t loc, const std::string& name) {
-  std::vector<hsize_t> dims;
-  const std::vector<T> data = h5::read_dataset<T>(loc, name, 2, dims);
-  using RowMajor = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  return Eigen::Map<const RowMajor>(data.data(), static_cast<Eigen::Index>(dims[0]),
-                                    static_cast<Eigen::Index>(dims[1]));
-}
-
-template <class T>
-Eigen::Matrix<T, Eigen::Dynamic, 1> read_column(hid_t loc, const std::string& name) {
-  const std::vector<T> data = h5::read_vector<T>(loc, name);
-  return Eigen::Map<const Eigen::Matrix<T, Eigen::Dynamic, 1>>(data.data(), static_cast<Eigen::Index>(data.size()));
-}
-
 // Format version 2 and before: a group per pair, its scalars as attributes.
 PairField read_pair_group(hid_t contacts, const std::string& name) {
   Handle g = h5::open_group(contacts, name);
@@ -235,8 +223,8 @@ PairField read_pair_group(hid_t contacts, const std::string& name) {
     if (r.size() == 2) p.resultant = Eigen::Vector2d(r[0], r[1]);
   }
   p.node = read_column<int>(g, "node");
-  p.position = read_matrix<double>(g, "position");
-  p.normal = read_matrix<double>(g, "normal");
+  p.position = read_matrix<double>(g, "position", 2);
+  p.normal = read_matrix<double>(g, "normal", 2);
   p.arc_length = read_column<double>(g, "arc_length");
   p.weight = read_column<double>(g, "weight");
   p.gap = read_column<double>(g, "gap");
@@ -250,7 +238,7 @@ PairField read_pair_group(hid_t contacts, const std::string& name) {
     p.friction_coefficient = h5::read_attribute<double>(g, "friction_coefficient");
     p.friction_bound = h5::read_attribute<double>(g, "friction_bound");
     p.tangential_force = h5::read_attribute<double>(g, "tangential_force");
-    p.tangent = read_matrix<double>(g, "tangent");
+    p.tangent = read_matrix<double>(g, "tangent", 2);
     p.tangential_traction = read_column<double>(g, "tangential_traction");
     p.slip = read_column<double>(g, "slip");
     p.stick = read_column<int>(g, "stick");

@@ -3,6 +3,7 @@
 
 #include "contact_tables.hpp"
 #include "h5.hpp"
+#include "h5_eigen.hpp"
 
 #include <stdexcept>
 
@@ -12,28 +13,8 @@ namespace {
 
 using h5::Handle;
 
-template <class T>
-using Matrix = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>;
-
-// A rows x cols dataset (cols checked unless expected_cols < 0) into a column-major Eigen matrix.
-template <class T>
-Matrix<T> read_matrix(hid_t loc, const std::string& name, Eigen::Index expected_cols = -1) {
-  std::vector<hsize_t> dims;
-  const std::vector<T> data = h5::read_dataset<T>(loc, name, 2, dims);
-  const auto rows = static_cast<Eigen::Index>(dims[0]);
-  const auto cols = static_cast<Eigen::Index>(dims[1]);
-  if (expected_cols >= 0 && cols != expected_cols)
-    throw std::runtime_error("dataset '" + h5::object_name(loc) + "/" + name + "' has " + std::to_string(cols) +
-                             " columns, expected " + std::to_string(expected_cols));
-  using RowMajor = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  return Eigen::Map<const RowMajor>(data.data(), rows, cols);
-}
-
-template <class T>
-Eigen::Matrix<T, Eigen::Dynamic, 1> read_column(hid_t loc, const std::string& name) {
-  const std::vector<T> data = h5::read_vector<T>(loc, name);
-  return Eigen::Map<const Eigen::Matrix<T, Eigen::Dynamic, 1>>(data.data(), static_cast<Eigen::Index>(data.size()));
-}
+using h5::read_column;
+using h5::read_matrix;
 
 // A dataset of any rank <= 2 as a matrix with one column per component.
 Eigen::MatrixXd read_components(hid_t loc, const std::string& name) {

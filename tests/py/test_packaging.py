@@ -75,10 +75,16 @@ def pattern_regex(pattern):
 
 
 def ignored(path, patterns):
-    """Whether the patterns exclude the path or one of its parent directories (which takes its contents)."""
+    """Whether the patterns exclude the path or one of its parent directories (which takes its contents). As Docker
+    reads them: the last pattern that matches decides, and a pattern starting with '!' takes the path back in."""
     parts = path.split("/")
     prefixes = ["/".join(parts[:k]) for k in range(1, len(parts) + 1)]
-    return any(pattern_regex(p).match(prefix) for p in patterns for prefix in prefixes)
+    out = False
+    for p in patterns:
+        negated = p.startswith("!")
+        if any(pattern_regex(p[1:] if negated else p).match(prefix) for prefix in prefixes):
+            out = not negated
+    return out
 
 
 setup = read("scripts", "setup.sh")
