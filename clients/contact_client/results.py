@@ -59,7 +59,7 @@ class ResultFile:
         import h5py
         self._h5py = h5py
         self.path = os.fspath(path)
-        self._tables, self._pair_index = {}, {}
+        self._tables, self._pair_index, self._node_keys = {}, {}, {}
         self._f = h5py.File(self.path, "r")
         try:
             self.attrs = {k: _attr(v) for k, v in self._f.attrs.items()}
@@ -147,9 +147,11 @@ class ResultFile:
                 attrs[key] = v if isinstance(v, str) else _attr(v)
         offsets = self._table(k, contacts, "offsets")
         begin, end = int(offsets[p]), int(offsets[p + 1])
-        per_node = [key for key, item in contacts.items()
-                    if isinstance(item, self._h5py.Dataset) and key not in _PAIR_COLUMNS
-                    and key not in ("offsets", "segment_offsets", "pair")]
+        per_node = self._node_keys.get(k)
+        if per_node is None:  # the step's per-node tables, listed once (h5py opens every member to list it)
+            per_node = self._node_keys[k] = [key for key, item in contacts.items()
+                                              if isinstance(item, self._h5py.Dataset) and key not in _PAIR_COLUMNS
+                                              and key not in ("offsets", "segment_offsets", "pair")]
         out = {}
         for key in (per_node if keys is None else keys):
             if key not in per_node or (key in _FRICTION_ONLY and not frictional):

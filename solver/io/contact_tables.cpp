@@ -133,7 +133,7 @@ std::vector<T> table(hid_t g, const std::string& name, std::int64_t rows, int co
   std::vector<T> v = h5::read_dataset<T>(g, name, cols == 0 ? 1 : 2, dims);
   if (static_cast<std::int64_t>(dims[0]) != rows || (cols > 0 && dims[1] != static_cast<hsize_t>(cols)))
     throw std::runtime_error("dataset '" + h5::object_name(g) + "/" + name + "' has " + std::to_string(dims[0]) +
-                             " rows, the offsets say " + std::to_string(rows));
+                             " rows, expected " + std::to_string(rows));
   return v;
 }
 
@@ -149,9 +149,9 @@ std::vector<PairField> read_tables(hid_t g, const std::vector<std::string>& name
   const size_t count = names.size();
   const auto offsets = table<std::int64_t>(g, "offsets", static_cast<std::int64_t>(count) + 1, 0);
   const std::int64_t n = offsets.back();
-  for (size_t p = 0; p < count; ++p)
-    if (offsets[p] > offsets[p + 1] || offsets[0] != 0)
-      throw std::runtime_error("dataset '" + h5::object_name(g) + "/offsets' does not increase from 0");
+  bool rising = offsets[0] == 0;
+  for (size_t p = 0; p < count; ++p) rising = rising && offsets[p] <= offsets[p + 1];
+  if (!rising) throw std::runtime_error("dataset '" + h5::object_name(g) + "/offsets' does not increase from 0");
   const auto node = table<std::int64_t>(g, "node", n, 0);
   const auto position = table<double>(g, "position", n, 2), normal = table<double>(g, "normal", n, 2),
              tangent = table<double>(g, "tangent", n, 2);
