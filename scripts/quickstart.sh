@@ -31,6 +31,9 @@ fi
 
 mkdir -p "$OUT_DIR"
 log="$OUT_DIR/contactd.log"
+# Created here: the background server's redirection opens it in the forked child, which may not have run yet when
+# the loop below first reads it.
+: > "$log"
 # A server of its own: no token, whatever the environment says (the client would not know it).
 env -u CONTACTD_TOKEN "$BUILD_DIR/server/contactd" --host 127.0.0.1 --port 0 --data-dir "$OUT_DIR/contactd-data" \
   > "$log" 2>&1 &
