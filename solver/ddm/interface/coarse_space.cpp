@@ -115,4 +115,39 @@ Eigen::VectorXd CoarseSpace::multipliers(const Eigen::VectorXd& r, const std::ve
   return Eigen::VectorXd();
 }
 
+struct CoarseSpace::Face::Factor {
+  Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> llt;
+};
+
+CoarseSpace::Face::~Face() = default;
+
+std::unique_ptr<CoarseSpace::Face> CoarseSpace::face(const std::vector<char>& columns) const {
+  std::unique_ptr<Face> f(new Face());
+  f->factor_ = std::make_unique<Face::Factor>();
+  if (empty()) return f;
+  f->GF_ = columns_of(columns);
+  f->GFt_ = f->GF_.transpose();
+  const SparseMatrix GFGFt = f->GF_ * f->GFt_;
+  if (!dependent_rows(problem_, GFGFt).empty()) return f;
+  f->factor_->llt.cholmod().print = 0;
+  f->factor_->llt.compute(GFGFt);
+  f->ok_ = f->factor_->llt.info() == Eigen::Success;
+  return f;
+}
+
+Eigen::VectorXd CoarseSpace::Face::correction(const Eigen::VectorXd& r) const {
+  if (GF_.rows() == 0) return Eigen::VectorXd::Zero(GF_.cols());
+  return GFt_ * factor_->llt.solve(r);
+}
+
+Eigen::VectorXd CoarseSpace::Face::project(const Eigen::VectorXd& v) const {
+  if (GF_.rows() == 0) return v;
+  return v - correction(GF_ * v);
+}
+
+Eigen::VectorXd CoarseSpace::Face::multipliers(const Eigen::VectorXd& h) const {
+  if (GF_.rows() == 0) return Eigen::VectorXd();
+  return -factor_->llt.solve(GF_ * h);
+}
+
 }  // namespace contact::ddm

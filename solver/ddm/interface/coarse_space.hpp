@@ -48,6 +48,28 @@ class CoarseSpace {
   // The rows of the floating bodies that the columns `columns` alone cannot hold (their block of G_A G_A^T is
   // singular): the bodies an active set leaves unheld.
   std::vector<Eigen::Index> unheld_by(const std::vector<char>& columns) const;
+  // The coarse space of a face: G_F, the columns `columns` of G (the contact rows strictly inside their bounds),
+  // with G_F G_F^T factorised. Serves the equality-constrained QP on a settled face (Smalbe::solve_face).
+  class Face {
+   public:
+    bool ok() const { return ok_; }  // false: G_F G_F^T is singular (the face leaves some rigid motion free)
+    // v - G_F^T (G_F G_F^T)^-1 G_F v: the part of v (zero off the face) in ker G_F.
+    Eigen::VectorXd project(const Eigen::VectorXd& v) const;
+    // G_F^T (G_F G_F^T)^-1 r: the least change on the face that changes G z by r.
+    Eigen::VectorXd correction(const Eigen::VectorXd& r) const;
+    // -(G_F G_F^T)^-1 G_F h: the multipliers alpha that make h + G^T alpha orthogonal to range G_F^T.
+    Eigen::VectorXd multipliers(const Eigen::VectorXd& h) const;
+    ~Face();
+
+   private:
+    friend class CoarseSpace;
+    Face() = default;
+    struct Factor;
+    SparseMatrix GF_, GFt_;
+    std::unique_ptr<Factor> factor_;
+    bool ok_ = false;
+  };
+  std::unique_ptr<Face> face(const std::vector<char>& columns) const;
   const SparseMatrix& G() const { return G_; }
   const Eigen::VectorXd& e() const { return e_; }
 

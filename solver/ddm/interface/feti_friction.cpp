@@ -95,7 +95,8 @@ std::string settled_message(const FrictionData& d, const ActiveSetResult& out, i
   os << "FETI (projected MPRGP on the box, SMALBE) with " << (d.coulomb ? "Coulomb" : "Tresca")
      << " friction converged: " << out.inner_iterations << " MPRGP iterations";
   if (d.coulomb) os << " in " << outer << " outer iterations on the slip bounds";
-  os << " (" << active << " nodes in contact: " << stick << " sticking, " << slip << " slipping; F products "
+  os << " (" << smalbe.face_steps() << " of them in CG on settled faces; " << active << " nodes in contact: " << stick
+     << " sticking, " << slip << " slipping; F products "
      << smalbe.seconds_F() << " s, coarse projections " << smalbe.seconds_coarse() << " s)";
   return os.str();
 }

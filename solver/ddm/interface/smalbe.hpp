@@ -43,6 +43,7 @@ class Smalbe {
   const CoarseSpace& coarse() const { return coarse_; }
   double seconds_F() const { return seconds_F_; }
   double seconds_coarse() const { return seconds_coarse_; }
+  long face_steps() const { return face_steps_; }  // products with F in CG on settled faces (in inner_iterations)
   const linalg::MprgpResult& last_inner() const { return last_inner_; }
 
  private:
@@ -50,6 +51,10 @@ class Smalbe {
   bool precondition(const Eigen::VectorXd& r, Eigen::VectorXd& y);
   void setup();
   bool finish(const Eigen::VectorXd& x, const Bounds& bounds, linalg::ActiveSetResult& out);
+  enum class FaceSolve { solved, not_solved, cancelled };
+  // The equality-constrained QP on x's face, by CG to the projected gradient `target`; solved: x is the answer to
+  // `tolerance` (smalbe_face.cpp).
+  FaceSolve solve_face(Eigen::VectorXd& x, double tolerance, double target, linalg::ActiveSetResult& out);
   bool report(int step, const Solve& how, linalg::ActiveSetResult& out);  // true: stop (the step callback asked)
   bool update_multipliers(const Eigen::VectorXd& x, const linalg::MprgpResult& r, int outer, double& M,
                           double& previous_L, std::vector<double>& violation);
@@ -65,6 +70,7 @@ class Smalbe {
   Eigen::VectorXd z_I_, Pc_, diagonal_, nu_, last_z_;
   Eigen::VectorXd range_;  // Q x of the last x apply_A took
   double rho_ = 1.0, norm_A_ = 1.0, norm_PHP_ = 1.0;
+  long face_steps_ = 0;  // products with H in solve_face, over the object's life
   double seconds_F_ = 0.0, seconds_coarse_ = 0.0;  // products with F (and their sum over processes), P and Q
   bool ready_ = false;
   linalg::BoundQp bound_;
