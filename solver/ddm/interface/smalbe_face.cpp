@@ -69,8 +69,9 @@ Smalbe::FaceSolve Smalbe::solve_face(Eigen::VectorXd& x_inout, double tolerance,
   if (precondition(r, y)) return FaceSolve::cancelled;
   Eigen::VectorXd d = y;
   double ry = r.dot(y);
-  // A face that is the answer's converges like FETI's CG; one that is not shows by a bound crossed or by stalling,
-  // so the budget is a few hundred products at most.
+  // The face's QP is well posed whether or not the face is the answer's (a wrong one shows at the end, by a bound
+  // crossed or a multiplier of the wrong sign); CG on it converges like FETI's, in 10-25 products on the walls'
+  // settled faces, and the budget only bounds what a face far from its answer can cost.
   const long budget = std::min<long>(300, s_.max_iterations - out.inner_iterations);
   for (long k = 0; r.norm() > target; ++k) {
     if (k >= budget) return FaceSolve::not_solved;
