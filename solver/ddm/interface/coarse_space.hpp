@@ -52,7 +52,9 @@ class CoarseSpace {
   // with G_F G_F^T factorised. Serves the equality-constrained QP on a settled face (Smalbe::solve_face).
   class Face {
    public:
-    bool ok() const { return ok_; }  // false: G_F G_F^T is singular (the face leaves some rigid motion free)
+    // false: G_F G_F^T is singular (the face leaves some rigid motion free), or there is no G at all (no floating
+    // body: SMALBE has no equalities and ends with its first inner solve, before a face solve would start).
+    bool ok() const { return ok_; }
     // v - G_F^T (G_F G_F^T)^-1 G_F v: the part of v (zero off the face) in ker G_F.
     Eigen::VectorXd project(const Eigen::VectorXd& v) const;
     // G_F^T (G_F G_F^T)^-1 r: the least change on the face that changes G z by r.
