@@ -9,6 +9,8 @@
   pulls at a contact and is not an answer.
 - Issue 30, item 2: an adaptive job with adaptivity.target_error streams one adaptive_step event per step (its
   pressure estimate, the last at most the target) and ends with the target met in its message.
+- Issue 28: a wall of 1,041 bricks held by friction (32 x 32, head joints) is accepted with the default limits
+  (512 bodies and 2,048 pairs until 2026-11-27) and solved.
 - Issue 31, item 4: a job over --max-bodies got its one real error followed by 200 that repeated it, one per
   contact naming a body. /v1/validate and a submission answer the one error.
 
@@ -174,15 +176,32 @@ with Server(args=["--workers", "1"]) as server:
     check("the message names the target met", final.get("state") == "SUCCEEDED" and
           "target met after" in (final.get("message") or ""), final.get("message"))
 
+    # --- a wall of a thousand bricks held by friction, with the default limits ----------------------------------
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "wall.json")
+        subprocess.run([sys.executable, os.path.join(SRC, "scripts", "make_brick_wall.py"), "--rows", "32", "--bricks",
+                        "32", "--head-joints", "--friction", "0.6", "--shear", "0.3", "-o", path], check=True,
+                       capture_output=True)
+        with open(path) as f:
+            wall = json.load(f)
+    job_id = server.submit_id(wall)
+    final = server.wait_done(job_id, timeout=300)
+    check(f"a 32 x 32 frictional wall ({len(wall['bodies'])} bodies, {len(wall['contacts'])} pairs) is accepted and "
+          "solved", final.get("state") == "SUCCEEDED" and "Coulomb friction converged" in final.get("message", ""),
+          final)
+    attrs = result_attributes(server, job_id)
+    check("its result holds every pair", attrs is not None and len(attrs["forces"]) == len(wall["contacts"]),
+          None if attrs is None else len(attrs["forces"]))
+
     # --- one error for one cause past a limit ------------------------------------------------------------------
-    r = server.request("POST", "/v1/validate", json_body=row_of_blocks(589))
+    r = server.request("POST", "/v1/validate", json_body=row_of_blocks(8193))
     errors = r.json().get("errors", []) if r.status == 400 else []
-    check("589 bodies: 400 with exactly one error", r.status == 400 and len(errors) == 1, (r.status, errors[:3]))
-    check("589 bodies: the error is the limit, at /bodies",
-          errors[:1] == [{"pointer": "/bodies", "message": "the job has 589 bodies; at most 512 are accepted"}],
+    check("8193 bodies: 400 with exactly one error", r.status == 400 and len(errors) == 1, (r.status, errors[:3]))
+    check("8193 bodies: the error is the limit, at /bodies",
+          errors[:1] == [{"pointer": "/bodies", "message": "the job has 8193 bodies; at most 8192 are accepted"}],
           errors[:3])
-    r = server.submit(row_of_blocks(589))
+    r = server.submit(row_of_blocks(8193))
     errors = r.json().get("errors", []) if r.status == 400 else []
-    check("589 bodies submitted: 400 with the same one error", r.status == 400 and len(errors) == 1, (r.status, errors[:3]))
+    check("8193 bodies submitted: 400 with the same one error", r.status == 400 and len(errors) == 1, (r.status, errors[:3]))
 
 finish()
