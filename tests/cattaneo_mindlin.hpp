@@ -69,11 +69,44 @@ inline nlohmann::json cattaneo_mesh(int nx, int ny, bool graded, double Q) {
   return job;
 }
 
+// The relative L2 error over |x| <= 1.5 a of a nodal profile (values at the slave nodes' x, piecewise linear
+// between them, constant past the ends) against `exact`, on 15,000 intervals: the norm of the function the nodal
+// values stand for, so that a node counts by the length it covers and the profile between nodes is measured too.
+template <class Exact>
+double profile_error(const PairField& p, const Eigen::VectorXd& values, double a, Exact exact) {
+  std::vector<std::pair<double, double>> nodes;  // (x, value), sorted
+  for (Eigen::Index j = 0; j < values.size(); ++j) nodes.emplace_back(p.position(j, 0), values[j]);
+  std::sort(nodes.begin(), nodes.end());
+  auto at = [&](double x) {
+    const auto it = std::lower_bound(nodes.begin(), nodes.end(), std::make_pair(x, -HUGE_VAL));
+    if (it == nodes.begin()) return nodes.front().second;
+    if (it == nodes.end()) return nodes.back().second;
+    const auto& [x1, v1] = *it;
+    const auto& [x0, v0] = *(it - 1);
+    return v0 + (v1 - v0) * (x - x0) / (x1 - x0);
+  };
+  double e2 = 0, r2 = 0;
+  const int n = 15000;
+  for (int i = 0; i <= n; ++i) {
+    const double x = -1.5 * a + 3 * a * i / n, w = (i == 0 || i == n) ? 0.5 : 1.0, v = exact(x);
+    e2 += w * std::pow(at(x) - v, 2);
+    r2 += w * v * v;
+  }
+  return std::sqrt(e2 / r2);
+}
+
 // A Cattaneo-Mindlin step against the theory, with the step's own normal force P and tangential load Q: the stick
-// zone's half-width c over a (c / a = sqrt(1 - Q / (mu P))) and the relative L2 error of the tangential traction
-// against Mindlin's (mu p(x) less the stick zone's mu p0 (c / a) sqrt(1 - x^2 / c^2)), over the slave nodes.
+// zone's half-width c over a (c / a = sqrt(1 - Q / (mu P))) and the error of the tangential traction against
+// Mindlin's (mu p(x) less the stick zone's mu p0 (c / a) sqrt(1 - x^2 / c^2)):
+//  - traction_error: the relative L2 error of the nodal tractions' piecewise-linear profile (profile_error), as
+//    the pressure's against Hertz's (hertz_pressure_error);
+//  - nodal_traction_error: the root sum of squares at the nodes only, the measure until 2026-11-27. It samples
+//    Mindlin's profile where the nodes happen to be, and the profile falls with an infinite slope just inside c:
+//    a mesh with no node there misses that fall. So the nodal measure does not converge with the mesh. Graded
+//    meshes: 400 x 12 2.1 % nodal, 7.7 % in L2; 1300 x 40 2.6 % and 3.4 %. The L2 error falls steadily: 7.7, 6.8,
+//    6.0, 5.2, 4.1, 3.4 % from 400 x 12 to 1300 x 40.
 struct MindlinFit {
-  double ratio = 0, c_over_a = 0, theory = 0, traction_error = 0;
+  double ratio = 0, c_over_a = 0, theory = 0, traction_error = 0, nodal_traction_error = 0;
 };
 
 inline MindlinFit mindlin_fit(const PairField& p, double Q) {
@@ -86,43 +119,29 @@ inline MindlinFit mindlin_fit(const PairField& p, double Q) {
   const double c = a * std::sqrt(1 - fit.ratio);
   fit.c_over_a = stick_half_width(p) / a;
   fit.theory = c / a;
-  double error = 0, norm = 0;
-  for (Eigen::Index j = 0; j < p.position.rows(); ++j) {
-    const double x = p.position(j, 0);
+  const auto mindlin = [&](double x) {
     double q = mu * p0 * std::sqrt(std::max(0.0, 1 - x * x / (a * a)));
     if (std::abs(x) < c) q -= mu * p0 * (c / a) * std::sqrt(1 - x * x / (c * c));
-    error += std::pow(-p.tangential_traction[j] - q, 2);
+    return q;
+  };
+  const Eigen::VectorXd traction = -p.tangential_traction;
+  fit.traction_error = profile_error(p, traction, a, mindlin);
+  double error = 0, norm = 0;
+  for (Eigen::Index j = 0; j < p.position.rows(); ++j) {
+    const double q = mindlin(p.position(j, 0));
+    error += std::pow(traction[j] - q, 2);
     norm += q * q;
   }
-  fit.traction_error = std::sqrt(error / norm);
+  fit.nodal_traction_error = std::sqrt(error / norm);
   return fit;
 }
 
 // The relative L2 error of a step's contact pressure against Hertz's at the step's own normal force (the geometry
-// of cattaneo_job), over |x| <= 1.5 a (past the edge the pressure is 0), on 15,000 intervals.
+// of cattaneo_job), over |x| <= 1.5 a (past the edge the pressure is 0).
 inline double hertz_pressure_error(const PairField& p) {
   const double R = 60, E_star = 2.1e5 / (2 * (1 - 0.3 * 0.3));
   const double a = std::sqrt(4 * p.force * R / (M_PI * E_star)), p0 = 2 * p.force / (M_PI * a);
-  std::vector<std::pair<double, double>> nodes;  // (x, p), sorted: the profile piecewise linear between them
-  for (Eigen::Index j = 0; j < p.pressure.size(); ++j) nodes.emplace_back(p.position(j, 0), p.pressure[j]);
-  std::sort(nodes.begin(), nodes.end());
-  auto at = [&](double x) {
-    const auto it = std::lower_bound(nodes.begin(), nodes.end(), std::make_pair(x, -HUGE_VAL));
-    if (it == nodes.begin()) return nodes.front().second;
-    if (it == nodes.end()) return nodes.back().second;
-    const auto& [x1, p1] = *it;
-    const auto& [x0, p0] = *(it - 1);
-    return p0 + (p1 - p0) * (x - x0) / (x1 - x0);
-  };
-  double e2 = 0, r2 = 0;
-  const int n = 15000;
-  for (int i = 0; i <= n; ++i) {
-    const double x = -1.5 * a + 3 * a * i / n, w = (i == 0 || i == n) ? 0.5 : 1.0;
-    const double hertz = p0 * std::sqrt(std::max(0.0, 1 - x * x / (a * a)));
-    e2 += w * std::pow(at(x) - hertz, 2);
-    r2 += w * hertz * hertz;
-  }
-  return std::sqrt(e2 / r2);
+  return profile_error(p, p.pressure, a, [&](double x) { return p0 * std::sqrt(std::max(0.0, 1 - x * x / (a * a))); });
 }
 
 }  // namespace contact::testing

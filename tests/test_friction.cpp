@@ -70,7 +70,11 @@ void check_cattaneo_mindlin(const std::string& interface_solver) {
     // Cattaneo-Mindlin with this step's normal force (the held top lets it change by a per cent).
     const MindlinFit fit = mindlin_fit(p, Q[k]);
     EXPECT_NEAR(fit.c_over_a, fit.theory, 0.03) << "Q / (mu P) = " << fit.ratio;
-    EXPECT_LT(fit.traction_error, 0.05) << "Q / (mu P) = " << fit.ratio;
+    // Issue 21's bound on its measure, the nodes' root sum of squares; in L2 (cattaneo_mindlin.hpp) the same within
+    // 5 % where the slip zone spans many nodes, and 6.4 % at Q / (mu P) = 0.25, where the slip annulus a - c =
+    // 0.13 a spans 3.5 nodes (h = 0.046) and the profile falls steeply at both of its ends.
+    EXPECT_LT(fit.nodal_traction_error, 0.05) << "Q / (mu P) = " << fit.ratio;
+    EXPECT_LT(fit.traction_error, fit.ratio < 0.3 ? 0.07 : 0.05) << "Q / (mu P) = " << fit.ratio;
     // Where a node slips its traction is on the bound.
     for (Eigen::Index j = 0; j < p.position.rows(); ++j)
       if (p.pressure[j] > 0) EXPECT_LE(std::abs(p.tangential_traction[j]), mu * p.pressure[j] * (1 + tolerance));
@@ -90,8 +94,8 @@ TEST(Friction, CattaneoMindlinAdaptsFromACoarseMeshAndEndsOnTheTheory) {
   json job = cattaneo_mesh(20, 4, false, Q);
   // Refinement graded towards the contact: a cell smaller than half its distance from the contact zone is not
   // refined, so the stress singularities of the cylinder's point loads and the block's held corner, far from
-  // the contact, do not take the unknowns (with the default grading 0 the run meets the theory at 54,077
-  // unknowns, 1.06x fewer than the graded mesh below; docs/algorithm.md, "Adaptivity with friction").
+  // the contact, do not take the unknowns (with the default grading 0 the run meets the theory at 22,121
+  // unknowns, 5.9x fewer than the graded mesh below; docs/algorithm.md, "Adaptivity with friction").
   job["adaptivity"] = {{"grading", 0.5}};
   job["output"] = {{"steps", "all"}};
   struct Estimates : Observer {
@@ -112,10 +116,10 @@ TEST(Friction, CattaneoMindlinAdaptsFromACoarseMeshAndEndsOnTheTheory) {
     // The pressure estimate (issue 30, item 2) against the pressure's true error: Hertz's at the step's force
     // (the bodies are 25 half-widths deep: their departure from half-spaces is far below these errors).
     const double truth = hertz_pressure_error(pair), effectivity = estimates.of_step[k] / truth;
-    std::printf("  step %d: %ld unknowns, Q / (mu P) %.3f, c / a %.4f (theory %.4f), traction error %.3f, pressure "
-                "error %.3f %%, estimate %.3f %% (effectivity %.2f)\n",
-                s.index, dofs, fit.ratio, fit.c_over_a, fit.theory, fit.traction_error, 100 * truth,
-                100 * estimates.of_step[k], effectivity);
+    std::printf("  step %d: %ld unknowns, Q / (mu P) %.3f, c / a %.4f (theory %.4f), traction error %.3f (at the "
+                "nodes %.3f), pressure error %.3f %%, estimate %.3f %% (effectivity %.2f)\n",
+                s.index, dofs, fit.ratio, fit.c_over_a, fit.theory, fit.traction_error, fit.nodal_traction_error,
+                100 * truth, 100 * estimates.of_step[k], effectivity);
     // Calibrated: within a factor of 3 either way (the paper's test and two cylinders measure 0.9 to 2.1;
     // docs/algorithm.md, "The pressure estimate") wherever the contact has nodes enough to be resolved at all
     // (6 in contact: at 3 the profile is three values and its error mostly the zone it cannot draw).
@@ -134,24 +138,26 @@ TEST(Friction, CattaneoMindlinAdaptsFromACoarseMeshAndEndsOnTheTheory) {
   EXPECT_NEAR(-p.weight.dot(p.tangential_traction), Q, 1e-8 * Q);
   for (Eigen::Index j = 0; j < p.position.rows(); ++j)
     if (p.pressure[j] > 0) EXPECT_LE(std::abs(p.tangential_traction[j]), 0.3 * p.pressure[j] * (1 + 1e-9));
-  // Against meshes graded towards the contact (cattaneo_job's grading 60 in both bodies): the family is noisy in
-  // c / a (the stick zone's end is read between nodes h = 60 / nx apart, 0.06 a at nx = 400): 350 x 11 and 375 x
-  // 11 miss it (c / a 0.07 and 0.046 off), 400 x 12 (21,573 unknowns) meets both, 500 x 15 misses the traction
-  // (5.9 %), 650 x 20 (57,480) meets both. The adaptive run meets both with at most a quarter of the smallest
-  // graded mesh found to meet them (measured 5.1x; against 650 x 20, 13.5x; docs/algorithm.md).
-  const Result coarse = run(cattaneo_mesh(375, 11, true, Q)), graded = run(cattaneo_mesh(400, 12, true, Q));
+  // Against meshes graded towards the contact (cattaneo_job's grading 60 in both bodies), the same two tests with
+  // the traction in L2: 400 x 12 7.7 %, 500 x 15 7.6 %, 560 x 17 6.8 %, 650 x 20 6.0 %, 800 x 24 5.2 % miss it, and
+  // 1000 x 30 (4.1 %, c / a 0.016 off) meets both. The adaptive run meets both with at most a tenth of its
+  // unknowns (measured 31x; docs/algorithm.md, "Adaptivity with friction"). By the nodes' values alone, which
+  // flatter a coarse mesh whose nodes miss the steep fall inside c, 400 x 12 would meet (2.1 %) and the ratio
+  // would be 5.1x.
+  const Result coarse = run(cattaneo_mesh(800, 24, true, Q)), graded = run(cattaneo_mesh(1000, 30, true, Q));
   ASSERT_TRUE(coarse.converged) << coarse.message;
   ASSERT_TRUE(graded.converged) << graded.message;
   const MindlinFit coarse_fit = mindlin_fit(pair_of(coarse.steps.back(), "block.top-cylinder.bottom"), Q);
   const MindlinFit graded_fit = mindlin_fit(pair_of(graded.steps.back(), "block.top-cylinder.bottom"), Q);
-  EXPECT_TRUE(std::abs(coarse_fit.c_over_a - coarse_fit.theory) > 0.03 || coarse_fit.traction_error >= 0.05);
+  EXPECT_TRUE(std::abs(coarse_fit.c_over_a - coarse_fit.theory) > 0.03 || coarse_fit.traction_error >= 0.05)
+      << coarse_fit.traction_error;
   EXPECT_LE(std::abs(graded_fit.c_over_a - graded_fit.theory), 0.03);
   EXPECT_LT(graded_fit.traction_error, 0.05);
   const long graded_dofs = unknowns(graded, graded.iterations);
-  std::printf("  adaptive meets both at %ld unknowns; graded 400 x 12: %ld (ratio %.1f)\n", first_meeting, graded_dofs,
-              static_cast<double>(graded_dofs) / static_cast<double>(first_meeting));
+  std::printf("  adaptive meets both at %ld unknowns; graded 1000 x 30: %ld (ratio %.1f)\n", first_meeting,
+              graded_dofs, static_cast<double>(graded_dofs) / static_cast<double>(first_meeting));
   ASSERT_GT(first_meeting, 0);
-  EXPECT_LE(4 * first_meeting, graded_dofs);
+  EXPECT_LE(10 * first_meeting, graded_dofs);
 }
 
 TEST(Friction, CattaneoMindlinByTheIterativeSolverFollowsTheTheoryToo) { check_cattaneo_mindlin("iterative"); }
