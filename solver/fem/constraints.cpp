@@ -86,4 +86,23 @@ std::string Constraints::close() {
   return {};
 }
 
+Eigen::VectorXd Constraints::condense_to_masters(const Eigen::VectorXd& f) const {
+  Eigen::VectorXd out = f;
+  std::function<void(int, double)> push = [&](int dof, double value) {
+    const auto it = lines_.find(dof);
+    if (it == lines_.end() || it->second.entries.empty()) {
+      out[dof] += value;
+      return;
+    }
+    for (const auto& [master, w] : it->second.entries) push(master, w * value);
+  };
+  for (const auto& [dof, line] : lines_) {
+    if (line.entries.empty()) continue;
+    const double value = out[dof];
+    out[dof] = 0.0;
+    push(dof, value);
+  }
+  return out;
+}
+
 }  // namespace contact::fem

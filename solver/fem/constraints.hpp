@@ -37,6 +37,11 @@ class Constraints {
 
   Eigen::VectorXd expand(const Eigen::VectorXd& x) const { return T_ * x + g_; }
 
+  // A nodal force vector (n_dofs) with every linearly constrained dof's value (a hanging node's) moved to its
+  // masters with the line's weights, through chains, and zero there: the forces the masters carry. Dirichlet
+  // dofs keep what they have and what reaches them (a support's reaction includes its hanging neighbours').
+  Eigen::VectorXd condense_to_masters(const Eigen::VectorXd& f) const;
+
  private:
   struct Line {
     std::vector<std::pair<int, double>> entries;
