@@ -34,14 +34,14 @@ struct PressureProfile {
   }
 };
 
-// Relative L2 error of a pressure over 0 <= x <= 1.5 against a reference (trapezoidal rule on 15,000 intervals,
-// finer than any mesh compared), the measure of issue 30.
-inline double pressure_error(const PairField& f, const PressureProfile& reference) {
+// Relative L2 error of a pressure over lo <= x <= hi (by default 0 <= x <= 1.5, the paper's test) against a
+// reference (trapezoidal rule on n intervals, finer than any mesh compared), the measure of issue 30.
+inline double pressure_error(const PairField& f, const PressureProfile& reference, double lo = 0.0, double hi = 1.5,
+                             int n = 15000) {
   const PressureProfile mine(f);
   double e2 = 0, r2 = 0;
-  const int n = 15000;
   for (int i = 0; i <= n; ++i) {
-    const double x = 1.5 * i / n, w = (i == 0 || i == n) ? 0.5 : 1.0;
+    const double x = lo + (hi - lo) * i / n, w = (i == 0 || i == n) ? 0.5 : 1.0;
     e2 += w * std::pow(mine.at(x) - reference.at(x), 2);
     r2 += w * std::pow(reference.at(x), 2);
   }
@@ -57,6 +57,22 @@ inline nlohmann::json seed_layers_defaults(int nx) {
     b["mesh"]["block"]["ny"] = nx / 4;
   }
   return job;
+}
+
+// A step's unknowns counted as 2 x nodes (hanging and supported nodes included), from its meshes.
+inline long mesh_unknowns(const Step& step) {
+  long dofs = 0;
+  for (const auto& b : step.bodies) dofs += 2L * b.mesh.num_nodes();
+  return dofs;
+}
+
+// The job's start refined uniformly: every cell at every step (delta below any indicator, plain marking), `levels`
+// levels, each kept (output.steps "all"): the reference of "fewer unknowns than uniform refinement".
+inline Result uniform_levels(nlohmann::json job, int levels) {
+  job["adaptivity"] = {{"indicator", "zz"}, {"delta", 1e-12}, {"marking", "plain"}, {"stop_tolerance", 0},
+                       {"max_steps", levels}, {"max_level", levels}, {"max_dofs", 2000000}};
+  job["output"] = {{"steps", "all"}};
+  return run(job);
 }
 
 // The unknowns (after the constraints) of a step, from its last iteration report.

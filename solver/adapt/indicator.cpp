@@ -57,6 +57,7 @@ Eigen::VectorXd normalised(const mesh::Mesh& m, const CellStresses& fe, const Ce
     total_area += area[c];
   }
   result.error2 = diff2.sum();
+  result.error2_cell = diff2;
   result.reference2 = ref2;
   const bool rms = normalization == Normalization::rms;
   const double scale = std::sqrt(ref2) / (rms ? std::sqrt(total_area) : total_area);

@@ -28,6 +28,7 @@ struct IndicatorResult {
   double seconds = 0.0;  // time spent (BEM solve and interior evaluations for fem_bem)
   double error2 = 0.0;      // ||sigma_R - sigma_F||^2 over the body (the global estimate's numerator)
   double reference2 = 0.0;  // ||sigma_R||^2 over the body
+  Eigen::VectorXd error2_cell;  // ||sigma_R - sigma_F||^2 per cell (unnormalised: the goal weights' primal factor)
   bool cancelled = false;   // the estimate was stopped by `cancelled` (eta is then empty)
   // fem_bem only: the FE displacements (all dofs) with the boundary nodes' replaced by the boundary-element
   // solution's, the body's response to the same data without the FE interior (pressure_estimate.hpp); empty

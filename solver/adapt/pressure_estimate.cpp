@@ -137,17 +137,31 @@ double squared_misfit(double a, double b, double la, double lb, double c0, doubl
 // active node i between a node with a larger pressure and an open one) gets the square-root model through
 // its last two nodes (p^2 linear in the arc length, as contact_extent.hpp extrapolates the zone's end) and the
 // integral of (model - profile)^2 over its last two segments. A zone whose pressure does not fall towards its
-// end (a punch's corner) has no such term.
-double edge_error2(const mortar::PairDiscretization& pair, const Eigen::VectorXd& z) {
-  const Eigen::VectorXd p = nodal_profile(pair, z);
-  const Eigen::Index n = p.size();
+// end (a punch's corner) has no such term. The nodes are the multiplier nodes: where the slave is finer than the
+// master, its nodes inside a multiplier segment only interpolate the segment's end values (docs/algorithm.md,
+// "coarse-grained multipliers"), and the profile's resolution at the edge is the multiplier segment's, not the
+// slave's (the two-cylinder example with the steel refined to 1.2e-4 at the edge and the aluminium not: a linear
+// tail over five slave segments that the slave's last two segments hardly saw).
+// `rows`: the profile's values per row (the pressure, or the tangential slack below).
+double edge_error2(const mortar::PairDiscretization& pair, const Eigen::VectorXd& rows, const mesh::Mesh& slave,
+                   const mesh::Mesh& master, double thickness, std::vector<PressureEstimate::EdgeShare>& shares) {
+  const Eigen::VectorXd all = nodal_profile(pair, rows);
+  std::vector<size_t> nodes;  // the multiplier nodes (positions in slave_nodes), each once
+  for (const size_t k : pair.multiplier_nodes)
+    if (k < pair.slave_nodes.size() && (nodes.empty() || nodes.back() != k)) nodes.push_back(k);
+  if (nodes.empty())
+    for (size_t k = 0; k < pair.slave_nodes.size(); ++k) nodes.push_back(k);
+  const Eigen::Index n = static_cast<Eigen::Index>(nodes.size());
+  Eigen::VectorXd p(n);
+  for (Eigen::Index j = 0; j < n; ++j) p[j] = all[static_cast<Eigen::Index>(nodes[static_cast<size_t>(j)])];
   const auto neighbour = [&](Eigen::Index j, int step) -> Eigen::Index {
     const Eigen::Index k = j + step;
     if (k >= 0 && k < n) return k;
     return pair.closed ? (k + n) % n : -1;
   };
   const auto distance = [&](Eigen::Index from, Eigen::Index to) {
-    double d = std::abs(pair.node_arc[to] - pair.node_arc[from]);
+    const auto at = [&](Eigen::Index j) { return pair.node_arc[static_cast<Eigen::Index>(nodes[static_cast<size_t>(j)])]; };
+    double d = std::abs(at(to) - at(from));
     return pair.closed ? std::min(d, pair.loop_length - d) : d;
   };
   double sum = 0.0;
@@ -161,17 +175,52 @@ double edge_error2(const mortar::PairDiscretization& pair, const Eigen::VectorXd
       // t from the inner node towards the open one: model^2 = p_j^2 + slope (t - h1).
       const double slope = (p[j] * p[j] - p[inner] * p[inner]) / h1;
       const double c0 = p[j] * p[j] - slope * h1;
-      sum += squared_misfit(0.0, h1, p[inner], p[j], c0, slope) + squared_misfit(h1, h1 + h2, p[j], 0.0, c0, slope);
+      const double e2 = thickness * (squared_misfit(0.0, h1, p[inner], p[j], c0, slope) +
+                                     squared_misfit(h1, h1 + h2, p[j], 0.0, c0, slope));
+      PressureEstimate::EdgeShare share;
+      share.slave_body = pair.slave_body;
+      share.master_body = pair.master_body;
+      share.at = slave.nodes[static_cast<size_t>(pair.slave_nodes[nodes[static_cast<size_t>(j)]])];
+      share.master_at = share.at;  // (a row without master terms: none to find)
+      if (const int row = pair.row_of_node[nodes[static_cast<size_t>(j)]]; row >= 0) {
+        Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+        double weight = 0.0;
+        for (mortar::SparseRows::InnerIterator it(pair.M, row); it; ++it) {
+          centre += std::abs(it.value()) * master.nodes[static_cast<size_t>(pair.master_nodes[static_cast<size_t>(it.col())])];
+          weight += std::abs(it.value());
+        }
+        if (weight > 0.0) share.master_at = centre / weight;
+      }
+      share.length = h1 + h2;
+      share.relative2 = e2;
+      shares.push_back(share);
+      sum += e2;
     }
   }
   return sum;
+}
+
+// A frictional pair's slack per row: the friction bound less |q| where the row is in contact and sticks, 0 where
+// it slips (within 1e-9 of the bound) or is open. In the stick zone it rises from a stick-slip point like a square
+// root of the distance (Mindlin: mu p0 (c / a) sqrt(1 - x^2 / c^2) for |x| < c), as the pressure does from a
+// contact edge, so edge_error2 on it measures what the piecewise-linear tangential traction misses there.
+Eigen::VectorXd slack_rows(const mortar::PairDiscretization& pair, const Eigen::VectorXd& z, const Eigen::VectorXd& q) {
+  Eigen::VectorXd s = Eigen::VectorXd::Zero(z.size());
+  for (Eigen::Index r = 0; r < z.size() && r < q.size(); ++r) {
+    if (!(z[r] > 0.0)) continue;
+    const double bound = pair.friction.law == FrictionSpec::Law::coulomb ? pair.friction.coefficient * z[r]
+                                                                          : pair.friction.bound;
+    const double slack = bound - std::abs(q[r]);
+    if (slack > 1e-9 * bound) s[r] = slack;
+  }
+  return s;
 }
 
 }  // namespace
 
 PressureEstimate pressure_estimate(const ddm::ContactSystem& system, const ddm::Displacements& u,
                                    const Pressures& z, const std::vector<IndicatorResult>& eta,
-                                   const std::function<bool()>& stop) {
+                                   const std::function<bool()>& stop, const Pressures* q) {
   PressureEstimate out;
   ddm::Displacements ub = u;
   int replaced = 0;
@@ -207,11 +256,22 @@ PressureEstimate pressure_estimate(const ddm::ContactSystem& system, const ddm::
   }
   const Model& model = system.problem().model;
   const double thickness = model.plane == Plane::stress ? model.thickness : 1.0;  // D is length x thickness
-  double edges2 = 0.0;
-  for (size_t k = 0; k < z.size(); ++k) edges2 += thickness * edge_error2(system.pairs()[k], z[k]);
+  double edges2 = 0.0, stick_slip2 = 0.0;
+  for (size_t k = 0; k < z.size(); ++k) {
+    const auto& pair = system.pairs()[k];
+    const auto& bodies = system.problem().bodies;
+    const mesh::Mesh& slave = bodies[static_cast<size_t>(pair.slave_body)].mesh;
+    const mesh::Mesh& master = bodies[static_cast<size_t>(pair.master_body)].mesh;
+    edges2 += edge_error2(pair, z[k], slave, master, thickness, out.edge_shares);
+    if (q && k < q->size() && pair.has_friction())
+      stick_slip2 += edge_error2(pair, slack_rows(pair, z[k], (*q)[k]), slave, master, thickness, out.edge_shares);
+  }
+  for (auto& share : out.edge_shares) share.relative2 /= norm2;
   out.defect = std::sqrt(dot(system, active, dz, dz) / norm2);
   out.edges = std::sqrt(edges2 / norm2);
-  out.relative = std::sqrt(out.defect * out.defect + out.edges * out.edges);
+  out.stick_slip = std::sqrt(stick_slip2 / norm2);
+  out.relative = std::sqrt(out.defect * out.defect + out.edges * out.edges + out.stick_slip * out.stick_slip);
+  out.correction = std::move(dz);
   return out;
 }
 
