@@ -246,8 +246,9 @@ void two_cylinder_runs() {
 }
 
 // Cattaneo-Mindlin (tests/cattaneo_mindlin.hpp: R 60, mu 0.3, Q / (mu P) = 0.5) adaptive from 20 x 4 uniform cells
-// per body, with the defaults, with grading 0.5 and with targets of 0.5 and 0.2 %: every step's pressure error against Hertz at its own force,
-// the pressure estimate and its effectivity, c / a against sqrt(1 - Q / (mu P)) and the tangential traction's
+// per body, with the defaults, with grading 0.5 and with targets of 0.5 and 0.2 %: every step's pressure error
+// against Hertz at its own force, the pressure estimate and its effectivity, c / a against sqrt(1 - Q / (mu P))
+// and the tangential traction's
 // error against Mindlin's (in L2, and at the nodes only: tests/cattaneo_mindlin.hpp); then meshes graded towards
 // the contact: 800 x 24, which misses the traction's 5 % in L2, and 1000 x 30, the smallest found to meet both.
 void cattaneo_mindlin_runs() {
