@@ -246,7 +246,7 @@ void two_cylinder_runs() {
 }
 
 // Cattaneo-Mindlin (tests/cattaneo_mindlin.hpp: R 60, mu 0.3, Q / (mu P) = 0.5) adaptive from 20 x 4 uniform cells
-// per body, with the defaults, with grading 0.5 and with targets of 0.5 and 0.2 %: every step's pressure error
+// per body, with the defaults, with grading 0.5 and with targets of 0.5, 0.2 and 0.1 %: every step's pressure error
 // against Hertz at its own force, the pressure estimate and its effectivity, c / a against sqrt(1 - Q / (mu P))
 // and the tangential traction's
 // error against Mindlin's (in L2, and at the nodes only: tests/cattaneo_mindlin.hpp); then meshes graded towards
@@ -260,7 +260,8 @@ void cattaneo_mindlin_runs() {
            {"defaults", json::object()},
            {"grading 0.5", {{"grading", 0.5}}},
            {"target_error 0.5 %", {{"target_error", 0.005}}},
-           {"target_error 0.2 %", {{"target_error", 0.002}}}}) {
+           {"target_error 0.2 %", {{"target_error", 0.002}}},
+           {"target_error 0.1 %", {{"target_error", 0.001}}}}) {
     json job = testing::cattaneo_mesh(20, 4, false, Q);
     job["adaptivity"] = adaptivity;
     job["output"] = {{"steps", "all"}};
