@@ -50,11 +50,23 @@ with tempfile.TemporaryDirectory() as tmp:
     with open(adaptive_path, "w") as f:
         json.dump(adaptive, f)
 
+    # The same with a target (issue 30): the goal-oriented marking's shares, summed over the bodies of every rank.
+    with open(os.path.join(EXAMPLES, "seed_layers.json")) as f:
+        targeted = json.load(f)
+    targeted.pop("solver", None)
+    for b in targeted["bodies"]:
+        b["mesh"]["block"].update(nx=8, ny=2)
+    targeted["adaptivity"] = {"target_error": 0.005}
+    targeted_path = os.path.join(tmp, "adaptive_target.json")
+    with open(targeted_path, "w") as f:
+        json.dump(targeted, f)
+
     jobs = {
         "stack3": os.path.join(EXAMPLES, "stack3.json"),               # the paper's Neumann DDM, 1477 iterations
         "stack3_floating": os.path.join(EXAMPLES, "stack3_floating.json"),  # interface Newton, a floating body
         "brick_wall": os.path.join(EXAMPLES, "brick_wall.json"),       # 69 bodies, 120 pairs, 68 floating
         "adaptive": adaptive_path,                                      # meshes refined between solves
+        "adaptive_target": targeted_path,                               # refined by the estimate's shares
         "roller_friction": os.path.join(EXAMPLES, "roller_friction.json"),  # friction, load histories, floating
     }
     for name, job in jobs.items():
