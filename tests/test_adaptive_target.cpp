@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -152,6 +153,27 @@ TEST(AdaptiveTarget, TwoCylindersErrorKeepsFallingBelowATenthOfAPercentFasterTha
     EXPECT_LT(dofs_of(r.steps[k]), n) << "level " << level;
     if (level == 4) EXPECT_LE(10 * dofs_of(r.steps[k]), n);
   }
+}
+
+TEST(AdaptiveTarget, TheMonolithicMethodAdaptsWithoutAnEstimateAndRefusesATarget) {
+  // The pressure estimate solves each body alone with its factorisation; the monolithic method builds one global
+  // system and no body factorisations. Its adaptive runs used to end in "internal error: BodySolver::solve called
+  // on a solver built without factorisation" once a step was estimated; now the estimate is not made there (NaN,
+  // with a reason), and a target with that method is refused where the job names it.
+  json job = example("hertz.json");
+  ASSERT_EQ(job["solver"]["method"], "monolithic");
+  job["adaptivity"] = {{"max_steps", 2}};
+  job["output"] = {{"steps", "all"}};
+  Estimates estimates;
+  CancelToken cancel;
+  const Result r = solve(parse_or_fail(job), estimates, cancel);
+  ASSERT_TRUE(r.converged) << r.message;
+  EXPECT_EQ(r.steps.size(), 3u);
+  for (const double e : estimates.pressure) EXPECT_TRUE(std::isnan(e));
+  job["adaptivity"] = {{"target_error", 0.01}};
+  EXPECT_NE(validation_errors(job).find("/adaptivity/target_error: target_error needs a domain-decomposition method"),
+            std::string::npos)
+      << validation_errors(job);
 }
 
 TEST(AdaptiveTarget, AMissedTargetIsSaidWithTheLastEstimate) {

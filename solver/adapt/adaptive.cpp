@@ -379,6 +379,21 @@ std::string stop_after_estimate(const AdaptivitySettings& s, const AdaptiveStepR
   return "";
 }
 
+// The step's pressure estimate. It solves each body alone with its factorisation, which the monolithic method
+// does not build (one global system instead): there it is not made, and says why (the job reader refuses a
+// target with that method; a Problem built in code meets it here).
+PressureEstimate step_pressure_estimate(const ddm::ContactSystem& system, ddm::RunFrame& frame,
+                                        const ddm::MethodOutcome& o, const std::vector<IndicatorResult>& eta) {
+  if (frame.settings().method == Method::monolithic) {
+    PressureEstimate none;
+    none.relative = std::nan("");
+    none.note = "no pressure estimate: it solves each body alone, and the monolithic method factorises none";
+    return none;
+  }
+  return pressure_estimate(system, o.u, o.z.empty() ? system.penalty_pressures(o.u) : o.z, eta, frame.stop_check(),
+                           o.q.empty() ? nullptr : &o.q);
+}
+
 // Solve, estimate, report the step, and stop (target, stop test, max_steps, nothing refinable, cancellation) or
 // refine.
 void converge_then_refine(Problem& working, ddm::ContactSystem& system, ddm::RunFrame& frame,
@@ -421,9 +436,7 @@ void converge_then_refine(Problem& working, ddm::ContactSystem& system, ddm::Run
       mark_cancelled(total);
       return finish(cancelled_here + std::to_string(step) + " (the result holds that step's solution)");
     }
-    const PressureEstimate pe =
-        pressure_estimate(system, o.u, o.z.empty() ? system.penalty_pressures(o.u) : o.z, eta, frame.stop_check(),
-                          o.q.empty() ? nullptr : &o.q);
+    const PressureEstimate pe = step_pressure_estimate(system, frame, o, eta);
     report.pressure_estimate = pe.relative;
     if (!o.converged) return finish("");
     if (const std::string stop = stop_after_estimate(s, report, pe, step, o.message); !stop.empty())

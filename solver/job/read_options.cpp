@@ -223,6 +223,12 @@ void JobReader::read_target_error(const json& value, const std::string& pointer,
                          "before each solve has converged, so no step has a pressure to estimate)");
     return;
   }
+  if (problem_.solver.method == Method::monolithic) {
+    errors_.add(pointer, "target_error needs a domain-decomposition method (the pressure estimate solves each body "
+                         "alone with its own factorisation, which the monolithic method does not build); use "
+                         "\"method\": \"interface_newton\" (the default) or remove the target");
+    return;
+  }
   a.target_error = *x;
   if (!stop_tolerance) {
     a.stop_tolerance = 0.0;
