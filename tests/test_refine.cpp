@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <random>
+#include <string>
 
 using namespace contact;
 using contact::testing::max_nodes_inside_a_side;
@@ -20,6 +21,15 @@ mesh::Mesh square(int n) {
   s.corners = {mesh::Point(0, 0), mesh::Point(2, 0), mesh::Point(2, 2), mesh::Point(0, 2)};
   s.nx = s.ny = n;
   return mesh::make_block(s);
+}
+
+// A steel body on square(3), to be refined by the test.
+Body square_body(const std::string& name) {
+  Body body;
+  body.name = name;
+  body.material = {2.1e5, 0.3};
+  body.mesh = square(3);
+  return body;
 }
 
 }  // namespace
@@ -89,10 +99,7 @@ TEST(HangingNodes, PatchTestLinearFieldIsExactOnANonConformingMesh) {
   // Several levels of local refinement: many hanging nodes. With the exact linear field u* (which satisfies
   // every hanging-node constraint), the constrained equations at the free interior unknowns hold exactly:
   // T^T K u* = 0 there, so the FE solution with u*'s boundary values is u*.
-  Body body;
-  body.name = "patch";
-  body.material = {2.1e5, 0.3};
-  body.mesh = square(3);
+  Body body = square_body("patch");
   refine_towards(body.mesh, mesh::Point(0.7, 1.3), 3);
   refine_towards(body.mesh, mesh::Point(1.6, 0.4), 2);
   const auto hanging = mesh::hanging_nodes(body.mesh);
@@ -128,10 +135,7 @@ TEST(HangingNodes, PatchTestLinearFieldIsExactOnANonConformingMesh) {
 }
 
 TEST(HangingNodes, UniformStressUnderTractionsOnANonConformingMesh) {
-  Body body;
-  body.name = "patch";
-  body.material = {2.1e5, 0.3};
-  body.mesh = square(3);
+  Body body = square_body("patch");
   refine_towards(body.mesh, mesh::Point(1.0, 1.0), 3);
   ASSERT_FALSE(mesh::hanging_nodes(body.mesh).empty());
   BoundaryCondition left{"left", BoundaryCondition::Kind::displacement};
@@ -158,10 +162,7 @@ TEST(HangingNodes, SupportReactionsBalanceTheLoadsWhereHangingNodesTouchTheSuppo
   // sit on sides whose lower end is a supported node; tractions on the top and the right. Whatever the mesh, the
   // supports' reactions balance the applied loads exactly: a hanging node's residual belongs to its masters, the
   // supported ones among them (left out, the refined two-cylinder example's supports were 4 % off).
-  Body body;
-  body.name = "clamped";
-  body.material = {2.1e5, 0.3};
-  body.mesh = square(3);
+  Body body = square_body("clamped");
   refine_towards(body.mesh, mesh::Point(1.0, 0.05), 3);
   BoundaryCondition bottom{"bottom", BoundaryCondition::Kind::displacement};
   bottom.ux = 0.0;
