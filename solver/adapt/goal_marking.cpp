@@ -54,18 +54,15 @@ std::vector<Eigen::VectorXd> goal_indicator(const Problem& problem, const ddm::C
   const ddm::Pressures& dz = pe.correction;
   const size_t n = problem.bodies.size();
   std::vector<Eigen::VectorXd> goal(n);
-  // phi: the bodies' response to dz's contact traction alone (their prescribed data's response subtracted).
-  ddm::Displacements none(system.n_bodies());
-  for (size_t a = 0; a < none.size(); ++a) none[a] = Eigen::VectorXd::Zero(system.body(a).n_dofs());
-  const ddm::Displacements free = system.solve_bodies(none);
-  ddm::Displacements phi = system.solve_bodies(system.loads_from_pressures(dz));
-  for (size_t a = 0; a < n; ++a) phi[a] -= free[a];
+  const ddm::Displacements loads = system.loads_from_pressures(dz);
   const parallel::BodyShare share{[&](size_t a, parallel::Packer& p) { p.put(goal[a]); },
                                   [&](size_t a, parallel::Unpacker& in) { goal[a] = in.get_vector(); }};
   runner.run_bodies(n, [&](size_t a) {
     if (a >= eta.size() || eta[a].error2_cell.size() != problem.bodies[a].mesh.num_cells()) return;
     const Body& body = problem.bodies[a];
-    const IndicatorResult dual = zz_indicator(body, system.body(a), phi[a]);
+    // phi: the body's response to dz's contact traction alone (prescribed values 0, no loads of its own).
+    const Eigen::VectorXd phi = system.body(a).solve_homogeneous(loads[a]);
+    const IndicatorResult dual = zz_indicator(body, system.body(a), phi);
     const double nu = body.material.nu;
     const double modulus = problem.model.plane == Plane::strain ? body.material.E / (1 - nu * nu) : body.material.E;
     goal[a] = (eta[a].error2_cell.cwiseProduct(dual.error2_cell)).cwiseSqrt() / modulus;
