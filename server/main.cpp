@@ -7,6 +7,7 @@
 #include "jobs/body_budget.hpp"
 #include "jobs/job_queue.hpp"
 #include "metrics/metrics.hpp"
+#include "store/crash_marker.hpp"
 #include "store/job_store.hpp"
 
 #include "contact/solve.hpp"
@@ -336,6 +337,7 @@ int shut_down(contactd::HttpServer& server, contactd::JobQueue& queue, std::thre
 int serve(const Config& config, const sigset_t& signals) {
   using namespace contactd;
   JobStore store(config.data_dir);
+  install_crash_marker(store.jobs_dir());
   Metrics metrics;
   BodyBudget budget(config.http.max_large_bodies, BodyBudget::validation_slots(config.http.max_validations), 256 * 1024,
                     std::chrono::seconds(10));

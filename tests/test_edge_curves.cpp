@@ -123,10 +123,15 @@ TEST(PairGroups, TheQuarterFitsPairsShareOneSurfaceAndACornerDoesNot) {
   }
   // The shaft's bottom (a radius) turns into its right arc at (500, 0) through a right angle: a corner, where each
   // edge keeps its own multiplier and normal, so the two pairs stay apart.
-  nlohmann::json corner = example("shrink_fit.json");
-  corner["contacts"] = nlohmann::json::array(
-      {{{"slave", "shaft.bottom"}, {"master", "ring.left"}}, {{"slave", "shaft.right"}, {"master", "ring.left"}}});
-  const Problem cornered = parse_or_fail(corner);
+  // (Built in code: the job reader refuses shaft.bottom -> ring.left, whose edges never face each other.)
+  Problem cornered = fit;
+  for (auto& c : cornered.contacts) {
+    c.slave_body = 0;  // shaft
+    c.master_body = 1;  // ring
+    c.master_edge = "left";
+  }
+  cornered.contacts[0].slave_edge = "bottom";
+  cornered.contacts[1].slave_edge = "right";
   EXPECT_EQ(pair_group(cornered, 0).pairs, (std::vector<int>{0}));
   EXPECT_EQ(pair_group(cornered, 1).pairs, (std::vector<int>{1}));
   // The stack's pairs are between different bodies: each alone.

@@ -1309,3 +1309,40 @@ TEST(JobHistory, AConditionsHistoryHasOneFactorPerLoadStep) {
             std::string::npos)
       << listing(parse(job));
 }
+
+// Issue 51, item 1: two clamped one-element blocks side by side and the pair b0.top -> b1.bottom, whose edges
+// never face each other, crashed the direct interface solver (an empty interface problem). The reader refuses
+// such a pair, naming it and the edges' ends; the pair that does face is accepted, slave and master either way.
+namespace {
+json two_clamped_blocks(const std::string& slave, const std::string& master, double x1 = 1.5) {
+  json job = json::parse(R"({"bodies": [
+    {"name": "b0", "material": {"E": 1, "nu": 0.3},
+     "mesh": {"block": {"corners": [[0, 0], [1, 0], [1, 1], [0, 1]], "nx": 1, "ny": 1}},
+     "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]},
+    {"name": "b1", "material": {"E": 1, "nu": 0.3},
+     "mesh": {"block": {"corners": [[1.5, 0], [2.5, 0], [2.5, 1], [1.5, 1]], "nx": 1, "ny": 1}},
+     "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]}]})");
+  job["bodies"][1]["mesh"]["block"]["corners"] = {{x1, 0}, {x1 + 1, 0}, {x1 + 1, 1}, {x1, 1}};
+  job["contacts"] = {{{"slave", slave}, {"master", master}}};
+  return job;
+}
+}  // namespace
+
+TEST(JobContacts, APairWhoseEdgesNeverFaceEachOtherIsRefusedWithItsEnds) {
+  expect_only_error(parse(two_clamped_blocks("b0.top", "b1.bottom")), "/contacts/0",
+                    "the edges of pair 'b0.top-b1.bottom' never face each other (slave b0.top runs from (1, 1) to "
+                    "(0, 1), master b1.bottom from (1.5, 0) to (2.5, 0)): no side of the master lies opposite");
+  // Opposite each other, but the bodies on the same side: b1.left's outward normal points at b0, b0.left's away.
+  expect_only_error(parse(two_clamped_blocks("b1.left", "b0.left")), "/contacts/0",
+                    "their outward normals point the same way");
+  // The edges that meet, either body the slave; and across a gap (the gap may close).
+  EXPECT_TRUE(parse(two_clamped_blocks("b1.left", "b0.right")).ok());
+  EXPECT_TRUE(parse(two_clamped_blocks("b0.right", "b1.left")).ok());
+  EXPECT_TRUE(parse(two_clamped_blocks("b0.right", "b1.left", 1.0)).ok());
+  // Overlapping by half a side along the slave's normal is facing; touching at a corner point is not.
+  json shifted = two_clamped_blocks("b1.bottom", "b0.top");
+  shifted["bodies"][1]["mesh"]["block"]["corners"] = {{0.5, 1}, {1.5, 1}, {1.5, 2}, {0.5, 2}};
+  EXPECT_TRUE(parse(shifted).ok()) << listing(parse(shifted));
+  shifted["bodies"][1]["mesh"]["block"]["corners"] = {{1, 1}, {2, 1}, {2, 2}, {1, 2}};
+  expect_only_error(parse(shifted), "/contacts/0", "never face each other");
+}

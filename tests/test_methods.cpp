@@ -281,3 +281,47 @@ TEST(AugmentedLagrangian, Stack3SettlesInFewUpdatesWithBothInterfacesClosed) {
     if (b.name == "top") reaction_top = b.reaction.col(1).sum();
   EXPECT_NEAR(-reaction_top, r.steps.back().pairs[0].force, 1e-8 * r.steps.back().pairs[0].force);
 }
+
+// Issue 51, item 1: what reaches the solver past the job reader (a problem built in code) is an error with a
+// message, never a signal. Two clamped one-element blocks side by side, b0.top against b1.bottom: edges that
+// never face each other (the direct interface solver read past an empty vector: SIGSEGV). And a pair that faces
+// but whose slave edge is clamped, so that every slave node is a crosspoint: with friction the same crash.
+TEST(EmptyInterface, APairThatNeverFacesOrHasNoContactNodeIsAnErrorNamingItForEveryMethod) {
+  json job = json::parse(R"({"bodies": [
+    {"name": "b0", "material": {"E": 1, "nu": 0.3},
+     "mesh": {"block": {"corners": [[0, 0], [1, 0], [1, 1], [0, 1]], "nx": 1, "ny": 1}},
+     "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]},
+    {"name": "b1", "material": {"E": 1, "nu": 0.3},
+     "mesh": {"block": {"corners": [[1.5, 0], [2.5, 0], [2.5, 1], [1.5, 1]], "nx": 1, "ny": 1}},
+     "boundary": [{"edge": "left", "displacement": {"x": -0.1, "y": 0}}]}],
+    "contacts": [{"slave": "b1.left", "master": "b0.right"}]})");
+  Problem facing = parse_or_fail(job);
+  ASSERT_FALSE(facing.bodies.empty());
+  Problem never = facing;  // b0.top -> b1.bottom, which the reader would refuse
+  never.contacts[0].slave_body = 0;
+  never.contacts[0].slave_edge = "top";
+  never.contacts[0].master_body = 1;
+  never.contacts[0].master_edge = "bottom";
+  never.contacts[0].name = "b0.top-b1.bottom";
+  for (const Method method : {Method::interface_newton, Method::monolithic, Method::neumann}) {
+    never.solver.method = method;
+    const Result r = solve_quietly(never);
+    EXPECT_EQ(r.stop_reason, StopReason::error) << to_string(method);
+    EXPECT_NE(r.message.find("contact 'b0.top-b1.bottom': its edges never face each other"), std::string::npos)
+        << to_string(method) << ": " << r.message;
+  }
+  for (const bool friction : {false, true}) {
+    if (friction) facing.contacts[0].friction.coefficient = 0.3;
+    const Result r = solve_quietly(facing);  // b1.left clamped: both its nodes are crosspoints
+    EXPECT_EQ(r.stop_reason, StopReason::error) << friction;
+    EXPECT_NE(r.message.find("no contact pair has a slave node that can carry a force ('b1.left-b0.right': 2 slave "
+                             "nodes, 2 with their displacement along the contact normal prescribed"),
+              std::string::npos)
+        << r.message;
+  }
+  // Slave and master swapped, the clamped edge is the master: a contact that carries the push.
+  std::swap(facing.contacts[0].slave_body, facing.contacts[0].master_body);
+  std::swap(facing.contacts[0].slave_edge, facing.contacts[0].master_edge);
+  const Result swapped = solve_quietly(facing);
+  EXPECT_TRUE(swapped.converged) << swapped.message;
+}

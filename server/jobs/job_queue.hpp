@@ -10,8 +10,9 @@
 //
 // Life of a job: submit() validates it, stores it (JobStore::create) and queues it (QUEUED); a worker takes it
 // (RUNNING), runs it (job_run.hpp: the outcomes) and ends it SUCCEEDED, FAILED or CANCELLED with an `end` event.
-// A server that died while a job ran queues it again at the next start-up, or ends it FAILED with stop_reason
-// "interrupted" once that has happened max_attempts times (a job that kills the server).
+// A server that died while a job ran queues it again at the next start-up, or ends it FAILED: with stop_reason
+// "crashed" when the job's own solve took the fatal signal (store/crash_marker.hpp), "interrupted" once it has
+// been cut short max_attempts times (a job that kills the server by other means).
 //
 // Lock order: WorkerPool's mutex, then JobRegistry's; a job's EventLog lock and the Janitor's are never held while
 // another is taken. None is held while solving, writing result files or waiting for a client.

@@ -3,6 +3,7 @@
 #include "common/log.hpp"
 #include "common/time.hpp"
 #include "jobs/events.hpp"
+#include "store/crash_marker.hpp"
 
 #include <functional>
 #include <stdexcept>
@@ -36,20 +37,34 @@ void JobRecovery::recover(const std::shared_ptr<Job>& job) {
   context_.registry.add_recovered(job, body_hash);
   const JobRecord& r = job->record;
   if (is_terminal(r.state)) {
+    remove_crash_marker(context_.store.job_dir(id));  // a crash after its outcome was stored marks nothing
     check_finished(job);
     return;
   }
   if (r.state == JobState::running) {
-    // Its run was cut short by the server dying (a crash, kill -9, running out of memory). A job that does that
-    // every time would do it at every start: after max_attempts such runs it ends FAILED.
+    // Its run was cut short by the server dying (a crash, kill -9, running out of memory). A job whose own solve
+    // took a fatal signal is marked (store/crash_marker.hpp) and is not run again: it would bring the server down
+    // at every start, and the jobs beside it with it. Any other interrupted job runs again, up to max_attempts
+    // times (one that kills the server without a signal it can catch, e.g. by running out of memory).
     context_.store.remove_result(id);  // of the interrupted run, if it got that far
     const int interruptions = r.interruptions + 1;
+    if (const auto signal = read_crash_marker(context_.store.job_dir(id))) {
+      give_up(job, interruptions, "crashed",
+              "the server crashed (" + *signal + ") while it solved this job; it is not run again. This is a "
+              "defect of the solver, not of the job: please report it with the job");
+      remove_crash_marker(context_.store.job_dir(id));
+      return;
+    }
     if (interruptions >= context_.settings.max_attempts) {
-      give_up(job, interruptions);
+      give_up(job, interruptions, "interrupted",
+              "interrupted " + std::to_string(interruptions) +
+                  " times: the server stopped (crashed, was killed or ran out of memory) while it ran; it is not "
+                  "run again");
       return;
     }
     requeue_interrupted(job, interruptions);
   }
+  remove_crash_marker(context_.store.job_dir(id));  // of an earlier crash, once the job's fate is recorded
   pool_.enqueue(job);
   ++requeued_;
 }
@@ -65,16 +80,14 @@ void JobRecovery::check_finished(const std::shared_ptr<Job>& job) {
   context_.registry.settle(job, context_.store.disk_usage(r.id));
 }
 
-void JobRecovery::give_up(const std::shared_ptr<Job>& job, int interruptions) {
-  const std::string message = "interrupted " + std::to_string(interruptions) +
-                              " times: the server stopped (crashed, was killed or ran out of memory) while it "
-                              "ran; it is not run again";
+void JobRecovery::give_up(const std::shared_ptr<Job>& job, int interruptions, const std::string& stop_reason,
+                          const std::string& message) {
   const std::int64_t now = now_unix_us();
   commit_or_throw(job, [&](JobRecord& x) {
     x.state = JobState::failed;
     x.interruptions = interruptions;
     x.finished_us = now;
-    x.stop_reason = "interrupted";
+    x.stop_reason = stop_reason;
     x.message = message;
     x.converged = false;
     x.result_available = false;

@@ -8,6 +8,7 @@
 
 #include "contact/result_file.hpp"
 #include "contact/solve.hpp"
+#include "contact/work_label.hpp"
 
 #include <sys/stat.h>
 #include <unistd.h>
@@ -57,6 +58,9 @@ JobRun::JobRun(const RunContext& context, std::shared_ptr<Job> job)
     : context_(context), job_(std::move(job)), id_(job_->record.id) {}
 
 void JobRun::execute() {
+  // The run's threads, and those the solver starts for it, carry the job's id: a fatal signal in any of them marks
+  // this job (store/crash_marker.hpp), which then is not run again.
+  const contact::WorkLabelScope label(id_);
   announce_start();
   const contact::Result result = solve();
   context_.metrics.solve_finished(result.wall_seconds);

@@ -7,6 +7,7 @@
 //   <data>/jobs/<id>/events.ndjson  the progress events, append-only (EventLog)
 //   <data>/jobs/<id>/result.hdf     the HDF5 result, and result.xmf its XDMF sidecar
 //   <data>/jobs/<id>/pairs.json     the last iteration's detail of every pair (GET /v1/jobs/{id}/pairs)
+//   <data>/jobs/<id>/crashed        the fatal signal its solve took, until the next start reads it (crash_marker.hpp)
 // Every rewrite goes to "<file>.tmp", is fsync'ed and renamed over the file. Ids are checked with is_job_id()
 // before they become paths; no file is opened through a symbolic link. Thread safety: the methods touch only the
 // files of the job they are given, so calls for different jobs may run concurrently; the JobQueue serialises the
@@ -33,6 +34,7 @@ class JobStore {
   JobStore& operator=(const JobStore&) = delete;
 
   const std::string& data_dir() const { return data_dir_; }
+  const std::string& jobs_dir() const { return jobs_dir_; }
   std::string job_dir(const std::string& id) const;
   std::string job_path(const std::string& id) const { return job_dir(id) + "/job.json"; }
   std::string key_path(const std::string& id) const { return job_dir(id) + "/idempotency.key"; }

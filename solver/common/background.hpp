@@ -9,6 +9,8 @@
 // wait_for_background_work() first (contact/background_work.hpp says what a program should do).
 #pragma once
 
+#include "contact/work_label.hpp"
+
 #include <chrono>
 #include <condition_variable>
 #include <exception>
@@ -43,7 +45,8 @@ std::unique_ptr<T> run_unless_cancelled(std::function<std::unique_ptr<T>()> work
   auto state = std::make_shared<State>();
   detail::background_started();
   try {
-    std::thread([state, work = std::move(work)]() mutable {
+    std::thread([state, work = std::move(work), label = std::string(work_label())]() mutable {
+      const WorkLabelScope labelled(label);  // a crash in the work names the caller's job
       std::unique_ptr<T> result;
       std::exception_ptr error;
       try {

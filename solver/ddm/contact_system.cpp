@@ -14,7 +14,9 @@ double relative_change(const Eigen::VectorXd& now, const Eigen::VectorXd& before
 
 namespace {
 
-void append_error(std::string& errors, const std::string& e) { errors += (errors.empty() ? "" : "; ") + e; }
+void append_error(std::string& errors, const std::string& e) {
+  if (!e.empty()) errors += (errors.empty() ? "" : "; ") + e;
+}
 
 // The errors of the bodies that failed, the first few in full and the others by name (a wall of a hundred
 // bricks must not give a hundred copies of one message).
@@ -95,9 +97,18 @@ void ContactSystem::discretize_pairs() {
     penalties_[k] = mortar::choose_penalty(problem_, static_cast<int>(k));
     pairs_[k] = mortar::discretize_pair(problem_, static_cast<int>(k), penalties_[k].theta, &index);
   });
-  for (size_t k = 0; k < n; ++k)
+  for (size_t k = 0; k < n; ++k) {
     if (!(penalties_[k].theta > 0))
       append_error(error_, "contact '" + pairs_[k].name + "': the penalty theta is not positive");
+    // The job reader refuses such a pair (job/read_contacts.cpp, check_pairs_face); a problem built in code, or a
+    // job past the reader's budget for that check, is told here, before it is solved as a pair that carries nothing.
+    if (!(pairs_[k].covered_length > 0))
+      append_error(error_, "contact '" + pairs_[k].name +
+                               "': its edges never face each other (no part of the slave edge lies opposite the "
+                               "master edge along its normal, with their outward normals opposed), so it could "
+                               "never carry a force; name the edges that meet");
+  }
+  check_some_row();
   // Each body's pairs: what a body asks of the pairs (its interface unknowns, its rows of G) without going over
   // every pair of the job (a wall of 4,129 bricks has 12,192).
   pairs_of_body_.assign(problem_.bodies.size(), {});
@@ -106,6 +117,31 @@ void ContactSystem::discretize_pairs() {
     pairs_of_body_[s].push_back(k);
     if (m != s) pairs_of_body_[m].push_back(k);
   }
+}
+
+// Pairs that face each other but of which not one slave node carries a multiplier (each is a crosspoint: its
+// displacement along the contact normal prescribed, as on a clamped slave edge; or barely covered): the interface
+// problem is empty, and the solve would report a contact that carries nothing as converged. One such pair among
+// others is a corner of a model (a short head joint between two bed joints); all of them is a modelling mistake.
+void ContactSystem::check_some_row() {
+  if (pairs_.empty() || !error_.empty()) return;
+  for (const auto& pair : pairs_)
+    if (pair.n_rows() > 0) return;
+  std::string detail;
+  for (size_t k = 0; k < pairs_.size() && k < 3; ++k) {
+    const auto& status = pairs_[k].status;
+    const auto count = [&](mortar::NodeStatus s) { return std::count(status.begin(), status.end(), s); };
+    detail += (k ? "; '" : "'") + pairs_[k].name + "': " + std::to_string(status.size()) + " slave nodes, " +
+              std::to_string(count(mortar::NodeStatus::crosspoint)) +
+              " with their displacement along the contact normal prescribed, " +
+              std::to_string(count(mortar::NodeStatus::barely_covered) + count(mortar::NodeStatus::uncovered)) +
+              " not (or hardly) opposite the master";
+  }
+  if (pairs_.size() > 3) detail += "; and " + std::to_string(pairs_.size() - 3) + " more";
+  append_error(error_, "no contact pair has a slave node that can carry a force (" + detail +
+                           "): a slave edge whose displacement is prescribed cannot press on anything; make the "
+                           "supported edge the master (swap slave and master) or remove the support from the "
+                           "contact edge");
 }
 
 bool ContactSystem::may_float(size_t a) const {

@@ -138,6 +138,7 @@ class ContactSystem {
   PairField pair_field(size_t k, const Displacements& u, const Eigen::VectorXd& z, const Eigen::VectorXd* q) const;
 
   void discretize_pairs();
+  void check_some_row();
   // Full dofs of body a that some pair's operators act on (empty unless Factorization::interface).
   std::vector<int> interface_dofs(size_t a) const;
   // Whether body a may float (held by its contacts): in a pair, and a method that handles it.

@@ -3,6 +3,7 @@
 
 #include "contact/version.hpp"
 #include "contact/utc_time.hpp"
+#include "contact/work_label.hpp"
 #include "view_layout.hpp"
 #include "file_util.hpp"
 #include "xdmf_series.hpp"
@@ -431,7 +432,10 @@ void ResultStream::take(const Step& step) {
     return;
   }
   try {
-    writer_ = std::thread([this, copy] { write_taken(*copy); });
+    writer_ = std::thread([this, copy, label = std::string(work_label())] {
+      const WorkLabelScope labelled(label);  // a crash in the write names the caller's job
+      write_taken(*copy);
+    });
   } catch (const std::system_error&) {  // no thread to be had: write it here
     write_taken(*copy);
   }

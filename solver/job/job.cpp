@@ -44,6 +44,7 @@ ParseResult JobReader::run() {
   read_bodies(top);
   if (!inputs_.empty()) gmsh_.check_table_used(errors_);  // not when the bodies could not be read at all
   read_contacts(top);
+  check_pairs_face();
   read_solver(top);
   if (const json* a = top.find("adaptivity")) read_adaptivity(*a, top.at("adaptivity"));
   read_loading(top);

@@ -183,6 +183,7 @@ class JobReader {
   bool bodies_all_named() const;
   void read_contacts(const Fields& top);
   void read_gap(const Fields& contact, GapSpec& gap, json& out);
+  void check_pairs_face();
 
   // read_friction.cpp: a pair's friction, a condition's load history, and what they require of the rest
   void read_friction(const Fields& contact, FrictionSpec& friction);
@@ -204,6 +205,7 @@ class JobReader {
   };
   GivenSetting method_, enforcement_{"/solver"};
   std::vector<std::string> friction_pointers_;  // per contact pair of problem_.contacts (empty: frictionless)
+  std::vector<std::string> contact_pointers_;   // per contact pair of problem_.contacts: /contacts/k
   // One error for one cause: what a part refused whole (over a limit, of the wrong type) or read only in part
   // leaves unknown, so the checks that depend on it are not run (docs/job-format.md, "Validation and errors").
   bool bodies_listed_ = false;     // the bodies' list was read (not refused whole); names may still be missing

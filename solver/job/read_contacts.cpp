@@ -2,7 +2,9 @@
 #include "job_reader.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
+#include <sstream>
 #include <optional>
 #include <string>
 #include <utility>
@@ -123,9 +125,93 @@ void JobReader::read_contacts(const Fields& top) {
     if (errors_.size() == before) {
       problem_.contacts.push_back(pair);
       friction_pointers_.push_back(pair.friction.active() ? f.at("friction") : std::string());
+      contact_pointers_.push_back(cp);
     } else {
       contacts_complete_ = false;
     }
+  }
+}
+
+namespace {
+
+// An edge's sides as a polyline of points (a closed loop's first node again at its end).
+std::vector<Eigen::Vector2d> edge_polyline(const mesh::Mesh& mesh, const std::string& edge) {
+  std::vector<Eigen::Vector2d> points;
+  const std::vector<int> nodes = mesh.edge_set_nodes(edge);
+  for (const int n : nodes) points.push_back(mesh.nodes[static_cast<size_t>(n)]);
+  if (mesh.edge_set_closed(edge) && !points.empty()) points.push_back(points.front());
+  return points;
+}
+
+std::string point_text(const Eigen::Vector2d& p) {
+  std::ostringstream os;
+  os.precision(6);
+  os << "(" << p.x() << ", " << p.y() << ")";
+  return os.str();
+}
+
+enum class Facing { yes, no_overlap, normals_agree, unknown };
+
+// Whether a side of the slave edge faces a side of the master edge as the mortar discretisation pairs them
+// (solver/mortar/segments.hpp): their outward normals oppose, and the master side's projection on the slave side's
+// line overlaps the slave side. A pair with no such sides could never carry a force. The search stops at the first
+// facing sides (tried from the master's end that meets the slave's start: the two run in opposite directions), and
+// after `budget` side pairs without one it says unknown (the solve reports such a pair when it discretises it).
+Facing edges_face(const std::vector<Eigen::Vector2d>& slave, const std::vector<Eigen::Vector2d>& master,
+                  long long& budget) {
+  bool overlap_seen = false;
+  for (size_t k = 0; k + 1 < slave.size(); ++k) {
+    const Eigen::Vector2d a = slave[k], e = slave[k + 1] - a;
+    const double L2 = e.squaredNorm();
+    if (!(L2 > 0)) continue;
+    const Eigen::Vector2d n(e.y(), -e.x());
+    for (size_t r = master.size(); r-- > 1;) {
+      if (--budget < 0) return Facing::unknown;
+      const Eigen::Vector2d &c = master[r - 1], &d = master[r];
+      const Eigen::Vector2d f = d - c;
+      const double xc = (c - a).dot(e) / L2, xd = (d - a).dot(e) / L2;
+      if (!(std::min(std::max(xc, xd), 1.0) - std::max(std::min(xc, xd), 0.0) > 1e-9)) continue;
+      overlap_seen = true;
+      const Eigen::Vector2d m(f.y(), -f.x());  // the master side's outward normal (unnormalised)
+      if (m.dot(n) < -1e-12 * std::sqrt(L2) * f.norm()) return Facing::yes;
+    }
+  }
+  return overlap_seen ? Facing::normals_agree : Facing::no_overlap;
+}
+
+}  // namespace
+
+// A pair whose edges never face each other (a mistyped edge: "b0.top" for "b0.right", a slave and master on the
+// same side of a joint) would be solved as a pair that carries nothing, or fail in the solve with a message that
+// blames the loads. The check costs at most kFacingBudget side pairs over the job (a typical pair finds facing
+// sides at once); past it the pairs left are checked by the solve.
+void JobReader::check_pairs_face() {
+  // Only on meshes read without an error: a mesh given with errors is built in part, and its edges may not be
+  // chains (an edge's nodes would then not be an ordered list to walk).
+  if (errors_.size() > 0) return;
+  constexpr long long kFacingBudget = 20'000'000;
+  long long budget = kFacingBudget;
+  for (size_t k = 0; k < problem_.contacts.size() && budget > 0; ++k) {
+    const ContactPair& c = problem_.contacts[k];
+    const Body& slave_body = inputs_[static_cast<size_t>(c.slave_body)].body;
+    const Body& master_body = inputs_[static_cast<size_t>(c.master_body)].body;
+    const auto slave = edge_polyline(slave_body.mesh, c.slave_edge);
+    const auto master = edge_polyline(master_body.mesh, c.master_edge);
+    if (slave.size() < 2 || master.size() < 2) continue;  // a mesh not built: its error is given
+    const Facing facing = edges_face(slave, master, budget);
+    if (facing == Facing::yes || facing == Facing::unknown) continue;
+    const std::string s = slave_body.name + "." + c.slave_edge, m = master_body.name + "." + c.master_edge;
+    const std::string where = "slave " + s + " runs from " + point_text(slave.front()) + " to " +
+                              point_text(slave.back()) + ", master " + m + " from " + point_text(master.front()) +
+                              " to " + point_text(master.back());
+    errors_.add(contact_pointers_[k],
+                "the edges of pair '" + c.name + "' never face each other (" + where + "): " +
+                    (facing == Facing::no_overlap
+                         ? "no side of the master lies opposite a side of the slave, along the slave's normal"
+                         : "where they lie opposite each other their outward normals point the same way, so the "
+                           "bodies are on the same side of them") +
+                    "; such a pair could never carry a force. Name the edges that meet (a block's are bottom, "
+                    "right, top and left)");
   }
 }
 

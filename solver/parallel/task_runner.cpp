@@ -1,5 +1,7 @@
 #include "task_runner.hpp"
 
+#include "contact/work_label.hpp"
+
 #include <algorithm>
 
 namespace contact::parallel {
@@ -19,6 +21,8 @@ ThreadTaskRunner::~ThreadTaskRunner() {
 
 void ThreadTaskRunner::drain() {
   std::unique_lock<std::mutex> lock(mutex_);
+  // A worker does the batch's work under its caller's label, so that a crash in a body's task names the job.
+  const contact::WorkLabelScope label(label_);
   while (task_ && next_ < count_) {
     const size_t i = next_++;
     const auto* task = task_;
@@ -67,6 +71,7 @@ void ThreadTaskRunner::run(size_t n, const std::function<void(size_t)>& task) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     task_ = &task;
+    label_ = contact::work_label();
     next_ = 0;
     count_ = n;
     finished_ = 0;

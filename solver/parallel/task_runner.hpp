@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <functional>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -61,13 +62,14 @@ class ThreadTaskRunner final : public TaskRunner {
 
  private:
   void work_loop();
-  void drain();  // takes tasks of the current batch until none is left
+  void drain();  // takes tasks of the current batch until none is left (labelled as the batch's caller)
 
   std::vector<std::thread> workers_;
   std::mutex mutex_;
   std::condition_variable wake_, done_;
   const std::function<void(size_t)>* task_ = nullptr;
   size_t next_ = 0, count_ = 0, finished_ = 0;
+  std::string label_;  // the caller's work label (contact/work_label.hpp), which its tasks carry
   unsigned long generation_ = 0;
   bool stop_ = false;
   std::exception_ptr error_;

@@ -8,7 +8,9 @@ linalg::ActiveSetResult SparseDirectSolver::solve(const InterfaceQp& qp, const E
                                                   InterfaceSolveContext& context) {
   const Eigen::Index m = qp.problem.size();
   SparseMatrix H = F_.of(qp.problem);
-  if (qp.penalty.size() == m && qp.penalty.cwiseAbs().maxCoeff() > 0) {
+  // (m == 0: no contact row at all, every slave node a crosspoint; Eigen's maxCoeff is undefined on an empty vector.)
+  const bool penalised = m > 0 && qp.penalty.size() == m && qp.penalty.cwiseAbs().maxCoeff() > 0;
+  if (penalised) {
     SparseMatrix D(m, m);
     D.reserve(Eigen::VectorXi::Constant(m, 1));
     for (Eigen::Index i = 0; i < m; ++i) D.insert(i, i) = qp.penalty[i];
@@ -19,7 +21,7 @@ linalg::ActiveSetResult SparseDirectSolver::solve(const InterfaceQp& qp, const E
   // zone's edge to within a node or two; the previous step's active set would move it a node or two per step.
   // Under the penalty and the augmented Lagrangian the previous pressures stay the start (an update shifts them
   // little).
-  const bool exact = qp.penalty.size() != m || qp.penalty.cwiseAbs().maxCoeff() == 0;
+  const bool exact = !penalised;
   if (!z0 || z0->size() != m || exact) {
     std::vector<std::pair<Eigen::Index, int>> levels;
     guess = linalg::nested_initial_guess(H, qp.g, qp.line, qp.position, qp.equilibrium, &levels);
