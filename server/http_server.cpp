@@ -71,6 +71,9 @@ HttpServer::HttpServer(HttpSettings settings, JobQueue& queue, JobStore& store, 
                [this](Response& res, const std::string& path, std::optional<std::uint64_t> bytes) {
                  send_too_large(res, path, bytes);
                }} {
+  // Every answer says its Content-Type is to be believed (a JSON error document or a result file is never to be
+  // sniffed into something a browser would run).
+  core_.set_default_headers({{"X-Content-Type-Options", "nosniff"}});
   core_.set_tcp_nodelay(true);
   core_.set_keep_alive_max_count(100);
   core_.set_keep_alive_timeout(static_cast<time_t>(std::max(1.0, settings_.idle_timeout_seconds)));

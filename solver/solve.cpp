@@ -89,8 +89,16 @@ std::string what_the_result_keeps(const Problem& problem, const ddm::StepLog& st
   if (held == 0 && !iterate && !steps.dropped_iterate()) return "";
   const std::string kind = problem.adaptivity.enabled ? "adaptive step" : problem.loading.factors.size() > 1 ? "load step" : "step";
   std::ostringstream os;
+  // output.steps "last" keeps the fields of one step (the last that held, or the iterate in its place); every
+  // step's scalars stay in /history/steps either way.
+  const bool last_only = problem.output.steps == StepOutput::last;
   if (held == 0)
     os << "no " << kind << " held: the result keeps ";
+  else if (last_only && iterate)
+    os << "the result keeps the scalars of the " << held << " " << kind << (held == 1 ? "" : "s")
+       << " that held (output.steps \"last\")";
+  else if (last_only && held > 1)
+    os << "the result keeps the last of the " << held << " " << kind << "s that held (output.steps \"last\")";
   else
     os << "the result keeps the " << held << " " << kind << (held == 1 ? "" : "s") << " that held";
   if (iterate)

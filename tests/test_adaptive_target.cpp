@@ -176,15 +176,25 @@ TEST(AdaptiveTarget, TheMonolithicMethodAdaptsWithoutAnEstimateAndRefusesATarget
       << validation_errors(job);
 }
 
-TEST(AdaptiveTarget, AMissedTargetIsSaidWithTheLastEstimate) {
+TEST(AdaptiveTarget, AMissedTargetIsSaidWithTheLastEstimateAndIsNotConverged) {
   // Two levels of refinement cannot reach 0.1 % from 8 x 2 cells: the run stops when nothing marked can be refined
-  // and says the target was not reached, with the last step's estimate.
+  // and says the target was not reached, with the last step's estimate. That is not what the job asked for: not
+  // converged (stagnation), every step it made kept, each converged (issue 51: it ended SUCCEEDED).
   json job = seed_layers_defaults(8);
   job["adaptivity"] = {{"target_error", 0.001}, {"max_level", 2}};
   Estimates estimates;
   CancelToken cancel;
   const Result r = solve(parse_or_fail(job), estimates, cancel);
-  ASSERT_TRUE(r.converged) << r.message;
+  EXPECT_FALSE(r.converged) << r.message;
+  EXPECT_EQ(r.stop_reason, StopReason::stagnation) << r.message;
+  ASSERT_FALSE(r.steps.empty());
+  EXPECT_TRUE(r.steps.back().converged);
+  EXPECT_NE(r.message.find("the result keeps the"), std::string::npos) << r.message;
+  // max_steps ends it before the meshes do: max_iterations.
+  job["adaptivity"] = {{"target_error", 0.001}, {"max_steps", 1}};
+  const Result short_run = solve(parse_or_fail(job), estimates, cancel);
+  EXPECT_FALSE(short_run.converged) << short_run.message;
+  EXPECT_EQ(short_run.stop_reason, StopReason::max_iterations) << short_run.message;
   ASSERT_FALSE(estimates.pressure.empty());
   EXPECT_GT(estimates.pressure.back(), 0.001);
   EXPECT_NE(r.message.find("target_error = 0.1 % not reached: the last step's estimated pressure error is"),

@@ -410,6 +410,17 @@ TEST(Masonry, AStepThatDidNotConvergeIsCutAndIfThatFailsKeptOnlyAsTheLastAndFlag
   EXPECT_TRUE(r.steps[0].converged) << r.message;
   EXPECT_FALSE(r.steps[1].converged);
   EXPECT_EQ(summarize(r.steps[1]).converged, false);
+  // With output.steps "last" the iterate takes the held step's place: the message says the held step's scalars
+  // are what is kept of it (issue 51: it said the held steps were kept).
+  job["output"] = {{"iterate", true}, {"steps", "last"}};
+  const Result last = run(job);
+  ASSERT_EQ(last.steps.size(), 1u) << last.message;
+  EXPECT_FALSE(last.steps[0].converged);
+  EXPECT_EQ(last.step_history.size(), 2u);
+  EXPECT_NE(last.message.find("the result keeps the scalars of the 1 load step that held (output.steps \"last\") "
+                              "and the last iterate (converged 0)"),
+            std::string::npos)
+      << last.message;
 }
 
 TEST(Masonry, FromRestWithClosedJointsTheAnswerIsProportionalToTheLoadSoAFailedFirstStepIsNotCut) {

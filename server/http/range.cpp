@@ -7,13 +7,17 @@ namespace contactd {
 
 namespace {
 
-// Digits only, at most 18 of them (so no overflow); nullopt for anything else, "" included.
+// Digits only; nullopt for anything else, "" included. A number past 2^64 - 1 saturates there: RFC 9110 (14.1.2)
+// puts no bound on a position, and a last position past the file is clamped to its end (bytes=0-99999999999999999999
+// is the whole file as 206), a first one past it is unsatisfiable either way.
 std::optional<std::uint64_t> number(const std::string& text) {
-  if (text.empty() || text.size() > 18) return std::nullopt;
+  if (text.empty()) return std::nullopt;
+  constexpr std::uint64_t kMax = UINT64_MAX;
   std::uint64_t value = 0;
   for (char c : text) {
     if (c < '0' || c > '9') return std::nullopt;
-    value = value * 10 + static_cast<std::uint64_t>(c - '0');
+    const auto digit = static_cast<std::uint64_t>(c - '0');
+    value = value > (kMax - digit) / 10 ? kMax : value * 10 + digit;
   }
   return value;
 }

@@ -260,6 +260,7 @@ std::int64_t EventLog::append(const std::string& type, const nlohmann::json& fie
       } else {
         if (file_ok_) log_line("events: cannot write " + path_ + ": " + std::strerror(errno));
         file_ok_ = false;
+        ++dropped_;  // not recorded (a full disk): served from memory while the job lives, counted as dropped
         // Cut the partial line so that the file stays a sequence of complete events.
         if (::ftruncate(fd_, static_cast<off_t>(file_size_)) != 0) {
           ::close(fd_);

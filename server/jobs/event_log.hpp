@@ -6,7 +6,8 @@
 // {"seq":N,"type":"...","time":"...", followed by the type's own fields (see docs/server.md).
 //
 // Bounded: once the file has `max_bytes`, further `iteration` events are dropped (counted by dropped()); the few
-// state, step and end events are always written. Damage is never served: a line that is not a whole event is
+// state, step and end events are always written, where the disk takes them (an event a write error lost, e.g. on a
+// full disk, is served to the streams from memory and counted by dropped() too). Damage is never served: a line that is not a whole event is
 // not sent to any client, and the log's problem() says where it is (the job store reports it).
 //
 // Thread safety: every member may be called from any thread. append() (the worker) never waits for readers: it
@@ -51,7 +52,7 @@ class EventLog {
   std::string problem() const;
   // Called (once) when a read finds damage, with the problem; set before the log is used.
   void on_damage(std::function<void(const std::string&)> callback) { on_damage_ = std::move(callback); }
-  // Iteration events not recorded because the log reached max_bytes.
+  // Events not recorded in the file: iteration events past max_bytes, and events a write error lost.
   std::int64_t dropped() const;
   // True when the event after `after` exists but cannot be read (damaged): a stream ends there.
   bool unreadable_after(std::int64_t after) const;

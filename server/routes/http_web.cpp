@@ -93,7 +93,6 @@ void send_file(const httplib::Request& req, httplib::Response& res, const assets
   const std::string etag = etag_of(file.data);
   res.set_header("ETag", etag);
   res.set_header("Cache-Control", "no-cache");  // revalidated at every load: a new binary may have a new page
-  res.set_header("X-Content-Type-Options", "nosniff");
   if (req.get_header_value("If-None-Match") == etag) {
     res.status = 304;
     return;

@@ -52,15 +52,23 @@ std::vector<std::string> parse_host_list(const std::string& text) {
 
 namespace {
 
-// The host of a Host header value or of an authority: "[::1]:8080" -> "[::1]", "Example.org:80" -> "example.org".
-std::string host_part(const std::string& authority) {
-  std::string host = lower(trim(authority));
+// The host of a Host header value or of an authority: "[::1]:8080" -> "[::1]", "Example.org:80" -> "example.org";
+// nullopt when what follows the host is not ":" and a port (RFC 9110 7.2: Host = uri-host [ ":" port ], port =
+// *DIGIT), as in "127.0.0.1:80:evil" or "[::1]x": such a value names no host at all.
+std::optional<std::string> host_part(const std::string& authority) {
+  std::string host = lower(trim(authority)), port;
   if (!host.empty() && host[0] == '[') {
     const auto close = host.find(']');
-    host = close == std::string::npos ? host : host.substr(0, close + 1);
+    if (close == std::string::npos) return std::nullopt;
+    port = host.substr(close + 1);
+    host = host.substr(0, close + 1);
   } else if (const auto colon = host.find(':'); colon != std::string::npos) {
+    port = host.substr(colon);
     host = host.substr(0, colon);
   }
+  if (!port.empty() && (port[0] != ':' || port.size() > 6 ||
+                        !std::all_of(port.begin() + 1, port.end(), [](char c) { return c >= '0' && c <= '9'; })))
+    return std::nullopt;
   if (!host.empty() && host.back() == '.') host.pop_back();  // "localhost." is "localhost"
   return host;
 }
@@ -104,7 +112,11 @@ std::optional<Refusal> check_framing(const httplib::Request& req) {
 
 std::optional<Refusal> check_host(const httplib::Request& req, const GuardSettings& settings) {
   if (!req.has_header("Host")) return std::nullopt;  // HTTP/1.0 (browsers always send one)
-  const std::string host = host_part(req.get_header_value("Host"));
+  const std::optional<std::string> parsed = host_part(req.get_header_value("Host"));
+  if (!parsed)
+    return Refusal{400, "invalid-request",
+                   "the Host header '" + clip(req.get_header_value("Host"), 100) + "' is not a host and an optional port"};
+  const std::string& host = *parsed;
   if (allowed(host, settings)) return std::nullopt;
   return Refusal{421, "host-not-allowed",
                  "this server does not serve the host '" + clip(host, 100) + "' (allowed: " + allowed_list(settings) +
@@ -117,7 +129,8 @@ std::optional<Refusal> check_cross_site(const httplib::Request& req, const Guard
   if (req.has_header("Origin")) {
     const std::string origin = lower(trim(req.get_header_value("Origin")));
     const auto scheme = origin.find("://");
-    const std::string host = scheme == std::string::npos ? std::string() : host_part(origin.substr(scheme + 3));
+    const std::string host =
+        scheme == std::string::npos ? std::string() : host_part(origin.substr(scheme + 3)).value_or(std::string());
     if (host.empty() || !allowed(host, settings))
       return Refusal{403, "cross-site-request",
                      "requests from the origin '" + clip(origin, 100) + "' may not change state here (allowed hosts: " +

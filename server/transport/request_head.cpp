@@ -44,6 +44,8 @@ HeadCheck check_head(std::string_view received, const HeadLimits& limits) {
       return refuse(414, "the request line is longer than " + std::to_string(limits.max_request_line) + " bytes");
     if (eol - skip > limits.max_head_bytes)
       return refuse(431, "the request head is larger than " + std::to_string(limits.max_head_bytes) + " bytes");
+    if (!first && line_length > limits.max_header_line)
+      return refuse(431, "a header field line is longer than " + std::to_string(limits.max_header_line) + " bytes");
     const std::string_view line = received.substr(pos, line_length);
     // Characters: checked as they arrive, so that a NUL is refused at once, not when the line ends.
     for (std::size_t k = 0; k < line.size(); ++k) {

@@ -12,6 +12,9 @@ namespace contactd {
 struct HeadLimits {
   std::size_t max_head_bytes = 16 * 1024;  // request line + header fields + the empty line (431 beyond)
   std::size_t max_request_line = 4096;     // (414 beyond)
+  // One header field line (431 beyond): httplib reads a line of at most 8,192 bytes with its CRLF and fails a longer
+  // one only after its read timeout, with 400; refused here first, at once and with the right status.
+  std::size_t max_header_line = 8000;
   std::size_t max_header_fields = 64;      // (431 beyond)
 };
 

@@ -296,6 +296,20 @@ std::string target_missed(const PressureEstimate& pe, double target) {
   return os.str();
 }
 
+// A run that stops refining before its pressure estimate meets the job's target_error has not done what the job
+// asked: its answer is kept (every step converged), but it is not SUCCEEDED. It stops as a solve that did not
+// converge: max_iterations where max_steps ended it, stagnation where the stop test or the meshes did (nothing
+// left to refine, the unknowns' limit), so that the command line exits 3 and the server says FAILED with that
+// reason and the estimate reached (docs/job-format.md, "A target").
+bool target_missed_at_stop(const AdaptivitySettings& s, const PressureEstimate& pe) {
+  return s.target_error > 0.0 && !(pe.relative <= s.target_error);
+}
+
+void miss_target(ddm::MethodOutcome& total, StopReason reason) {
+  total.converged = false;
+  total.stop_reason = reason;
+}
+
 // Marks and refines. Without a target, or where the step has no pressure correction (the estimate failed), by the
 // indicator over delta with the job's marking rule. With a target, by the share each cell has in the pressure
 // estimate's correction (goal_marking.hpp): Doerfler's bulk marking of the cells that hold half of it. The
@@ -439,14 +453,19 @@ void converge_then_refine(Problem& working, ddm::ContactSystem& system, ddm::Run
     const PressureEstimate pe = step_pressure_estimate(system, frame, o, eta);
     report.pressure_estimate = pe.relative;
     if (!o.converged) return finish("");
-    if (const std::string stop = stop_after_estimate(s, report, pe, step, o.message); !stop.empty())
+    if (const std::string stop = stop_after_estimate(s, report, pe, step, o.message); !stop.empty()) {
+      if (target_missed_at_stop(s, pe))
+        miss_target(total, step >= s.max_steps && stalled(report, s.stop_tolerance).empty() ? StopReason::max_iterations
+                                                                                             : StopReason::stagnation);
       return finish(stop);
+    }
     RefineOutcome r = refine_for_step(working, system, eta, pe, steps.back(), steps.committed_nodes(), frame.runner());
     if (!r.any) {
       std::ostringstream os;
       os << "adaptive: " << (r.blocked ? "nothing marked can be refined" : "no cell marked") << " after " << step
          << " refinement steps (" << (r.note.empty() ? "" : r.note + "; ") << "last solve: " << o.message << ")"
          << target_missed(pe, s.target_error);
+      if (target_missed_at_stop(s, pe)) miss_target(total, StopReason::stagnation);
       return finish(os.str());
     }
     if (frame.stop_requested()) {  // during the marking and refinement: the refined meshes are not solved
