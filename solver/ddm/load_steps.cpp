@@ -1,19 +1,19 @@
 #include "load_steps.hpp"
 
+#include "friction_policy.hpp"
+
 #include <algorithm>
 
 namespace contact::ddm {
 
 namespace {
 
-// A frictional step that does not converge is cut: its increment is halved (at most kMaxCuts times, down to 1/32 of
-// the step) and the sub-steps are solved and accepted in turn from the last state that held. Why: friction is
+// A frictional step that does not converge is cut: its increment is halved (at most policy::LoadStepCuts::max_cuts
+// times, down to 1/32 of the step) and the sub-steps are solved and accepted in turn from the last state that held. Why: friction is
 // path dependent and the semismooth Newton's start is the previous state; near the limit of what friction holds
 // (bricks at the heel of a sheared wall whose bed joints slip above and below) a whole step's increment can leave
 // the Newton in sets that hold no answer, while halves of it, each from an answer, converge. The sub-steps follow
 // the load path more closely; they are not output steps (the step's result is its last sub-step's).
-constexpr int kMaxCuts = 5;
-
 bool may_cut(const ContactSystem& system, const MethodOutcome& outcome, const RunFrame& frame) {
   // Not: frictionless steps (path independent: a cut solves the same problem), a statics refusal (the loads of the
   // step's end are refused whatever the path) or a cancel.
@@ -56,7 +56,7 @@ void run_load_steps(ContactSystem& system, const std::vector<double>& factors, R
         ++sub_steps;
         continue;
       }
-      if (total.converged || cuts == kMaxCuts || !may_cut(system, total, frame)) break;
+      if (total.converged || cuts == policy::kFrictionPolicy.cuts.max_cuts || !may_cut(system, total, frame)) break;
       if (homogeneous_from_rest(system, k, done)) {
         not_cut = true;
         break;

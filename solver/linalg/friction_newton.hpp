@@ -1,7 +1,10 @@
-// The one semismooth Newton of frictional contact (Hueber, Stadler & Wohlmuth's primal-dual active set on the stick
-// and slip sets, friction_sets.hpp), globalised. Every frictional solver runs it: the direct interface solver
+// The semismooth Newton of frictional contact (Hueber, Stadler & Wohlmuth's primal-dual active set on the stick and
+// slip sets, friction_sets.hpp), globalised. The direct frictional solvers run it: the direct interface solver
 // (ddm/interface/friction_direct), its coarse levels (friction_nested) and the monolithic reference (ddm/monolithic);
-// each gives only the linear system of a set (`FrictionNewtonProblem::solve`).
+// each gives only the linear system of a set (`FrictionNewtonProblem::solve`). The iterative interface solver with
+// friction (ddm/interface/feti_friction) does not: it solves the friction box by SMALBE + MPRGP, Coulomb by an outer
+// iteration on the slip bounds, and of linalg's friction code uses only friction_sets.hpp (the rows, the sets'
+// prediction, the complementarity).
 //
 // Why a globalisation: the full-step iteration is exact once the sets are right and usually gets there in a few
 // steps, but from a poor start on many bodies it can cycle (the sets of two or more steps repeating) or run into

@@ -33,6 +33,7 @@ PUBLIC_HEADERS = {
     "mesh.hpp": "mesh", "problem.hpp": "problem", "result.hpp": "result", "solve.hpp": "solve",
     "session.hpp": "session", "job.hpp": "job", "result_file.hpp": "io", "progress_json.hpp": "io",
     "files.hpp": "common", "utc_time.hpp": "common", "background_work.hpp": "common", "version.hpp": "common",
+    "work_label.hpp": "common",
 }
 # The library's own files at the top of solver/, by the module (row of the table) they belong to.
 ROOT_FILES = {
@@ -90,10 +91,33 @@ def row_module(cell):
     return None
 
 
+# The qualifiers of a "may use" cell that narrow a module it names, read from the text (module: the module named):
+#   "`ddm/interface/` in `method.cpp` only"    a file-level exception: only that file of the row's module may
+#                                             include the named module's files (FILE_ONLY[row] = {module: file})
+#   "io through its public headers"          only the named module's public headers (contact/*.hpp), never its
+#                                             private files (PUBLIC_ONLY[row] = {module})
+FILE_ONLY_RE = re.compile(r"`([\w/]+?)/?` in `([\w.]+)` only")
+PUBLIC_ONLY_RE = re.compile(r"(?<![\w/])([\w/]+) through its public headers")
+FILE_ONLY = {}
+PUBLIC_ONLY = {}
+
+
+def narrowings(cell, server):
+    """The file-level exceptions and the public-header-only uses of a "may use" cell."""
+    if server:
+        return {}, set()
+    files = {m.group(1): m.group(2) for m in FILE_ONLY_RE.finditer(cell)}
+    public = {m.group(1) for m in PUBLIC_ONLY_RE.finditer(cell) if m.group(1) in SOLVER_MODULES}
+    return files, public
+
+
 def allowed_of(cell, server):
-    """The modules a "may use" cell names: module names as words; "the public headers"; "its folders below"."""
+    """The modules a "may use" cell names: module names as words; "the public headers"; "its folders below".
+    A module named only with a narrowing (narrowings()) is not among them: its uses are checked apart."""
     names = SERVER_MODULES if server else SOLVER_MODULES
     text = re.sub(r"`[^`]*\(\)`", "", cell)  # function names (`current_exchange()`) are not modules
+    text = FILE_ONLY_RE.sub("", text)
+    text = PUBLIC_ONLY_RE.sub("", text)
     found = set()
     for name in names:
         if re.search(r"(?<![\w/])" + re.escape(name) + r"(?![\w])", text):
@@ -119,6 +143,7 @@ def read_rules():
                 continue
             server = module.startswith("server") or module == "cli"
             rules[module] = allowed_of(cells[2], server) | (set() if server else {"common"})
+            FILE_ONLY[module], PUBLIC_ONLY[module] = narrowings(cells[2], server)
     return rules
 
 
@@ -198,6 +223,11 @@ def main():
                 if target_module == source_module:
                     continue
                 ok = target_module in reach.get(source_module, set())
+                exception = FILE_ONLY.get(source_module, {}).get(target_module)
+                if not ok and exception is not None:  # "`module/` in `file` only"
+                    ok = os.path.basename(here) == exception
+                if not ok and target_module in PUBLIC_ONLY.get(source_module, set()):  # "through its public headers"
+                    ok = target.startswith(PUBLIC_DIR + "/")
                 failures += not ok
                 check(f"{what}: {source_module} may use {target_module} (docs/architecture.md)", ok,
                       f"{source_module} may use {', '.join(sorted(reach.get(source_module, set()))) or 'nothing'}")

@@ -11,6 +11,7 @@
 
 #include "../../linalg/anderson.hpp"
 #include "../../linalg/friction_sets.hpp"
+#include "../friction_policy.hpp"
 #include "../friction_rows.hpp"
 #include "feti.hpp"
 #include "friction_direct.hpp"
@@ -127,32 +128,32 @@ linalg::ActiveSetStep outer_step(int outer, const FrictionData& d, const ActiveS
 // far more; a cap of 1e-6 cost 1.4x the MPRGP iterations on sheared walls, 1819 against 1302 at 16 x 16, H/V 0.3,
 // and 2.4x at 12 x 12, H/V 0.5, 59506 against 24981, for the same answer; 1e-2 was too loose: the 8 x 8 wall's
 // take-over without a preconditioner at H/V 0.5 then failed its whole increment), never below ten times the
-// tolerance: a
-// warm-started solve near the answer meets the projected gradient's rounding floor there (measured on
-// roller_friction: ~1e-11 of the free response's penetration), and asking for less would stall SMALBE. Stops when the bounds moved by less than 1e3 x the tolerance and the Coulomb
-// complementarity is below that too, or the bounds have settled (below): reduced quantities only, so every process
-// takes the same decision.
+// tolerance: a warm-started solve near the answer meets the projected gradient's rounding floor there (measured on
+// roller_friction: ~1e-11 of the free response's penetration), and asking for less would stall SMALBE. Stops when the
+// bounds moved by less than 1e3 x the tolerance and the Coulomb complementarity is below that too, or the bounds have
+// settled (below): reduced quantities only, so every process takes the same decision.
 void coulomb_outer(Smalbe& smalbe, const FrictionData& d, const Eigen::VectorXd* z0, Smalbe::Solve how,
                    double tolerance, InterfaceSolveContext& context, ActiveSetResult& out) {
   const Eigen::Index n = smalbe.diagonal().size();
-  const double outer_tolerance = 1e3 * tolerance;
+  const policy::CoulombOuter& tuning = policy::kFrictionPolicy.coulomb;
+  const double outer_tolerance = tuning.stop_factor * tolerance;
   const Eigen::VectorXd tied = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(d.rows.size()), infinity);
   Eigen::VectorXd b = z0 && coulomb_bounds(d, *z0).maxCoeff() > 0 ? coulomb_bounds(d, *z0) : tied;
   how.report = false;
   linalg::FrictionSets previous;
   double change = 1.0;
   int settled = 0;
-  how.tolerance = std::max(10 * tolerance, 1e-3);
+  how.tolerance = std::max(tuning.tolerance_floor * tolerance, tuning.first_tolerance);
   // The bounds Anderson-mixed (linalg/anderson.hpp): where the stick and slip sets no longer change, z(b) is affine
   // in b and the mixing converges like a Krylov method on it, where the plain update contracts by a constant factor
   // (about 0.5 per outer iteration on a sheared brick wall).
-  linalg::NonnegativeAnderson mixing(5);
+  linalg::NonnegativeAnderson mixing(tuning.anderson_depth);
   Eigen::VectorXd plain;  // the last plain update mu z, the fallback of mixed bounds
   bool mixed = false;
   for (int outer = 1; outer <= std::max(1, context.max_steps); ++outer) {
     // Never looser than the last: a solve that its start already satisfies leaves the bounds where they were, and
     // a tolerance from that zero change would loosen the next one again.
-    how.tolerance = std::clamp(0.01 * change, 10 * tolerance, how.tolerance);
+    how.tolerance = std::clamp(tuning.tolerance_per_change * change, tuning.tolerance_floor * tolerance, how.tolerance);
     smalbe.solve(friction_box(n, d, b), outer == 1 ? z0 : nullptr, how, out);
     if (out.cancelled) return;
     if (!out.converged && outer == 1 && b.allFinite()) {  // the warm start's bounds do not hold a body: tied
@@ -179,13 +180,13 @@ void coulomb_outer(Smalbe& smalbe, const FrictionData& d, const Eigen::VectorXd*
     }
     // Settled: the bounds stopped moving in two outer iterations at the finest inner tolerance. The complementarity
     // is then as small as the inner precision lets it be; above the tolerance only where a row's c = 1 / F_jj
-    // magnifies the slip's rounding (see friction_data), which the message reports.
-    // Rounding of that kind stays below 1e-6 (hertz_force with friction, c capped); a settled complementarity far
-    // above it is a slip against its friction force that the bounds no longer correct (seen at 0.16 on a 16 x 16
-    // wall with head joints at H/V = 0.5): not an answer.
-    settled = change <= outer_tolerance && how.tolerance <= 10 * tolerance ? settled + 1 : 0;
-    constexpr double settled_limit = 1e-5;
-    if (settled >= 2 && info.complementarity > settled_limit) {
+    // magnifies the slip's rounding (see friction_data), which the message reports. Rounding of that kind stays below
+    // 1e-6 (hertz_force with friction, c capped); a settled complementarity far above it is a slip against its friction
+    // force that the bounds no longer correct (seen at 0.16 on a 16 x 16 wall with head joints at H/V = 0.5): not an
+    // answer.
+    settled = change <= outer_tolerance && how.tolerance <= tuning.tolerance_floor * tolerance ? settled + 1 : 0;
+    const double settled_limit = tuning.settled_complementarity_limit;
+    if (settled >= tuning.settled_iterations && info.complementarity > settled_limit) {
       std::ostringstream os;
       os.precision(3);
       os << "FETI with Coulomb friction: the slip bounds settled, but the Coulomb complementarity stays at "
@@ -194,7 +195,7 @@ void coulomb_outer(Smalbe& smalbe, const FrictionData& d, const Eigen::VectorXd*
       out.message = os.str();
       return;
     }
-    if (change <= outer_tolerance && (info.complementarity <= outer_tolerance || settled >= 2)) {
+    if (change <= outer_tolerance && (info.complementarity <= outer_tolerance || settled >= tuning.settled_iterations)) {
       out.converged = true;
       out.message = settled_message(d, out, outer, smalbe);
       if (info.complementarity > outer_tolerance) {

@@ -1,5 +1,6 @@
 #include "interface_newton.hpp"
 
+#include "../friction_policy.hpp"
 #include "../friction_statics.hpp"
 #include "feti.hpp"
 #include "friction_direct.hpp"
@@ -111,12 +112,9 @@ void InterfaceNewton::solve(RunFrame& frame) {
   solver_note = &ctx.note;
   const Eigen::VectorXd* z0 = last_z_.size() == m && m > 0 && last_z_.cwiseAbs().maxCoeff() > 0 ? &last_z_ : nullptr;
   // With friction the direct solver's Newton gets a budget of its own before the iterative solver takes the step
-  // over (below): where it settles it does so within tens of steps (7 to 8 on sheared walls, 51 at the most
-  // measured, an 8 x 8 wall with head joints at H/V = 0.5); past that it is crawling by damped steps, each a sparse
-  // LU of the sets' system (0.3 s at 16 x 16), and 2000 of them took ten minutes before the take-over.
+  // over (below; the chain and the budget's rule: ddm/friction_policy.hpp).
   const bool may_take_over = system_.has_friction() && kind_ == InterfaceSolverKind::direct;
-  constexpr int kDirectFrictionSteps = 100;
-  if (may_take_over) ctx.max_steps = std::min(ctx.max_steps, kDirectFrictionSteps);
+  if (may_take_over) ctx.max_steps = std::min(ctx.max_steps, policy::kFrictionPolicy.direct.budget);
   linalg::ActiveSetResult result = solver_->solve(qp, z0, ctx);
   ctx.max_steps = std::max(1, settings.max_iterations);
   bool took_over = false;

@@ -1,6 +1,7 @@
 #include "smalbe.hpp"
 
 #include "../../common/scoped_timer.hpp"
+#include "../friction_policy.hpp"
 
 #include <cmath>
 #include <limits>
@@ -146,7 +147,9 @@ bool Smalbe::report(int step, const Solve& how, ActiveSetResult& out) {
 // friction holds).
 bool Smalbe::stagnating(const std::vector<double>& violation) const {
   const size_t k = violation.size();
-  return k >= 8 && violation[k - 1] > 0.5 * violation[k - 4] && rho_ >= 1e6 * norm_PHP_;
+  const policy::Smalbe& p = policy::kFrictionPolicy.smalbe;
+  return k >= static_cast<size_t>(p.stagnation_window) && violation[k - 1] > p.stagnation_fall * violation[k - 4] &&
+         rho_ >= p.stagnation_rho * norm_PHP_;
 }
 
 // The rows of the floating bodies whose equilibrium G_b z = e_b is violated by more than a thousandth of the
@@ -178,7 +181,8 @@ void Smalbe::solve(const Bounds& bounds, const Eigen::VectorXd* z0, const Solve&
   bound_.upper = bounds.upper.size() == m_ ? Eigen::VectorXd(bounds.upper - z_I_) : Eigen::VectorXd();
   double scale_g = 1.0;
   scales(scale_g);
-  const double eta = 0.1 * scale_g;
+  const policy::Smalbe& tuning = policy::kFrictionPolicy.smalbe;
+  const double eta = tuning.eta * scale_g;
   // rho from ||P H P|| again: raised where the previous solve's multipliers crawled, at its cap it would take the
   // equality violation's rounding floor near a warm start for a body nothing holds (stagnating()).
   rho_ = norm_A_ = norm_PHP_;
@@ -191,7 +195,7 @@ void Smalbe::solve(const Bounds& bounds, const Eigen::VectorXd* z0, const Solve&
   linalg::MprgpSettings inner;
   const int max_outer = std::max(1, ctx_.max_steps);
   for (int outer = 1; outer <= max_outer; ++outer) {
-    inner.alpha_bar = 1.9 / (1.05 * norm_A_);  // the power method underestimates ||A|| a little
+    inner.alpha_bar = tuning.step / (tuning.norm_margin * norm_A_);
     bound_.b = -(Pc_ + nu_);
     inner.max_iterations = std::max<long>(1, s_.max_iterations - out.inner_iterations);
     bool global = false;
@@ -200,7 +204,7 @@ void Smalbe::solve(const Bounds& bounds, const Eigen::VectorXd* z0, const Solve&
       const double feasibility = state.image.norm();  // ||Q x||
       const double z_scale = std::max((state.x + z_I_).norm(), 1e-300);
       if (norm_gp <= how.tolerance * scale_g && feasibility <= how.tolerance * z_scale) return global = true;
-      return norm_gp <= std::max(std::min(M * feasibility, eta), 0.1 * how.tolerance * scale_g);
+      return norm_gp <= std::max(std::min(M * feasibility, eta), tuning.inner_floor * how.tolerance * scale_g);
     };
     last_inner_ = linalg::solve_mprgp(bound_, x, inner, done);
     const linalg::MprgpResult& r = last_inner_;
@@ -209,7 +213,7 @@ void Smalbe::solve(const Bounds& bounds, const Eigen::VectorXd* z0, const Solve&
     out.steps = outer;
     // A face that the last inner solve kept throughout (CG steps only) after a multiplier update: solved on the
     // face directly (smalbe_face.cpp), at most twice a solve (a face that was not the answer's costs its products).
-    if (!global && r.converged && outer >= 2 && face_attempts < 2 && r.expansion_steps == 0 &&
+    if (!global && r.converged && outer >= 2 && face_attempts < tuning.face_attempts && r.expansion_steps == 0 &&
         r.proportioning_steps == 0) {
       ++face_attempts;
       // CG to a tenth of the tolerance where it is the finest the solve is asked for, as SMALBE's inner solves go
@@ -217,7 +221,8 @@ void Smalbe::solve(const Bounds& bounds, const Eigen::VectorXd* z0, const Solve&
       // SMALBE's (hertz_force.json: pressures 1.7e-8 from the monolithic reference against 7.5e-10). The
       // intermediate solves of Coulomb's outer iteration need only their own tolerance (a tenth there too cost the
       // 8 x 8 wall 30 % more products).
-      const double target = how.tolerance <= 10 * s_.tolerance ? 0.1 : 1.0;
+      const double target =
+          how.tolerance <= tuning.face_finest_factor * s_.tolerance ? tuning.face_target_finest : 1.0;
       const FaceSolve f = solve_face(x, how.tolerance * scale_g, target * how.tolerance * scale_g, out);
       if (f == FaceSolve::cancelled) {
         out.cancelled = true;
@@ -278,37 +283,23 @@ bool Smalbe::update_multipliers(const Eigen::VectorXd& x, const linalg::MprgpRes
   if (stagnating(violation)) return false;
   // On a face much smaller than the contact surface (a cylinder on a block) rho Q acts there only through the
   // face's share of the rigid modes' gaps, and the multiplier updates crawl: rho is raised (A's spectrum on ker G is
-  // unchanged; the expansion step shortens with ||A||) once the violation has fallen by less than half in each of
-  // the last three updates, up to 10 ||P H P||; past that only where the updates have stalled (the violation fell
-  // by less than 5 % in each of the last three) while the inner solves are cheap (at most 50 iterations: the
-  // multipliers' pace, not MPRGP's, is what costs), up to 1e6 ||P H P||.
-  // Three updates falling by less than half, not one by less than 10x: each Tresca solve of Coulomb's outer
-  // iteration starts from the last answer projected onto its new bounds, whose violation the first updates take
-  // down by 2-3x each with a few MPRGP iterations; raising rho there made every later CG step of the solve work
-  // against 10 ||P H P|| on the free rows (A's two parts mixed by the face). Whole runs' MPRGP iterations, walls
-  // with head joints at H/V 0.3 (8 x 8, 16 x 16, 22 x 22, 64 x 64), one run each:
-  //   one update < 10x:     1918, 2222, 2461, 4320   hertz_force 153
-  //   three updates < 10x:  1323, 1738, 1857, 2938               163
-  //   three updates < 1/2:  1000, 1057, 1331, 2188               163   (this rule)
-  //   three updates < 0.8:   938, 1010, 1121, 1990               154
-  //   three updates < 0.9:   906, 1010, 1121, 1847               429   (the floating cylinder crawls again)
-  // Never raising it: 906 at 8 x 8, hertz_force 435. A half keeps a margin from where hertz_force needs the raise.
-  // Past 10 ||P H P|| the free rows' steps mix A's two parts and MPRGP slows
-  // down more than the updates gain: on a sheared wall (16 x 16 bricks with head joints, mu 0.6, H/V = 0.5) every
-  // Coulomb outer iteration's Tresca solve climbed to 1e3-1e4 ||P H P|| (thousands of CG steps per update) and the
-  // step took 52,688 MPRGP iterations, against 13,456 with this rule and the same answer; at 22 x 22 the step did
-  // not settle within 100,000 MPRGP iterations (the budget then) and was cut 3 times, and now holds uncut (80,913;
-  // 121,364 on another machine's rounding, which is why interface.max_iterations is now 300,000).
-  // Without the stall rule the tolerance's last decades crawled there (hundreds of updates of 23 iterations).
+  // unchanged; the expansion step shortens with ||A||) once the violation has fallen little in each of the last
+  // three updates, up to a cap; past the cap only where the updates have stalled while the inner solves are cheap
+  // (the multipliers' pace, not MPRGP's, is what costs). Three updates, not one: each Tresca solve of Coulomb's
+  // outer iteration starts from the last answer projected onto its new bounds, whose violation the first updates
+  // take down by 2-3x each; raising rho there made every later CG step work against a large rho on the free rows.
+  // The factors and caps: policy::Smalbe (ddm/friction_policy.hpp); the runs that chose them: docs/algorithm.md,
+  // "The interface solvers".
   const size_t k = violation.size();
   const auto fell_little = [&](size_t i, double factor) { return violation[i] > factor * violation[i - 1]; };
   const auto fell_little_thrice = [&](double factor) {
     return k >= 4 && fell_little(k - 1, factor) && fell_little(k - 2, factor) && fell_little(k - 3, factor);
   };
-  const bool crawling = fell_little_thrice(0.5);
-  const bool stalled = fell_little_thrice(0.95) && r.iterations <= 50;
-  if (crawling && rho_ < (stalled ? 1e6 : 10.0) * norm_PHP_) {
-    rho_ *= 10;
+  const policy::Smalbe& tuning = policy::kFrictionPolicy.smalbe;
+  const bool crawling = fell_little_thrice(tuning.rho_crawl);
+  const bool stalled = fell_little_thrice(tuning.rho_stall) && r.iterations <= tuning.rho_stall_inner;
+  if (crawling && rho_ < (stalled ? tuning.rho_stall_cap : tuning.rho_cap) * norm_PHP_) {
+    rho_ *= tuning.rho_raise;
     norm_A_ = std::max(norm_PHP_, rho_);
   }
   return true;
