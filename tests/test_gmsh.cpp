@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -539,6 +540,10 @@ json flat_patch_with_names(std::size_t count, const std::vector<int>& dims) {
   return job;
 }
 
+// Not a latency bound (tests run on loaded 2-core machines, where a fraction of a second can take several): the
+// quadratic search these tests guard against took 57 s and 130 s, and only it breaks 15 s.
+constexpr double kQuadraticSearchBound = 15.0;
+
 double seconds_to_parse(const json& job, job::ParseResult& r) {
   const auto start = std::chrono::steady_clock::now();
   r = job::parse(job);
@@ -547,23 +552,28 @@ double seconds_to_parse(const json& job, job::ParseResult& r) {
 
 }  // namespace
 
-// Issue 22, defect 2: the names were grouped by a search over the list being built (150k names: 57 s).
-TEST(GmshJob, ManyPhysicalNamesValidateInWellUnderASecond) {
+// Issue 22, defect 2: the names were grouped by a search over the list being built (150k names: 57 s). The parse
+// takes a fraction of a second (printed); the bound, kQuadraticSearchBound, is broken only by that search.
+TEST(GmshJob, ManyPhysicalNamesValidateWithoutAQuadraticSearch) {
   const json job = flat_patch_with_names(150'000, {0, 1, 2});  // points, curves and surfaces of no entity
   job::ParseResult r;
   const double seconds = seconds_to_parse(job, r);
+  std::printf("  150k physical names parsed in %.3f s\n", seconds);
   ASSERT_TRUE(r.ok()) << job::format_errors(r.errors);
   EXPECT_EQ(r.problem->bodies[0].mesh.num_nodes() + r.problem->bodies[1].mesh.num_nodes(), 115);
-  EXPECT_LT(seconds, 1.0) << "150k physical names took " << seconds << " s";
+  EXPECT_LT(seconds, kQuadraticSearchBound)
+      << "150k physical names took " << seconds << " s (the quadratic search: 57 s)";
 }
 
 // ... and a missing surface among 200k surface names was listed by the same search (130 s) and all of them.
-TEST(GmshJob, AMissingSurfaceAmongManyNamesIsReportedFastWithAShortList) {
+TEST(GmshJob, AMissingSurfaceAmongManyNamesIsReportedWithoutAQuadraticSearchAndWithAShortList) {
   json job = flat_patch_with_names(200'000, {2});
   job["bodies"][0]["mesh"]["gmsh"]["surface"] = "missing";
   job::ParseResult r;
   const double seconds = seconds_to_parse(job, r);
-  EXPECT_LT(seconds, 1.0) << "a missing surface among 200k names took " << seconds << " s";
+  std::printf("  a missing surface among 200k names reported in %.3f s\n", seconds);
+  EXPECT_LT(seconds, kQuadraticSearchBound)
+      << "a missing surface among 200k names took " << seconds << " s (the quadratic search: 130 s)";
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.errors[0].pointer, "/bodies/0/mesh/gmsh/surface");
   const std::string& message = r.errors[0].message;

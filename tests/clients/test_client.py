@@ -565,7 +565,10 @@ def test_unreachable(tmp):
         took = time.time() - t0
         check("no answer: exit 1 with a timeout line", r.returncode == 1 and "timeout" in r.stderr
               and len(r.stderr.splitlines()) == 1, r.stderr)
-        check("no answer: gives up after the timeout", took < 10, took)
+        print(f"no answer, --timeout 1: gave up after {took:.1f} s", flush=True)
+        # About a second (printed); a client that ignored --timeout would wait its default 30 s. 20 s is broken only
+        # by that, not by a loaded machine.
+        check(f"no answer: gives up by --timeout, not the default 30 s ({took:.1f} s measured)", took < 20, took)
 
 
 def test_token(tmp):

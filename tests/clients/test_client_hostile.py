@@ -216,13 +216,16 @@ check("delete answered 302: exit 1, a line naming the redirect", code == 1 and "
 code, out, err, _ = run_main(["download", JOB_ID, "-o", download_to, "--url", server.url])
 check("download answered 302: no 0-byte file", code == 1 and not os.path.exists(download_to), (code, err))
 
-# watch honours --timeout on a stream that goes silent (it used to wait 60 s per attempt).
+# watch honours --timeout on a stream that goes silent (it used to wait 60 s per attempt). Two attempts of 1 s take
+# a few seconds (printed); without the timeout the first attempt alone lasts the stream's 30 s of silence. 20 s is
+# broken only by that, not by a loaded machine.
 server.answer = Silent(30)
 begin = time.time()
 code, out, err, _ = run_main(["watch", JOB_ID, "--url", server.url, "--timeout", "1", "--retries", "1"])
 took = time.time() - begin
-check("watch --timeout 1 on a silent stream: gives up within seconds", code == 1 and took < 6 and
-      "no event or heartbeat for 1 s" in err, (code, took, err))
+print(f"watch --timeout 1 --retries 1 on a silent stream: gave up after {took:.1f} s", flush=True)
+check(f"watch --timeout 1 on a silent stream: gives up by its timeout, not the stream's end ({took:.1f} s measured)",
+      code == 1 and took < 20 and "no event or heartbeat for 1 s" in err, (code, took, err))
 
 # As commands: the same answers print no traceback.
 for name in ("problem with non-string fields", "JSON null", "SSE data not JSON", "Content-Length abc",
@@ -288,6 +291,7 @@ for name, answer, expect_file in (
         os.remove(download_to)
     begin = time.time()
     code, out, err, escaped = run_main(["download", JOB_ID, "-o", download_to, "--url", server.url, "--timeout", "5"])
+    took = time.time() - begin
     total = sum(written)
     if expect_file:
         check(f"download, {name}: saves exactly the announced 1000 bytes", code == 0 and total == 1000 and
@@ -296,7 +300,9 @@ for name, answer, expect_file in (
         check(f"download, {name}: exit 1 with a message, no file", code == 1 and err.startswith("error: ") and
               not os.path.exists(download_to), (code, err[-300:], escaped))
         check(f"download, {name}: at most a few KB written before the error", total <= 4096, total)
-    check(f"download, {name}: within seconds", time.time() - begin < 10, time.time() - begin)
+    # What it stops is checked above (the bytes written); the time is printed, and 60 s only catches a hang.
+    print(f"download, {name}: {took:.2f} s", flush=True)
+    check(f"download, {name}: ends (no hang; {took:.2f} s measured)", took < 60, took)
 client_module.open = open
 
 # Issue 22, defect 9: escape sequences in what a server sends reached the terminal. Every string field of every

@@ -95,13 +95,16 @@ with Server(args=["--workers", "1"]) as server:
     server.wait_for(first, lambda j: j["state"] == "RUNNING", 30)
     small = server.submit_id(flat_patch(name="small"))
     start = time.time()
-    done = server.wait_done(small, 30)
+    done = server.wait_done(small, 60)  # a flat patch takes well under a second: 60 s only if it never runs
     waited = time.time() - start
     states = server.job(first)["state"], server.job(second)["state"]
+    print(f"  the small job was done {waited:.2f} s after its submission", flush=True)
     check("the long jobs go to the general lane, the flat patch to the small-job lane",
           server.job(first)["lane"] == "general" and done.get("lane") == "small", done.get("lane"))
-    check("the small job SUCCEEDED in seconds while a long job runs and the other waits",
-          done.get("state") == "SUCCEEDED" and waited < 10 and states == ("RUNNING", "QUEUED"), (waited, states))
+    # What it did not wait for is checked, not how long it took: done while the first long job (~200 s) still runs
+    # and the second still waits.
+    check(f"the small job SUCCEEDED while a long job runs and the other waits ({waited:.2f} s measured)",
+          done.get("state") == "SUCCEEDED" and states == ("RUNNING", "QUEUED"), (waited, states))
     check("the small-job lane never takes a long job", server.job(second)["state"] == "QUEUED")
     ready = server.get("/readyz").json()
     check("/readyz counts both lanes' workers", ready.get("workers") == 2 and ready.get("small_job_workers") == 1,
@@ -118,17 +121,18 @@ with Server(args=["--workers", "1", "--small-job-workers", "0"]) as server:
         server.wait_for(big, lambda j: j["state"] == "RUNNING", 30)
         time.sleep(delay)  # into the factorisation of its two bodies (set-up of about 6 s)
         server.request("POST", f"/v1/jobs/{big}/cancel")
-        cancelled = server.wait_done(big, 10)
-        check("the large job stops within a second of the cancel", cancelled.get("state") == "CANCELLED", cancelled)
+        cancelled = server.wait_done(big, 60)  # a deadline against a hang, not a latency bound
+        check("the large job ends CANCELLED", cancelled.get("state") == "CANCELLED", cancelled)
         after = server.submit_id(flat_patch(name="after"))
         abandoned_until = time.time()
         deadline = time.time() + 60
         while time.time() < deadline:
+            asked = time.time()  # the server counted them after this: a bound on when they ended, whatever the load
             count = server.metric("contactd_abandoned_factorisations") or 0.0
             seen = max(seen, count)
             if count == 0:
                 break
-            abandoned_until = time.time()
+            abandoned_until = asked
             time.sleep(0.05)
         if seen >= 1:
             break

@@ -2,8 +2,9 @@
 """Memory amplification (issue 10, item 6): 64 concurrent /v1/validate requests, each a 7 MB job whose body name
 is 7 MB long, took the server from 27 MB to 3.7 GB, never returned. Now large bodies are read and validated a few
 at a time, every request gets its answer (400, or 503 busy with Retry-After), the peak stays bounded and the
-memory is returned afterwards. Also: a 5 MB job of 20 000 bodies is refused at once (it cost 5.6 s of CPU).
-Prints RSS before / peak / after."""
+memory is returned afterwards. Also: a 5 MB job of 20 000 bodies is refused before its bodies are read (it cost
+5.6 s of CPU; the server's CPU time for it is checked, not the wall time, which a loaded machine stretches).
+Prints RSS before / peak / after and the times."""
 import json
 import os
 import sys
@@ -78,12 +79,18 @@ with Server(args=["--workers", "1"]) as server:
     one = many["bodies"][0]
     many["bodies"] = [dict(one, name=f"b{k}") for k in range(20000)]
     text = json.dumps(many).encode()
+    cpu_before = server.cpu_seconds()
     start = time.time()
     r = server.request("POST", "/v1/validate", body=text, headers={"Content-Type": "application/json"})
     seconds = time.time() - start
-    check("20 000 bodies: 400 at /bodies, at once", r.status == 400 and
-          any(e.get("pointer") == "/bodies" for e in (r.json() or {}).get("errors", [])) and seconds < 2.0,
-          (r.status, seconds))
-    print(f"a {len(text) / 1e6:.1f} MB job of 20 000 bodies answered in {seconds:.2f} s", flush=True)
+    cpu = server.cpu_seconds() - cpu_before
+    print(f"a {len(text) / 1e6:.1f} MB job of 20 000 bodies answered in {seconds:.2f} s, {cpu:.2f} s of the "
+          "server's CPU", flush=True)
+    check("20 000 bodies: 400 at /bodies", r.status == 400 and
+          any(e.get("pointer") == "/bodies" for e in (r.json() or {}).get("errors", [])), r)
+    # CPU time, not wall time: about the same on a loaded machine. Taking the 5 MB of JSON in costs about a second
+    # (0.8-1.2 s measured); reading the bodies cost 5.6 s. 3 s is broken by that, not by a loaded machine.
+    check(f"20 000 bodies: refused before the bodies are read ({cpu:.2f} s of the server's CPU; reading them took "
+          "5.6 s)", cpu < 3.0, cpu)
 
 finish()
