@@ -44,19 +44,26 @@ void catch_stop_signals() {
 
 const char* method_name(contact::Method m) {
   switch (m) {
-    case contact::Method::interface_newton: return "interface_newton";
-    case contact::Method::neumann: return "neumann";
-    case contact::Method::robin: return "robin";
-    case contact::Method::monolithic: return "monolithic";
+    case contact::Method::interface_newton:
+      return "interface_newton";
+    case contact::Method::neumann:
+      return "neumann";
+    case contact::Method::robin:
+      return "robin";
+    case contact::Method::monolithic:
+      return "monolithic";
   }
   return "?";
 }
 
 const char* enforcement_name(contact::Enforcement e) {
   switch (e) {
-    case contact::Enforcement::exact: return "exact";
-    case contact::Enforcement::penalty: return "penalty";
-    case contact::Enforcement::augmented_lagrangian: return "augmented_lagrangian";
+    case contact::Enforcement::exact:
+      return "exact";
+    case contact::Enforcement::penalty:
+      return "penalty";
+    case contact::Enforcement::augmented_lagrangian:
+      return "augmented_lagrangian";
   }
   return "?";
 }
@@ -87,7 +94,8 @@ class ProgressPrinter final : public contact::Observer {
       std::printf("  active %4d (changed %3d)  complementarity %.3e", r.active_nodes, r.active_set_changes,
                   r.complementarity);
     else if (r.measure == contact::Measure::gradient)
-      std::printf("  gradient %.3e  active %4d (changed %3d)", r.fixed_point_residual, r.active_nodes, r.active_set_changes);
+      std::printf("  gradient %.3e  active %4d (changed %3d)", r.fixed_point_residual, r.active_nodes,
+                  r.active_set_changes);
     else
       std::printf("  paper %.3e  residual %.3e", r.paper_criterion, r.fixed_point_residual);
     if (r.gamma > 0) std::printf("  gamma %.3g", r.gamma);
@@ -105,9 +113,8 @@ class ProgressPrinter final : public contact::Observer {
   void print_pairs(const nlohmann::json& progress) const {
     const auto& pairs = progress["pairs"];
     auto print_pair = [](const nlohmann::json& p) {
-      std::printf("  | %s: force %.6g  p_max %.6g  active %d (%+d)", p.value("name", "").c_str(),
-                  p.value("force", 0.0), p.value("max_pressure", 0.0), p.value("active_nodes", 0),
-                  p.value("changed_nodes", 0));
+      std::printf("  | %s: force %.6g  p_max %.6g  active %d (%+d)", p.value("name", "").c_str(), p.value("force", 0.0),
+                  p.value("max_pressure", 0.0), p.value("active_nodes", 0), p.value("changed_nodes", 0));
       if (p.contains("stick_nodes"))
         std::printf("  stick %d slip %d", p.value("stick_nodes", 0), p.value("slip_nodes", 0));
     };
@@ -128,7 +135,8 @@ class ProgressPrinter final : public contact::Observer {
         print_pair(p);
         ++shown;
       }
-    if (selected > shown) std::printf("  | and %zu more selected pairs (--progress ndjson lists them)", selected - shown);
+    if (selected > shown)
+      std::printf("  | and %zu more selected pairs (--progress ndjson lists them)", selected - shown);
   }
   static constexpr size_t kPairsShown = 6;
 
@@ -188,7 +196,6 @@ std::string read_file(const std::string& path) {
   return os.str();
 }
 
-
 // The summary lines of the last step: per pair its force, resultant, peak pressure and penetration (and friction),
 // per supported body its reactions (per displacement condition, the components it prescribes, and the total).
 void print_final_step(const contact::Step& step) {
@@ -201,12 +208,14 @@ void print_final_step(const contact::Step& step) {
       penetration = std::max(penetration, p.penetration[j]);
     }
     if (p.enforcement == "exact")
-      std::printf("pair %s: exact contact, force %.8g, resultant (%.8g, %.8g), max pressure %.8g, max penetration %.4g\n",
-                  p.name.c_str(), p.force, p.resultant.x(), p.resultant.y(), p_max, penetration);
+      std::printf(
+          "pair %s: exact contact, force %.8g, resultant (%.8g, %.8g), max pressure %.8g, max penetration %.4g\n",
+          p.name.c_str(), p.force, p.resultant.x(), p.resultant.y(), p_max, penetration);
     else
-      std::printf("pair %s: %s, theta %.4g, force %.8g, resultant (%.8g, %.8g), max pressure %.8g, max penetration %.4g\n",
-                  p.name.c_str(), p.enforcement.c_str(), p.theta, p.force, p.resultant.x(), p.resultant.y(), p_max,
-                  penetration);
+      std::printf(
+          "pair %s: %s, theta %.4g, force %.8g, resultant (%.8g, %.8g), max pressure %.8g, max penetration %.4g\n",
+          p.name.c_str(), p.enforcement.c_str(), p.theta, p.force, p.resultant.x(), p.resultant.y(), p_max,
+          penetration);
     if (p.friction != "none") {
       const long stick = p.stick.size() ? p.stick.cast<long>().sum() : 0, in_contact = p.active.cast<long>().sum();
       std::printf("pair %s: %s friction (%s %.4g), tangential force %.8g, %ld of %ld nodes in contact sticking\n",
@@ -255,8 +264,10 @@ void print_header(const contact::Session& session, const contact::Problem& probl
 
 // Whether the method's outer loop counts active-set steps (else iterations), for the stop line.
 bool counts_active_set_steps(const contact::Problem& problem) {
-  const bool fixed_point = problem.solver.method == contact::Method::neumann || problem.solver.method == contact::Method::robin;
-  const bool adaptive_paper = problem.adaptivity.enabled && problem.adaptivity.strategy == contact::AdaptStrategy::paper;
+  const bool fixed_point =
+      problem.solver.method == contact::Method::neumann || problem.solver.method == contact::Method::robin;
+  const bool adaptive_paper =
+      problem.adaptivity.enabled && problem.adaptivity.strategy == contact::AdaptStrategy::paper;
   return !fixed_point && !adaptive_paper &&
          (problem.solver.method == contact::Method::interface_newton ||
           problem.solver.enforcement == contact::Enforcement::exact);
@@ -375,8 +386,9 @@ int main(int argc, char** argv) {
   app.add_flag("--validate", validate_only, "only validate the job and exit");
   app.add_flag("-q,--quiet", quiet, "no per-iteration lines");
   app.add_option("--max-dofs", max_dofs, "reject jobs with more unknowns than this")->check(CLI::PositiveNumber);
-  app.add_option("--threads", threads, "threads for the per-body solves (per rank under mpirun; overrides the job; "
-                                       "0 = automatic)")
+  app.add_option("--threads", threads,
+                 "threads for the per-body solves (per rank under mpirun; overrides the job; "
+                 "0 = automatic)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--progress", progress,
                  "text (default): one line per iteration; ndjson: one JSON object per iteration and a final "

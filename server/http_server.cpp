@@ -79,7 +79,8 @@ HttpServer::HttpServer(HttpSettings settings, JobQueue& queue, JobStore& store, 
   core_.set_keep_alive_timeout(static_cast<time_t>(std::max(1.0, settings_.idle_timeout_seconds)));
   core_.set_payload_max_length(settings_.max_request_bytes);  // Content-Length bodies: read and dropped, 413
   core_.set_pre_routing_handler([this](const Request& req, Response& res) { return pre_route(req, res); });
-  core_.set_expect_100_continue_handler([this](const Request& req, Response& res) { return expect_continue(req, res); });
+  core_.set_expect_100_continue_handler(
+      [this](const Request& req, Response& res) { return expect_continue(req, res); });
   core_.set_error_handler(
       httplib::Server::HandlerWithResponse([this](const Request& req, Response& res) { return on_error(req, res); }));
   core_.set_exception_handler(
@@ -101,8 +102,7 @@ HttpServer::HttpServer(HttpSettings settings, JobQueue& queue, JobStore& store, 
       transport_settings(settings_), core_,
       // Range requests are served by handle_result itself (httplib's own handling answers 200 to bytes=0-0 and
       // overflows on a range past the end).
-      [](Request& req) { req.ranges.clear(); },
-      [this](int status) { metrics_.http_response(status); });
+      [](Request& req) { req.ranges.clear(); }, [this](int status) { metrics_.http_response(status); });
   register_web_routes(router_, context_);
   register_service_routes(router_, context_);
   register_job_routes(router_, context_);
@@ -166,7 +166,8 @@ Handled HttpServer::pre_route(const Request& req, Response& res) {
     if (length > 4 * static_cast<std::uint64_t>(settings_.max_request_bytes) + (1u << 20))
       return (send_too_large(res, req.path, length), res.set_header("Connection", "close"), Handled::Handled);
   }
-  if (api && !state_.ready) return (res.set_header("Retry-After", "1"), refuse(503, "not-ready", "the server is starting"));
+  if (api && !state_.ready)
+    return (res.set_header("Retry-After", "1"), refuse(503, "not-ready", "the server is starting"));
   // Unknown paths (404) and methods (405) are answered here, before httplib reads a body for them.
   const std::string method = req.method == "HEAD" ? std::string("GET") : req.method;
   if (!router_.known(method, req.path)) {
@@ -217,8 +218,8 @@ void HttpServer::send_too_large(Response& res, const std::string& path, std::opt
   nlohmann::json extra = {{"limit_bytes", limit}, {"setting", "--max-request-bytes"}};
   if (bytes) extra["request_bytes"] = *bytes;
   send_problem(res, 413, "",
-               "the request body " + size + " the limit of " + std::to_string(limit) + " bytes (" +
-                   format_mib(limit) + ") that contactd's --max-request-bytes (CONTACTD_MAX_REQUEST_BYTES) sets; a job "
+               "the request body " + size + " the limit of " + std::to_string(limit) + " bytes (" + format_mib(limit) +
+                   ") that contactd's --max-request-bytes (CONTACTD_MAX_REQUEST_BYTES) sets; a job "
                    "whose bodies come from one Gmsh file can give its text once, in the job's \"meshes\" table, "
                    "instead of once per body (docs/job-format.md)",
                path, std::move(extra));

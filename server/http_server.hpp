@@ -28,7 +28,6 @@
 
 namespace contactd {
 
-
 class HttpServer {
  public:
   // `budget` bounds the job bodies read and validated at once; the queue's workers share its validation slots.

@@ -362,9 +362,8 @@ int serve(const Config& config, const sigset_t& signals) {
   }
   server.set_ready();
   std::printf("contactd %s listening on http://%s:%d (data dir %s, %d workers + %d for small jobs%s)\n",
-              contact::solver_version(), config.http.host.c_str(), port, config.data_dir.c_str(),
-              config.queue.workers, config.queue.small_workers,
-              config.http.token.empty() ? "" : ", bearer token required");
+              contact::solver_version(), config.http.host.c_str(), port, config.data_dir.c_str(), config.queue.workers,
+              config.queue.small_workers, config.http.token.empty() ? "" : ", bearer token required");
   std::fflush(stdout);
   capture_stdout();
 

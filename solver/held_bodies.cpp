@@ -33,10 +33,12 @@ std::vector<Eigen::RowVector3d> held_rows(const Problem& problem, const Step& st
     if (pair.slave_body != body.name && pair.master_body != body.name) continue;
     for (Eigen::Index i = 0; i < pair.active.size(); ++i) {
       if (pair.active[i] == 0 || !(pair.normal.row(i).squaredNorm() > 0)) continue;
-      rows.push_back(held_row(pair.position.row(i).transpose(), pair.normal.row(i).transpose(), body.rigid_center, radius));
+      rows.push_back(
+          held_row(pair.position.row(i).transpose(), pair.normal.row(i).transpose(), body.rigid_center, radius));
       // A node that sticks holds along its tangent too.
       if (pair.stick.size() == pair.active.size() && pair.stick[i] != 0)
-        rows.push_back(held_row(pair.position.row(i).transpose(), pair.tangent.row(i).transpose(), body.rigid_center, radius));
+        rows.push_back(
+            held_row(pair.position.row(i).transpose(), pair.tangent.row(i).transpose(), body.rigid_center, radius));
     }
   }
   return rows;

@@ -10,11 +10,13 @@ namespace contact {
 namespace {
 
 constexpr std::array<std::pair<Method, const char*>, 4> kMethods = {{{Method::neumann, "neumann"},
-                                                                    {Method::monolithic, "monolithic"},
-                                                                    {Method::interface_newton, "interface_newton"},
-                                                                    {Method::robin, "robin"}}};
+                                                                     {Method::monolithic, "monolithic"},
+                                                                     {Method::interface_newton, "interface_newton"},
+                                                                     {Method::robin, "robin"}}};
 constexpr std::array<std::pair<Enforcement, const char*>, 3> kEnforcements = {
-    {{Enforcement::exact, "exact"}, {Enforcement::penalty, "penalty"}, {Enforcement::augmented_lagrangian, "augmented_lagrangian"}}};
+    {{Enforcement::exact, "exact"},
+     {Enforcement::penalty, "penalty"},
+     {Enforcement::augmented_lagrangian, "augmented_lagrangian"}}};
 
 }  // namespace
 
@@ -67,9 +69,11 @@ std::string settings_conflict(const SolverSettings& settings) {
 std::string friction_conflict(const SolverSettings& settings) {
   if (iterates_on_penalty(settings.method))
     return std::string("friction is solved on the interface problem (semismooth Newton on stick and slip): method \"") +
-           to_string(settings.method) + "\" cannot take it; use method \"interface_newton\" (the default) or \"monolithic\"";
+           to_string(settings.method) +
+           "\" cannot take it; use method \"interface_newton\" (the default) or \"monolithic\"";
   if (settings.enforcement != Enforcement::exact)
-    return std::string("friction needs exact contact (enforcement \"exact\", the default of interface_newton), not \"") +
+    return std::string(
+               "friction needs exact contact (enforcement \"exact\", the default of interface_newton), not \"") +
            to_string(settings.enforcement) + "\"";
   return {};
 }

@@ -25,8 +25,9 @@ double max_penetration(const Step& step) {
 
 // The monolithic reference solves the coupled system however little holds a floating body (its rigid motion
 // then comes out zero, one of many solutions; MethodFacts::checks_held_bodies): a solution at which the contacts in
-// contact do not hold every floating body is refused as interface Newton refuses it, with no result (the iterate left out of the result,
-// output.iterate unset, is checked too: a run stopped on it is refused for that reason, not for the iterations).
+// contact do not hold every floating body is refused as interface Newton refuses it, with no result (the iterate left
+// out of the result, output.iterate unset, is checked too: a run stopped on it is refused for that reason, not for the
+// iterations).
 void refuse_unheld_bodies(const Problem& problem, Result& result, const Step* dropped_iterate) {
   if (result.stop_reason != StopReason::converged && result.stop_reason != StopReason::max_iterations) return;
   std::vector<const Step*> reached;
@@ -51,7 +52,8 @@ void refuse_unheld_bodies(const Problem& problem, Result& result, const Step* dr
 std::string tensile_pairs(const Step& step) {
   double scale = 0.0;
   for (const auto& p : step.pairs)
-    if (p.weight.size() == p.pressure.size()) scale = std::max(scale, p.weight.cwiseProduct(p.pressure).cwiseAbs().sum());
+    if (p.weight.size() == p.pressure.size())
+      scale = std::max(scale, p.weight.cwiseProduct(p.pressure).cwiseAbs().sum());
   std::ostringstream os;
   for (const auto& p : step.pairs) {
     if (!(p.force < -1e-6 * scale)) continue;
@@ -87,7 +89,9 @@ std::string what_the_result_keeps(const Problem& problem, const ddm::StepLog& st
   const int held = steps.held();
   const bool iterate = steps.ends_with_iterate();
   if (held == 0 && !iterate && !steps.dropped_iterate()) return "";
-  const std::string kind = problem.adaptivity.enabled ? "adaptive step" : problem.loading.factors.size() > 1 ? "load step" : "step";
+  const std::string kind = problem.adaptivity.enabled           ? "adaptive step"
+                           : problem.loading.factors.size() > 1 ? "load step"
+                                                                : "step";
   std::ostringstream os;
   // output.steps "last" keeps the fields of one step (the last that held, or the iterate in its place); every
   // step's scalars stay in /history/steps either way.

@@ -114,9 +114,7 @@ std::string clip(const std::string& text, std::size_t max) {
   return text.substr(0, end) + "...";
 }
 
-std::string dump(const nlohmann::json& j) {
-  return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-}
+std::string dump(const nlohmann::json& j) { return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace); }
 
 std::string problem_document(int status, const std::string& slug, const std::string& detail,
                              const std::string& instance, nlohmann::json extra) {

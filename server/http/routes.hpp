@@ -50,8 +50,8 @@ class Router {
   using Handler = std::function<void(const Request&, Response&)>;
   using BodyHandler = std::function<void(const Request&, Response&, const ContentReader&)>;
   explicit Router(httplib::Server& core) : core_(core) {}
-  void get(const std::string& pattern, Handler handler);        // HEAD too
-  void post(const std::string& pattern, Handler handler);       // the body is read by httplib (or absent)
+  void get(const std::string& pattern, Handler handler);            // HEAD too
+  void post(const std::string& pattern, Handler handler);           // the body is read by httplib (or absent)
   void post_body(const std::string& pattern, BodyHandler handler);  // the handler reads the body itself
   void del(const std::string& pattern, Handler handler);
   bool known(const std::string& method, const std::string& path) const;

@@ -44,8 +44,10 @@ void BodyBudget::Slot::release() {
 
 bool BodyBudget::free_locked(Kind kind) const {
   switch (kind) {
-    case Kind::body: return large_in_use_ < large_slots_;
-    case Kind::validation: return validation_in_use_ < validation_slots_;
+    case Kind::body:
+      return large_in_use_ < large_slots_;
+    case Kind::validation:
+      return validation_in_use_ < validation_slots_;
     case Kind::large_validation:
       return validation_in_use_ < validation_slots_ && large_validation_in_use_ < large_validation_slots_;
   }

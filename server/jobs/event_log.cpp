@@ -63,8 +63,8 @@ bool copy_prefix(int from, const std::string& to, std::uint64_t bytes) {
   std::uint64_t done = 0;
   bool ok = true;
   while (ok && done < bytes) {
-    const ssize_t n = ::pread(from, buffer.data(), std::min<std::uint64_t>(buffer.size(), bytes - done),
-                              static_cast<off_t>(done));
+    const ssize_t n =
+        ::pread(from, buffer.data(), std::min<std::uint64_t>(buffer.size(), bytes - done), static_cast<off_t>(done));
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) break;
     for (ssize_t w = 0; ok && w < n;) {
@@ -105,7 +105,8 @@ int EventLog::open_for_load() {
   if (fd < 0 && errno == ELOOP) {  // a symbolic link planted in the store: moved aside (the link, not its target)
     const std::string aside = path_ + ".damaged-" + std::to_string(now_unix_us() / 1000000);
     problem_ = "events.ndjson was a symbolic link (moved to " + aside.substr(aside.rfind('/') + 1) + ")";
-    if (::rename(path_.c_str(), aside.c_str()) != 0) problem_ += "; cannot move it: " + std::string(std::strerror(errno));
+    if (::rename(path_.c_str(), aside.c_str()) != 0)
+      problem_ += "; cannot move it: " + std::string(std::strerror(errno));
     log_line("events: " + path_ + ": " + problem_);
   }
   return fd;
@@ -130,8 +131,8 @@ EventLog::LoadScan EventLog::index_lines(int fd) {
     while (from < static_cast<std::size_t>(n)) {
       const char* begin = chunk.data() + from;
       const void* nl = std::memchr(begin, '\n', static_cast<std::size_t>(n) - from);
-      const std::size_t take = nl ? static_cast<std::size_t>(static_cast<const char*>(nl) - begin)
-                                  : static_cast<std::size_t>(n) - from;
+      const std::size_t take =
+          nl ? static_cast<std::size_t>(static_cast<const char*>(nl) - begin) : static_cast<std::size_t>(n) - from;
       line.append(begin, take);
       from += take;
       if (!nl) break;

@@ -7,8 +7,8 @@
 //
 // Bounded: once the file has `max_bytes`, further `iteration` events are dropped (counted by dropped()); the few
 // state, step and end events are always written, where the disk takes them (an event a write error lost, e.g. on a
-// full disk, is served to the streams from memory and counted by dropped() too). Damage is never served: a line that is not a whole event is
-// not sent to any client, and the log's problem() says where it is (the job store reports it).
+// full disk, is served to the streams from memory and counted by dropped() too). Damage is never served: a line that is
+// not a whole event is not sent to any client, and the log's problem() says where it is (the job store reports it).
 //
 // Thread safety: every member may be called from any thread. append() (the worker) never waits for readers: it
 // holds the lock only to write one line and to notify.

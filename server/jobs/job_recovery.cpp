@@ -50,8 +50,9 @@ void JobRecovery::recover(const std::shared_ptr<Job>& job) {
     const int interruptions = r.interruptions + 1;
     if (const auto signal = read_crash_marker(context_.store.job_dir(id))) {
       give_up(job, interruptions, "crashed",
-              "the server crashed (" + *signal + ") while it solved this job; it is not run again. This is a "
-              "defect of the solver, not of the job: please report it with the job");
+              "the server crashed (" + *signal +
+                  ") while it solved this job; it is not run again. This is a "
+                  "defect of the solver, not of the job: please report it with the job");
       remove_crash_marker(context_.store.job_dir(id));
       return;
     }

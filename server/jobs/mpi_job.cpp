@@ -52,8 +52,7 @@ namespace {
 // lines and its stderr kept for the message, a stop request forwarded, and its end read back as an outcome.
 class MpiRun {
  public:
-  MpiRun(const MpiSettings& settings, const ProgressLine& on_progress,
-         const contact::CancelToken& cancel)
+  MpiRun(const MpiSettings& settings, const ProgressLine& on_progress, const contact::CancelToken& cancel)
       : settings_(settings), on_progress_(on_progress), cancel_(cancel) {}
 
   MpiOutcome run(std::vector<std::string> args) {
@@ -242,16 +241,16 @@ class MpiRun {
 
 MpiOutcome run_mpi_job(const MpiSettings& settings, int ranks, const std::string& job_file,
                        const std::string& result_path, const std::string& job_id, long max_dofs,
-                       const ProgressLine& on_progress,
-                       const contact::CancelToken& cancel) {
+                       const ProgressLine& on_progress, const contact::CancelToken& cancel) {
   std::vector<std::string> args;
   for (std::string a : settings.launcher) {
     for (size_t at; (at = a.find("{ranks}")) != std::string::npos;) a.replace(at, 7, std::to_string(ranks));
     args.push_back(a);
   }
-  for (const std::string& a : {settings.solver, job_file, std::string("-o"), result_path, std::string("--progress"),
-                               std::string("ndjson"), std::string("--progress-pairs"), std::string("all"), std::string("--job-id"), job_id, std::string("--max-dofs"),
-                               std::to_string(max_dofs), std::string("--no-mesh-files")})
+  for (const std::string& a :
+       {settings.solver, job_file, std::string("-o"), result_path, std::string("--progress"), std::string("ndjson"),
+        std::string("--progress-pairs"), std::string("all"), std::string("--job-id"), job_id, std::string("--max-dofs"),
+        std::to_string(max_dofs), std::string("--no-mesh-files")})
     args.push_back(a);
   return MpiRun(settings, on_progress, cancel).run(std::move(args));
 }

@@ -14,8 +14,8 @@ void ProgressObserver::on_iteration_json(nlohmann::json full) {
   nlohmann::json event = contact::io::bounded_progress(full, selection_);
   const int iteration = event.value("iteration", 0);
   if (auto pairs = full.find("pairs"); pairs != full.end() && pairs->is_array())
-    job_.set_pair_detail(std::make_shared<const nlohmann::json>(
-        nlohmann::json{{"iteration", iteration}, {"pairs", std::move(*pairs)}}));
+    job_.set_pair_detail(
+        std::make_shared<const nlohmann::json>(nlohmann::json{{"iteration", iteration}, {"pairs", std::move(*pairs)}}));
   job_.events.append("iteration", event);
   nlohmann::json summary = std::move(event);  // the summary is the event without the profiles
   if (summary.contains("pairs") && summary["pairs"].is_array())

@@ -12,13 +12,13 @@
 namespace contactd {
 
 struct QueueSettings {
-  int workers = 1;                     // jobs solved at once
+  int workers = 1;  // jobs solved at once
   // The small-job lane: this many more workers that take only small jobs (small_job), so that a job of seconds
   // never waits behind long ones; and the size below which a job is small: unknowns x load steps.
   int small_workers = 1;
   long small_job_dofs = 20'000;
-  std::size_t max_queued = 100;        // QUEUED jobs beyond which submissions are refused (503)
-  long max_dofs = 2'000'000;           // job::Limits::max_dofs
+  std::size_t max_queued = 100;  // QUEUED jobs beyond which submissions are refused (503)
+  long max_dofs = 2'000'000;     // job::Limits::max_dofs
   // job::Limits::max_bodies and max_contacts: a server's share of the machine, a setting. The 64 x 64 frictional
   // brick wall (4,129 bodies, 12,192 pairs) fits: about 20 s and 630 MB through contactd.
   int max_bodies = 8192;

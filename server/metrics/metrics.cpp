@@ -46,7 +46,8 @@ std::string Metrics::render(const Gauges& g) const {
   counter("contactd_jobs_submitted_total", "Jobs accepted since start-up.", jobs_submitted_.load());
   counter("contactd_jobs_expired_total", "Finished jobs deleted by retention since start-up.", g.jobs_expired_total);
   counter("contactd_iterations_total", "Solver iterations done since start-up.", iterations_.load());
-  counter("contactd_events_dropped_total", "Events not recorded in a job's event log: iteration events past its cap, or lost to a failed write.",
+  counter("contactd_events_dropped_total",
+          "Events not recorded in a job's event log: iteration events past its cap, or lost to a failed write.",
           g.events_dropped_total);
   gauge("contactd_stream_clients", "Open progress streams.", stream_clients_.load());
   std::lock_guard<std::mutex> lock(mutex_);

@@ -14,10 +14,10 @@ struct File {
   std::string_view data;
 };
 
-std::string_view job_schema();    // api/job.schema.json
-std::string_view openapi_yaml();  // api/openapi.yaml
-const std::vector<File>& web_files();  // server/web/**, sorted by name
-const std::vector<File>& examples();   // api/examples/*.json, sorted by name
+std::string_view job_schema();              // api/job.schema.json
+std::string_view openapi_yaml();            // api/openapi.yaml
+const std::vector<File>& web_files();       // server/web/**, sorted by name
+const std::vector<File>& examples();        // api/examples/*.json, sorted by name
 const std::vector<File>& example_meshes();  // api/examples/*.msh by file name ("punch_rounded_gmsh.msh")
 
 }  // namespace contactd::assets

@@ -102,10 +102,10 @@ bool RouteContext::read_json_body(const Request& req, Response& res, const Conte
     res.set_header("Connection", "close");
     const Exchange* exchange = current_exchange();
     if (exchange && exchange->body_timed_out)
-      send_problem(res, 408, "",
-                   "the body did not arrive within " + std::to_string(static_cast<int>(settings.body_timeout_seconds)) +
-                       " s",
-                   req.path);
+      send_problem(
+          res, 408, "",
+          "the body did not arrive within " + std::to_string(static_cast<int>(settings.body_timeout_seconds)) + " s",
+          req.path);
     else
       send_problem(res, 400, "", "the request body could not be read", req.path);
     return false;
@@ -253,7 +253,8 @@ void handle_list(RouteContext& ctx, const Request& req, Response& res) {
   }
   // A poller (the web page, every 2 s) that sends the page's ETag back gets 304 and no body while nothing in it
   // changed: a page of 50 walls is some 50 kB.
-  const nlohmann::json answer = {{"jobs", jobs}, {"next_page_token", page.next ? encode_cursor(*page.next) : std::string()}};
+  const nlohmann::json answer = {{"jobs", jobs},
+                                 {"next_page_token", page.next ? encode_cursor(*page.next) : std::string()}};
   char etag[24];
   std::snprintf(etag, sizeof etag, "\"%016zx\"", std::hash<std::string>{}(answer.dump()));
   res.set_header("ETag", etag);

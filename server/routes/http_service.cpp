@@ -39,7 +39,9 @@ nlohmann::json RouteContext::job_resource(const JobRecord& r, int queue_position
                       {"attempts", r.attempts},
                       {"interruptions", r.interruptions},
                       {"iterations", r.iterations},
-                      {"progress", !r.progress ? nlohmann::json(nullptr) : listed ? progress_digest(*r.progress) : *r.progress},
+                      {"progress", !r.progress ? nlohmann::json(nullptr)
+                                   : listed    ? progress_digest(*r.progress)
+                                               : *r.progress},
                       {"timings", timings},
                       {"result_available", r.result_available},
                       {"result_bytes", r.result_available ? nlohmann::json(r.result_bytes) : nlohmann::json(nullptr)},
@@ -80,11 +82,11 @@ void handle_readyz(RouteContext& ctx, const Request&, Response& res) {
   const bool unavailable = !problems.empty();
   if (!health.damaged.empty())
     problems.push_back(std::to_string(health.damaged.size()) + " job(s) have damaged files in the data directory");
-  std::string status = !ctx.state.ready      ? "starting"
-                       : ctx.state.stopping  ? "stopping"
-                       : unavailable ? "unavailable"
-                       : !problems.empty() ? "degraded"
-                                           : "ready";
+  std::string status = !ctx.state.ready     ? "starting"
+                       : ctx.state.stopping ? "stopping"
+                       : unavailable        ? "unavailable"
+                       : !problems.empty()  ? "degraded"
+                                            : "ready";
   nlohmann::json damaged = nlohmann::json::array();
   for (std::size_t k = 0; k < health.damaged.size() && k < 100; ++k)
     damaged.push_back({{"id", health.damaged[k].first}, {"problem", health.damaged[k].second}});

@@ -45,8 +45,8 @@ void handle_pairs(RouteContext& ctx, const Request& req, Response& res) {
   std::vector<std::string> patterns;
   const std::string names = req.has_param("names") ? req.get_param_value("names") : std::string();
   if (names.size() > 2000) {
-    send_problem(res, 400, "invalid-request", "names has " + std::to_string(names.size()) +
-                                                  " characters: at most 2000", req.path);
+    send_problem(res, 400, "invalid-request", "names has " + std::to_string(names.size()) + " characters: at most 2000",
+                 req.path);
     return;
   }
   std::size_t from = 0;
@@ -90,8 +90,12 @@ void handle_pairs(RouteContext& ctx, const Request& req, Response& res) {
                  req.path);
     return;
   }
-  send_json(res, 200, {{"iteration", detail->value("iteration", 0)}, {"source", source},
-                       {"state", to_string(record.state)}, {"matched", matched}, {"pairs", std::move(pairs)}});
+  send_json(res, 200,
+            {{"iteration", detail->value("iteration", 0)},
+             {"source", source},
+             {"state", to_string(record.state)},
+             {"matched", matched},
+             {"pairs", std::move(pairs)}});
 }
 
 void handle_result(RouteContext& ctx, const Request& req, Response& res, bool sidecar) {
@@ -187,7 +191,8 @@ void handle_events(RouteContext& ctx, const Request& req, Response& res) {
     --ctx.state.streams;
     res.set_header("Retry-After", "5");
     send_problem(res, 503, "too-many-streams",
-                 "the server already serves " + std::to_string(ctx.settings.max_streams) + " progress streams", req.path);
+                 "the server already serves " + std::to_string(ctx.settings.max_streams) + " progress streams",
+                 req.path);
     return;
   }
   ctx.metrics.stream_opened();
@@ -268,7 +273,8 @@ void register_stream_routes(Router& router, RouteContext& ctx) {
   router.get(job + "/events", [&ctx](const Request& req, Response& res) { handle_events(ctx, req, res); });
   router.get(job + "/pairs", [&ctx](const Request& req, Response& res) { handle_pairs(ctx, req, res); });
   router.get(job + "/result", [&ctx](const Request& req, Response& res) { handle_result(ctx, req, res, false); });
-  router.get(job + R"(/result\.xmf)", [&ctx](const Request& req, Response& res) { handle_result(ctx, req, res, true); });
+  router.get(job + R"(/result\.xmf)",
+             [&ctx](const Request& req, Response& res) { handle_result(ctx, req, res, true); });
 }
 
 }  // namespace contactd

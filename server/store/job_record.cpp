@@ -82,7 +82,8 @@ JobRecord from_state_json(const nlohmann::json& j) {
   r.result_bytes = j.value("result_bytes", std::int64_t{0});
   r.events_dropped = j.value("events_dropped", std::int64_t{0});
   if (j.contains("converged") && j["converged"].is_boolean()) r.converged = j["converged"].get<bool>();
-  if (j.contains("progress") && !j["progress"].is_null()) r.progress = std::make_shared<const nlohmann::json>(j["progress"]);
+  if (j.contains("progress") && !j["progress"].is_null())
+    r.progress = std::make_shared<const nlohmann::json>(j["progress"]);
   return r;
 }
 

@@ -36,10 +36,10 @@ struct JobRecord {
   std::string stop_reason;  // converged, max_iterations, stagnation, cancelled, error, time_limit
   std::string message;
   std::optional<bool> converged;
-  int iterations = 0;             // iterations of the last run so far
-  double solve_seconds = 0.0;     // the solver's own wall time (Result::wall_seconds)
-  bool result_available = false;  // result.hdf and result.xmf exist
-  std::int64_t result_bytes = 0;  // the size of result.hdf as written (checked before it is served)
+  int iterations = 0;               // iterations of the last run so far
+  double solve_seconds = 0.0;       // the solver's own wall time (Result::wall_seconds)
+  bool result_available = false;    // result.hdf and result.xmf exist
+  std::int64_t result_bytes = 0;    // the size of result.hdf as written (checked before it is served)
   std::int64_t events_dropped = 0;  // iteration events not recorded: the job's event log reached its cap
   // The latest iteration in short (null before the first); shared, so copying a record (a listing, a snapshot)
   // does not copy it: a 500-body wall's is 0.6 MB.

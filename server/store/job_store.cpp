@@ -36,15 +36,13 @@ bool is_link(const std::string& path) {
 int lock_data_dir(const std::string& data_dir) {
   const std::string path = data_dir + "/.lock";
   const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0644);
-  if (fd < 0)
-    throw std::runtime_error("cannot open the lock file '" + path + "': " + std::strerror(errno));
+  if (fd < 0) throw std::runtime_error("cannot open the lock file '" + path + "': " + std::strerror(errno));
   if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
     const int code = errno;
     char pid[32] = "";
     const ssize_t n = ::pread(fd, pid, sizeof pid - 1, 0);
     std::string holder = n > 0 ? std::string(pid, static_cast<std::size_t>(n)) : std::string();
-    holder.erase(std::remove_if(holder.begin(), holder.end(), [](char c) { return c < '0' || c > '9'; }),
-                 holder.end());
+    holder.erase(std::remove_if(holder.begin(), holder.end(), [](char c) { return c < '0' || c > '9'; }), holder.end());
     ::close(fd);
     if (code == EWOULDBLOCK)
       throw std::runtime_error("the data directory '" + data_dir + "' is in use by another contactd" +

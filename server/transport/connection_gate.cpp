@@ -250,9 +250,9 @@ void ConnectionGate::hold(std::unique_ptr<Connection> connection, Mode mode) {
   entry.connection = std::move(connection);
   entry.mode = mode;
   entry.since = now;
-  entry.deadline = now + (mode == Mode::head      ? settings_.head_timeout
-                          : mode == Mode::idle    ? settings_.idle_timeout
-                                                  : std::chrono::duration_cast<std::chrono::milliseconds>(kDrain));
+  entry.deadline = now + (mode == Mode::head   ? settings_.head_timeout
+                          : mode == Mode::idle ? settings_.idle_timeout
+                                               : std::chrono::duration_cast<std::chrono::milliseconds>(kDrain));
   epoll_event ev{};
   ev.events = EPOLLIN;
   ev.data.fd = fd;
@@ -333,8 +333,10 @@ bool ConnectionGate::evict_oldest_waiting(Clock::time_point now, const std::stri
   if (oldest == entries_.end()) return false;
   if (oldest->second.mode == Mode::head) {
     if (refused_) refused_(408);
-    send_now(oldest->first, canned_response(408, "the request head took too long while the server is at its "
-                                                 "connection limit", false));
+    send_now(oldest->first, canned_response(408,
+                                            "the request head took too long while the server is at its "
+                                            "connection limit",
+                                            false));
   }
   close_entry(oldest->first);  // at once: its place in the caps is what the new connection needs
   return true;

@@ -59,7 +59,7 @@ class Connection {
   const std::string& peer_ip() const { return peer_ip_; }
   int peer_port() const { return peer_port_; }
 
-  std::string buffer;         // bytes received and not yet consumed: the request head first
+  std::string buffer;          // bytes received and not yet consumed: the request head first
   std::size_t head_bytes = 0;  // the current request's head length at the start of `buffer` (set by the gate)
   bool probe = false;          // the current request is GET /healthz or /readyz
   int requests = 0;            // requests served on this connection so far

@@ -179,11 +179,10 @@ Transport::Transport(TransportSettings settings, HttplibCore& core, std::functio
     : settings_(std::move(settings)),
       core_(core),
       setup_(std::move(setup)),
-      gate_(settings_.gate,
-            [this](std::unique_ptr<Connection> c) {
-              (c->probe ? probe_pool_ : api_pool_)->submit(std::move(c));
-            },
-            std::move(refused)) {
+      gate_(
+          settings_.gate,
+          [this](std::unique_ptr<Connection> c) { (c->probe ? probe_pool_ : api_pool_)->submit(std::move(c)); },
+          std::move(refused)) {
   api_pool_ = std::make_unique<Pool>(settings_.threads, [this](std::unique_ptr<Connection> c) { serve(std::move(c)); });
   probe_pool_ = std::make_unique<Pool>(2, [this](std::unique_ptr<Connection> c) { serve(std::move(c)); });
 }
@@ -216,8 +215,8 @@ void Transport::serve(std::unique_ptr<Connection> connection) {
   t_exchange = nullptr;
   stream.finish();
   ++connection->requests;
-  const bool keep_alive = ok && !closed && !last && !exchange.close_after && !exchange.body_timed_out &&
-                          !stopping_.load();
+  const bool keep_alive =
+      ok && !closed && !last && !exchange.close_after && !exchange.body_timed_out && !stopping_.load();
   gate_.give_back(std::move(connection), keep_alive);
 }
 

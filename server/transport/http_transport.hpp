@@ -25,11 +25,11 @@ namespace contactd {
 
 struct TransportSettings {
   GateSettings gate;
-  std::size_t threads = 96;                          // API threads
-  std::size_t keep_alive_max = 100;                  // requests per connection
-  std::chrono::milliseconds read_timeout{10000};     // per read of a body
-  std::chrono::milliseconds write_timeout{5000};     // per write of a response
-  std::chrono::milliseconds body_timeout{60000};     // a whole request body (slow uploads are cut off)
+  std::size_t threads = 96;                       // API threads
+  std::size_t keep_alive_max = 100;               // requests per connection
+  std::chrono::milliseconds read_timeout{10000};  // per read of a body
+  std::chrono::milliseconds write_timeout{5000};  // per write of a response
+  std::chrono::milliseconds body_timeout{60000};  // a whole request body (slow uploads are cut off)
 };
 
 // What the HTTP thread serving a request knows about its exchange (thread-local; null outside a request).

@@ -104,7 +104,8 @@ std::optional<Refusal> check_framing(const httplib::Request& req) {
         lower(trim(req.get_header_value("Transfer-Encoding"))) != "chunked")
       return Refusal{501, "", "the only transfer coding accepted is chunked"};
   }
-  if (req.get_header_value_count("Host") > 1) return Refusal{400, "invalid-request", "the request has two Host headers"};
+  if (req.get_header_value_count("Host") > 1)
+    return Refusal{400, "invalid-request", "the request has two Host headers"};
   if (req.version == "HTTP/1.1" && !req.has_header("Host"))
     return Refusal{400, "invalid-request", "an HTTP/1.1 request needs a Host header"};
   return std::nullopt;
@@ -114,8 +115,9 @@ std::optional<Refusal> check_host(const httplib::Request& req, const GuardSettin
   if (!req.has_header("Host")) return std::nullopt;  // HTTP/1.0 (browsers always send one)
   const std::optional<std::string> parsed = host_part(req.get_header_value("Host"));
   if (!parsed)
-    return Refusal{400, "invalid-request",
-                   "the Host header '" + clip(req.get_header_value("Host"), 100) + "' is not a host and an optional port"};
+    return Refusal{
+        400, "invalid-request",
+        "the Host header '" + clip(req.get_header_value("Host"), 100) + "' is not a host and an optional port"};
   const std::string& host = *parsed;
   if (allowed(host, settings)) return std::nullopt;
   return Refusal{421, "host-not-allowed",
@@ -133,16 +135,17 @@ std::optional<Refusal> check_cross_site(const httplib::Request& req, const Guard
         scheme == std::string::npos ? std::string() : host_part(origin.substr(scheme + 3)).value_or(std::string());
     if (host.empty() || !allowed(host, settings))
       return Refusal{403, "cross-site-request",
-                     "requests from the origin '" + clip(origin, 100) + "' may not change state here (allowed hosts: " +
-                         allowed_list(settings) + ")"};
+                     "requests from the origin '" + clip(origin, 100) +
+                         "' may not change state here (allowed hosts: " + allowed_list(settings) + ")"};
   }
   // A body that is not JSON is refused with 415 before anything happens; a body-less POST or a DELETE proves
   // nothing by its content, so it needs one of the two headers.
   if (has_body(req) || media_type(req.get_header_value("Content-Type")) == "application/json") return std::nullopt;
   if (!trim(req.get_header_value("X-Requested-With")).empty()) return std::nullopt;
   return Refusal{403, "cross-site-request",
-                 req.method + " needs 'Content-Type: application/json' or an 'X-Requested-With' header (a web page of "
-                              "another site cannot send either without the server's consent)"};
+                 req.method +
+                     " needs 'Content-Type: application/json' or an 'X-Requested-With' header (a web page of "
+                     "another site cannot send either without the server's consent)"};
 }
 
 }  // namespace contactd

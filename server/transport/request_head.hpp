@@ -15,7 +15,7 @@ struct HeadLimits {
   // One header field line (431 beyond): httplib reads a line of at most 8,192 bytes with its CRLF and fails a longer
   // one only after its read timeout, with 400; refused here first, at once and with the right status.
   std::size_t max_header_line = 8000;
-  std::size_t max_header_fields = 64;      // (431 beyond)
+  std::size_t max_header_fields = 64;  // (431 beyond)
 };
 
 struct HeadCheck {

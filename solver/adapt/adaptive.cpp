@@ -33,33 +33,36 @@ std::vector<IndicatorResult> estimate(const Problem& problem, const ddm::Contact
                                       parallel::TaskRunner& runner, const std::function<bool()>& stop = {}) {
   std::vector<IndicatorResult> out(problem.bodies.size());
   const parallel::BodyShare share{[&](size_t a, parallel::Packer& p) {
-                               p.put(out[a].eta);
-                               p.put(out[a].note);
-                               p.put(out[a].seconds);
-                               p.put(out[a].error2);
-                               p.put(out[a].reference2);
-                               p.put(out[a].cancelled ? 1.0 : 0.0);
-                               p.put(out[a].bem_displacement);
-                               p.put(out[a].error2_cell);
-                             },
-                             [&](size_t a, parallel::Unpacker& in) {
-                               out[a].eta = in.get_vector();
-                               out[a].note = in.get_string();
-                               out[a].seconds = in.get_double();
-                               out[a].error2 = in.get_double();
-                               out[a].reference2 = in.get_double();
-                               out[a].cancelled = in.get_double() != 0.0;
-                               out[a].bem_displacement = in.get_vector();
-                               out[a].error2_cell = in.get_vector();
-                             }};
-  runner.run_bodies(problem.bodies.size(), [&](size_t a) {
-    if (!adapts(problem.adaptivity, a)) return;
-    const Body& body = problem.bodies[a];
-    const Normalization norm = problem.adaptivity.normalization;
-    out[a] = problem.adaptivity.indicator == Indicator::fem_bem
-                 ? fem_bem_indicator(body, problem.model, system.body(a), u[a], contact_loads[a], norm, stop)
-                 : zz_indicator(body, system.body(a), u[a], norm);
-  }, share);
+                                    p.put(out[a].eta);
+                                    p.put(out[a].note);
+                                    p.put(out[a].seconds);
+                                    p.put(out[a].error2);
+                                    p.put(out[a].reference2);
+                                    p.put(out[a].cancelled ? 1.0 : 0.0);
+                                    p.put(out[a].bem_displacement);
+                                    p.put(out[a].error2_cell);
+                                  },
+                                  [&](size_t a, parallel::Unpacker& in) {
+                                    out[a].eta = in.get_vector();
+                                    out[a].note = in.get_string();
+                                    out[a].seconds = in.get_double();
+                                    out[a].error2 = in.get_double();
+                                    out[a].reference2 = in.get_double();
+                                    out[a].cancelled = in.get_double() != 0.0;
+                                    out[a].bem_displacement = in.get_vector();
+                                    out[a].error2_cell = in.get_vector();
+                                  }};
+  runner.run_bodies(
+      problem.bodies.size(),
+      [&](size_t a) {
+        if (!adapts(problem.adaptivity, a)) return;
+        const Body& body = problem.bodies[a];
+        const Normalization norm = problem.adaptivity.normalization;
+        out[a] = problem.adaptivity.indicator == Indicator::fem_bem
+                     ? fem_bem_indicator(body, problem.model, system.body(a), u[a], contact_loads[a], norm, stop)
+                     : zz_indicator(body, system.body(a), u[a], norm);
+      },
+      share);
   return out;
 }
 
@@ -84,7 +87,8 @@ void add_note(std::string& notes, const std::string& note) {
 mesh::RefinementResult refine_within(mesh::Mesh& mesh, std::vector<int> cells, int max_level, long allowed,
                                      std::string& note, const std::string& body) {
   // Far from the limit (a split and its closure add well under 60 unknowns per marked cell): in place.
-  if (2L * mesh.num_nodes() + 60L * static_cast<long>(cells.size()) <= allowed) return mesh::refine(mesh, cells, max_level);
+  if (2L * mesh.num_nodes() + 60L * static_cast<long>(cells.size()) <= allowed)
+    return mesh::refine(mesh, cells, max_level);
   for (;;) {
     mesh::Mesh trial = mesh;
     mesh::RefinementResult r = mesh::refine(trial, cells, max_level);
@@ -105,8 +109,10 @@ Marking chosen_marking(const std::vector<int>& chosen, const std::vector<char>& 
                        long allowed) {
   Marking m;
   for (const int c : chosen) {
-    if (!graded.empty() && graded[static_cast<size_t>(c)]) ++m.graded_out;
-    else m.cells.push_back(c);
+    if (!graded.empty() && graded[static_cast<size_t>(c)])
+      ++m.graded_out;
+    else
+      m.cells.push_back(c);
   }
   const long room = (allowed - 2L * mesh.num_nodes()) / 20;  // as mark() counts it
   if (static_cast<long>(m.cells.size()) > room) {
@@ -131,7 +137,8 @@ RefineOutcome mark_and_refine(Problem& problem, const std::vector<IndicatorResul
     result_bound = max_total <= 0 || left < max_total;
     if (result_bound) max_total = left;
   }
-  const std::vector<ContactZone> zones = s.marking == MarkingRule::contact ? contact_zones(step) : std::vector<ContactZone>{};
+  const std::vector<ContactZone> zones =
+      s.marking == MarkingRule::contact ? contact_zones(step) : std::vector<ContactZone>{};
   RefineOutcome out;
   const size_t n = problem.bodies.size();
   // The job's total: each body may grow by what the others leave (counted as 2 x nodes, as mark() does).
@@ -148,12 +155,14 @@ RefineOutcome mark_and_refine(Problem& problem, const std::vector<IndicatorResul
     Eigen::VectorXd weighted = eta[a].eta;
     for (Eigen::Index c = 0; c < weighted.size(); ++c) weighted[c] *= rules.factor[static_cast<size_t>(c)];
     const long own = 2L * mesh.num_nodes();
-    const long allowed = max_total > 0 || result_bound ? std::min(s.max_dofs, own + std::max(0L, max_total - total))
-                                                       : s.max_dofs;
+    const long allowed =
+        max_total > 0 || result_bound ? std::min(s.max_dofs, own + std::max(0L, max_total - total)) : s.max_dofs;
     Marking m = goal ? chosen_marking(goal->cells[a], rules.graded, mesh, allowed)
                      : mark(mesh, weighted, s.delta, s.max_level, allowed, rules.graded);
-    if (m.dof_limit_hit && allowed < s.max_dofs) total_hit = true;
-    else if (m.dof_limit_hit) add_note(out.note, "body '" + problem.bodies[a].name + "': max_dofs reached, refinement cut back");
+    if (m.dof_limit_hit && allowed < s.max_dofs)
+      total_hit = true;
+    else if (m.dof_limit_hit)
+      add_note(out.note, "body '" + problem.bodies[a].name + "': max_dofs reached, refinement cut back");
     if (m.level_limit_hit) add_note(out.note, "body '" + problem.bodies[a].name + "': cells at max_level not refined");
     if (m.graded_out > 0)
       add_note(out.note, "body '" + problem.bodies[a].name + "': " + std::to_string(m.graded_out) +
@@ -173,8 +182,9 @@ RefineOutcome mark_and_refine(Problem& problem, const std::vector<IndicatorResul
     out.blocked = true;
   }
   if (total_hit && result_bound) {
-    add_note(out.note, "the result's limit on its size (the steps kept, --max-result-bytes) reached, refinement "
-                       "cut back");
+    add_note(out.note,
+             "the result's limit on its size (the steps kept, --max-result-bytes) reached, refinement "
+             "cut back");
     out.blocked = true;
   } else if (total_hit) {
     add_note(out.note, "the job's limit of " + std::to_string(s.max_total_dofs) +
@@ -188,7 +198,8 @@ RefineOutcome mark_and_refine(Problem& problem, const std::vector<IndicatorResul
 void transfer(ddm::Displacements& u, const Problem& problem, const RefineOutcome& r) {
   for (size_t a = 0; a < u.size(); ++a) {
     if (!r.changed[a]) continue;
-    const Eigen::MatrixXd old = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>(u[a].data(), u[a].size() / 2, 2);
+    const Eigen::MatrixXd old =
+        Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>(u[a].data(), u[a].size() / 2, 2);
     const Eigen::MatrixXd moved = mesh::transfer(old, r.refinements[a], problem.bodies[a].mesh.num_nodes());
     Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor> rowmajor = moved;
     u[a] = Eigen::Map<Eigen::VectorXd>(rowmajor.data(), rowmajor.size());
@@ -197,8 +208,7 @@ void transfer(ddm::Displacements& u, const Problem& problem, const RefineOutcome
 
 Step make_step(const ddm::ContactSystem& system, const ddm::Displacements& u, const ddm::Pressures& z, int iteration,
                int index, const std::vector<IndicatorResult>& eta, const ddm::Pressures& q = {}) {
-  Step st = z.empty() ? system.fields(u, iteration)
-                      : system.fields(u, z, iteration, nullptr, q.empty() ? nullptr : &q);
+  Step st = z.empty() ? system.fields(u, iteration) : system.fields(u, z, iteration, nullptr, q.empty() ? nullptr : &q);
   st.index = index;
   for (size_t a = 0; a < st.bodies.size() && a < eta.size(); ++a)
     if (eta[a].eta.size() == st.bodies[a].mesh.num_cells()) st.bodies[a].indicator_cell = eta[a].eta;
@@ -344,9 +354,8 @@ const ddm::MethodOutcome& solve_step(ddm::ContactSystem& system, ddm::RunFrame& 
   const ddm::InnerMarks marks{0, std::exchange(refined_last, {})};
   if (path.size() > 1) {
     ddm::StepLog path_steps(StepOutput::last, false);
-    return frame.nested(nullptr, marks, [&](ddm::RunFrame& inner) {
-      ddm::run_load_steps(system, path, inner, method, path_steps);
-    });
+    return frame.nested(nullptr, marks,
+                        [&](ddm::RunFrame& inner) { ddm::run_load_steps(system, path, inner, method, path_steps); });
   }
   return frame.nested(warm.empty() ? nullptr : &warm, marks,
                       [&](ddm::RunFrame& inner) { ddm::run_enforced(system, inner, method); });
@@ -368,8 +377,8 @@ bool rebuild_refined(Problem& working, ddm::ContactSystem& system, ddm::RunFrame
   if (system.cancelled()) {  // during the refined meshes' assembly or factorisation: they are not solved
     mark_cancelled(total);
     total.message = "cancelled during adaptive step " + std::to_string(step + 1) +
-                    " (assembling and factorising its refined meshes; the result holds step " +
-                    std::to_string(step) + "'s solution)";
+                    " (assembling and factorising its refined meshes; the result holds step " + std::to_string(step) +
+                    "'s solution)";
     return false;
   }
   if (!system.ok()) {
@@ -429,8 +438,8 @@ void converge_then_refine(Problem& working, ddm::ContactSystem& system, ddm::Run
       return;
     }
     // The whole contact traction, the tangential one too where there is friction, is the bodies' Neumann data.
-    const ddm::Displacements loads = o.z.empty() ? system.contact_loads(o.u)
-                                                 : system.loads_from_pressures(o.z, o.q.empty() ? nullptr : &o.q);
+    const ddm::Displacements loads =
+        o.z.empty() ? system.contact_loads(o.u) : system.loads_from_pressures(o.z, o.q.empty() ? nullptr : &o.q);
     const auto eta = estimate(working, system, o.u, loads, frame.runner(), frame.stop_check());
     for (const auto& e : eta) total.indicator_seconds += e.seconds;
     Step solved = make_step(system, o.u, o.z, total.iterations, step, eta, o.q);
@@ -456,7 +465,7 @@ void converge_then_refine(Problem& working, ddm::ContactSystem& system, ddm::Run
     if (const std::string stop = stop_after_estimate(s, report, pe, step, o.message); !stop.empty()) {
       if (target_missed_at_stop(s, pe))
         miss_target(total, step >= s.max_steps && stalled(report, s.stop_tolerance).empty() ? StopReason::max_iterations
-                                                                                             : StopReason::stagnation);
+                                                                                            : StopReason::stagnation);
       return finish(stop);
     }
     RefineOutcome r = refine_for_step(working, system, eta, pe, steps.back(), steps.committed_nodes(), frame.runner());

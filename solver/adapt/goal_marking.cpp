@@ -57,16 +57,19 @@ std::vector<Eigen::VectorXd> goal_indicator(const Problem& problem, const ddm::C
   const ddm::Displacements loads = system.loads_from_pressures(dz);
   const parallel::BodyShare share{[&](size_t a, parallel::Packer& p) { p.put(goal[a]); },
                                   [&](size_t a, parallel::Unpacker& in) { goal[a] = in.get_vector(); }};
-  runner.run_bodies(n, [&](size_t a) {
-    if (a >= eta.size() || eta[a].error2_cell.size() != problem.bodies[a].mesh.num_cells()) return;
-    const Body& body = problem.bodies[a];
-    // phi: the body's response to dz's contact traction alone (prescribed values 0, no loads of its own).
-    const Eigen::VectorXd phi = system.body(a).solve_homogeneous(loads[a]);
-    const IndicatorResult dual = zz_indicator(body, system.body(a), phi);
-    const double nu = body.material.nu;
-    const double modulus = problem.model.plane == Plane::strain ? body.material.E / (1 - nu * nu) : body.material.E;
-    goal[a] = (eta[a].error2_cell.cwiseProduct(dual.error2_cell)).cwiseSqrt() / modulus;
-  }, share);
+  runner.run_bodies(
+      n,
+      [&](size_t a) {
+        if (a >= eta.size() || eta[a].error2_cell.size() != problem.bodies[a].mesh.num_cells()) return;
+        const Body& body = problem.bodies[a];
+        // phi: the body's response to dz's contact traction alone (prescribed values 0, no loads of its own).
+        const Eigen::VectorXd phi = system.body(a).solve_homogeneous(loads[a]);
+        const IndicatorResult dual = zz_indicator(body, system.body(a), phi);
+        const double nu = body.material.nu;
+        const double modulus = problem.model.plane == Plane::strain ? body.material.E / (1 - nu * nu) : body.material.E;
+        goal[a] = (eta[a].error2_cell.cwiseProduct(dual.error2_cell)).cwiseSqrt() / modulus;
+      },
+      share);
   add_edge_shares(problem, pe, goal);
   return goal;
 }

@@ -43,7 +43,6 @@ struct BulkMarking {
   std::vector<std::vector<int>> cells;  // per body
   bool level_limit_hit = false;
 };
-BulkMarking bulk_marking(const Problem& problem, const std::vector<Eigen::VectorXd>& goal, double theta,
-                         int max_level);
+BulkMarking bulk_marking(const Problem& problem, const std::vector<Eigen::VectorXd>& goal, double theta, int max_level);
 
 }  // namespace contact::adapt

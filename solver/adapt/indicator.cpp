@@ -326,7 +326,8 @@ void pin_rigid_motions(const Body& body, const Eigen::VectorXd& u, const Eigen::
   if (bem::free_rigid_motions(bp).empty()) return;
   std::vector<Eigen::Vector2d> contact;
   for (int n : loop)
-    if (contact_load.size() && contact_load.segment<2>(2 * n).squaredNorm() > 0.0) contact.push_back(m.nodes[static_cast<size_t>(n)]);
+    if (contact_load.size() && contact_load.segment<2>(2 * n).squaredNorm() > 0.0)
+      contact.push_back(m.nodes[static_cast<size_t>(n)]);
   size_t farthest = 0;
   double best = -1.0;
   for (size_t i = 0; i < nb; ++i) {
@@ -406,8 +407,8 @@ Marking mark(const mesh::Mesh& mesh, const Eigen::VectorXd& eta, double delta, i
     candidates.push_back(c);
   }
   std::sort(candidates.begin(), candidates.end(), [&](int a, int b) { return eta[a] > eta[b]; });
-  // A split adds at most 5 nodes (a quadrilateral's 4 midpoints and centre; a triangle's 3 midpoints), 10 dofs; the 1-irregularity closure can add more,
-  // so keep a margin of one extra split per marked cell.
+  // A split adds at most 5 nodes (a quadrilateral's 4 midpoints and centre; a triangle's 3 midpoints), 10 dofs; the
+  // 1-irregularity closure can add more, so keep a margin of one extra split per marked cell.
   const long dofs = 2L * mesh.num_nodes();
   const long room = (max_dofs - dofs) / 20;
   if (static_cast<long>(candidates.size()) > room) {

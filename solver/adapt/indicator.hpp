@@ -23,13 +23,13 @@
 namespace contact::adapt {
 
 struct IndicatorResult {
-  Eigen::VectorXd eta;   // per cell
-  std::string note;      // e.g. why fem_bem fell back to zz
-  double seconds = 0.0;  // time spent (BEM solve and interior evaluations for fem_bem)
-  double error2 = 0.0;      // ||sigma_R - sigma_F||^2 over the body (the global estimate's numerator)
-  double reference2 = 0.0;  // ||sigma_R||^2 over the body
+  Eigen::VectorXd eta;          // per cell
+  std::string note;             // e.g. why fem_bem fell back to zz
+  double seconds = 0.0;         // time spent (BEM solve and interior evaluations for fem_bem)
+  double error2 = 0.0;          // ||sigma_R - sigma_F||^2 over the body (the global estimate's numerator)
+  double reference2 = 0.0;      // ||sigma_R||^2 over the body
   Eigen::VectorXd error2_cell;  // ||sigma_R - sigma_F||^2 per cell (unnormalised: the goal weights' primal factor)
-  bool cancelled = false;   // the estimate was stopped by `cancelled` (eta is then empty)
+  bool cancelled = false;       // the estimate was stopped by `cancelled` (eta is then empty)
   // fem_bem only: the FE displacements (all dofs) with the boundary nodes' replaced by the boundary-element
   // solution's, the body's response to the same data without the FE interior (pressure_estimate.hpp); empty
   // for zz and where fem_bem fell back to zz.
@@ -43,9 +43,9 @@ IndicatorResult zz_indicator(const Body& body, const fem::BodySolver& solver, co
 // The paper's FEM-BEM indicator. contact_load: the body's contact forces (all dofs) of the current iterate,
 // turned into boundary tractions by lumping over the boundary sides. Falls back to zz (with a note) where the
 // BEM cannot be set up (a body with a hole: its boundary is not one closed polygon). Rigid motions the body's
-// edge conditions leave free are fixed by the FE displacement on a few sides (indicator.cpp, pin_rigid_motions). `cancelled` is polled inside
-// the boundary-element work (between blocks and GMRES iterations of the hierarchical path): true stops it and
-// returns a result with cancelled set.
+// edge conditions leave free are fixed by the FE displacement on a few sides (indicator.cpp, pin_rigid_motions).
+// `cancelled` is polled inside the boundary-element work (between blocks and GMRES iterations of the hierarchical
+// path): true stops it and returns a result with cancelled set.
 IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fem::BodySolver& solver,
                                   const Eigen::VectorXd& u, const Eigen::VectorXd& contact_load,
                                   Normalization normalization = Normalization::rms,

@@ -90,7 +90,6 @@ int solve_correction(const ddm::ContactSystem& system, const std::vector<std::ve
   return -1;
 }
 
-
 // The nodal pressure profile along a pair's slave edge (what the result shows: each slave node's value from the
 // rows, piecewise linear in the arc length between nodes).
 Eigen::VectorXd nodal_profile(const mortar::PairDiscretization& pair, const Eigen::VectorXd& z) {
@@ -160,7 +159,9 @@ double edge_error2(const mortar::PairDiscretization& pair, const Eigen::VectorXd
     return pair.closed ? (k + n) % n : -1;
   };
   const auto distance = [&](Eigen::Index from, Eigen::Index to) {
-    const auto at = [&](Eigen::Index j) { return pair.node_arc[static_cast<Eigen::Index>(nodes[static_cast<size_t>(j)])]; };
+    const auto at = [&](Eigen::Index j) {
+      return pair.node_arc[static_cast<Eigen::Index>(nodes[static_cast<size_t>(j)])];
+    };
     double d = std::abs(at(to) - at(from));
     return pair.closed ? std::min(d, pair.loop_length - d) : d;
   };
@@ -186,7 +187,8 @@ double edge_error2(const mortar::PairDiscretization& pair, const Eigen::VectorXd
         Eigen::Vector2d centre = Eigen::Vector2d::Zero();
         double weight = 0.0;
         for (mortar::SparseRows::InnerIterator it(pair.M, row); it; ++it) {
-          centre += std::abs(it.value()) * master.nodes[static_cast<size_t>(pair.master_nodes[static_cast<size_t>(it.col())])];
+          centre += std::abs(it.value()) *
+                    master.nodes[static_cast<size_t>(pair.master_nodes[static_cast<size_t>(it.col())])];
           weight += std::abs(it.value());
         }
         if (weight > 0.0) share.master_at = centre / weight;
@@ -208,8 +210,8 @@ Eigen::VectorXd slack_rows(const mortar::PairDiscretization& pair, const Eigen::
   Eigen::VectorXd s = Eigen::VectorXd::Zero(z.size());
   for (Eigen::Index r = 0; r < z.size() && r < q.size(); ++r) {
     if (!(z[r] > 0.0)) continue;
-    const double bound = pair.friction.law == FrictionSpec::Law::coulomb ? pair.friction.coefficient * z[r]
-                                                                          : pair.friction.bound;
+    const double bound =
+        pair.friction.law == FrictionSpec::Law::coulomb ? pair.friction.coefficient * z[r] : pair.friction.bound;
     const double slack = bound - std::abs(q[r]);
     if (slack > 1e-9 * bound) s[r] = slack;
   }
@@ -218,9 +220,9 @@ Eigen::VectorXd slack_rows(const mortar::PairDiscretization& pair, const Eigen::
 
 }  // namespace
 
-PressureEstimate pressure_estimate(const ddm::ContactSystem& system, const ddm::Displacements& u,
-                                   const Pressures& z, const std::vector<IndicatorResult>& eta,
-                                   const std::function<bool()>& stop, const Pressures* q) {
+PressureEstimate pressure_estimate(const ddm::ContactSystem& system, const ddm::Displacements& u, const Pressures& z,
+                                   const std::vector<IndicatorResult>& eta, const std::function<bool()>& stop,
+                                   const Pressures* q) {
   PressureEstimate out;
   ddm::Displacements ub = u;
   int replaced = 0;

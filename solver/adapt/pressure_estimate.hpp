@@ -27,7 +27,7 @@ struct PressureEstimate {
   // With friction: the tangential traction's misfit at the stick-slip points, the same square-root model on the
   // slack (the friction bound less |q|) that rises from them into the stick zone, relative to ||z||_D.
   double stick_slip = 0.0;
-  int iterations = 0;     // conjugate-gradient iterations (one solve per body each)
+  int iterations = 0;         // conjugate-gradient iterations (one solve per body each)
   ddm::Pressures correction;  // dz per pair and row (zero on the open rows); empty when there is no estimate
   // Each contact edge's share of `edges` and each stick-slip point's of `stick_slip`: where (its last node in
   // contact, or sticking), over what length (its last two multiplier segments) and its squared misfit relative to
@@ -40,7 +40,7 @@ struct PressureEstimate {
     double relative2 = 0.0;
   };
   std::vector<EdgeShare> edge_shares;
-  std::string note;       // why there is none, or that the iteration stopped short
+  std::string note;  // why there is none, or that the iteration stopped short
 };
 
 // z: the pressures the solve reached (per pair, per row); eta: the estimate's per-body results (bodies without

@@ -36,8 +36,8 @@ void residual_row(const BlockRow& row, const std::vector<Eigen::VectorXd>& us, c
 // the residual is checked on sample rows spread over the block, both components: returns a row whose residual is
 // above the tolerance (scaled to the block), or -1.
 int unconverged_sample_row(const BlockRow& row, const std::vector<Eigen::VectorXd>& us,
-                           const std::vector<Eigen::VectorXd>& vs, const std::vector<bool>& used, int rows,
-                           int columns, double tolerance, double norm2) {
+                           const std::vector<Eigen::VectorXd>& vs, const std::vector<bool>& used, int rows, int columns,
+                           double tolerance, double norm2) {
   constexpr int kSamplePairs = 4;
   Eigen::VectorXd r(columns);
   for (int s = 0; s < kSamplePairs; ++s)

@@ -102,12 +102,12 @@ struct HierarchicalOptions {
   // amplifies it (by ~20 at 2k nodes, more on larger boundaries); 1e-8 keeps the hierarchical result within
   // ~1e-6 of the dense one, far below the 1e-4 of the stresses the indicator resolves (docs/bem.md).
   double tolerance = 1e-8;
-  double eta = 1.0;                    // admissibility: min(diam) <= eta dist
-  int leaf_size = 32;                  // boundary nodes (or targets) per leaf cluster at most
-  double solver_tolerance = 1e-10;     // GMRES: relative residual
-  int restart = 60;                    // GMRES Krylov dimension
-  int max_iterations = 2000;           // GMRES matrix products
-  std::function<bool()> cancelled;     // polled between blocks and per GMRES iteration; true throws Cancelled
+  double eta = 1.0;                 // admissibility: min(diam) <= eta dist
+  int leaf_size = 32;               // boundary nodes (or targets) per leaf cluster at most
+  double solver_tolerance = 1e-10;  // GMRES: relative residual
+  int restart = 60;                 // GMRES Krylov dimension
+  int max_iterations = 2000;        // GMRES matrix products
+  std::function<bool()> cancelled;  // polled between blocks and per GMRES iteration; true throws Cancelled
   // Interior evaluation: a far block of P points x E elements is compressed only if P E > break_even (P + E)
   // (ACA costs ~20 (P + E) kernel evaluations, the exact sum P E); smaller ones are summed exactly. 0: always ACA.
   double break_even = 20.0;

@@ -250,7 +250,8 @@ std::vector<std::string> free_rigid_motions(const BoundaryProblem& problem) {
 void check_rigid_motions(const BoundaryProblem& problem, const BoundaryGeometry&) {
   const std::vector<std::string> free = free_rigid_motions(problem);
   bool any_prescribed = false;
-  for (const auto& e : problem.elements) any_prescribed = any_prescribed || e.displacement_prescribed[0] || e.displacement_prescribed[1];
+  for (const auto& e : problem.elements)
+    any_prescribed = any_prescribed || e.displacement_prescribed[0] || e.displacement_prescribed[1];
   if (!any_prescribed)
     fail(
         "no displacement is prescribed, so the body is free to translate and rotate: prescribe displacement "

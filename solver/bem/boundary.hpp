@@ -5,7 +5,6 @@
 #include <vector>
 
 #include <Eigen/Core>
-#include <vector>
 
 #include "bem.hpp"
 

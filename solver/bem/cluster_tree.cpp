@@ -30,9 +30,8 @@ int ClusterTree::build(const std::vector<Eigen::Vector2d>& points, int begin, in
   if (!(extent(axis) > 0.0)) return index;  // coincident points: cannot be split, stays a (large) leaf
   const double middle = 0.5 * (box.lo(axis) + box.hi(axis));
   // Both halves are non-empty: the box is tight, so its two extreme points lie on either side of the middle.
-  const auto split = std::partition(order_.begin() + begin, order_.begin() + end, [&](int p) {
-    return points[static_cast<std::size_t>(p)](axis) < middle;
-  });
+  const auto split = std::partition(order_.begin() + begin, order_.begin() + end,
+                                    [&](int p) { return points[static_cast<std::size_t>(p)](axis) < middle; });
   const int mid = static_cast<int>(split - order_.begin());
   const int left = build(points, begin, mid, leaf_size);
   const int right = build(points, mid, end, leaf_size);

@@ -39,7 +39,7 @@ struct BoundingBox {
 class ClusterTree {
  public:
   struct Cluster {
-    int begin = 0, end = 0;              // positions in order()
+    int begin = 0, end = 0;               // positions in order()
     std::array<int, 2> children{-1, -1};  // cluster indices; -1 for a leaf
     bool leaf() const { return children[0] < 0; }
     int size() const { return end - begin; }

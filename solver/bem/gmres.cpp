@@ -80,8 +80,7 @@ GmresResult gmres(const LinearOperator& A, const LinearOperator& M, const Eigen:
     }
     // Phase 3: x += M V_k y_k with H_k y_k = g_k (upper triangular after the rotations).
     if (k > 0) {
-      const Eigen::VectorXd y =
-          h.topLeftCorner(k, k).triangularView<Eigen::Upper>().solve(g.head(k));
+      const Eigen::VectorXd y = h.topLeftCorner(k, k).triangularView<Eigen::Upper>().solve(g.head(k));
       Eigen::VectorXd update = Eigen::VectorXd::Zero(n);
       for (int i = 0; i < k; ++i) update += y(i) * basis[static_cast<std::size_t>(i)];
       M(update, z);

@@ -133,8 +133,8 @@ class HierarchicalCollocation {
       for (int c = 0; c < 2; ++c) {
         const auto k = static_cast<std::size_t>(c);
         const auto node = static_cast<std::size_t>(i);
-        for (int u : {num_.displacement[node][k],
-                      num_.traction[static_cast<std::size_t>((i + n_ - 1) % n_)][k][1], num_.traction[node][k][0]})
+        for (int u : {num_.displacement[node][k], num_.traction[static_cast<std::size_t>((i + n_ - 1) % n_)][k][1],
+                      num_.traction[node][k][0]})
           if (u >= 0 && std::find(unknowns_of[node].begin(), unknowns_of[node].end(), u) == unknowns_of[node].end())
             unknowns_of[node].push_back(u);
       }
@@ -144,8 +144,9 @@ class HierarchicalCollocation {
     for (int p = 0; p < n_; ++p) {
       const auto node = static_cast<std::size_t>(tree_.order()[static_cast<std::size_t>(p)]);
       if (rows_of[node].size() != unknowns_of[node].size())
-        throw std::logic_error("bem: node " + std::to_string(node) + " carries " + std::to_string(rows_of[node].size()) +
-                               " equations but " + std::to_string(unknowns_of[node].size()) + " unknowns");
+        throw std::logic_error("bem: node " + std::to_string(node) + " carries " +
+                               std::to_string(rows_of[node].size()) + " equations but " +
+                               std::to_string(unknowns_of[node].size()) + " unknowns");
       for (std::size_t k = 0; k < rows_of[node].size(); ++k) {
         const auto [point, component] = row_of_equation[static_cast<std::size_t>(rows_of[node][k])];
         row_point_.push_back(point);
@@ -193,9 +194,8 @@ class HierarchicalCollocation {
       if (pair.admissible) {
         const int max_rank = std::min(rows, kColumnsPerElement * elements) / 2;
         low_rank = adaptive_cross_approximation(
-            rows, kColumnsPerElement * elements, [&](int i, Eigen::Ref<Eigen::VectorXd> out) {
-              element_row(r0 + i, columns.begin, columns.end, out);
-            },
+            rows, kColumnsPerElement * elements,
+            [&](int i, Eigen::Ref<Eigen::VectorXd> out) { element_row(r0 + i, columns.begin, columns.end, out); },
             [&](int j, Eigen::Ref<Eigen::VectorXd> out) { element_column(r0, rows, columns.begin, j, out); },
             options_.tolerance, max_rank);
         compressed = low_rank.rank() < max_rank;
@@ -242,7 +242,8 @@ class HierarchicalCollocation {
     const int l = row_component_[static_cast<std::size_t>(row)];
     for (int p = position_begin; p < position_end; ++p) {
       const ElementCoefficients c = coefficients(row, element_at(p));
-      for (int k = 0; k < kColumnsPerElement; ++k) out(kColumnsPerElement * (p - position_begin) + k) = column_value(c, l, k);
+      for (int k = 0; k < kColumnsPerElement; ++k)
+        out(kColumnsPerElement * (p - position_begin) + k) = column_value(c, l, k);
     }
   }
 
@@ -265,7 +266,8 @@ class HierarchicalCollocation {
     for (int i = 0; i < rows; ++i) {
       const int point = row_point_[static_cast<std::size_t>(r0 + i)];
       if (point != cached_point) {  // both directions of a point from one set of coefficients
-        for (int e = 0; e < elements; ++e) cache[static_cast<std::size_t>(e)] = coefficients(r0 + i, element_at(position_begin + e));
+        for (int e = 0; e < elements; ++e)
+          cache[static_cast<std::size_t>(e)] = coefficients(r0 + i, element_at(position_begin + e));
         cached_point = point;
       }
       const int l = row_component_[static_cast<std::size_t>(r0 + i)];

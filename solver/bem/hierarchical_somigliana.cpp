@@ -8,8 +8,8 @@
 // exactly, then the tensor-product polynomial through them at every point of the box (the field of elements
 // that far is analytic over the box; see interpolation.hpp). Other far blocks are compressed by ACA and applied
 // to the element-column values at once (nothing is stored); a near-field block is summed exactly, as
-// interior_stresses() does. The inside test uses the boundary's tree: the ray crossings and the distance to the boundary visit only
-// the clusters whose boxes can matter.
+// interior_stresses() does. The inside test uses the boundary's tree: the ray crossings and the distance to the
+// boundary visit only the clusters whose boxes can matter.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -60,7 +60,8 @@ class HierarchicalSomigliana {
     std::vector<BoundingBox> point_boxes(points_.size());
     for (std::size_t k = 0; k < points_.size(); ++k) point_boxes[k].extend(points_[k]);
     target_boxes_ = targets_.cluster_boxes(point_boxes);
-    const std::vector<BlockPair> pairs = block_partition(targets_, target_boxes_, sources_, source_boxes_, options_.eta);
+    const std::vector<BlockPair> pairs =
+        block_partition(targets_, target_boxes_, sources_, source_boxes_, options_.eta);
     stresses_ = Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(points_.size()), 3);
     for (const BlockPair& pair : pairs) {
       if (options_.cancelled && options_.cancelled()) throw Cancelled();
@@ -93,7 +94,8 @@ class HierarchicalSomigliana {
     for (Eigen::Index e = 0; e < n; ++e)
       for (int m = 0; m < 2; ++m)
         for (int j = 0; j < 2; ++j) {
-          values_(kColumnsPerElement * e + 2 * m + j) = solution.traction[static_cast<std::size_t>(e)](j, m) / traction_scale_;
+          values_(kColumnsPerElement * e + 2 * m + j) =
+              solution.traction[static_cast<std::size_t>(e)](j, m) / traction_scale_;
           values_(kColumnsPerElement * e + 4 + 2 * m + j) = solution.displacement((e + m) % n, j);
         }
   }
@@ -112,10 +114,12 @@ class HierarchicalSomigliana {
         return;
       }
       for (int p = cluster.begin; p < cluster.end; ++p) {
-        const BoundaryElement& el = geometry_.elements[static_cast<std::size_t>(sources_.order()[static_cast<std::size_t>(p)])];
+        const BoundaryElement& el =
+            geometry_.elements[static_cast<std::size_t>(sources_.order()[static_cast<std::size_t>(p)])];
         if (distance_to_segment(x, el.start, el.end) <= tolerance) on_boundary = true;
         if ((el.start.y() > x.y()) != (el.end.y() > x.y())) {
-          const double crossing = el.start.x() + (x.y() - el.start.y()) / (el.end.y() - el.start.y()) * (el.end.x() - el.start.x());
+          const double crossing =
+              el.start.x() + (x.y() - el.start.y()) / (el.end.y() - el.start.y()) * (el.end.x() - el.start.x());
           if (x.x() < crossing) inside = !inside;
         }
       }
@@ -150,7 +154,8 @@ class HierarchicalSomigliana {
   Eigen::VectorXd cluster_values(const ClusterTree::Cluster& c) const {
     Eigen::VectorXd y(kColumnsPerElement * c.size());
     for (int p = c.begin; p < c.end; ++p)
-      y.segment<kColumnsPerElement>(kColumnsPerElement * (p - c.begin)) = values_.segment<kColumnsPerElement>(kColumnsPerElement * element_at(p));
+      y.segment<kColumnsPerElement>(kColumnsPerElement * (p - c.begin)) =
+          values_.segment<kColumnsPerElement>(kColumnsPerElement * element_at(p));
     return y;
   }
 
@@ -258,7 +263,8 @@ class HierarchicalSomigliana {
           at_points(child, it->first, it->second);
           continue;
         }
-        const std::vector<Eigen::Vector2d> nodes = interpolation_.nodes_in(target_boxes_[static_cast<std::size_t>(child)]);
+        const std::vector<Eigen::Vector2d> nodes =
+            interpolation_.nodes_in(target_boxes_[static_cast<std::size_t>(child)]);
         auto [child_it, fresh] = node_stresses_.try_emplace(child);
         if (fresh) child_it->second = Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(nodes.size()), 3);
         for (std::size_t k = 0; k < nodes.size(); ++k)
@@ -299,14 +305,16 @@ class HierarchicalSomigliana {
           if (strip.size() == 0) {
             strip.resize(m, kColumnsPerElement);
             const int e = element_at(columns.begin + j / kColumnsPerElement);
-            for (int t = 0; t < rows.size(); ++t) strip.middleRows<3>(3 * t) = coefficients(target_at(rows.begin + t), e);
+            for (int t = 0; t < rows.size(); ++t)
+              strip.middleRows<3>(3 * t) = coefficients(target_at(rows.begin + t), e);
           }
           out = strip.col(j % kColumnsPerElement);
         },
         options_.tolerance, max_rank);
     if (block.rank() >= max_rank) return false;
     const Eigen::VectorXd product = block.U * (block.V.transpose() * cluster_values(columns));
-    for (int t = 0; t < rows.size(); ++t) stresses_.row(target_at(rows.begin + t)) += product.segment<3>(3 * t).transpose();
+    for (int t = 0; t < rows.size(); ++t)
+      stresses_.row(target_at(rows.begin + t)) += product.segment<3>(3 * t).transpose();
     ++far_blocks_;
     rank_sum_ += block.rank();
     largest_rank_ = std::max(largest_rank_, block.rank());

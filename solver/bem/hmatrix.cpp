@@ -33,7 +33,8 @@ void HierarchicalMatrix::factorize_diagonal(const std::vector<std::pair<int, int
   // Which range each row belongs to.
   std::vector<int> range_of(static_cast<std::size_t>(size_), -1);
   for (std::size_t r = 0; r < ranges.size(); ++r)
-    for (int i = ranges[r].first; i < ranges[r].second; ++i) range_of[static_cast<std::size_t>(i)] = static_cast<int>(r);
+    for (int i = ranges[r].first; i < ranges[r].second; ++i)
+      range_of[static_cast<std::size_t>(i)] = static_cast<int>(r);
   std::vector<Eigen::MatrixXd> diagonal(ranges.size());
   for (std::size_t r = 0; r < ranges.size(); ++r) {
     const int n = ranges[r].second - ranges[r].first;

@@ -9,14 +9,14 @@
 #ifdef NDEBUG
 #define CONTACT_ASSERT_SIZE(actual, expected, what) ((void)0)
 #else
-#define CONTACT_ASSERT_SIZE(actual, expected, what)                                                           \
-  do {                                                                                                         \
-    const long long contact_actual_ = static_cast<long long>(actual);                                         \
-    const long long contact_expected_ = static_cast<long long>(expected);                                     \
-    if (contact_actual_ != contact_expected_) {                                                               \
-      std::fprintf(stderr, "%s:%d: %s has size %lld, expected %lld\n", __FILE__, __LINE__, what,             \
-                   contact_actual_, contact_expected_);                                                       \
-      std::abort();                                                                                            \
-    }                                                                                                          \
+#define CONTACT_ASSERT_SIZE(actual, expected, what)                                                               \
+  do {                                                                                                            \
+    const long long contact_actual_ = static_cast<long long>(actual);                                             \
+    const long long contact_expected_ = static_cast<long long>(expected);                                         \
+    if (contact_actual_ != contact_expected_) {                                                                   \
+      std::fprintf(stderr, "%s:%d: %s has size %lld, expected %lld\n", __FILE__, __LINE__, what, contact_actual_, \
+                   contact_expected_);                                                                            \
+      std::abort();                                                                                               \
+    }                                                                                                             \
   } while (false)
 #endif

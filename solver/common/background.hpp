@@ -31,7 +31,8 @@ void background_abandoned();  // the caller left; background_finished(true) foll
 // soon as cancelled() says so (checked every `poll`), leaving the thread to finish and discard its result.
 // Exceptions of the work reach the caller (unless it was abandoned).
 template <class T>
-std::unique_ptr<T> run_unless_cancelled(std::function<std::unique_ptr<T>()> work, const std::function<bool()>& cancelled,
+std::unique_ptr<T> run_unless_cancelled(std::function<std::unique_ptr<T>()> work,
+                                        const std::function<bool()>& cancelled,
                                         std::chrono::milliseconds poll = std::chrono::milliseconds(20)) {
   if (!cancelled) return work();
   if (cancelled()) return nullptr;

@@ -14,11 +14,11 @@ namespace {
 // projected onto lambda >= 0, restarted when a mixed update makes the residual ten times worse).
 class UzawaMultipliers {
  public:
-  explicit UzawaMultipliers(const ContactSystem& system)
-      : pairs_(system.pairs()), offset_(pairs_.size() + 1, 0) {
+  explicit UzawaMultipliers(const ContactSystem& system) : pairs_(system.pairs()), offset_(pairs_.size() + 1, 0) {
     for (size_t k = 0; k < pairs_.size(); ++k) offset_[k + 1] = offset_[k] + pairs_[k].n_rows();
     sqrt_w_.resize(offset_.back());
-    for (size_t k = 0; k < pairs_.size(); ++k) sqrt_w_.segment(offset_[k], pairs_[k].n_rows()) = pairs_[k].area.cwiseSqrt();
+    for (size_t k = 0; k < pairs_.size(); ++k)
+      sqrt_w_.segment(offset_[k], pairs_[k].n_rows()) = pairs_[k].area.cwiseSqrt();
     lambda_ = Eigen::VectorXd::Zero(offset_.back());
   }
 
@@ -41,7 +41,8 @@ class UzawaMultipliers {
   // lambda <- the Anderson-mixed image, projected onto lambda >= 0, and given to the system's pairs.
   void update(ContactSystem& system, const Eigen::VectorXd& image, const Eigen::VectorXd& residual) {
     lambda_ = mixing_.next(image, residual);
-    for (size_t k = 0; k < pairs_.size(); ++k) system.set_multipliers(k, lambda_.segment(offset_[k], pairs_[k].n_rows()));
+    for (size_t k = 0; k < pairs_.size(); ++k)
+      system.set_multipliers(k, lambda_.segment(offset_[k], pairs_[k].n_rows()));
   }
 
  private:
@@ -84,8 +85,8 @@ void run_augmented_lagrangian(ContactSystem& system, RunFrame& frame, ContactMet
       total.converged = true;
       total.stop_reason = StopReason::converged;
       std::ostringstream os;
-      os << "augmented Lagrangian: pressures settled (relative change " << change << " <= " << al.tolerance << ") after "
-         << update << " updates; last inner solve: " << inner_message;
+      os << "augmented Lagrangian: pressures settled (relative change " << change << " <= " << al.tolerance
+         << ") after " << update << " updates; last inner solve: " << inner_message;
       total.message = os.str();
       return;
     }
@@ -94,7 +95,8 @@ void run_augmented_lagrangian(ContactSystem& system, RunFrame& frame, ContactMet
     if (update == al.max_updates) {
       total.stop_reason = StopReason::max_iterations;
       std::ostringstream os;
-      os << "augmented Lagrangian: max_updates = " << update << " reached with a relative pressure change of " << change;
+      os << "augmented Lagrangian: max_updates = " << update << " reached with a relative pressure change of "
+         << change;
       total.message = os.str();
     }
   }

@@ -49,7 +49,8 @@ ContactSystem::ContactSystem(const Problem& problem, parallel::TaskRunner& runne
   build_bodies(all, stop);
 }
 
-std::unique_ptr<fem::BodySolver> ContactSystem::make_body(size_t a, bool local, const std::function<bool()>& stop) const {
+std::unique_ptr<fem::BodySolver> ContactSystem::make_body(size_t a, bool local,
+                                                          const std::function<bool()>& stop) const {
   auto b = std::make_unique<fem::BodySolver>(problem_.bodies[a], problem_.model, factorization_ != Factorization::none,
                                              interface_dofs(a), may_float(a), local, stop);
   b->set_load_between(load_step_, previous_factor_, load_factor_, step_fraction_);
@@ -57,10 +58,13 @@ std::unique_ptr<fem::BodySolver> ContactSystem::make_body(size_t a, bool local, 
 }
 
 void ContactSystem::build_bodies(const std::vector<size_t>& todo, const std::function<bool()>& stop) {
-  runner_.run_bodies(todo, [&](size_t a) {
-    bodies_[a].reset();  // free the old factorisation first
-    bodies_[a] = make_body(a, true, stop);
-  }, body_outcome_share());
+  runner_.run_bodies(
+      todo,
+      [&](size_t a) {
+        bodies_[a].reset();  // free the old factorisation first
+        bodies_[a] = make_body(a, true, stop);
+      },
+      body_outcome_share());
   std::vector<std::pair<std::string, std::string>> failed;
   for (size_t a : todo) {
     if (bodies_[a]->was_cancelled())
@@ -181,7 +185,8 @@ Pressures ContactSystem::penalty_pressures(const Displacements& u) const {
   Pressures z(pairs_.size());
   for (size_t k = 0; k < pairs_.size(); ++k) {
     const auto& pair = pairs_[k];
-    z[k] = pair.penalty_pressure(pair.nodal_gap(u[static_cast<size_t>(pair.slave_body)], u[static_cast<size_t>(pair.master_body)]));
+    z[k] = pair.penalty_pressure(
+        pair.nodal_gap(u[static_cast<size_t>(pair.slave_body)], u[static_cast<size_t>(pair.master_body)]));
   }
   return z;
 }
@@ -210,7 +215,8 @@ bool ContactSystem::has_histories() const {
 void ContactSystem::accept_step(const Displacements& u) {
   for (auto& pair : pairs_)
     if (pair.has_friction())
-      pair.jump_origin = pair.weighted_jump(u[static_cast<size_t>(pair.slave_body)], u[static_cast<size_t>(pair.master_body)]);
+      pair.jump_origin =
+          pair.weighted_jump(u[static_cast<size_t>(pair.slave_body)], u[static_cast<size_t>(pair.master_body)]);
 }
 
 Displacements ContactSystem::contact_loads(const Displacements& u, Pressures* pressures) const {
@@ -240,12 +246,14 @@ Eigen::VectorXd ContactSystem::zone_normals(size_t a, const Eigen::VectorXd& u_a
 
 Displacements ContactSystem::solve_bodies(const Displacements& loads) const {
   Displacements u(bodies_.size());
-  runner_.run_bodies(bodies_.size(), [&](size_t a) { u[a] = bodies_[a]->solve(loads[a]); }, share_vectors(u));
+  runner_.run_bodies(
+      bodies_.size(), [&](size_t a) { u[a] = bodies_[a]->solve(loads[a]); }, share_vectors(u));
   return u;
 }
 
 parallel::BodyShare share_vectors(std::vector<Eigen::VectorXd>& v) {
-  return {[&v](size_t a, parallel::Packer& out) { out.put(v[a]); }, [&v](size_t a, parallel::Unpacker& in) { v[a] = in.get_vector(); }};
+  return {[&v](size_t a, parallel::Packer& out) { out.put(v[a]); },
+          [&v](size_t a, parallel::Unpacker& in) { v[a] = in.get_vector(); }};
 }
 
 Displacements ContactSystem::elastic_layer_guess() const {
@@ -262,8 +270,10 @@ Displacements ContactSystem::elastic_layer_guess() const {
   Pressures z(pairs_.size());
   for (size_t k = 0; k < pairs_.size(); ++k) {
     const auto& pair = pairs_[k];
-    const double compliance = penalties_[k].slave_height / M(pair.slave_body) + penalties_[k].master_height / M(pair.master_body);
-    const Eigen::VectorXd g = pair.nodal_gap(free_u[static_cast<size_t>(pair.slave_body)], free_u[static_cast<size_t>(pair.master_body)]);
+    const double compliance =
+        penalties_[k].slave_height / M(pair.slave_body) + penalties_[k].master_height / M(pair.master_body);
+    const Eigen::VectorXd g =
+        pair.nodal_gap(free_u[static_cast<size_t>(pair.slave_body)], free_u[static_cast<size_t>(pair.master_body)]);
     z[k] = (-g).cwiseMax(0.0) / compliance;
   }
   return solve_bodies(loads_from_pressures(z));
@@ -272,7 +282,8 @@ Displacements ContactSystem::elastic_layer_guess() const {
 Pressures ContactSystem::nodal_gaps(const Displacements& u) const {
   Pressures g(pairs_.size());
   for (size_t k = 0; k < pairs_.size(); ++k)
-    g[k] = pairs_[k].nodal_gap(u[static_cast<size_t>(pairs_[k].slave_body)], u[static_cast<size_t>(pairs_[k].master_body)]);
+    g[k] = pairs_[k].nodal_gap(u[static_cast<size_t>(pairs_[k].slave_body)],
+                               u[static_cast<size_t>(pairs_[k].master_body)]);
   return g;
 }
 

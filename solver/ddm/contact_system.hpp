@@ -34,8 +34,8 @@ class ContactSystem {
   // `runner`, which every per-body work of the system runs on from then on. Check ok() / error(). With `stop` (the
   // run's stop check, RunFrame::stop_check), a stop asked during the assembly or a factorisation ends the set-up
   // within a poll (fem/body_solver.hpp): then cancelled() and not ok(), and the system must not be used.
-  ContactSystem(const Problem& problem, parallel::TaskRunner& runner, Factorization factorization = Factorization::plain,
-                std::function<bool()> stop = {});
+  ContactSystem(const Problem& problem, parallel::TaskRunner& runner,
+                Factorization factorization = Factorization::plain, std::function<bool()> stop = {});
 
   // After the meshes of the bodies flagged in `changed` were refined (in the Problem this system refers to):
   // rediscretises every pair and reassembles and refactorises the changed bodies, and any other body whose
@@ -131,8 +131,8 @@ class ContactSystem {
  private:
   // fields() in phases (system_fields.cpp): the bodies' stresses and support reactions (on their owners), one
   // body's field, one pair's field.
-  void stresses_and_reactions(const Displacements& u, const Displacements& loads, std::vector<fem::StressFields>& stress,
-                              std::vector<Eigen::VectorXd>& reaction) const;
+  void stresses_and_reactions(const Displacements& u, const Displacements& loads,
+                              std::vector<fem::StressFields>& stress, std::vector<Eigen::VectorXd>& reaction) const;
   BodyField body_field(size_t a, const Eigen::VectorXd& u, fem::StressFields stress, const Eigen::VectorXd& reaction,
                        const Eigen::VectorXd* rigid_amplitudes) const;
   PairField pair_field(size_t k, const Displacements& u, const Eigen::VectorXd& z, const Eigen::VectorXd* q) const;

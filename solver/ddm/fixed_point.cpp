@@ -49,7 +49,8 @@ Pressures linear_pressures(const ContactSystem& system, const Displacements& du)
   Pressures dz(system.pairs().size());
   for (size_t k = 0; k < dz.size(); ++k) {
     const auto& pair = system.pairs()[k];
-    const Eigen::VectorXd dg = pair.Gm * du[static_cast<size_t>(pair.master_body)] - pair.Gs * du[static_cast<size_t>(pair.slave_body)];
+    const Eigen::VectorXd dg =
+        pair.Gm * du[static_cast<size_t>(pair.master_body)] - pair.Gs * du[static_cast<size_t>(pair.slave_body)];
     dz[k] = -dg.cwiseQuotient(pair.area) / pair.theta;
   }
   return dz;
@@ -60,7 +61,8 @@ Displacements NeumannMap::apply(const Displacements& u) { return system_.solve_b
 Displacements NeumannMap::linear_response(const Displacements& du) {
   const Displacements loads = system_.loads_from_pressures(linear_pressures(system_, du));
   Displacements out(loads.size());
-  runner_.run_bodies(loads.size(), [&](size_t a) { out[a] = system_.body(a).solve_homogeneous(loads[a]); }, share_vectors(out));
+  runner_.run_bodies(
+      loads.size(), [&](size_t a) { out[a] = system_.body(a).solve_homogeneous(loads[a]); }, share_vectors(out));
   return out;
 }
 
@@ -116,10 +118,20 @@ struct Image {
 class FixedPointIteration {
  public:
   FixedPointIteration(const ContactSystem& system, RunFrame& frame, BodyMap& map, Displacements u)
-      : system_(system), settings_(frame.settings()), frame_(frame), map_(map), n_(system.n_bodies()), out_(frame.outcome()),
-        gamma_(settings_.gamma), anderson_requested_(settings_.acceleration == Acceleration::anderson),
-        anderson_(anderson_requested_), u_(std::move(u)), zone_(stacked_zone_normals(system, u_)),
-        zone_per_body_(n_), history_(static_cast<size_t>(std::max(1, settings_.anderson_depth))), best_u_(u_) {
+      : system_(system),
+        settings_(frame.settings()),
+        frame_(frame),
+        map_(map),
+        n_(system.n_bodies()),
+        out_(frame.outcome()),
+        gamma_(settings_.gamma),
+        anderson_requested_(settings_.acceleration == Acceleration::anderson),
+        anderson_(anderson_requested_),
+        u_(std::move(u)),
+        zone_(stacked_zone_normals(system, u_)),
+        zone_per_body_(n_),
+        history_(static_cast<size_t>(std::max(1, settings_.anderson_depth))),
+        best_u_(u_) {
     for (size_t a = 0; a < n_; ++a) zone_per_body_[a] = system.zone_normals(a, u_[a]);
   }
 
@@ -140,7 +152,8 @@ class FixedPointIteration {
       report(k, paper, image.residual, note);
       if (test_for_stop(k, paper, image.residual)) break;
     }
-    if (anderson_requested_ && !anderson_) out_.message += " (Anderson acceleration was abandoned for plain relaxation)";
+    if (anderson_requested_ && !anderson_)
+      out_.message += " (Anderson acceleration was abandoned for plain relaxation)";
     out_.u = std::move(u_);
     out_.gamma = gamma_;
     out_.subdomain_solves = solves_;
@@ -192,11 +205,11 @@ class FixedPointIteration {
     // Anderson residuals are not monotone (its own restart handles overshoots), so under it only a large
     // growth counts.
     const double residual = image.residual;
-    const bool growing = !std::isfinite(residual) ||
-                         (anderson_ ? residual > 100.0 * smallest_residual_
-                                    : growth_ >= 3 && residual > 1.5 * smallest_residual_);
+    const bool growing = !std::isfinite(residual) || (anderson_ ? residual > 100.0 * smallest_residual_
+                                                                : growth_ >= 3 && residual > 1.5 * smallest_residual_);
     const bool stalled = k - best_iteration_ >= stagnation_window / 2;
-    if (settings_.gamma_auto && backoffs_ < max_backoffs && (growing || stalled)) return back_off(k, growing, residual, note);
+    if (settings_.gamma_auto && backoffs_ < max_backoffs && (growing || stalled))
+      return back_off(k, growing, residual, note);
     if (anderson_) return mix(image, note);
     return axpy(u_, gamma_, image.R);  // paper (17)
   }
@@ -287,7 +300,8 @@ class FixedPointIteration {
       std::ostringstream os;
       os << "the iteration stagnates: the fixed-point residual has not fallen below " << smallest_residual_
          << " (reached at iteration " << best_iteration_ << ") in " << stagnation_window << " iterations";
-      if (smallest_residual_ > 1e-6) os << "; gamma = " << gamma_ << " is probably above the stability bound: reduce it";
+      if (smallest_residual_ > 1e-6)
+        os << "; gamma = " << gamma_ << " is probably above the stability bound: reduce it";
       out_.stop_reason = StopReason::stagnation;
       out_.message = os.str();
       return true;
@@ -304,7 +318,8 @@ class FixedPointIteration {
     if (k == settings_.max_iterations) {
       out_.stop_reason = StopReason::max_iterations;
       std::ostringstream os;
-      os << "max_iterations = " << k << " reached; fixed-point residual " << residual << ", paper's criterion " << paper;
+      os << "max_iterations = " << k << " reached; fixed-point residual " << residual << ", paper's criterion "
+         << paper;
       out_.message = os.str();
     }
     return false;
@@ -320,10 +335,10 @@ class FixedPointIteration {
   double gamma_;
   std::string pending_note_;  // for the first report: how gamma was chosen
   const bool anderson_requested_;
-  bool anderson_;  // false once Anderson was abandoned for plain relaxation
+  bool anderson_;                          // false once Anderson was abandoned for plain relaxation
   std::vector<std::vector<char>> active_;  // per pair, the contact nodes in contact at the last report
   Displacements u_;
-  Eigen::VectorXd zone_;                       // u's contact-zone normal displacements, all bodies stacked
+  Eigen::VectorXd zone_;                        // u's contact-zone normal displacements, all bodies stacked
   std::vector<Eigen::VectorXd> zone_per_body_;  // the same per body
   // Anderson history: iterate and residual differences (full bodies) and interface-residual differences.
   linalg::AndersonHistory<std::pair<Displacements, Displacements>> history_;

@@ -26,7 +26,8 @@ namespace contact::ddm::policy {
 // 1-2. The direct solver's friction Newton before the iterative solver takes the step over.
 struct DirectNewton {
   // Steps of the direct friction Newton before the take-over: where it settles it does so within tens of steps (51
-  // at the most measured); past that it crawls by damped steps of one sparse LU each (docs/friction.md, "Solvers and their cost").
+  // at the most measured); past that it crawls by damped steps of one sparse LU each (docs/friction.md, "Solvers and
+  // their cost").
   int budget = 100;
 };
 

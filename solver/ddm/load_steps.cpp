@@ -9,11 +9,11 @@ namespace contact::ddm {
 namespace {
 
 // A frictional step that does not converge is cut: its increment is halved (at most policy::LoadStepCuts::max_cuts
-// times, down to 1/32 of the step) and the sub-steps are solved and accepted in turn from the last state that held. Why: friction is
-// path dependent and the semismooth Newton's start is the previous state; near the limit of what friction holds
-// (bricks at the heel of a sheared wall whose bed joints slip above and below) a whole step's increment can leave
-// the Newton in sets that hold no answer, while halves of it, each from an answer, converge. The sub-steps follow
-// the load path more closely; they are not output steps (the step's result is its last sub-step's).
+// times, down to 1/32 of the step) and the sub-steps are solved and accepted in turn from the last state that held.
+// Why: friction is path dependent and the semismooth Newton's start is the previous state; near the limit of what
+// friction holds (bricks at the heel of a sheared wall whose bed joints slip above and below) a whole step's increment
+// can leave the Newton in sets that hold no answer, while halves of it, each from an answer, converge. The sub-steps
+// follow the load path more closely; they are not output steps (the step's result is its last sub-step's).
 bool may_cut(const ContactSystem& system, const MethodOutcome& outcome, const RunFrame& frame) {
   // Not: frictionless steps (path independent: a cut solves the same problem), a statics refusal (the loads of the
   // step's end are refused whatever the path) or a cancel.
@@ -64,12 +64,12 @@ void run_load_steps(ContactSystem& system, const std::vector<double>& factors, R
       increment *= 0.5;
       ++cuts;
     }
-    std::string prefix = factors.size() == 1 ? std::string()
-                                             : "load step " + std::to_string(k + 1) + " of " +
-                                                   std::to_string(factors.size());
+    std::string prefix = factors.size() == 1
+                             ? std::string()
+                             : "load step " + std::to_string(k + 1) + " of " + std::to_string(factors.size());
     if (cuts > 0)
-      prefix += std::string(prefix.empty() ? "" : " ") + "(cut " + std::to_string(cuts) + " times: " +
-                std::to_string(sub_steps + (total.converged ? 1 : 0)) + " sub-steps held, the last at " +
+      prefix += std::string(prefix.empty() ? "" : " ") + "(cut " + std::to_string(cuts) +
+                " times: " + std::to_string(sub_steps + (total.converged ? 1 : 0)) + " sub-steps held, the last at " +
                 std::to_string(static_cast<int>(100 * (total.converged ? 1.0 : done) + 0.5)) + " % of the step)";
     if (not_cut)
       prefix += std::string(prefix.empty() ? "" : " ") +

@@ -83,20 +83,27 @@ const MethodFacts& facts_of(Method method) {
       "or choose interface_newton, neumann or robin",
       true};
   switch (method) {
-    case Method::interface_newton: return interface_newton;
-    case Method::monolithic: return monolithic;
+    case Method::interface_newton:
+      return interface_newton;
+    case Method::monolithic:
+      return monolithic;
     case Method::neumann:
-    case Method::robin: break;
+    case Method::robin:
+      break;
   }
   return fixed_point;
 }
 
 std::unique_ptr<ContactMethod> make_method(const ContactSystem& system, Method method) {
   switch (method) {
-    case Method::monolithic: return std::make_unique<MonolithicMethod>(system);
-    case Method::robin: return std::make_unique<RobinMethod>(system);
-    case Method::interface_newton: return std::make_unique<InterfaceNewtonMethod>(system);
-    case Method::neumann: break;
+    case Method::monolithic:
+      return std::make_unique<MonolithicMethod>(system);
+    case Method::robin:
+      return std::make_unique<RobinMethod>(system);
+    case Method::interface_newton:
+      return std::make_unique<InterfaceNewtonMethod>(system);
+    case Method::neumann:
+      break;
   }
   return std::make_unique<NeumannMethod>(system);
 }

@@ -58,7 +58,8 @@ Stacked stack(const ContactSystem& system, bool shift_by_multipliers) {
   for (size_t a = 0; a < n_bodies; ++a) {
     const auto& K = system.body(a).reduced_stiffness();
     for (int col = 0; col < K.outerSize(); ++col)
-      for (SpMat::InnerIterator it(K, col); it; ++it) tk.emplace_back(s.offset[a] + it.row(), s.offset[a] + it.col(), it.value());
+      for (SpMat::InnerIterator it(K, col); it; ++it)
+        tk.emplace_back(s.offset[a] + it.row(), s.offset[a] + it.col(), it.value());
     s.b.segment(s.offset[a], system.body(a).n_free()) = system.body(a).reduced_rhs();
   }
   s.K.resize(n, n);
@@ -88,9 +89,11 @@ Stacked stack(const ContactSystem& system, bool shift_by_multipliers) {
     const size_t sb = static_cast<size_t>(pair.slave_body), mb = static_cast<size_t>(pair.master_body);
     const SpMat Bs = SpMat(Gs) * system.body(sb).constraints().T(), Bm = SpMat(Gm) * system.body(mb).constraints().T();
     for (int col = 0; col < Bs.outerSize(); ++col)
-      for (SpMat::InnerIterator it(Bs, col); it; ++it) tb.emplace_back(first + it.row(), s.offset[sb] + it.col(), -it.value());
+      for (SpMat::InnerIterator it(Bs, col); it; ++it)
+        tb.emplace_back(first + it.row(), s.offset[sb] + it.col(), -it.value());
     for (int col = 0; col < Bm.outerSize(); ++col)
-      for (SpMat::InnerIterator it(Bm, col); it; ++it) tb.emplace_back(first + it.row(), s.offset[mb] + it.col(), it.value());
+      for (SpMat::InnerIterator it(Bm, col); it; ++it)
+        tb.emplace_back(first + it.row(), s.offset[mb] + it.col(), it.value());
     const Eigen::VectorXd g = Gm * system.body(mb).prescribed() - Gs * system.body(sb).prescribed();
     s.g0.segment(first, pair.n_rows()) = g;
     s.D.segment(first, pair.n_rows()) = pair.area;
@@ -110,7 +113,8 @@ Stacked stack(const ContactSystem& system, bool shift_by_multipliers) {
       s.g0.segment(s.row_offset[k], pair.n_rows()) -= pair.theta * pair.area.cwiseProduct(pair.multiplier);
     if (s.tangential_offset[k] < 0) continue;
     add_rows(k, s.tangential_offset[k], pair.Ts, pair.Tm);
-    if (pair.jump_origin.size() == pair.n_rows()) s.g0.segment(s.tangential_offset[k], pair.n_rows()) -= pair.jump_origin;
+    if (pair.jump_origin.size() == pair.n_rows())
+      s.g0.segment(s.tangential_offset[k], pair.n_rows()) -= pair.jump_origin;
   }
   s.B.resize(m, n);
   s.B.setFromTriplets(tb.begin(), tb.end());
@@ -125,8 +129,7 @@ Stacked stack(const ContactSystem& system, bool shift_by_multipliers) {
 
 Displacements to_bodies(const ContactSystem& system, const Stacked& s, const Eigen::VectorXd& x) {
   Displacements u(system.n_bodies());
-  for (size_t a = 0; a < u.size(); ++a)
-    u[a] = system.body(a).expand(x.segment(s.offset[a], system.body(a).n_free()));
+  for (size_t a = 0; a < u.size(); ++a) u[a] = system.body(a).expand(x.segment(s.offset[a], system.body(a).n_free()));
   return u;
 }
 
@@ -226,10 +229,10 @@ void run_exact(const ContactSystem& system, RunFrame& frame) {
   std::vector<std::vector<char>> report_active;
   std::vector<Eigen::VectorXd> zone(system.n_bodies());
   bool first = true;
-  const linalg::FrictionNewtonProblem problem{s.friction, mask, c, [&](const linalg::FrictionParametrization& p, linalg::FrictionIterate& it) {
-                                                return solve_sets(s, p, it);
-                                              },
-                                              [&] { return frame.stop_requested(); }};
+  const linalg::FrictionNewtonProblem problem{
+      s.friction, mask, c,
+      [&](const linalg::FrictionParametrization& p, linalg::FrictionIterate& it) { return solve_sets(s, p, it); },
+      [&] { return frame.stop_requested(); }};
   linalg::FrictionNewtonSettings newton;
   newton.max_steps = std::max(1, frame.settings().max_iterations);
   newton.tolerance = 1e-12;
@@ -254,7 +257,8 @@ void run_exact(const ContactSystem& system, RunFrame& frame) {
       out.converged = true;
       out.stop_reason = StopReason::converged;
       int na = 0;
-      for (Eigen::Index j = 0; j < m; ++j) na += result.sets.active[static_cast<size_t>(j)] && !mask[static_cast<size_t>(j)];
+      for (Eigen::Index j = 0; j < m; ++j)
+        na += result.sets.active[static_cast<size_t>(j)] && !mask[static_cast<size_t>(j)];
       std::ostringstream os;
       os << "monolithic active set settled (" << na << " of " << s.row_offset.back() << " contact nodes in contact)";
       if (result.damped_steps > 0) os << "; " << result.damped_steps << " steps damped by the line search";
@@ -277,8 +281,11 @@ void run_exact(const ContactSystem& system, RunFrame& frame) {
       out.message = "monolithic: the active set did not settle within max_iterations";
       break;
   }
-  const Eigen::VectorXd x = result.iterate.other.size() == s.b.size() ? result.iterate.other : Eigen::VectorXd(Eigen::VectorXd::Zero(s.b.size()));
-  const Eigen::VectorXd lambda = result.iterate.lambda.size() == m ? result.iterate.lambda : Eigen::VectorXd(Eigen::VectorXd::Zero(m));
+  const Eigen::VectorXd x = result.iterate.other.size() == s.b.size()
+                                ? result.iterate.other
+                                : Eigen::VectorXd(Eigen::VectorXd::Zero(s.b.size()));
+  const Eigen::VectorXd lambda =
+      result.iterate.lambda.size() == m ? result.iterate.lambda : Eigen::VectorXd(Eigen::VectorXd::Zero(m));
   out.u = to_bodies(system, s, x);
   out.z = split_rows(system, s, lambda);
   if (!s.friction.empty()) out.q = split_tangential(system, s, lambda);

@@ -21,8 +21,13 @@ using Factor = Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::L
 class RobinMap final : public BodyMap {
  public:
   RobinMap(const ContactSystem& system, const SolverSettings& settings, parallel::TaskRunner& runner)
-      : system_(system), settings_(settings), runner_(runner), psi_(system.n_bodies()), factor_(system.n_bodies()),
-        remote_(system.n_bodies(), 0), active_(system.pairs().size()) {}
+      : system_(system),
+        settings_(settings),
+        runner_(runner),
+        psi_(system.n_bodies()),
+        factor_(system.n_bodies()),
+        remote_(system.n_bodies(), 0),
+        active_(system.pairs().size()) {}
 
   std::string error;
 
@@ -30,12 +35,15 @@ class RobinMap final : public BodyMap {
     update_weights(u);
     const Displacements contact = system_.contact_loads(u);
     Displacements out(u.size());
-    runner_.run_bodies(u.size(), [&](size_t a) {
-      const auto& body = system_.body(a);
-      const auto& c = body.constraints();
-      const Eigen::VectorXd load = psi_[a] * (u[a] - body.prescribed()) + contact[a];
-      out[a] = body.expand(solve(a, body.reduced_rhs() + c.T().transpose() * load));
-    }, share_vectors(out));
+    runner_.run_bodies(
+        u.size(),
+        [&](size_t a) {
+          const auto& body = system_.body(a);
+          const auto& c = body.constraints();
+          const Eigen::VectorXd load = psi_[a] * (u[a] - body.prescribed()) + contact[a];
+          out[a] = body.expand(solve(a, body.reduced_rhs() + c.T().transpose() * load));
+        },
+        share_vectors(out));
     return out;
   }
 
@@ -43,10 +51,13 @@ class RobinMap final : public BodyMap {
     update_weights(du, /*all_active=*/true);
     const Displacements loads = system_.loads_from_pressures(linear_pressures(system_, du));
     Displacements out(du.size());
-    runner_.run_bodies(du.size(), [&](size_t a) {
-      const auto& c = system_.body(a).constraints();
-      out[a] = c.T() * solve(a, c.T().transpose() * (psi_[a] * du[a] + loads[a]));
-    }, share_vectors(out));
+    runner_.run_bodies(
+        du.size(),
+        [&](size_t a) {
+          const auto& c = system_.body(a).constraints();
+          out[a] = c.T() * solve(a, c.T().transpose() * (psi_[a] * du[a] + loads[a]));
+        },
+        share_vectors(out));
     return out;
   }
 
@@ -67,8 +78,8 @@ class RobinMap final : public BodyMap {
       const auto& pair = pairs[k];
       std::vector<char> now(static_cast<size_t>(pair.n_rows()), 1);
       if (settings_.robin.active_set && !all_active) {
-        const Eigen::VectorXd p = pair.penalty_pressure(pair.nodal_gap(u[static_cast<size_t>(pair.slave_body)],
-                                                                       u[static_cast<size_t>(pair.master_body)]));
+        const Eigen::VectorXd p = pair.penalty_pressure(
+            pair.nodal_gap(u[static_cast<size_t>(pair.slave_body)], u[static_cast<size_t>(pair.master_body)]));
         for (Eigen::Index q = 0; q < p.size(); ++q) now[static_cast<size_t>(q)] = p[q] > 0 ? 1 : 0;
       }
       const size_t sb = static_cast<size_t>(pair.slave_body);
@@ -85,12 +96,19 @@ class RobinMap final : public BodyMap {
     if (todo.empty()) return;
     // Each owner refactorises its bodies; the others only note that the weights changed (a failure throws on the
     // owner, and run_bodies throws it everywhere).
-    runner_.run_bodies(todo, [&](size_t a) {
-      refactorize(a);
-      if (factor_[a]->info() != Eigen::Success)
-        throw std::runtime_error("robin: the stiffness of body '" + system_.problem().bodies[a].name +
-                                 "' plus the Robin term could not be factorised");
-    }, parallel::BodyShare{[](size_t, parallel::Packer&) {}, [this](size_t a, parallel::Unpacker&) { psi_[a].resize(0, 0); remote_[a] = 1; }});
+    runner_.run_bodies(
+        todo,
+        [&](size_t a) {
+          refactorize(a);
+          if (factor_[a]->info() != Eigen::Success)
+            throw std::runtime_error("robin: the stiffness of body '" + system_.problem().bodies[a].name +
+                                     "' plus the Robin term could not be factorised");
+        },
+        parallel::BodyShare{[](size_t, parallel::Packer&) {},
+                            [this](size_t a, parallel::Unpacker&) {
+                              psi_[a].resize(0, 0);
+                              remote_[a] = 1;
+                            }});
     factorizations_ += static_cast<int>(todo.size());
   }
 
@@ -111,7 +129,8 @@ class RobinMap final : public BodyMap {
     }
     psi_[a] = Psi;
     const auto& T = body.constraints().T();
-    const Eigen::SparseMatrix<double> A = body.reduced_stiffness() + Eigen::SparseMatrix<double>(T.transpose() * Psi * T);
+    const Eigen::SparseMatrix<double> A =
+        body.reduced_stiffness() + Eigen::SparseMatrix<double>(T.transpose() * Psi * T);
     auto f = std::make_unique<Factor>();
     f->compute(A);
     factor_[a] = std::move(f);

@@ -8,7 +8,8 @@ namespace {
 void mark(IterationReport& r, const InnerMarks& marks, bool first) {
   if (marks.update > 0) r.update = marks.update;
   if (first)
-    for (size_t a = 0; a < r.bodies.size() && a < marks.refined.size(); ++a) r.bodies[a].elements_refined = marks.refined[a];
+    for (size_t a = 0; a < r.bodies.size() && a < marks.refined.size(); ++a)
+      r.bodies[a].elements_refined = marks.refined[a];
 }
 
 }  // namespace
@@ -18,8 +19,14 @@ RunFrame::RunFrame(const SolverSettings& settings, Observer& observer, const Can
     : settings_(settings), observer_(observer), cancel_(cancel), runner_(runner), start_(start) {}
 
 RunFrame::RunFrame(RunFrame& parent, InnerMarks marks, const Displacements* warm)
-    : settings_(parent.settings_), observer_(parent.observer_), cancel_(parent.cancel_), runner_(parent.runner_),
-      start_(parent.start_), warm_(warm), parent_(&parent), offset_(parent.outcome_.iterations),
+    : settings_(parent.settings_),
+      observer_(parent.observer_),
+      cancel_(parent.cancel_),
+      runner_(parent.runner_),
+      start_(parent.start_),
+      warm_(warm),
+      parent_(&parent),
+      offset_(parent.outcome_.iterations),
       marks_(std::move(marks)) {}
 
 void RunFrame::report(IterationReport r) {

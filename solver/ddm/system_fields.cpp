@@ -14,7 +14,7 @@
 namespace contact::ddm {
 
 IterationReport ContactSystem::report_gaps(int iteration, const Pressures& z, const Pressures& nodal_gaps,
-                                      std::vector<std::vector<char>>& previous_active) const {
+                                           std::vector<std::vector<char>>& previous_active) const {
   IterationReport r;
   r.iteration = iteration;
   for (size_t a = 0; a < bodies_.size(); ++a)
@@ -178,10 +178,13 @@ void ContactSystem::stresses_and_reactions(const Displacements& u, const Displac
                                     reaction[a] = in.get_vector();
                                   }};
   // On each body's owner (the reactions need its assembled loads).
-  runner_.run_bodies(bodies_.size(), [&](size_t a) {
-    stress[a] = bodies_[a]->stresses(u[a]);
-    reaction[a] = bodies_[a]->reactions(u[a], loads[a]);
-  }, share);
+  runner_.run_bodies(
+      bodies_.size(),
+      [&](size_t a) {
+        stress[a] = bodies_[a]->stresses(u[a]);
+        reaction[a] = bodies_[a]->reactions(u[a], loads[a]);
+      },
+      share);
 }
 
 BodyField ContactSystem::body_field(size_t a, const Eigen::VectorXd& u, fem::StressFields stress,

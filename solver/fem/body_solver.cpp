@@ -77,7 +77,8 @@ void BodySolver::setup_constraints() {
     // as well conditioned as possible; the factorisation then gives a generalised inverse of the stiffness.
     std::vector<char> avoid(static_cast<size_t>(constraints_.n_dofs()), 0);
     for (const auto& [node, c] : prescribed) avoid[static_cast<size_t>(2 * node + c)] = 1;
-    for (const auto& [node, ends] : mesh::hanging_nodes(body_.mesh)) avoid[static_cast<size_t>(2 * node)] = avoid[static_cast<size_t>(2 * node + 1)] = 1;
+    for (const auto& [node, ends] : mesh::hanging_nodes(body_.mesh))
+      avoid[static_cast<size_t>(2 * node)] = avoid[static_cast<size_t>(2 * node + 1)] = 1;
     // A set of candidates is good only if the free motions restricted to it have full rank: away from the
     // contact there may be enough dofs but all of one component (a brick whose top and bottom are both contact
     // edges leaves only x dofs, which see no vertical translation), so the second pass takes every dof.
@@ -91,11 +92,13 @@ void BodySolver::setup_constraints() {
         if (!skip[static_cast<size_t>(d)]) candidates.push_back(d);
       if (static_cast<Eigen::Index>(candidates.size()) < k) continue;
       Eigen::MatrixXd at(k, static_cast<Eigen::Index>(candidates.size()));
-      for (size_t j = 0; j < candidates.size(); ++j) at.col(static_cast<Eigen::Index>(j)) = modes.modes.row(candidates[j]).transpose();
+      for (size_t j = 0; j < candidates.size(); ++j)
+        at.col(static_cast<Eigen::Index>(j)) = modes.modes.row(candidates[j]).transpose();
       Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(at);
       qr.setThreshold(1e-8);
       if (qr.rank() < k) continue;
-      for (Eigen::Index i = 0; i < k; ++i) fixing_dofs_.push_back(candidates[static_cast<size_t>(qr.colsPermutation().indices()[i])]);
+      for (Eigen::Index i = 0; i < k; ++i)
+        fixing_dofs_.push_back(candidates[static_cast<size_t>(qr.colsPermutation().indices()[i])]);
     }
     if (fixing_dofs_.empty()) {
       // Not reachable for a mesh with at least one cell (every free motion moves some unprescribed dof).
@@ -222,8 +225,10 @@ void BodySolver::assemble_system() {
   for (int c = 0; c < m.num_cells(); ++c) {
     unknowns.clear();
     for (int d : cell_dofs(m.cells[static_cast<size_t>(c)]))
-      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(T, d); it; ++it) unknowns.push_back(static_cast<int>(it.col()));
-    for (int k : unknowns) columns[static_cast<size_t>(k)].insert(columns[static_cast<size_t>(k)].end(), unknowns.begin(), unknowns.end());
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(T, d); it; ++it)
+        unknowns.push_back(static_cast<int>(it.col()));
+    for (int k : unknowns)
+      columns[static_cast<size_t>(k)].insert(columns[static_cast<size_t>(k)].end(), unknowns.begin(), unknowns.end());
   }
   std::vector<int> outer(static_cast<size_t>(nf) + 1, 0), inner;
   for (int k = 0; k < nf; ++k) {
@@ -239,12 +244,13 @@ void BodySolver::assemble_system() {
   }
   std::vector<double> values(inner.size(), 0.0);
   auto entry = [&](int row, int col) -> double& {
-    const auto first = inner.begin() + outer[static_cast<size_t>(col)], last = inner.begin() + outer[static_cast<size_t>(col) + 1];
+    const auto first = inner.begin() + outer[static_cast<size_t>(col)],
+               last = inner.begin() + outer[static_cast<size_t>(col) + 1];
     return values[static_cast<size_t>(std::lower_bound(first, last, row) - inner.begin())];
   };
 
   // Values and the right-hand side.
-  rhs_base_ = T.transpose() * f_ext_;  // T^T f of the tractions; each element adds T^T (f_e - K_e g_e)
+  rhs_base_ = T.transpose() * f_ext_;       // T^T f of the tractions; each element adds T^T (f_e - K_e g_e)
   constexpr int kCellsBetweenPolls = 8192;  // ~10 ms of assembly
   for (int c = 0; c < m.num_cells(); ++c) {
     if (cancelled_ && c % kCellsBetweenPolls == 0 && cancelled_()) return stop_cancelled("assembly");
@@ -291,7 +297,8 @@ std::vector<int> BodySolver::interface_unknowns_of(const std::vector<int>& dofs)
   std::vector<char> used(static_cast<size_t>(n_free()), 0);
   const Eigen::SparseMatrix<double, Eigen::RowMajor> rows = constraints_.T();
   for (int dof : dofs)
-    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(rows, dof); it; ++it) used[static_cast<size_t>(it.col())] = 1;
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(rows, dof); it; ++it)
+      used[static_cast<size_t>(it.col())] = 1;
   std::vector<int> out;
   for (int k = 0; k < n_free(); ++k)
     if (used[static_cast<size_t>(k)]) out.push_back(k);
@@ -311,9 +318,10 @@ void BodySolver::factorize() {
   if (!factor_) return stop_cancelled("factorisation");
   if (!factor_->ok()) {
     std::ostringstream os;
-    os << "body '" << body_.name << "': the stiffness matrix (" << n_free() << " unknowns) could not be factorised: "
-       << factor_->error();
-    if (rigid_modes_.cols() == 0) os << " (is the body restrained against rigid motion by its displacement conditions?)";
+    os << "body '" << body_.name << "': the stiffness matrix (" << n_free()
+       << " unknowns) could not be factorised: " << factor_->error();
+    if (rigid_modes_.cols() == 0)
+      os << " (is the body restrained against rigid motion by its displacement conditions?)";
     error_ = os.str();
   }
 }

@@ -92,9 +92,9 @@ class BodySolver {
   double load_factor() const { return load_factor_; }
   // The factor a condition of this body is at now: its own history's where it has one, else load_factor().
   double condition_factor(const BoundaryCondition& bc) const;
-  Eigen::VectorXd external_load() const;   // all dofs: tractions, forces, body force
-  Eigen::VectorXd reduced_rhs() const;     // T^T (f_ext - K g)
-  Eigen::VectorXd prescribed() const;      // g: the prescribed values (and 0 elsewhere), all dofs
+  Eigen::VectorXd external_load() const;                   // all dofs: tractions, forces, body force
+  Eigen::VectorXd reduced_rhs() const;                     // T^T (f_ext - K g)
+  Eigen::VectorXd prescribed() const;                      // g: the prescribed values (and 0 elsewhere), all dofs
   Eigen::VectorXd expand(const Eigen::VectorXd& x) const;  // T x + g
   const Elasticity& elasticity() const { return elasticity_; }
   // The free unknowns behind the interface dofs, in the order of the rows of interface_factor(), and the

@@ -31,8 +31,8 @@ class Constraints {
   int n_free() const { return n_free_; }
   bool is_constrained(int dof) const { return lines_.count(dof) != 0; }
   bool is_dirichlet(int dof) const;
-  const Eigen::SparseMatrix<double>& T() const { return T_; }  // n_dofs x n_free
-  const Eigen::VectorXd& g() const { return g_; }              // n_dofs
+  const Eigen::SparseMatrix<double>& T() const { return T_; }       // n_dofs x n_free
+  const Eigen::VectorXd& g() const { return g_; }                   // n_dofs
   const std::vector<int>& free_dofs() const { return free_dofs_; }  // free unknown k -> dof
 
   Eigen::VectorXd expand(const Eigen::VectorXd& x) const { return T_ * x + g_; }

@@ -82,11 +82,13 @@ Vector8d element_body_force(const Eigen::Matrix<double, 4, 2>& x, const Eigen::V
   return f;
 }
 
-Eigen::Matrix<double, 3, 4> gauss_stresses(const Eigen::Matrix<double, 4, 2>& x, const Vector8d& u, const Elasticity& el) {
+Eigen::Matrix<double, 3, 4> gauss_stresses(const Eigen::Matrix<double, 4, 2>& x, const Vector8d& u,
+                                           const Elasticity& el) {
   Eigen::Matrix<double, 3, 4> s;
   for (int q = 0; q < 4; ++q) {
     double det_j = 0;
-    const Matrix38d B = strain_matrix(x, kGaussPoints[static_cast<size_t>(q)].x(), kGaussPoints[static_cast<size_t>(q)].y(), det_j);
+    const Matrix38d B =
+        strain_matrix(x, kGaussPoints[static_cast<size_t>(q)].x(), kGaussPoints[static_cast<size_t>(q)].y(), det_j);
     s.col(q) = el.D * (B * u);
   }
   return s;

@@ -19,8 +19,8 @@ using Vector8d = Eigen::Matrix<double, 8, 1>;
 using Matrix38d = Eigen::Matrix<double, 3, 8>;
 
 struct Elasticity {
-  Eigen::Matrix3d D;     // stress = D * (exx, eyy, gxy)
-  double nu_zz = 0.0;    // szz = nu_zz * (sxx + syy)
+  Eigen::Matrix3d D;   // stress = D * (exx, eyy, gxy)
+  double nu_zz = 0.0;  // szz = nu_zz * (sxx + syy)
   double thickness = 1.0;
 };
 
@@ -40,7 +40,8 @@ Matrix8d element_stiffness(const Eigen::Matrix<double, 4, 2>& x, const Elasticit
 Vector8d element_body_force(const Eigen::Matrix<double, 4, 2>& x, const Eigen::Vector2d& force, const Elasticity& el);
 
 // In-plane stresses (sxx, syy, sxy) at the four Gauss points (columns) for element displacements u.
-Eigen::Matrix<double, 3, 4> gauss_stresses(const Eigen::Matrix<double, 4, 2>& x, const Vector8d& u, const Elasticity& el);
+Eigen::Matrix<double, 3, 4> gauss_stresses(const Eigen::Matrix<double, 4, 2>& x, const Vector8d& u,
+                                           const Elasticity& el);
 
 // Values at the four Gauss points extrapolated (bilinearly) to the four corners: row k = corner k.
 Eigen::Matrix<double, 4, 3> extrapolate_to_corners(const Eigen::Matrix<double, 3, 4>& gauss_values);

@@ -14,7 +14,8 @@ Eigen::Matrix<double, 3, 2> triangle_coordinates(const mesh::Mesh& m, int cell) 
 }
 
 // The triangle rule's points in area coordinates (L1, L2, L3 = weights of nodes 0, 1, 2).
-const double kTrianglePoints[3][3] = {{2.0 / 3, 1.0 / 6, 1.0 / 6}, {1.0 / 6, 2.0 / 3, 1.0 / 6}, {1.0 / 6, 1.0 / 6, 2.0 / 3}};
+const double kTrianglePoints[3][3] = {
+    {2.0 / 3, 1.0 / 6, 1.0 / 6}, {1.0 / 6, 2.0 / 3, 1.0 / 6}, {1.0 / 6, 1.0 / 6, 2.0 / 3}};
 
 }  // namespace
 

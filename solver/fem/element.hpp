@@ -28,8 +28,8 @@ CellDofs cell_dofs(const mesh::Cell& cell);
 // the products of linear functions that the indicators integrate).
 struct CellQuadrature {
   int size = 0;
-  std::array<Eigen::Vector2d, 4> point;                           // physical coordinates
-  std::array<double, 4> weight{};                                 // |J| w: they sum to the cell's area
+  std::array<Eigen::Vector2d, 4> point;                                  // physical coordinates
+  std::array<double, 4> weight{};                                        // |J| w: they sum to the cell's area
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 4, 4> shape;  // (point, node): the shape functions
 };
 CellQuadrature cell_quadrature(const mesh::Mesh& m, int cell);

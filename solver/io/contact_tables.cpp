@@ -80,14 +80,17 @@ struct Tables {
       status.push_back(static_cast<std::int8_t>(p.status[j]));
       // A frictionless pair's rows: its tangent (the normal turned a quarter anticlockwise), no traction, no slip
       // measured (NaN), not sticking.
-      if (frictional) tangent.insert(tangent.end(), {p.tangent(j, 0), p.tangent(j, 1)});
-      else tangent.insert(tangent.end(), {-p.normal(j, 1), p.normal(j, 0)});
+      if (frictional)
+        tangent.insert(tangent.end(), {p.tangent(j, 0), p.tangent(j, 1)});
+      else
+        tangent.insert(tangent.end(), {-p.normal(j, 1), p.normal(j, 0)});
       tangential_traction.push_back(frictional ? p.tangential_traction[j] : 0.0);
       slip.push_back(frictional ? p.slip[j] : nan);
       stick.push_back(frictional ? static_cast<std::int8_t>(p.stick[j]) : std::int8_t{0});
     }
     const auto lines = pair_segments(n, closed);
-    for (Eigen::Index j = 0; j < lines.rows(); ++j) segments.insert(segments.end(), {first + lines(j, 0), first + lines(j, 1)});
+    for (Eigen::Index j = 0; j < lines.rows(); ++j)
+      segments.insert(segments.end(), {first + lines(j, 0), first + lines(j, 1)});
     offsets.push_back(static_cast<std::int64_t>(node.size()));
     segment_offsets.push_back(static_cast<std::int64_t>(segments.size() / 2));
     slave_body.push_back(p.slave_body);
@@ -288,8 +291,7 @@ void write_contact_tables(hid_t step, const Step& s, const std::string& where) {
   write_pairs_of(g, "segments", t.segments);
 }
 
-std::vector<PairField> read_contact_tables(hid_t contacts, const std::vector<std::string>& names,
-                                           int format_version) {
+std::vector<PairField> read_contact_tables(hid_t contacts, const std::vector<std::string>& names, int format_version) {
   if (format_version >= 3) return read_tables(contacts, names);
   std::vector<PairField> out;
   for (const auto& name : names) out.push_back(read_pair_group(contacts, name));

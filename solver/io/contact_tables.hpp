@@ -23,7 +23,6 @@ void write_contact_tables(hid_t step, const Step& s, const std::string& where);
 
 // Reads the pairs `names` (in that order) of a step's contacts group: the tables of version 3, or a group per pair
 // (version 2 and before).
-std::vector<PairField> read_contact_tables(hid_t contacts, const std::vector<std::string>& names,
-                                           int format_version);
+std::vector<PairField> read_contact_tables(hid_t contacts, const std::vector<std::string>& names, int format_version);
 
 }  // namespace contact::io

@@ -28,8 +28,7 @@ Handle check(hid_t id, Handle::Closer closer, const std::string& step) {
 
 Handle dataspace(const std::vector<hsize_t>& dims) {
   if (dims.empty()) return check(H5Screate(H5S_SCALAR), H5Sclose, "create a scalar dataspace");
-  return check(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose,
-               "create a dataspace");
+  return check(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose, "create a dataspace");
 }
 
 Handle string_type(bool variable, size_t size = 0) {
@@ -119,8 +118,8 @@ std::vector<std::string> read_strings(const Source& src) {
 
 void write_strings_to(hid_t loc, const std::string& name, const std::vector<std::string>& values, bool scalar,
                       bool attribute) {
-  const std::string what = (attribute ? "attribute '" + name + "' of '" + object_name(loc) + "'"
-                                      : "dataset '" + join_path(loc, name) + "'");
+  const std::string what =
+      (attribute ? "attribute '" + name + "' of '" + object_name(loc) + "'" : "dataset '" + join_path(loc, name) + "'");
   Handle type = string_type(true);
   Handle space = scalar ? dataspace({}) : dataspace({static_cast<hsize_t>(values.size())});
   std::vector<const char*> pointers;
@@ -246,8 +245,7 @@ void write_raw(hid_t loc, const std::string& name, hid_t mem_type, hid_t file_ty
   Handle space = dataspace(dims);
   Handle d = check(H5Dcreate2(loc, name.c_str(), file_type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Dclose,
                    "create " + what);
-  if (element_count(dims) > 0 && H5Dwrite(d, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0)
-    fail("write " + what);
+  if (element_count(dims) > 0 && H5Dwrite(d, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) fail("write " + what);
 }
 
 void write_string_dataset(hid_t loc, const std::string& name, const std::string& value) {
@@ -262,8 +260,8 @@ void write_attribute_raw(hid_t obj, const std::string& name, hid_t mem_type, hid
                          const std::vector<hsize_t>& dims) {
   const std::string what = "attribute '" + name + "' of '" + object_name(obj) + "'";
   Handle space = dataspace(dims);
-  Handle a = check(H5Acreate2(obj, name.c_str(), file_type, space, H5P_DEFAULT, H5P_DEFAULT), H5Aclose,
-                   "create " + what);
+  Handle a =
+      check(H5Acreate2(obj, name.c_str(), file_type, space, H5P_DEFAULT, H5P_DEFAULT), H5Aclose, "create " + what);
   if (element_count(dims) > 0 && H5Awrite(a, mem_type, data) < 0) fail("write " + what);
 }
 

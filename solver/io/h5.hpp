@@ -116,7 +116,7 @@ bool has_link(hid_t loc, const std::string& name);  // one path component
 // A second name for an existing object in the same group (an HDF5 hard link: one object, two names).
 void hard_link(hid_t loc, const std::string& existing, const std::string& name);
 bool has_attribute(hid_t obj, const std::string& name);
-std::string object_name(hid_t obj);  // full path inside the file, for messages
+std::string object_name(hid_t obj);                // full path inside the file, for messages
 std::vector<std::string> link_names(hid_t group);  // members of a group, in name order
 std::vector<hsize_t> dataset_shape(hid_t loc, const std::string& name);
 
@@ -144,8 +144,7 @@ void write_attribute(hid_t obj, const std::string& name, T value) {
 }
 template <class T>
 void write_attribute_array(hid_t obj, const std::string& name, const std::vector<T>& values) {
-  write_attribute_raw(obj, name, Type<T>::mem(), Type<T>::file(), values.data(),
-                      {static_cast<hsize_t>(values.size())});
+  write_attribute_raw(obj, name, Type<T>::mem(), Type<T>::file(), values.data(), {static_cast<hsize_t>(values.size())});
 }
 void write_attribute(hid_t obj, const std::string& name, const std::string& value);  // variable-length UTF-8
 void write_attribute(hid_t obj, const std::string& name, const char* value);

@@ -34,7 +34,7 @@ inline void write_column(hid_t loc, const std::string& name, const Eigen::Matrix
 // A rows x cols dataset into a column-major Eigen matrix (its columns checked unless expected_cols < 0).
 template <class T>
 inline Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> read_matrix(hid_t loc, const std::string& name,
-                                                                   Eigen::Index expected_cols = -1) {
+                                                                    Eigen::Index expected_cols = -1) {
   std::vector<hsize_t> dims;
   const std::vector<T> data = read_dataset<T>(loc, name, 2, dims);
   const auto rows = static_cast<Eigen::Index>(dims[0]);

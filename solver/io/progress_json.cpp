@@ -196,9 +196,10 @@ nlohmann::json step_json(const StepSummary& step) {
     if (step.body_names.size() <= kBodiesListedAll)
       bodies.push_back({{"name", step.body_names[b]}, {"elements", step.elements[b]}, {"nodes", step.nodes[b]}});
   }
-  nlohmann::json j = {{"step", step.index},
-                      {"iteration", step.iteration},
-                      {"bodies_summary", {{"count", step.body_names.size()}, {"elements", elements}, {"nodes", nodes}}}};
+  nlohmann::json j = {
+      {"step", step.index},
+      {"iteration", step.iteration},
+      {"bodies_summary", {{"count", step.body_names.size()}, {"elements", elements}, {"nodes", nodes}}}};
   if (step.body_names.size() <= kBodiesListedAll) j["bodies"] = std::move(bodies);
   return j;
 }

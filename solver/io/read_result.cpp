@@ -32,8 +32,8 @@ void read_root(hid_t file, ResultFile& r) {
     throw std::runtime_error("not a result file: format is '" + r.format + "', expected '" + kFormatName + "'");
   r.format_version = h5::read_attribute<std::int32_t>(file, "format_version");
   if (r.format_version > kFormatVersion)
-    throw std::runtime_error("format_version " + std::to_string(r.format_version) +
-                             " is newer than this reader's " + std::to_string(kFormatVersion));
+    throw std::runtime_error("format_version " + std::to_string(r.format_version) + " is newer than this reader's " +
+                             std::to_string(kFormatVersion));
   r.solver_version = h5::read_string_attribute(file, "solver_version");
   r.job_id = h5::read_string_attribute(file, "job_id");
   r.job_name = h5::read_string_attribute(file, "name");

@@ -11,7 +11,7 @@
 namespace contact::io {
 
 inline constexpr std::uint8_t kVtkLine = 3, kVtkTriangle = 5, kVtkQuad = 9;  // VTK's cell types
-inline constexpr std::int64_t kXdmfTriangle = 4, kXdmfQuadrilateral = 5;       // XDMF's Mixed topology codes
+inline constexpr std::int64_t kXdmfTriangle = 4, kXdmfQuadrilateral = 5;     // XDMF's Mixed topology codes
 
 inline std::uint8_t vtk_cell_type(const mesh::Cell& cell) { return cell.is_triangle() ? kVtkTriangle : kVtkQuad; }
 inline std::int64_t xdmf_cell_type(const mesh::Cell& cell) {

@@ -7,8 +7,9 @@
 
 namespace contact::io {
 
-// The final step as a VTKHDF 1.0 UnstructuredGrid (what ParaView 5.11 reads): one partition per body (quadrilaterals and triangles),
-// then one per contact pair (the slave polyline as line cells, with pressure, gap and active per point).
+// The final step as a VTKHDF 1.0 UnstructuredGrid (what ParaView 5.11 reads): one partition per body (quadrilaterals
+// and triangles), then one per contact pair (the slave polyline as line cells, with pressure, gap and active per
+// point).
 void write_vtkhdf(hid_t file, const Step& last);
 
 }  // namespace contact::io

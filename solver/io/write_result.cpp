@@ -144,10 +144,9 @@ void write_iteration_history(hid_t history, const Problem& problem, const Result
   for (Eigen::Index i = 0; i < n; ++i) {
     const IterationReport& r = rows[static_cast<size_t>(i)];
     if (static_cast<Eigen::Index>(r.bodies.size()) != nb || static_cast<Eigen::Index>(r.pairs.size()) != np)
-      throw std::runtime_error("history row " + rows_text(i) + " (iteration " + std::to_string(r.iteration) +
-                               ") has " + std::to_string(r.bodies.size()) + " bodies and " +
-                               std::to_string(r.pairs.size()) + " pairs; the first row has " + rows_text(nb) +
-                               " and " + rows_text(np));
+      throw std::runtime_error("history row " + rows_text(i) + " (iteration " + std::to_string(r.iteration) + ") has " +
+                               std::to_string(r.bodies.size()) + " bodies and " + std::to_string(r.pairs.size()) +
+                               " pairs; the first row has " + rows_text(nb) + " and " + rows_text(np));
     iteration.push_back(r.iteration);
     measure.push_back(to_string(r.measure));
     update.push_back(r.update);
@@ -472,8 +471,8 @@ void ResultStream::finish(const Problem& problem, const Result& result, const Wr
     return;
   }
   if (static_cast<std::size_t>(result.streamed_steps) != taken_)
-    throw std::runtime_error("result file '" + path_ + "': " + std::to_string(taken_) + " steps written, the run says " +
-                             std::to_string(result.streamed_steps));
+    throw std::runtime_error("result file '" + path_ + "': " + std::to_string(taken_) +
+                             " steps written, the run says " + std::to_string(result.streamed_steps));
   try {
     h5::QuietErrors quiet;
     const std::vector<StepSummary> rows = step_rows(result);

@@ -1,7 +1,7 @@
 // write_vtkhdf: the final step as a VTKHDF 1.0 UnstructuredGrid (docs/results-format.md, "/VTKHDF").
 //
-// Partitions: every body (VTK_QUAD and VTK_TRIANGLE cells), then every contact pair (its slave polyline, VTK_LINE cells). The
-// per-partition counts are NumberOf*, and Points, Connectivity, Offsets, Types and the data arrays are the
+// Partitions: every body (VTK_QUAD and VTK_TRIANGLE cells), then every contact pair (its slave polyline, VTK_LINE
+// cells). The per-partition counts are NumberOf*, and Points, Connectivity, Offsets, Types and the data arrays are the
 // partitions' arrays one after the other, with Connectivity holding partition-local point ids and each
 // partition's Offsets starting at 0. VTKHDF 1.0 needs every array on every partition, so:
 //  * a contact partition's points carry the slave body's displacement, stress and reaction at those nodes;
@@ -146,8 +146,11 @@ void append_pair(Grid& g, const PairField& p, size_t k, const BodyField* slave) 
     const bool known = b && p.node.size() == n && p.node[j] >= 0 && p.node[j] < b->mesh.num_nodes();
     const Eigen::Index node = known ? p.node[j] : 0;
     const Eigen::RowVector3d none3 = Eigen::RowVector3d::Constant(nan);
-    g.displacement.row(p0 + j) = known && g.has.displacement ? Eigen::RowVector3d(b->displacement(node, 0), b->displacement(node, 1), 0.0) : none3;
-    g.reaction.row(p0 + j) = known && g.has.reaction ? Eigen::RowVector3d(b->reaction(node, 0), b->reaction(node, 1), 0.0) : none3;
+    g.displacement.row(p0 + j) = known && g.has.displacement
+                                     ? Eigen::RowVector3d(b->displacement(node, 0), b->displacement(node, 1), 0.0)
+                                     : none3;
+    g.reaction.row(p0 + j) =
+        known && g.has.reaction ? Eigen::RowVector3d(b->reaction(node, 0), b->reaction(node, 1), 0.0) : none3;
     if (known && g.has.stress_node)
       g.stress_node.row(p0 + j) = stress_tensor(b->stress_node.row(node)).row(0);
     else

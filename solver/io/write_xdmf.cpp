@@ -26,12 +26,23 @@ std::string xml_escape(const std::string& s) {
   out.reserve(s.size());
   for (char ch : s) {
     switch (ch) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default: out += ch;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&apos;";
+        break;
+      default:
+        out += ch;
     }
   }
   return out;
@@ -163,8 +174,10 @@ void XdmfSeries::write(const std::string& xmf_path) const {
   for (size_t k = 0; k < grids_.size(); ++k) {
     std::ostringstream time;
     time.precision(17);
-    if (by_load) time << load_factors_[k];
-    else time << k;
+    if (by_load)
+      time << load_factors_[k];
+    else
+      time << k;
     out << "    <Grid Name=\"step " << k << "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n"
         << "      <Time Value=\"" << time.str() << "\"/>\n"
         << grids_[k] << "    </Grid>\n";

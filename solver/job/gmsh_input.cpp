@@ -57,8 +57,8 @@ std::unique_ptr<GmshMeshes::Parsed> GmshMeshes::parse(const std::string& text) c
   auto p = std::make_unique<Parsed>();
   try {
     // Node coordinates are bounded like every number of the job.
-    p->file = mesh::gmsh::parse(text, static_cast<std::size_t>(std::max(0L, limits_.max_dofs / 2)),
-                                read::kMaxMagnitude);
+    p->file =
+        mesh::gmsh::parse(text, static_cast<std::size_t>(std::max(0L, limits_.max_dofs / 2)), read::kMaxMagnitude);
   } catch (const mesh::gmsh::ParseError& e) {
     p->error = e.what();
   }
@@ -114,8 +114,9 @@ void GmshMeshes::read_table(const json& value, const std::string& pointer, read:
     read::Fields f(item.value(), p, "a mesh", {"file", "data"}, errors);
     if (!f.ok() || errors.size() != before) continue;
     if (f.has("file") == f.has("data")) {
-      errors.add(p, "give exactly one of file (the .msh file's path, relative to the job file) or data (the .msh "
-                    "file's text)");
+      errors.add(p,
+                 "give exactly one of file (the .msh file's path, relative to the job file) or data (the .msh "
+                 "file's text)");
       continue;
     }
     const std::string key = f.has("file") ? "file" : "data";
@@ -128,8 +129,10 @@ void GmshMeshes::read_table(const json& value, const std::string& pointer, read:
 void GmshMeshes::check_table_used(read::Errors& errors) const {
   for (const auto& [name, entry] : table_)
     if (!entry.used)
-      errors.add(entry.pointer, "mesh '" + read::shown(name) + "' is used by no body (a body uses it as {\"gmsh\": "
-                                "{\"mesh\": \"" + read::shown(name) + "\", \"surface\": ...}}); remove it or use it");
+      errors.add(entry.pointer, "mesh '" + read::shown(name) +
+                                    "' is used by no body (a body uses it as {\"gmsh\": "
+                                    "{\"mesh\": \"" +
+                                    read::shown(name) + "\", \"surface\": ...}}); remove it or use it");
 }
 
 bool GmshMeshes::usable(Parsed& parsed, const std::string& pointer, const std::string& message, read::Errors& errors) {
@@ -149,8 +152,9 @@ const GmshMeshes::Parsed* GmshMeshes::resolve(const Source& source, const std::s
     return &parsed;
   }
   if (!limits_.mesh_directory) {
-    errors.add(pointer, "a gmsh mesh cannot be read from a file here: the server reads no files for a job; send the "
-                        ".msh file's text as \"data\" instead of \"file\"");
+    errors.add(pointer,
+               "a gmsh mesh cannot be read from a file here: the server reads no files for a job; send the "
+               ".msh file's text as \"data\" instead of \"file\"");
     return nullptr;
   }
   if (text.empty()) {
@@ -189,8 +193,8 @@ const GmshMeshes::Parsed* GmshMeshes::from_table(const std::string& name, const 
   if (!entry.source) return nullptr;  // its fields are bad: reported at /meshes/<name>
   if (!entry.resolved) {
     // Its problems are the entry's: reported once, at its field, however many bodies use it.
-    entry.parsed = resolve(*entry.source, read::child(entry.pointer, entry.source->file ? "file" : "data"), errors,
-                           entry.label);
+    entry.parsed =
+        resolve(*entry.source, read::child(entry.pointer, entry.source->file ? "file" : "data"), errors, entry.label);
     entry.resolved = true;
     if (!entry.source->file) entry.label = "'" + read::shown(name) + "'";
   }
@@ -209,8 +213,9 @@ std::optional<GmshBody> GmshMeshes::read(const json& value, const std::string& p
   if (surface)
     if (auto problem = read::control_character_problem(*surface, "surface")) errors.add(f.at("surface"), *problem);
   if (f.has("file") + f.has("data") + f.has("mesh") != 1) {
-    errors.add(pointer, "give exactly one of mesh (the name of an entry of the job's \"meshes\" table), file (the "
-                        ".msh file's path, relative to the job file) or data (the .msh file's text)");
+    errors.add(pointer,
+               "give exactly one of mesh (the name of an entry of the job's \"meshes\" table), file (the "
+               ".msh file's path, relative to the job file) or data (the .msh file's text)");
     return std::nullopt;
   }
   const std::string key = f.has("mesh") ? "mesh" : f.has("file") ? "file" : "data";

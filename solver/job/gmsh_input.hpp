@@ -18,9 +18,9 @@ namespace contact::job {
 
 struct GmshBody {
   mesh::Mesh mesh;
-  std::vector<std::string> edges;      // physical curves on the surface's boundary (the body's edge names)
-  std::vector<std::string> elsewhere;  // the file's other physical curves (for "not on this surface" messages)
-  std::vector<std::string> vertices;   // physical points on the surface (the body's vertex names)
+  std::vector<std::string> edges;             // physical curves on the surface's boundary (the body's edge names)
+  std::vector<std::string> elsewhere;         // the file's other physical curves (for "not on this surface" messages)
+  std::vector<std::string> vertices;          // physical points on the surface (the body's vertex names)
   std::vector<std::string> points_elsewhere;  // the file's other physical points
   std::string surface;
 };
@@ -42,14 +42,13 @@ class GmshMeshes {
 
   // Reads the job's "meshes" table at `pointer` (before the bodies): each entry's name and its one field, file
   // or data; the text is parsed when a body first uses the entry. `out` is the table's normalized copy.
-  void read_table(const nlohmann::json& value, const std::string& pointer, read::Errors& errors,
-                  nlohmann::json& out);
+  void read_table(const nlohmann::json& value, const std::string& pointer, read::Errors& errors, nlohmann::json& out);
   // After the bodies: an entry that no body used is an error at its pointer.
   void check_table_used(read::Errors& errors) const;
 
  private:
   struct Parsed {
-    std::string error;  // empty if parsed
+    std::string error;        // empty if parsed
     bool unreadable = false;  // the error is the file's (cannot be opened, too large), not its text's
     bool reported = false;    // the error was reported, at the first body that gave this file or text
     mesh::gmsh::File file;
@@ -75,7 +74,7 @@ class GmshMeshes {
                            std::string& label);
 
   struct TableEntry {
-    std::string pointer;       // /meshes/<name>
+    std::string pointer;           // /meshes/<name>
     std::optional<Source> source;  // unset when the entry's fields are bad (reported at its pointer)
     bool used = false;
     bool resolved = false;
@@ -84,10 +83,10 @@ class GmshMeshes {
   };
 
   const Limits& limits_;
-  std::map<std::string, std::unique_ptr<Parsed>> files_;             // by resolved path
-  std::multimap<std::size_t, std::unique_ptr<Parsed>> data_;         // by the hash of the text
-  std::map<std::string, TableEntry> table_;                          // the job's "meshes", by name
-  bool table_given_ = false;                                         // the job has "meshes" (maybe malformed)
+  std::map<std::string, std::unique_ptr<Parsed>> files_;      // by resolved path
+  std::multimap<std::size_t, std::unique_ptr<Parsed>> data_;  // by the hash of the text
+  std::map<std::string, TableEntry> table_;                   // the job's "meshes", by name
+  bool table_given_ = false;                                  // the job has "meshes" (maybe malformed)
   bool table_incomplete_ = false;  // "meshes" not an object, or an entry refused for its name: reported there
 };
 

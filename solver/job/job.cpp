@@ -64,8 +64,8 @@ void JobReader::check_work_limits() {
   auto over = [&](const std::string& pointer, const std::string& what, long long value, long long max,
                   const std::string& why) {
     if (value > max)
-      errors_.add(pointer, what + " = " + std::to_string(value) + " is too large (at most " + std::to_string(max) +
-                               "): " + why);
+      errors_.add(pointer,
+                  what + " = " + std::to_string(value) + " is too large (at most " + std::to_string(max) + "): " + why);
   };
   over("/solver/threads", "threads", s.threads, limits_.max_threads,
        "each thread solves one body; 0 means one per body up to the cores");
@@ -84,8 +84,9 @@ void JobReader::check_work_limits() {
 
 // The result's size (and the memory its kept steps take until written) from the meshes' nodes and the steps kept:
 // every load step with output.steps "all". An adaptive run's meshes are made as it runs: its first must fit, and
-// it refines within what the limit leaves (AdaptivitySettings::max_kept_nodes). A job's unknowns times its load steps had no bound: 1000 load steps of two
-// 100 x 100 blocks wrote 5.15 GB and held 2.3 GB in the server after they were written.
+// it refines within what the limit leaves (AdaptivitySettings::max_kept_nodes). A job's unknowns times its load steps
+// had no bound: 1000 load steps of two 100 x 100 blocks wrote 5.15 GB and held 2.3 GB in the server after they were
+// written.
 void JobReader::check_result_size() {
   if (limits_.max_result_bytes <= 0 || errors_.size() > 0) return;
   double nodes = 0;
@@ -268,8 +269,8 @@ class TextPath {
           Frame& f = frames_.back();
           f.key = parsed.get<std::string>();
           if (!f.keys.insert(f.key).second)
-            errors_.add(pending_pointer(),
-                        "duplicate key '" + read::shown(f.key) + "' in one object (a JSON reader keeps only one of them)");
+            errors_.add(pending_pointer(), "duplicate key '" + read::shown(f.key) +
+                                               "' in one object (a JSON reader keeps only one of them)");
         }
         break;
       case json::parse_event_t::value:

@@ -64,7 +64,7 @@ struct MeshInput {
   std::vector<Point> nodes;
   std::vector<mesh::Cell> quads;
   std::vector<std::pair<std::string, std::vector<std::array<int, 2>>>> edge_pairs;
-  std::map<std::string, int> vertices;  // named vertices of an explicit mesh: name -> node
+  std::map<std::string, int> vertices;             // named vertices of an explicit mesh: name -> node
   std::map<std::string, mesh::Curve> edge_curves;  // "curves" given as an arc or a parabola, by edge
   std::set<std::string> chord_edges;               // "curves" given as "chords"
   // gmsh: the surface's mesh, built while reading (gmsh_input.hpp)
@@ -166,8 +166,7 @@ class JobReader {
   void read_quads(const json& quads, const std::string& pointer, const NodeIndex& index, MeshInput& m);
   void read_named_edges(const Fields& f, bool nodes_ok, const NodeIndex& index, MeshInput& m, json& out);
   void read_named_vertices(const Fields& f, bool nodes_ok, const NodeIndex& index, MeshInput& m, json& out);
-  bool no_side_twice(const std::string& name, const std::vector<std::array<int, 2>>& pairs,
-                     const std::string& pointer);
+  bool no_side_twice(const std::string& name, const std::vector<std::array<int, 2>>& pairs, const std::string& pointer);
   template <typename Index>
   void read_edge_set(const std::string& name, const json& value, const std::string& pointer, bool nodes_ok,
                      const Index& index, MeshInput& m);

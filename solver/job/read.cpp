@@ -275,7 +275,8 @@ Fields::Fields(const json& value, std::string pointer, std::string what, std::ve
     size_t best = 3;  // suggest only close misspellings
     for (const auto& name : allowed) {
       // Lengths 3 or more apart are never a close misspelling (and a huge key costs nothing).
-      const size_t longer = std::max(item.key().size(), name.size()), shorter = std::min(item.key().size(), name.size());
+      const size_t longer = std::max(item.key().size(), name.size()),
+                   shorter = std::min(item.key().size(), name.size());
       if (longer - shorter >= best) continue;
       const size_t d = edit_distance(item.key(), name);
       if (d < best) {
@@ -326,8 +327,10 @@ std::optional<std::string> name_problem(const std::string& s, const std::string&
   }
   // "." and "..": a path's components, not names (the result file would take them for its own groups).
   if (s == "." || s == "..")
-    return what + " '" + s + "' is not a name: '.' and '..' mean this and the parent group in the result file; a "
-                             "name must consist of " + allowed;
+    return what + " '" + s +
+           "' is not a name: '.' and '..' mean this and the parent group in the result file; a "
+           "name must consist of " +
+           allowed;
   return std::nullopt;
 }
 

@@ -82,8 +82,9 @@ void JobReader::read_body(const json& value, BodyInput& in, json& out) {
     }
   if (const json* m = f.require("material", "an object {\"E\": Young's modulus, \"nu\": Poisson's ratio}"))
     read_material(*m, f.at("material"), in.body.material);
-  if (const json* m = f.require("mesh", "one of {\"block\": {...}}, {\"nodes\": ..., \"quads\": ..., \"edges\": ...} "
-                                        "or {\"gmsh\": {...}}"))
+  if (const json* m = f.require("mesh",
+                                "one of {\"block\": {...}}, {\"nodes\": ..., \"quads\": ..., \"edges\": ...} "
+                                "or {\"gmsh\": {...}}"))
     read_mesh(*m, f.at("mesh"), in.mesh, sub_object(out, "mesh"));
   if (const json* b = f.find("boundary")) read_boundary(*b, f.at("boundary"), in);
   set_default(out, "boundary", json::array());
@@ -107,9 +108,8 @@ void JobReader::read_material(const json& value, const std::string& pointer, Mat
       if (*x > -1 && *x < 0.5)
         material.nu = *x;
       else
-        errors_.add(f.at("nu"),
-                    "nu = " + format_number(*x) +
-                        " is outside (-1, 0.5): Poisson's ratio must be greater than -1 and less than 0.5");
+        errors_.add(f.at("nu"), "nu = " + format_number(*x) +
+                                    " is outside (-1, 0.5): Poisson's ratio must be greater than -1 and less than 0.5");
     }
 }
 
@@ -126,8 +126,8 @@ void JobReader::read_boundary(const json& value, const std::string& pointer, Bod
 // free), its load history; kept in the body only if all of it reads without error.
 void JobReader::read_condition(const json& value, const std::string& bp, BodyInput& in,
                                std::map<std::string, std::string>& first_pointer_of_place) {
-  Fields f(value, bp, "a boundary condition", {"edge", "vertex", "displacement", "traction", "force", "free", "history"},
-           errors_);
+  Fields f(value, bp, "a boundary condition",
+           {"edge", "vertex", "displacement", "traction", "force", "free", "history"}, errors_);
   if (!f.ok()) return;
   const size_t before = errors_.size();
   BoundaryCondition bc;
@@ -180,8 +180,9 @@ bool JobReader::condition_kinds_allowed(const Fields& f, const std::string& bp, 
   const int loads = int(f.has("traction")) + int(f.has("force"));
   const int kinds = int(f.has("displacement")) + loads + int(f.has("free"));
   if (kinds == 0 || loads > 1 || (f.has("free") && kinds > 1)) {
-    errors_.add(bp, "give a displacement, a load (traction or force), a displacement with a load on the other "
-                    "component, or free");
+    errors_.add(bp,
+                "give a displacement, a load (traction or force), a displacement with a load on the other "
+                "component, or free");
     return false;
   }
   if (at_vertex && (f.has("traction") || f.has("free"))) {
@@ -232,12 +233,14 @@ void JobReader::read_condition_values(const Fields& f, const std::string& bp, Bo
 // A load may not act where the displacement is prescribed: it would go straight into the support.
 void JobReader::check_loads_off_supports(const Fields& f, const std::string& bp, const BoundaryCondition& bc) {
   if (f.has("displacement") && bc.normal_pressure)
-    errors_.add(bp, "a normal pressure cannot be combined with a displacement (part of it would go into the "
-                    "support); give the traction as a vector [tx, ty] along the free component");
+    errors_.add(bp,
+                "a normal pressure cannot be combined with a displacement (part of it would go into the "
+                "support); give the traction as a vector [tx, ty] along the free component");
   // A load component along a prescribed displacement component would go straight into the support.
   const Eigen::Vector2d load = bc.kind == BoundaryCondition::Kind::force ? bc.force
-                               : bc.kind == BoundaryCondition::Kind::traction && !bc.normal_pressure ? bc.traction
-                                                                                                     : Eigen::Vector2d::Zero();
+                               : bc.kind == BoundaryCondition::Kind::traction && !bc.normal_pressure
+                                   ? bc.traction
+                                   : Eigen::Vector2d::Zero();
   for (int c = 0; c < 2; ++c)
     if ((c == 0 ? bc.ux : bc.uy) && load[c] != 0.0)
       errors_.add(bp, std::string("the load's ") + (c == 0 ? "x" : "y") + " component acts where the " +
@@ -293,7 +296,8 @@ namespace {
 // The directions in which body i is held whatever the loads, at best: its prescribed components, and the normal of
 // every node of its contact edges (a frictionless contact pushes only along it); a contact with friction may also
 // hold along the tangent, so at best in every direction.
-std::vector<mesh::HeldDirection> best_held_directions(const Body& body, const std::vector<ContactPair>& contacts, size_t i) {
+std::vector<mesh::HeldDirection> best_held_directions(const Body& body, const std::vector<ContactPair>& contacts,
+                                                      size_t i) {
   std::vector<mesh::HeldDirection> held;
   for (const auto& bc : body.boundary) {
     if (!prescribes_displacement(bc)) continue;
@@ -369,7 +373,9 @@ void JobReader::check_floating_bodies() {
                   "body '" + in.body.name + "' is not restrained against rigid motion (" + free +
                       ") and touches no other body: prescribe a displacement component on one of its edges or "
                       "vertices, or give it a contact that can hold it");
-    } else if (const auto loose = mesh::free_rigid_modes_along(in.body.mesh, best_held_directions(in.body, problem_.contacts, i)).names;
+    } else if (const auto loose =
+                   mesh::free_rigid_modes_along(in.body.mesh, best_held_directions(in.body, problem_.contacts, i))
+                       .names;
                !loose.empty()) {
       // Frictionless contacts push only along their normals: a motion no normal resists is free whatever the
       // loads (a plate sliding along a flat contact, a roller spinning about its centre, where all its normals
@@ -377,14 +383,16 @@ void JobReader::check_floating_bodies() {
       std::string modes;
       for (const auto& m : loose)
         modes += (modes.empty() ? "" : "; ") + m +
-                 (m.rfind("translation", 0) == 0    ? " (it slides along them)"
+                 (m.rfind("translation", 0) == 0      ? " (it slides along them)"
                   : m.rfind("rotation about", 0) == 0 ? " (it spins: every contact normal passes through that point)"
                                                       : "");
-      errors_.add(child(in.pointer, "boundary"),
-                  "body '" + in.body.name + "' floats (" + free + ") and its frictionless contacts " +
-                      contact_names(problem_, i) + " cannot hold it whatever the loads, since they push only along "
-                      "their normals: nothing resists its " + modes + "; prescribe a displacement component that "
-                      "stops it, on an edge or a named vertex");
+      errors_.add(child(in.pointer, "boundary"), "body '" + in.body.name + "' floats (" + free +
+                                                     ") and its frictionless contacts " + contact_names(problem_, i) +
+                                                     " cannot hold it whatever the loads, since they push only along "
+                                                     "their normals: nothing resists its " +
+                                                     modes +
+                                                     "; prescribe a displacement component that "
+                                                     "stops it, on an edge or a named vertex");
     } else if (method == Method::neumann || method == Method::robin) {
       errors_.add(method_.pointer.empty() ? child(in.pointer, "boundary") : method_.pointer,
                   "body '" + in.body.name + "' floats (" + free + ": only its contacts hold it), and method \"" +

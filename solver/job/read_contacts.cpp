@@ -19,7 +19,7 @@ bool JobReader::bodies_all_named() const {
 // every body's name was read: a job whose bodies were refused whole (over the limit) or whose body names are in
 // error has that error already, and every pair naming those bodies would only repeat it.
 std::optional<JobReader::EdgeRef> JobReader::resolve(const json& value, const std::string& pointer,
-                                                    const std::string& what) {
+                                                     const std::string& what) {
   auto s = read::string(value, pointer, what, errors_);
   if (!s) return std::nullopt;
   const size_t dot = s->find('.');
@@ -38,7 +38,7 @@ std::optional<JobReader::EdgeRef> JobReader::resolve(const json& value, const st
     const MeshInput& m = inputs_[b].mesh;
     if (m.edges_known && !has_edge(m, edge)) {
       errors_.add(pointer, gmsh_elsewhere(m, edge).value_or("body '" + body + "' has no edge '" + read::shown(edge) +
-                                                             "'; its edges are " + join_names(m.edge_names)));
+                                                            "'; its edges are " + join_names(m.edge_names)));
       return std::nullopt;
     }
     return EdgeRef{static_cast<int>(b), edge};

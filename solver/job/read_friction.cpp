@@ -12,8 +12,9 @@ void JobReader::read_friction(const Fields& contact, FrictionSpec& friction) {
   Fields f(*v, contact.at("friction"), "friction", {"coefficient", "bound"}, errors_);
   if (!f.ok() || errors_.size() > before) return;  // (an unknown field is the error to read first)
   if (f.has("coefficient") == f.has("bound")) {
-    errors_.add(contact.at("friction"), "give exactly one of coefficient (Coulomb's mu: |t| <= mu p) and bound "
-                                        "(Tresca's g: |t| <= g, a traction like the pressure)");
+    errors_.add(contact.at("friction"),
+                "give exactly one of coefficient (Coulomb's mu: |t| <= mu p) and bound "
+                "(Tresca's g: |t| <= g, a traction like the pressure)");
     return;
   }
   const std::string key = f.has("coefficient") ? "coefficient" : "bound";
@@ -34,8 +35,8 @@ void JobReader::read_history(const Fields& condition, BoundaryCondition& bc) {
   if (!v) return;
   const std::string pointer = condition.at("history");
   if (!v->is_array() || v->empty()) {
-    errors_.add(pointer, "history must be a non-empty array of load factors, one per load step, got " +
-                             read::type_name(*v));
+    errors_.add(pointer,
+                "history must be a non-empty array of load factors, one per load step, got " + read::type_name(*v));
     return;
   }
   if (static_cast<long>(v->size()) > limits_.max_load_steps) {
@@ -74,8 +75,9 @@ void JobReader::check_friction_and_histories() {
       return;
     }
     if (problem_.adaptivity.enabled && problem_.adaptivity.strategy == AdaptStrategy::paper) {
-      errors_.add(at, "friction with the adaptive strategy \"paper\" is not supported (its penalty iteration is "
-                      "frictionless): use strategy \"converge_then_refine\"");
+      errors_.add(at,
+                  "friction with the adaptive strategy \"paper\" is not supported (its penalty iteration is "
+                  "frictionless): use strategy \"converge_then_refine\"");
       return;
     }
   }

@@ -206,8 +206,8 @@ std::optional<long long> JobReader::read_count(const json& value, const std::str
   return n;
 }
 
-std::optional<mesh::Curve> JobReader::read_curve(const json& value, const std::string& pointer,
-                                                 const std::string& edge, MeshInput& m) {
+std::optional<mesh::Curve> JobReader::read_curve(const json& value, const std::string& pointer, const std::string& edge,
+                                                 MeshInput& m) {
   Fields f(value, pointer, "the curve of edge " + edge, {"parabola", "arc"}, errors_);
   if (!f.ok()) return std::nullopt;
   if (f.has("parabola") == f.has("arc")) {
@@ -251,8 +251,8 @@ bool JobReader::no_side_twice(const std::string& name, const std::vector<std::ar
     const auto [i, j] = pairs[k];
     auto [it, inserted] = first.emplace(std::make_pair(std::min(i, j), std::max(i, j)), k);
     if (inserted) continue;
-    errors_.add(child(pointer, k), "the side [" + std::to_string(i) + ", " + std::to_string(j) + "] of edge '" +
-                                       name + "' is already listed at " + child(pointer, it->second) +
+    errors_.add(child(pointer, k), "the side [" + std::to_string(i) + ", " + std::to_string(j) + "] of edge '" + name +
+                                       "' is already listed at " + child(pointer, it->second) +
                                        " (a side listed twice would carry its load twice)");
     ok = false;
   }
@@ -397,8 +397,10 @@ void JobReader::read_named_edges(const Fields& f, bool nodes_ok, const NodeIndex
 void JobReader::read_edge_curves(const Fields& f, MeshInput& m, json& out) {
   const json* c = f.find("curves");
   if (c && !c->is_object()) {
-    errors_.add(f.at("curves"), "curves must be an object {\"edge\": \"fitted\" | \"chords\" | {\"arc\": ...} | "
-                                "{\"parabola\": ...}}, got " + read::type_name(*c));
+    errors_.add(f.at("curves"),
+                "curves must be an object {\"edge\": \"fitted\" | \"chords\" | {\"arc\": ...} | "
+                "{\"parabola\": ...}}, got " +
+                    read::type_name(*c));
     return;
   }
   json& normalized = sub_object(out, "curves");
@@ -414,11 +416,14 @@ void JobReader::read_edge_curves(const Fields& f, MeshInput& m, json& out) {
       const json& v = item.value();
       if (v.is_string()) {
         const std::string how = v.get<std::string>();
-        if (how == "chords") m.chord_edges.insert(item.key());
+        if (how == "chords")
+          m.chord_edges.insert(item.key());
         else if (how != "fitted")
-          errors_.add(pointer, "unknown curve \"" + how + "\": give \"fitted\" (a smooth curve through the edge's nodes), "
-                               "\"chords\" (the straight sides as they are), {\"arc\": {\"center\": [x, y], \"radius\": R}} "
-                               "or {\"parabola\": {\"a\": a}}");
+          errors_.add(pointer,
+                      "unknown curve \"" + how +
+                          "\": give \"fitted\" (a smooth curve through the edge's nodes), "
+                          "\"chords\" (the straight sides as they are), {\"arc\": {\"center\": [x, y], \"radius\": R}} "
+                          "or {\"parabola\": {\"a\": a}}");
       } else if (auto curve = read_curve(v, pointer, item.key(), m)) {
         m.edge_curves[item.key()] = *curve;
       }

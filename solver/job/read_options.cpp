@@ -68,13 +68,13 @@ void JobReader::read_gamma(const json& value, const std::string& pointer) {
     if (value.get<std::string>() == "auto")
       s.gamma_auto = true;
     else
-      errors_.add(pointer, "gamma must be a number in (0, 2) or \"auto\", got \"" + read::shown(value.get<std::string>()) + "\"");
+      errors_.add(pointer, "gamma must be a number in (0, 2) or \"auto\", got \"" +
+                               read::shown(value.get<std::string>()) + "\"");
   } else {
     auto x = read::number(value, pointer, "gamma", errors_);
     if (x && !(*x > 0 && *x < 2))
-      errors_.add(pointer,
-                  "gamma = " + format_number(*x) +
-                      " is outside (0, 2): the relaxation weight must be greater than 0 and less than 2");
+      errors_.add(pointer, "gamma = " + format_number(*x) +
+                               " is outside (0, 2): the relaxation weight must be greater than 0 and less than 2");
     else if (x) {
       s.gamma = *x;
       s.gamma_auto = false;
@@ -135,7 +135,8 @@ void JobReader::resolve_method_defaults() {
     errors_.add(method_.pointer.empty() ? "/adaptivity/strategy" : method_.pointer,
                 std::string("the adaptive strategy \"paper\" interleaves single Neumann iterations (paper (16)-(17)) "
                             "with refinement: it needs method \"neumann\", not \"") +
-                    to_string(s.method) + "\" (or use strategy \"converge_then_refine\", which works with every method)");
+                    to_string(s.method) +
+                    "\" (or use strategy \"converge_then_refine\", which works with every method)");
   else if (paper_strategy && s.enforcement != Enforcement::penalty)
     errors_.add(enforcement_.pointer,
                 "the adaptive strategy \"paper\" runs the paper's penalty iteration: enforcement must be \"penalty\" "
@@ -184,7 +185,8 @@ void JobReader::read_adaptivity(const json& value, const std::string& pointer) {
   if (const json* t = f.find("stop_tolerance"))
     if (auto x = read::number(*t, f.at("stop_tolerance"), "stop_tolerance", errors_)) {
       if (*x < 0.0 || *x >= 1.0)
-        errors_.add(f.at("stop_tolerance"), "stop_tolerance must lie in [0, 1) (a relative change; 0 turns the test off)");
+        errors_.add(f.at("stop_tolerance"),
+                    "stop_tolerance must lie in [0, 1) (a relative change; 0 turns the test off)");
       else
         a.stop_tolerance = *x;
     }
@@ -209,24 +211,28 @@ void JobReader::read_target_error(const json& value, const std::string& pointer,
   const auto x = read::number(value, pointer, "target_error", errors_);
   if (!x) return;
   if (!(*x > 0.0 && *x < 1.0)) {
-    errors_.add(pointer, "target_error must lie in (0, 1): the relative error of the contact pressure to reach "
-                         "(0.001 is 0.1 %)");
+    errors_.add(pointer,
+                "target_error must lie in (0, 1): the relative error of the contact pressure to reach "
+                "(0.001 is 0.1 %)");
     return;
   }
   if (a.indicator != Indicator::fem_bem) {
-    errors_.add(pointer, "target_error needs the fem_bem indicator (the pressure estimate takes its "
-                         "boundary-element solutions); remove \"indicator\": \"zz\" or the target");
+    errors_.add(pointer,
+                "target_error needs the fem_bem indicator (the pressure estimate takes its "
+                "boundary-element solutions); remove \"indicator\": \"zz\" or the target");
     return;
   }
   if (a.strategy != AdaptStrategy::converge_then_refine) {
-    errors_.add(pointer, "target_error needs the strategy \"converge_then_refine\" (the paper's strategy refines "
-                         "before each solve has converged, so no step has a pressure to estimate)");
+    errors_.add(pointer,
+                "target_error needs the strategy \"converge_then_refine\" (the paper's strategy refines "
+                "before each solve has converged, so no step has a pressure to estimate)");
     return;
   }
   if (problem_.solver.method == Method::monolithic) {
-    errors_.add(pointer, "target_error needs a domain-decomposition method (the pressure estimate solves each body "
-                         "alone with its own factorisation, which the monolithic method does not build); use "
-                         "\"method\": \"interface_newton\" (the default) or remove the target");
+    errors_.add(pointer,
+                "target_error needs a domain-decomposition method (the pressure estimate solves each body "
+                "alone with its own factorisation, which the monolithic method does not build); use "
+                "\"method\": \"interface_newton\" (the default) or remove the target");
     return;
   }
   a.target_error = *x;
@@ -294,7 +300,8 @@ void JobReader::read_robin(const json& value, const std::string& pointer) {
   if (const json* p = f.find("psi")) {
     if (p->is_string()) {
       if (p->get<std::string>() != "active_set")
-        errors_.add(f.at("psi"), "psi must be a positive number or \"active_set\", got \"" + read::shown(p->get<std::string>()) + "\"");
+        errors_.add(f.at("psi"), "psi must be a positive number or \"active_set\", got \"" +
+                                     read::shown(p->get<std::string>()) + "\"");
     } else if (auto x = positive(*p, f.at("psi"), "psi", errors_)) {
       problem_.solver.robin.active_set = false;
       problem_.solver.robin.psi = *x;
@@ -322,8 +329,9 @@ void JobReader::read_interface_solver(const json& value, const std::string& poin
   if (const json* t = f.find("tolerance")) {
     auto x = positive(*t, f.at("tolerance"), "tolerance", errors_);
     if (x && *x >= 1e-2)
-      errors_.add(f.at("tolerance"), "tolerance = " + format_number(*x) +
-                                         " is not below 0.01: the interface solver's tolerance is relative (1e-12 by default)");
+      errors_.add(f.at("tolerance"),
+                  "tolerance = " + format_number(*x) +
+                      " is not below 0.01: the interface solver's tolerance is relative (1e-12 by default)");
     else if (x)
       in.tolerance = *x;
   }
@@ -410,7 +418,8 @@ void JobReader::read_loading_steps(const json& value, const std::string& pointer
     }
   } else if (const json* list = f.find("factors")) {
     if (!list->is_array() || list->empty()) {
-      errors_.add(f.at("factors"), "factors must be a non-empty array of positive numbers, got " + read::type_name(*list));
+      errors_.add(f.at("factors"),
+                  "factors must be a non-empty array of positive numbers, got " + read::type_name(*list));
       return;
     }
     if (static_cast<long>(list->size()) > limits_.max_load_steps) {
@@ -423,14 +432,15 @@ void JobReader::read_loading_steps(const json& value, const std::string& pointer
   }
   if (factors.empty()) return;
   if (problem_.adaptivity.enabled && problem_.adaptivity.strategy == AdaptStrategy::paper && factors.size() > 1)
-    errors_.add(pointer, "load steps with the adaptive strategy \"paper\" are not supported (it refines inside one "
-                         "solve): use strategy \"converge_then_refine\", which solves the path on each mesh");
+    errors_.add(pointer,
+                "load steps with the adaptive strategy \"paper\" are not supported (it refines inside one "
+                "solve): use strategy \"converge_then_refine\", which solves the path on each mesh");
   problem_.loading.factors = std::move(factors);
 }
 
-// {"steps": "last" | "all", "progress_pairs": [glob, ...], "iterate": bool}. steps: which steps' fields the result keeps. The
-// default depends on the job (after adaptivity was read): an adaptive run's steps are ever finer meshes on the way
-// to the answer, each about as large as the last, so only the last is kept; load steps are answers to different
+// {"steps": "last" | "all", "progress_pairs": [glob, ...], "iterate": bool}. steps: which steps' fields the result
+// keeps. The default depends on the job (after adaptivity was read): an adaptive run's steps are ever finer meshes on
+// the way to the answer, each about as large as the last, so only the last is kept; load steps are answers to different
 // loads, kept all. progress_pairs: the pairs whose detail the progress lists (contact/progress_json.hpp), each
 // pattern matching at least one pair (after the contacts were read). iterate: whether a step that did not converge
 // keeps its last iterate (flagged); not by default (OutputSettings::iterate).

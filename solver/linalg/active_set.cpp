@@ -36,7 +36,8 @@ SparseMatrix restrict_to(const SparseMatrix& H, const std::vector<Eigen::Index>&
 SparseMatrix columns_of(const SparseMatrix& G, const std::vector<Eigen::Index>& A) {
   std::vector<Eigen::Triplet<double>> entries;
   for (size_t j = 0; j < A.size(); ++j)
-    for (SparseMatrix::InnerIterator it(G, A[j]); it; ++it) entries.emplace_back(it.row(), static_cast<Eigen::Index>(j), it.value());
+    for (SparseMatrix::InnerIterator it(G, A[j]); it; ++it)
+      entries.emplace_back(it.row(), static_cast<Eigen::Index>(j), it.value());
   SparseMatrix out(G.rows(), static_cast<Eigen::Index>(A.size()));
   out.setFromTriplets(entries.begin(), entries.end());
   return out;
@@ -114,7 +115,8 @@ bool solve_saddle(const SparseMatrix& HAA, const SparseMatrix& GA, const Eigen::
 // definite; `unrestrained` receives the rows of G that A leaves without support: a body no node of A touches, or
 // every row when the system is singular (a group of bodies A holds by nothing as a whole).
 Eigen::VectorXd solve_on(const SparseMatrix& H, const Eigen::VectorXd& g, const std::vector<Eigen::Index>& A,
-                         const Equalities& eq, Eigen::VectorXd& alpha, bool& ok, std::vector<Eigen::Index>& unrestrained) {
+                         const Equalities& eq, Eigen::VectorXd& alpha, bool& ok,
+                         std::vector<Eigen::Index>& unrestrained) {
   Eigen::VectorXd z = Eigen::VectorXd::Zero(g.size());
   ok = true;
   unrestrained.clear();
@@ -221,7 +223,9 @@ Eigen::VectorXd nested_initial_guess(const SparseMatrix& H, const Eigen::VectorX
   std::vector<Eigen::Triplet<double>> p_entries;
   for (Eigen::Index c = 0; c < nc; ++c) {
     p_entries.emplace_back(keep[static_cast<size_t>(c)], c, 1.0);
-    if (c + 1 == nc || line[static_cast<size_t>(keep[static_cast<size_t>(c) + 1])] != line[static_cast<size_t>(keep[static_cast<size_t>(c)])]) continue;
+    if (c + 1 == nc || line[static_cast<size_t>(keep[static_cast<size_t>(c) + 1])] !=
+                           line[static_cast<size_t>(keep[static_cast<size_t>(c)])])
+      continue;
     const Eigen::Index a = keep[static_cast<size_t>(c)], b = keep[static_cast<size_t>(c) + 1];
     for (Eigen::Index j = a + 1; j < b; ++j) {
       const double t = (position[j] - position[a]) / (position[b] - position[a]);
@@ -245,9 +249,9 @@ Eigen::VectorXd nested_initial_guess(const SparseMatrix& H, const Eigen::VectorX
   const size_t at = levels ? levels->size() : 0;
   if (levels) levels->emplace_back(nc, 0);
   const Eigen::VectorXd guess = nested_initial_guess(Hc, gc, line_c, position_c, coarse_eq, levels, coarsest);
-  const ActiveSetResult coarse =
-      solve_active_set(Hc, gc, 50, [](const Eigen::VectorXd&, const Eigen::VectorXd&, const ActiveSetStep&) { return false; },
-                       guess.cwiseAbs().maxCoeff() > 0 ? &guess : nullptr, coarse_eq);
+  const ActiveSetResult coarse = solve_active_set(
+      Hc, gc, 50, [](const Eigen::VectorXd&, const Eigen::VectorXd&, const ActiveSetStep&) { return false; },
+      guess.cwiseAbs().maxCoeff() > 0 ? &guess : nullptr, coarse_eq);
   if (levels) (*levels)[at].second = coarse.steps;
   if (!coarse.converged) return Eigen::VectorXd::Zero(n);  // no guess: the fine problem starts as without one
   return P * coarse.z.cwiseMax(0.0);
@@ -293,7 +297,8 @@ class PrimalDualActiveSet {
   }
   // Solves on `active`, fills out's z, alpha, h and the step's report; `next` receives the predicted set. False
   // when the step cannot be taken (out.message says why).
-  bool step(int k, const std::vector<char>& active, ActiveSetResult& out, ActiveSetStep& report, std::vector<char>& next) const {
+  bool step(int k, const std::vector<char>& active, ActiveSetResult& out, ActiveSetStep& report,
+            std::vector<char>& next) const {
     std::vector<Eigen::Index> A;
     for (Eigen::Index j = 0; j < n_; ++j)
       if (active[static_cast<size_t>(j)]) A.push_back(j);
@@ -312,7 +317,8 @@ class PrimalDualActiveSet {
     next = predict(z, h);
     report.step = k;
     report.active = static_cast<int>(A.size());
-    for (Eigen::Index j = 0; j < n_; ++j) report.changes += next[static_cast<size_t>(j)] != active[static_cast<size_t>(j)];
+    for (Eigen::Index j = 0; j < n_; ++j)
+      report.changes += next[static_cast<size_t>(j)] != active[static_cast<size_t>(j)];
     report.complementarity = complementarity(z, h);
     out.z = z;
     out.alpha = alpha;

@@ -36,9 +36,9 @@ namespace contact::linalg {
 using SparseMatrix = Eigen::SparseMatrix<double>;
 
 struct ActiveSetStep {
-  int step = 0;             // 1-based
-  int active = 0;           // |A|
-  int changes = 0;          // nodes that entered or left A in this step
+  int step = 0;                  // 1-based
+  int active = 0;                // |A|
+  int changes = 0;               // nodes that entered or left A in this step
   double complementarity = 0.0;  // ||C(z)|| / max(||z||, tiny) after the step
 };
 
@@ -51,11 +51,11 @@ struct Equalities {
 
 struct ActiveSetResult {
   Eigen::VectorXd z;
-  Eigen::VectorXd alpha;    // the equalities' multipliers (empty without)
-  Eigen::VectorXd h;        // g + H z + G^T alpha
+  Eigen::VectorXd alpha;  // the equalities' multipliers (empty without)
+  Eigen::VectorXd h;      // g + H z + G^T alpha
   bool converged = false;
   bool cancelled = false;
-  int steps = 0;            // active-set steps (direct) or outer iterations (iterative solvers)
+  int steps = 0;              // active-set steps (direct) or outer iterations (iterative solvers)
   long inner_iterations = 0;  // iterative solvers: products with H (0 for the direct one)
   bool used_fallback = false;
   // The equalities could not be met by the active nodes (a floating body held by nothing): the rows of G that

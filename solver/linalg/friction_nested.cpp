@@ -19,7 +19,8 @@ SparseMatrix select_rows(const SparseMatrix& A, const Rows& rows) {
   std::vector<Eigen::Triplet<double>> entries;
   for (int col = 0; col < A.outerSize(); ++col)
     for (SparseMatrix::InnerIterator it(A, col); it; ++it)
-      if (const Eigen::Index i = position[static_cast<size_t>(it.row())]; i >= 0) entries.emplace_back(i, col, it.value());
+      if (const Eigen::Index i = position[static_cast<size_t>(it.row())]; i >= 0)
+        entries.emplace_back(i, col, it.value());
   SparseMatrix out(static_cast<Eigen::Index>(rows.size()), A.cols());
   out.setFromTriplets(entries.begin(), entries.end());
   return out;
@@ -41,7 +42,8 @@ Coarsening coarsen(const FrictionLevel& level) {
   // Each fine normal unknown's friction row (if any), and the coarse unknowns: the kept normals, then one
   // tangential unknown per kept normal that has a friction row.
   std::vector<long> row_of(static_cast<size_t>(level.m), -1);
-  for (size_t t = 0; t < level.rows.size(); ++t) row_of[static_cast<size_t>(level.rows[t].normal)] = static_cast<long>(t);
+  for (size_t t = 0; t < level.rows.size(); ++t)
+    row_of[static_cast<size_t>(level.rows[t].normal)] = static_cast<long>(t);
   std::vector<Eigen::Index> coarse_tangential(keep.size(), -1);
   c.n = c.m;
   for (size_t k = 0; k < keep.size(); ++k)
@@ -64,7 +66,8 @@ Coarsening coarsen(const FrictionLevel& level) {
   auto put = [&](Eigen::Index fine, size_t k, double w) {
     entries.emplace_back(fine, static_cast<Eigen::Index>(k), w);
     const long t = row_of[static_cast<size_t>(fine)];
-    if (t >= 0 && coarse_tangential[k] >= 0) entries.emplace_back(level.rows[static_cast<size_t>(t)].tangential, coarse_tangential[k], w);
+    if (t >= 0 && coarse_tangential[k] >= 0)
+      entries.emplace_back(level.rows[static_cast<size_t>(t)].tangential, coarse_tangential[k], w);
   };
   for (size_t k = 0; k < keep.size(); ++k) {
     put(keep[k], k, 1.0);
@@ -127,7 +130,8 @@ bool solve_sets_system(const SparseMatrix& F, const Equalities& eq, const Fricti
   std::vector<Eigen::Triplet<double>> entries;
   auto put = [&](const SparseMatrix& A, Eigen::Index row0, Eigen::Index col0) {
     for (int col = 0; col < A.outerSize(); ++col)
-      for (SparseMatrix::InnerIterator it(A, col); it; ++it) entries.emplace_back(row0 + it.row(), col0 + col, it.value());
+      for (SparseMatrix::InnerIterator it(A, col); it; ++it)
+        entries.emplace_back(row0 + it.row(), col0 + col, it.value());
   };
   put(RFP, 0, 0);
   put(RGt, 0, na);
@@ -167,7 +171,6 @@ bool solve_sets_system(const SparseMatrix& F, const Equalities& eq, const Fricti
          residual.head(na).norm() <= 1e-9 * std::max(rhs.head(na).norm(), 1e-300);
 }
 
-
 }  // namespace
 
 Equalities normal_equalities(const Equalities& all, Eigen::Index m) {
@@ -199,7 +202,6 @@ bool solve_on_friction_sets(const SparseMatrix& F, const Eigen::VectorXd& g, con
   return true;
 }
 
-
 Eigen::VectorXd friction_scaling(const SparseMatrix& F) {
   const Eigen::VectorXd diagonal = F.diagonal();
   const double dmax = diagonal.size() ? diagonal.cwiseAbs().maxCoeff() : 0.0;
@@ -217,8 +219,9 @@ bool nested_friction_sets(const FrictionLevel& level, FrictionSets& sets, std::v
   const SparseMatrix Fc = Pt * level.F * coarse.P;
   const Eigen::VectorXd gc = Pt * level.g;
   // G P (no rows without floating bodies, but always as many columns as unknowns).
-  const Equalities eqc{level.eq.G.cols() == level.F.rows() ? SparseMatrix(level.eq.G * coarse.P) : SparseMatrix(0, coarse.n),
-                       level.eq.G.cols() == level.F.rows() ? level.eq.e : Eigen::VectorXd(0)};
+  const Equalities eqc{
+      level.eq.G.cols() == level.F.rows() ? SparseMatrix(level.eq.G * coarse.P) : SparseMatrix(0, coarse.n),
+      level.eq.G.cols() == level.F.rows() ? level.eq.e : Eigen::VectorXd(0)};
   const std::vector<char> mask = tangential_mask(coarse.n, coarse.rows);
   const FrictionLevel coarse_level{Fc, gc, eqc, coarse.rows, mask, coarse.m, coarse.line, coarse.position};
   const size_t at = coarse_steps ? coarse_steps->size() : 0;

@@ -33,10 +33,10 @@ struct FrictionLevel {
   const Eigen::VectorXd& g;
   const Equalities& eq;
   const std::vector<FrictionRow>& rows;
-  const std::vector<char>& mask;        // the tangential unknowns (those without a row too: q = 0 there)
-  Eigen::Index m = 0;                   // normal unknowns
-  const std::vector<int>& line;         // per normal unknown: its line (pair)
-  const Eigen::VectorXd& position;      // per normal unknown: its arc length along its line
+  const std::vector<char>& mask;    // the tangential unknowns (those without a row too: q = 0 there)
+  Eigen::Index m = 0;               // normal unknowns
+  const std::vector<int>& line;     // per normal unknown: its line (pair)
+  const Eigen::VectorXd& position;  // per normal unknown: its arc length along its line
 };
 
 // The floating bodies' equilibrium as far as normal pressures alone can give it: the columns of the first m

@@ -144,8 +144,9 @@ class Mprgp {
   // where phi > 0 (a step of alpha_bar would reach l), max((x - u) / alpha_bar, phi) where phi < 0.
   bool proportional(const Eigen::VectorXd& beta) const {
     const Eigen::VectorXd phi = free_gradient(out_.x, out_.gradient, box_);
-    const Eigen::VectorXd reduced = (phi.array() > 0).select(
-        ((out_.x - qp_.lower) / s_.alpha_bar).cwiseMin(phi), ((out_.x - box_.u) / s_.alpha_bar).cwiseMax(phi));
+    const Eigen::VectorXd reduced = (phi.array() > 0)
+                                        .select(((out_.x - qp_.lower) / s_.alpha_bar).cwiseMin(phi),
+                                                ((out_.x - box_.u) / s_.alpha_bar).cwiseMax(phi));
     return beta.squaredNorm() <= s_.gamma * s_.gamma * reduced.dot(phi);
   }
 
@@ -177,7 +178,8 @@ MprgpResult solve_mprgp(const BoundQp& qp, const Eigen::VectorXd& x0, const Mprg
   }
   for (;;) {
     const Box& box = method.box();
-    out.projected_gradient = (free_gradient(out.x, out.gradient, box) + chopped_gradient(out.x, out.gradient, box)).norm();
+    out.projected_gradient =
+        (free_gradient(out.x, out.gradient, box) + chopped_gradient(out.x, out.gradient, box)).norm();
     if (done(out)) {
       out.converged = true;
       return out;

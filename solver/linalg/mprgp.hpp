@@ -50,10 +50,10 @@ struct MprgpSettings {
 };
 
 struct MprgpResult {
-  Eigen::VectorXd x, gradient;  // the last iterate and its gradient A x - b
+  Eigen::VectorXd x, gradient;      // the last iterate and its gradient A x - b
   Eigen::VectorXd image;            // L x when the problem gives `image`, else empty
   double projected_gradient = 0.0;  // ||g^P(x)||
-  long iterations = 0;          // products with A
+  long iterations = 0;              // products with A
   long cg_steps = 0, expansion_steps = 0, proportioning_steps = 0;
   bool converged = false, cancelled = false;
 };

@@ -43,7 +43,7 @@ struct File {
     std::vector<std::size_t> tags;
     std::vector<std::vector<std::size_t>> nodes;  // node tags per element
   };
-  std::map<std::pair<int, int>, std::string> physical_names;     // (dim, physical tag) -> name
+  std::map<std::pair<int, int>, std::string> physical_names;      // (dim, physical tag) -> name
   std::map<std::pair<int, int>, std::vector<int>> entity_groups;  // (dim, entity tag) -> its physical tags
   std::vector<Node> nodes;
   std::unordered_map<std::size_t, std::size_t> node_index;  // node tag -> index into nodes
@@ -55,21 +55,20 @@ struct File {
 // node or with the wrong number of nodes for its type, more than max_nodes nodes or 4 max_nodes + 16 elements
 // (checked from the sections' headers, before they are read), a node coordinate larger than max_magnitude in
 // magnitude (the job reader passes its bound on every number, read::kMaxMagnitude).
-File parse(const std::string& text, std::size_t max_nodes,
-           double max_magnitude = std::numeric_limits<double>::max());
+File parse(const std::string& text, std::size_t max_nodes, double max_magnitude = std::numeric_limits<double>::max());
 
 // The name of a Gmsh element type for messages ("6-node second-order triangle").
 std::string element_type_name(int type);
 
 // One physical surface of a file as a body's mesh.
 struct Surface {
-  bool found = false;                 // the file has a physical surface of that name
-  Mesh mesh;                          // nodes, cells and an edge set per physical curve on its boundary
-  std::vector<std::string> edges;     // the names of those edge sets, in the order of their physical tags
-  std::vector<std::string> elsewhere; // physical curves of the file that are not on this surface's boundary
-  std::vector<std::string> vertices;  // physical points on this surface (mesh.vertices), by physical tag
+  bool found = false;                         // the file has a physical surface of that name
+  Mesh mesh;                                  // nodes, cells and an edge set per physical curve on its boundary
+  std::vector<std::string> edges;             // the names of those edge sets, in the order of their physical tags
+  std::vector<std::string> elsewhere;         // physical curves of the file that are not on this surface's boundary
+  std::vector<std::string> vertices;          // physical points on this surface (mesh.vertices), by physical tag
   std::vector<std::string> points_elsewhere;  // physical points of the file that are not on this surface
-  std::vector<std::string> errors;    // empty if and only if the mesh is usable
+  std::vector<std::string> errors;            // empty if and only if the mesh is usable
 };
 
 // Builds the mesh of the physical surface `name` (all its surface entities): its 3-node triangles and 4-node

@@ -130,8 +130,9 @@ void read_format(Lexer& in) {
   const int file_type = integer<int>(in, "the file type");
   integer<int>(in, "the data size");
   if (file_type != 0)
-    in.fail("binary MSH files are not supported: save the mesh as ASCII (Mesh.Binary = 0, the default; "
-            "gmsh -2 model.geo -format msh41)");
+    in.fail(
+        "binary MSH files are not supported: save the mesh as ASCII (Mesh.Binary = 0, the default; "
+        "gmsh -2 model.geo -format msh41)");
   expect(in, "$EndMeshFormat");
 }
 
@@ -212,22 +213,38 @@ void read_nodes(Lexer& in, File& f, std::size_t max_nodes, double max_magnitude)
 // The number of nodes of the element types a 2-D mesh may hold (0 for types not listed: not checked).
 std::size_t nodes_per_element(int type) {
   switch (type) {
-    case 1: return 2;
-    case 2: return 3;
-    case 3: return 4;
-    case 4: return 4;
-    case 5: return 8;
-    case 6: return 6;
-    case 7: return 5;
-    case 8: return 3;
-    case 9: return 6;
-    case 10: return 9;
-    case 11: return 10;
-    case 15: return 1;
-    case 16: return 8;
-    case 20: return 9;
-    case 21: return 10;
-    default: return 0;
+    case 1:
+      return 2;
+    case 2:
+      return 3;
+    case 3:
+      return 4;
+    case 4:
+      return 4;
+    case 5:
+      return 8;
+    case 6:
+      return 6;
+    case 7:
+      return 5;
+    case 8:
+      return 3;
+    case 9:
+      return 6;
+    case 10:
+      return 9;
+    case 11:
+      return 10;
+    case 15:
+      return 1;
+    case 16:
+      return 8;
+    case 20:
+      return 9;
+    case 21:
+      return 10;
+    default:
+      return 0;
   }
 }
 
@@ -280,22 +297,38 @@ void read_elements(Lexer& in, File& f, std::size_t max_nodes) {
 
 std::string element_type_name(int type) {
   switch (type) {
-    case 1: return "2-node line";
-    case 2: return "3-node triangle";
-    case 3: return "4-node quadrangle";
-    case 4: return "4-node tetrahedron";
-    case 5: return "8-node hexahedron";
-    case 6: return "6-node prism";
-    case 7: return "5-node pyramid";
-    case 8: return "3-node second-order line";
-    case 9: return "6-node second-order triangle";
-    case 10: return "9-node second-order quadrangle";
-    case 11: return "10-node second-order tetrahedron";
-    case 15: return "1-node point";
-    case 16: return "8-node second-order quadrangle";
-    case 20: return "9-node third-order triangle";
-    case 21: return "10-node third-order triangle";
-    default: return "Gmsh element type " + std::to_string(type);
+    case 1:
+      return "2-node line";
+    case 2:
+      return "3-node triangle";
+    case 3:
+      return "4-node quadrangle";
+    case 4:
+      return "4-node tetrahedron";
+    case 5:
+      return "8-node hexahedron";
+    case 6:
+      return "6-node prism";
+    case 7:
+      return "5-node pyramid";
+    case 8:
+      return "3-node second-order line";
+    case 9:
+      return "6-node second-order triangle";
+    case 10:
+      return "9-node second-order quadrangle";
+    case 11:
+      return "10-node second-order tetrahedron";
+    case 15:
+      return "1-node point";
+    case 16:
+      return "8-node second-order quadrangle";
+    case 20:
+      return "9-node third-order triangle";
+    case 21:
+      return "10-node third-order triangle";
+    default:
+      return "Gmsh element type " + std::to_string(type);
   }
 }
 
@@ -304,8 +337,9 @@ File parse(const std::string& text, std::size_t max_nodes, double max_magnitude)
   File f;
   if (in.at_end()) throw ParseError("the file is empty");
   if (in.token("$MeshFormat") != "$MeshFormat")
-    in.fail("not a Gmsh MSH file: it does not start with $MeshFormat (a .geo file must first be meshed: "
-            "gmsh -2 model.geo -format msh41 -o model.msh)");
+    in.fail(
+        "not a Gmsh MSH file: it does not start with $MeshFormat (a .geo file must first be meshed: "
+        "gmsh -2 model.geo -format msh41 -o model.msh)");
   read_format(in);
   bool nodes = false, elements = false;
   while (!in.at_end()) {
@@ -331,7 +365,8 @@ File parse(const std::string& text, std::size_t max_nodes, double max_magnitude)
       in.fail("expected a section such as $Nodes, got '" + section.substr(0, 40) + "'");
     }
   }
-  if (!nodes || !elements) throw ParseError(std::string("the file has no ") + (nodes ? "$Elements" : "$Nodes") + " section");
+  if (!nodes || !elements)
+    throw ParseError(std::string("the file has no ") + (nodes ? "$Elements" : "$Nodes") + " section");
   return f;
 }
 

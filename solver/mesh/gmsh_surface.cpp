@@ -340,7 +340,8 @@ void add_arcs(const File& f, const std::unordered_map<std::size_t, int>& local,
     const Point ab = b - a, ac = c - a;
     const double det = 2 * cross(ab, ac);
     const Point centre = a + Point(ac.y() * ab.squaredNorm() - ab.y() * ac.squaredNorm(),
-                                   ab.x() * ac.squaredNorm() - ac.x() * ab.squaredNorm()) / det;
+                                   ab.x() * ac.squaredNorm() - ac.x() * ab.squaredNorm()) /
+                                 det;
     const double radius = (a - centre).norm();
     if (!std::all_of(x.begin(), x.end(),
                      [&](const Point& p) { return std::abs((p - centre).norm() - radius) <= 1e-8 * radius; })) {
@@ -371,7 +372,8 @@ Surface surface(const File& f, const std::string& name) {
     std::string other_kind;
     for (const auto& [group, n] : f.physical_names) {
       if (group.first == 2 && seen.insert(n).second) surfaces.push_back(n);
-      if (group.first != 2 && n == name) other_kind = group.first == 1 ? "curve" : group.first == 0 ? "point" : "volume";
+      if (group.first != 2 && n == name)
+        other_kind = group.first == 1 ? "curve" : group.first == 0 ? "point" : "volume";
     }
     out.errors.push_back(
         (other_kind.empty() ? "the file has no physical surface '" + name + "'"
@@ -383,7 +385,8 @@ Surface surface(const File& f, const std::string& name) {
   out.found = true;
   const RawCells raw = collect_cells(f, groups, name, out.errors);
   if (raw.nodes.empty()) {
-    if (out.errors.empty()) out.errors.push_back("physical surface '" + name + "' has no elements (was the file meshed in 2-D?)");
+    if (out.errors.empty())
+      out.errors.push_back("physical surface '" + name + "' has no elements (was the file meshed in 2-D?)");
     return out;
   }
   // Nodes renumbered from 0 in the order of their tags.

@@ -24,7 +24,8 @@ std::vector<double> graded_parameters(int n, double ratio, bool small_at_start) 
   std::vector<double> t(static_cast<size_t>(n) + 1, 0.0);
   double total = 0.0;
   for (double s : sizes) total += s;
-  for (int i = 0; i < n; ++i) t[static_cast<size_t>(i) + 1] = t[static_cast<size_t>(i)] + sizes[static_cast<size_t>(i)] / total;
+  for (int i = 0; i < n; ++i)
+    t[static_cast<size_t>(i) + 1] = t[static_cast<size_t>(i)] + sizes[static_cast<size_t>(i)] / total;
   t.back() = 1.0;
   return t;
 }
@@ -67,12 +68,13 @@ std::optional<std::string> fit_curve(Curve& curve, const Point& p, const Point& 
     const double tol = 1e-6 * curve.radius;
     if (std::abs(dp - curve.radius) > tol || std::abs(dq - curve.radius) > tol) {
       std::ostringstream os;
-      os << "the edge's end corners are at distances " << dp << " and " << dq << " from the arc centre, not at the radius "
-         << curve.radius;
+      os << "the edge's end corners are at distances " << dp << " and " << dq
+         << " from the arc centre, not at the radius " << curve.radius;
       return os.str();
     }
     const Point a = p - curve.center, b = q - curve.center;
-    if (cross(a, b) == 0.0 && a.dot(b) < 0) return "the arc's end corners are diametrically opposite: the arc is ambiguous";
+    if (cross(a, b) == 0.0 && a.dot(b) < 0)
+      return "the arc's end corners are diametrically opposite: the arc is ambiguous";
     return std::nullopt;
   }
   return std::nullopt;
@@ -97,7 +99,8 @@ double Mesh::cell_area(int cell) const {
   const auto& c = cells[static_cast<size_t>(cell)];
   const auto n = static_cast<size_t>(c.size());
   double a = 0.0;
-  for (size_t k = 0; k < n; ++k) a += cross(nodes[static_cast<size_t>(c[k])], nodes[static_cast<size_t>(c[(k + 1) % n])]);
+  for (size_t k = 0; k < n; ++k)
+    a += cross(nodes[static_cast<size_t>(c[k])], nodes[static_cast<size_t>(c[(k + 1) % n])]);
   return 0.5 * a;
 }
 
@@ -170,7 +173,10 @@ Mesh make_block(const BlockSpec& spec) {
   for (int j = ny - 1; j >= 0; --j) l.push_back({cell(0, j), 3});
   for (const auto& [name, c] : spec.curves)
     if (c.kind != Curve::Kind::line) m.edge_curves[name] = c;
-  m.vertices = {{"bottom_left", node(0, 0)}, {"bottom_right", node(nx, 0)}, {"top_right", node(nx, ny)}, {"top_left", node(0, ny)}};
+  m.vertices = {{"bottom_left", node(0, 0)},
+                {"bottom_right", node(nx, 0)},
+                {"top_right", node(nx, ny)},
+                {"top_left", node(0, ny)}};
   return m;
 }
 
@@ -246,7 +252,8 @@ std::optional<std::string> order_chain(const Mesh& m, std::vector<EdgeRef>& refs
 
 }  // namespace
 
-std::optional<std::string> add_edge_set(Mesh& m, const std::string& name, const std::vector<std::array<int, 2>>& pairs) {
+std::optional<std::string> add_edge_set(Mesh& m, const std::string& name,
+                                        const std::vector<std::array<int, 2>>& pairs) {
   // Sides of all cells by their unordered node pair.
   std::map<std::pair<int, int>, std::vector<EdgeRef>> sides;
   for (int c = 0; c < m.num_cells(); ++c)

@@ -36,7 +36,8 @@ std::map<std::pair<int, int>, std::vector<int>> sides_of(const Mesh& m) {
 // The marked cells below max_level, closed: refining a cell whose side is half of a coarser neighbour's side
 // would put two hanging nodes on that neighbour's side, so the neighbour is refined too (and so on). Counts the
 // cells the closure added in `closure_cells`.
-std::vector<char> mark_with_closure(const Mesh& m, const std::vector<int>& marked_in, int max_level, int& closure_cells) {
+std::vector<char> mark_with_closure(const Mesh& m, const std::vector<int>& marked_in, int max_level,
+                                    int& closure_cells) {
   std::vector<char> marked(static_cast<size_t>(m.num_cells()), 0);
   for (int c : marked_in)
     if (c >= 0 && c < m.num_cells() && m.level[static_cast<size_t>(c)] < max_level) marked[static_cast<size_t>(c)] = 1;
@@ -88,7 +89,8 @@ class CellSplitter {
       const int m01 = midpoint(q[0], q[1]), m12 = midpoint(q[1], q[2]), m20 = midpoint(q[2], q[0]);
       split = {{q[0], m01, m20}, {m01, q[1], m12}, {m20, m12, q[2]}, {m01, m12, m20}};
     } else {
-      const int m01 = midpoint(q[0], q[1]), m12 = midpoint(q[1], q[2]), m23 = midpoint(q[2], q[3]), m30 = midpoint(q[3], q[0]);
+      const int m01 = midpoint(q[0], q[1]), m12 = midpoint(q[1], q[2]), m23 = midpoint(q[2], q[3]),
+                m30 = midpoint(q[3], q[0]);
       // Centre: the bilinear centre corrected for curved sides (equal to the corner mean for straight ones).
       const auto& x = m_.nodes;
       const Point centre = 0.5 * (x[static_cast<size_t>(m01)] + x[static_cast<size_t>(m12)] +

@@ -60,8 +60,7 @@ void centroid_and_radius(const Mesh& mesh, Eigen::Vector2d& centroid, double& ra
 
 RigidModes free_rigid_modes(const Mesh& mesh, const std::vector<PrescribedDof>& prescribed) {
   std::vector<HeldDirection> held;
-  for (const auto& p : prescribed)
-    held.push_back({p[0], p[1] == 0 ? Eigen::Vector2d(1, 0) : Eigen::Vector2d(0, 1)});
+  for (const auto& p : prescribed) held.push_back({p[0], p[1] == 0 ? Eigen::Vector2d(1, 0) : Eigen::Vector2d(0, 1)});
   return free_rigid_modes_along(mesh, held);
 }
 

@@ -5,8 +5,7 @@
 
 namespace contact::mortar {
 
-ContactIndex::ContactIndex(const Problem& problem)
-    : as_slave(problem.bodies.size()), as_master(problem.bodies.size()) {
+ContactIndex::ContactIndex(const Problem& problem) : as_slave(problem.bodies.size()), as_master(problem.bodies.size()) {
   for (size_t q = 0; q < problem.contacts.size(); ++q) {
     const ContactPair& c = problem.contacts[q];
     if (c.slave_body >= 0 && static_cast<size_t>(c.slave_body) < as_slave.size())

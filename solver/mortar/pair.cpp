@@ -53,7 +53,8 @@ void PairDiscretization::add_forces(const Eigen::VectorXd& z, Eigen::VectorXd& f
   fm.noalias() += Gm.transpose() * z;
 }
 
-void PairDiscretization::add_tangential_forces(const Eigen::VectorXd& q, Eigen::VectorXd& fs, Eigen::VectorXd& fm) const {
+void PairDiscretization::add_tangential_forces(const Eigen::VectorXd& q, Eigen::VectorXd& fs,
+                                               Eigen::VectorXd& fm) const {
   if (!has_friction() || q.size() != n_rows()) return;
   fs.noalias() -= Ts.transpose() * q;
   fm.noalias() += Tm.transpose() * q;
@@ -153,7 +154,8 @@ std::vector<size_t> multiplier_partition(const SegmentMesh& segments, const std:
   const size_t n_segments = segments.slave_length.size();
   std::vector<double> opposite(n_segments, 0.0);  // the longest master segment opposite each slave segment
   for (const auto& s : segments.segments)
-    opposite[static_cast<size_t>(s.slave)] = std::max(opposite[static_cast<size_t>(s.slave)], master_length[static_cast<size_t>(s.master)]);
+    opposite[static_cast<size_t>(s.slave)] =
+        std::max(opposite[static_cast<size_t>(s.slave)], master_length[static_cast<size_t>(s.master)]);
   std::vector<size_t> nodes = {0};
   double run = 0, longest = 0;
   for (size_t k = 0; k < n_segments; ++k) {
@@ -314,7 +316,8 @@ class PairBuilder {
         d_.status[i] = NodeStatus::uncovered;
       } else if (covered < kDropCoverage * support) {
         d_.status[i] = NodeStatus::barely_covered;
-      } else if (auto p = prescribed.find(poly_[i]); p != prescribed.end() && normal_is_prescribed(p->second, nu.normalized())) {
+      } else if (auto p = prescribed.find(poly_[i]);
+                 p != prescribed.end() && normal_is_prescribed(p->second, nu.normalized())) {
         d_.status[i] = NodeStatus::crosspoint;
       } else if (auto c = friction_corner(corners, i, nu); c && c->third_body) {
         d_.status[i] = NodeStatus::crosspoint;
@@ -449,7 +452,8 @@ class PairBuilder {
     for (size_t k = a; k < b_node; ++k) {
       const double L = segments_.slave_length[k];
       for (const auto* s : on_segment_[k]) {
-        const int m0 = master_poly_[static_cast<size_t>(s->master)], m1 = master_poly_[static_cast<size_t>(s->master) + 1];
+        const int m0 = master_poly_[static_cast<size_t>(s->master)],
+                  m1 = master_poly_[static_cast<size_t>(s->master) + 1];
         const int n_master = static_cast<int>(d_.master_nodes.size());  // a closed master's last position is its first
         for (size_t q = 0; q < kGaussX.size(); ++q) {
           const double u = kGaussX[q];
@@ -563,7 +567,8 @@ class PairBuilder {
     VectorEntries ts, tm;
     for (const auto& [key, v] : ss_) ts[key] = v * d_.tangent[static_cast<size_t>(key.first)];
     for (const auto& [key, v] : mm_)
-      tm[{key.first, d_.master_nodes[static_cast<size_t>(key.second)]}] = v * d_.tangent[static_cast<size_t>(key.first)];
+      tm[{key.first, d_.master_nodes[static_cast<size_t>(key.second)]}] =
+          v * d_.tangent[static_cast<size_t>(key.first)];
     d_.Ts = sparse_rows(ts, 2 * slave_.mesh.num_nodes());
     d_.Tm = sparse_rows(tm, 2 * master_.mesh.num_nodes());
   }

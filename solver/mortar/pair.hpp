@@ -57,28 +57,28 @@ struct PairDiscretization {
   // them; on a closed slave edge the last is slave_nodes.size(), the start again.
   std::vector<size_t> multiplier_nodes;
   std::vector<std::vector<std::pair<int, double>>> node_from_rows;  // per slave node: (row, weight) giving its value
-  Eigen::VectorXd node_arc;         // arc length along the slave polyline from its first node (a loop's start)
-  bool closed = false;              // the slave edge is a closed loop
-  double loop_length = 0.0;         // a closed slave edge's length, its closing segment included (0 if open)
-  std::vector<NodeStatus> status;   // per slave node
-  std::vector<int> row_of_node;     // per slave node: its row, or -1
+  Eigen::VectorXd node_arc;        // arc length along the slave polyline from its first node (a loop's start)
+  bool closed = false;             // the slave edge is a closed loop
+  double loop_length = 0.0;        // a closed slave edge's length, its closing segment included (0 if open)
+  std::vector<NodeStatus> status;  // per slave node
+  std::vector<int> row_of_node;    // per slave node: its row, or -1
 
   // One row per contact node.
-  std::vector<int> node_of_row;     // row -> index into slave_nodes
+  std::vector<int> node_of_row;  // row -> index into slave_nodes
   // Per row: its friction row is dropped (q = 0 there), at a corner where the slave edge meets another contact
   // edge of its body and friction would tie three bodies in a loop (pair.cpp, slave_corners).
   std::vector<char> tangential_dropped;
-  Eigen::VectorXd D;                // D_r = integral Phi_r N_r (length x thickness): the diagonal mortar matrix
-  Eigen::VectorXd area;             // integral Phi_r = sum_j M_rj: the row's share of the surface. Equal to D_r
-                                    // except next to a dropped node (Phi_r then also covers the neighbour's part)
-  Eigen::VectorXd gap0;             // weighted initial gap (geometric + analytic), length^2 x thickness
+  Eigen::VectorXd D;                    // D_r = integral Phi_r N_r (length x thickness): the diagonal mortar matrix
+  Eigen::VectorXd area;                 // integral Phi_r = sum_j M_rj: the row's share of the surface. Equal to D_r
+                                        // except next to a dropped node (Phi_r then also covers the neighbour's part)
+  Eigen::VectorXd gap0;                 // weighted initial gap (geometric + analytic), length^2 x thickness
   std::vector<Eigen::Vector2d> normal;  // unit normal of row r (direction of D_r nu_r): for reports
-  SparseRows Gs;                    // rows x slave dofs
-  SparseRows Gm;                    // rows x master dofs
-  std::vector<int> master_nodes;    // the master edge's nodes in order (a closed one's each once, from its start);
-                                    // in a group of pairs (pair_group.hpp) the group's master chain, all its edges
-  SparseRows M;                     // rows x master_nodes (scalar mortar matrix, summed over segments)
-  double covered_length = 0.0;      // length of the slave edge opposite the master edge (this pair's pieces)
+  SparseRows Gs;                        // rows x slave dofs
+  SparseRows Gm;                        // rows x master dofs
+  std::vector<int> master_nodes;        // the master edge's nodes in order (a closed one's each once, from its start);
+                                        // in a group of pairs (pair_group.hpp) the group's master chain, all its edges
+  SparseRows M;                         // rows x master_nodes (scalar mortar matrix, summed over segments)
+  double covered_length = 0.0;          // length of the slave edge opposite the master edge (this pair's pieces)
 
   // Augmented-Lagrangian multipliers per row (empty: none). The pressure is then max(0, lambda - g / theta).
   Eigen::VectorXd multiplier;
@@ -91,7 +91,9 @@ struct PairDiscretization {
   bool has_friction() const { return friction.active() && Ts.rows() == n_rows(); }
   // w = Tm u_master - Ts u_slave (weighted; / area gives the master's tangential displacement relative to the
   // slave's, a length).
-  Eigen::VectorXd weighted_jump(const Eigen::VectorXd& us, const Eigen::VectorXd& um) const { return Tm * um - Ts * us; }
+  Eigen::VectorXd weighted_jump(const Eigen::VectorXd& us, const Eigen::VectorXd& um) const {
+    return Tm * um - Ts * us;
+  }
   // The slip of this step: w - w_origin.
   Eigen::VectorXd weighted_slip(const Eigen::VectorXd& us, const Eigen::VectorXd& um) const {
     Eigen::VectorXd w = weighted_jump(us, um);
@@ -106,7 +108,9 @@ struct PairDiscretization {
   void add_tangential_forces(const Eigen::VectorXd& q, Eigen::VectorXd& fs, Eigen::VectorXd& fm) const;
 
   int n_rows() const { return static_cast<int>(D.size()); }
-  Eigen::VectorXd weighted_gap(const Eigen::VectorXd& us, const Eigen::VectorXd& um) const { return gap0 + Gm * um - Gs * us; }
+  Eigen::VectorXd weighted_gap(const Eigen::VectorXd& us, const Eigen::VectorXd& um) const {
+    return gap0 + Gm * um - Gs * us;
+  }
   // Weighted gap / area: a length (negative = penetration); the node's value for a gap linear along the slave
   // edge, a mean with the dropped neighbour next to one, and the constant for a constant gap.
   Eigen::VectorXd nodal_gap(const Eigen::VectorXd& us, const Eigen::VectorXd& um) const {
@@ -139,7 +143,6 @@ PenaltyChoice choose_penalty(const Problem& problem, int pair_index);
 
 // A slave node whose covered part of its support is below this fraction of the support carries no multiplier.
 constexpr double kDropCoverage = 1e-3;
-
 
 // Builds the mortar discretisation of pair `pair_index` on the bodies' current meshes. `index`: the problem's pairs
 // by body (made here when null; a caller discretizing every pair makes it once).

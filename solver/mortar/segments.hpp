@@ -33,7 +33,7 @@ struct MortarSegment {
 };
 
 struct SegmentMesh {
-  std::vector<MortarSegment> segments;  // ordered by slave segment, then by xi
+  std::vector<MortarSegment> segments;        // ordered by slave segment, then by xi
   std::vector<Eigen::Vector2d> slave_normal;  // outward unit normal of each slave segment
   std::vector<double> slave_length;           // length of each slave segment
 };

@@ -17,7 +17,8 @@ MpiTaskRunner::MpiTaskRunner(MPI_Comm comm, std::vector<int> owner, unsigned thr
   // A test hook (docs/parallel.md, "Failures"): the first task of this body throws on its owner.
   if (const char* v = std::getenv("CONTACT_MPI_FAIL_BODY")) fail_body_ = std::strtol(v, nullptr, 10);
   for (int r : owner_)
-    if (r < 0 || r >= size_) throw std::invalid_argument("MpiTaskRunner: a body's owner is not a rank of the communicator");
+    if (r < 0 || r >= size_)
+      throw std::invalid_argument("MpiTaskRunner: a body's owner is not a rank of the communicator");
 }
 
 namespace {
@@ -94,7 +95,8 @@ Gathered all_gather(MPI_Comm comm, int ranks, const std::vector<char>& out) {
 
 // Reads every rank's message: the other ranks' failures into `errors`, their bodies' outputs through
 // share.unpack (a body that fails to unpack is an error too). Returns whether some rank asked to cancel.
-bool unpack_messages(const Gathered& g, int rank, const parallel::BodyShare& share, std::map<size_t, std::string>& errors) {
+bool unpack_messages(const Gathered& g, int rank, const parallel::BodyShare& share,
+                     std::map<size_t, std::string>& errors) {
   bool cancel = false;
   for (size_t r = 0; r < g.sizes.size(); ++r) {
     parallel::Unpacker in(g.all.data() + g.displs[r], static_cast<size_t>(g.sizes[r]));

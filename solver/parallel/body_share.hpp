@@ -84,7 +84,8 @@ class Unpacker {
   size_t remaining() const { return static_cast<size_t>(end_ - at_); }
   size_t count(size_t item = 1) {
     const std::int64_t n = get_int();
-    if (n < 0 || static_cast<size_t>(n) > remaining() / item) throw std::runtime_error("body data from another process is truncated");
+    if (n < 0 || static_cast<size_t>(n) > remaining() / item)
+      throw std::runtime_error("body data from another process is truncated");
     return static_cast<size_t>(n);
   }
   template <class T>

@@ -22,9 +22,9 @@ std::vector<int> assign_bodies(const Problem& problem, int ranks) {
     int choice = least;
     double best = -1;
     for (const auto& c : problem.contacts) {
-      const int other = static_cast<size_t>(c.slave_body) == a   ? c.master_body
+      const int other = static_cast<size_t>(c.slave_body) == a    ? c.master_body
                         : static_cast<size_t>(c.master_body) == a ? c.slave_body
-                                                                   : -1;
+                                                                  : -1;
       if (other < 0 || owner[static_cast<size_t>(other)] < 0) continue;
       const int r = owner[static_cast<size_t>(other)];
       const double after = load[static_cast<size_t>(r)] + weight[a];

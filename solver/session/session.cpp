@@ -72,20 +72,21 @@ int Session::broadcast(int value) const {
 namespace {
 
 std::unique_ptr<parallel::TaskRunner> make_runner(const Problem& problem, bool mpi, int rank, int size,
-                                             const std::atomic<bool>* request, CancelToken* agreed) {
+                                                  const std::atomic<bool>* request, CancelToken* agreed) {
 #ifdef CONTACT_WITH_MPI
   if (mpi && size > 1) {
     const std::vector<int> owner = parallel::assign_bodies(problem, size);
     size_t mine = 0;
     for (int r : owner) mine += r == rank ? 1 : 0;
-    auto runner = std::make_unique<mpi::MpiTaskRunner>(MPI_COMM_WORLD, owner,
-                                                       parallel::choose_threads(problem.solver.threads, std::max<size_t>(mine, 1)));
+    auto runner = std::make_unique<mpi::MpiTaskRunner>(
+        MPI_COMM_WORLD, owner, parallel::choose_threads(problem.solver.threads, std::max<size_t>(mine, 1)));
     runner->watch_cancel(request, agreed);
     return runner;
   }
 #endif
   (void)mpi, (void)rank, (void)size, (void)request, (void)agreed;
-  return std::make_unique<parallel::ThreadTaskRunner>(parallel::choose_threads(problem.solver.threads, problem.bodies.size()));
+  return std::make_unique<parallel::ThreadTaskRunner>(
+      parallel::choose_threads(problem.solver.threads, problem.bodies.size()));
 }
 
 }  // namespace

@@ -30,7 +30,11 @@ std::vector<Eigen::Index> dependent_rows(const InterfaceProblem& problem, const 
 }  // namespace
 
 CoarseSpace::CoarseSpace(const InterfaceProblem& problem, const Equalities& equilibrium)
-    : problem_(problem), G_(equilibrium.G), Gt_(equilibrium.G.transpose()), e_(equilibrium.e), factor_(std::make_unique<Factor>()) {
+    : problem_(problem),
+      G_(equilibrium.G),
+      Gt_(equilibrium.G.transpose()),
+      e_(equilibrium.e),
+      factor_(std::make_unique<Factor>()) {
   if (empty()) return;
   const SparseMatrix GGt = G_ * Gt_;
   unheld_ = dependent_rows(problem, GGt);
@@ -81,8 +85,8 @@ Eigen::VectorXd CoarseSpace::solve_GGt(const Eigen::VectorXd& v) const {
   return factor_->llt.solve(v);
 }
 
-Eigen::VectorXd CoarseSpace::multipliers(const Eigen::VectorXd& r, const std::vector<char>& columns,
-                                         bool indeterminate, const Eigen::VectorXd* prior) const {
+Eigen::VectorXd CoarseSpace::multipliers(const Eigen::VectorXd& r, const std::vector<char>& columns, bool indeterminate,
+                                         const Eigen::VectorXd* prior) const {
   if (empty()) return Eigen::VectorXd();
   const SparseMatrix GA = columns_of(columns);
   const SparseMatrix GAt = GA.transpose();

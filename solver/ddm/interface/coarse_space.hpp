@@ -31,9 +31,9 @@ class CoarseSpace {
   bool empty() const { return G_.rows() == 0; }
   Eigen::Index rows() const { return G_.rows(); }
 
-  Eigen::VectorXd project(const Eigen::VectorXd& x) const;        // P x
-  Eigen::VectorXd range_part(const Eigen::VectorXd& x) const;     // Q x
-  Eigen::VectorXd particular() const;                             // z_I
+  Eigen::VectorXd project(const Eigen::VectorXd& x) const;     // P x
+  Eigen::VectorXd range_part(const Eigen::VectorXd& x) const;  // Q x
+  Eigen::VectorXd particular() const;                          // z_I
   // The least-squares multipliers alpha of G^T alpha = -r on the columns `columns` (the active contact nodes):
   // (G_A G_A^T)^-1 G_A (-r_A). Empty when G_A G_A^T is singular (the active set leaves a body unheld), unless
   // `indeterminate` allows it: then the least-squares solution with the least |alpha| along the motions no column

@@ -4,7 +4,8 @@
 
 namespace contact::ddm {
 
-linalg::ActiveSetResult FetiSolver::solve(const InterfaceQp& qp, const Eigen::VectorXd* z0, InterfaceSolveContext& context) {
+linalg::ActiveSetResult FetiSolver::solve(const InterfaceQp& qp, const Eigen::VectorXd* z0,
+                                          InterfaceSolveContext& context) {
   if (qp.problem.size() > qp.problem.normal_size()) return solve_friction(qp, z0, context);
   linalg::ActiveSetResult out;
   Smalbe smalbe(qp, settings_, context);

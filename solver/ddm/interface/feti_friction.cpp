@@ -22,8 +22,8 @@ namespace contact::ddm {
 namespace {
 
 using linalg::ActiveSetResult;
-using linalg::FrictionState;
 using linalg::FrictionRow;
+using linalg::FrictionState;
 
 constexpr double infinity = std::numeric_limits<double>::infinity();
 
@@ -97,8 +97,8 @@ std::string settled_message(const FrictionData& d, const ActiveSetResult& out, i
      << " friction converged: " << out.inner_iterations << " MPRGP iterations";
   if (d.coulomb) os << " in " << outer << " outer iterations on the slip bounds";
   os << " (" << smalbe.face_steps() << " of them in CG on settled faces; " << active << " nodes in contact: " << stick
-     << " sticking, " << slip << " slipping; F products "
-     << smalbe.seconds_F() << " s, coarse projections " << smalbe.seconds_coarse() << " s)";
+     << " sticking, " << slip << " slipping; F products " << smalbe.seconds_F() << " s, coarse projections "
+     << smalbe.seconds_coarse() << " s)";
   return os.str();
 }
 
@@ -190,12 +190,12 @@ void coulomb_outer(Smalbe& smalbe, const FrictionData& d, const Eigen::VectorXd*
       std::ostringstream os;
       os.precision(3);
       os << "FETI with Coulomb friction: the slip bounds settled, but the Coulomb complementarity stays at "
-         << info.complementarity << " (a node slips against its friction force) after " << outer
-         << " outer iterations";
+         << info.complementarity << " (a node slips against its friction force) after " << outer << " outer iterations";
       out.message = os.str();
       return;
     }
-    if (change <= outer_tolerance && (info.complementarity <= outer_tolerance || settled >= tuning.settled_iterations)) {
+    if (change <= outer_tolerance &&
+        (info.complementarity <= outer_tolerance || settled >= tuning.settled_iterations)) {
       out.converged = true;
       out.message = settled_message(d, out, outer, smalbe);
       if (info.complementarity > outer_tolerance) {

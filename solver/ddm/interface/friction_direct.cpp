@@ -14,9 +14,9 @@ namespace contact::ddm {
 
 namespace {
 
-using linalg::FrictionState;
 using linalg::FrictionRow;
 using linalg::FrictionSets;
+using linalg::FrictionState;
 
 // The first sets: the frictionless normal problem's (with the equilibrium normal pressures can meet; from nested
 // coarse solves, which keeps the number of steps independent of the mesh, also at a new load step, where the
@@ -34,7 +34,9 @@ FrictionSets first_sets(const SparseMatrix& F, const InterfaceQp& qp, const Eige
   const linalg::Equalities held = linalg::normal_equalities(qp.equilibrium, m);
   const std::vector<int> line(qp.line.begin(), qp.line.begin() + m);
   const Eigen::VectorXd guess = linalg::nested_initial_guess(Fnn, gn, line, qp.position.head(m), held);
-  const linalg::StepCallback quiet = [](const Eigen::VectorXd&, const Eigen::VectorXd&, const linalg::ActiveSetStep&) { return false; };
+  const linalg::StepCallback quiet = [](const Eigen::VectorXd&, const Eigen::VectorXd&, const linalg::ActiveSetStep&) {
+    return false;
+  };
   const linalg::ActiveSetResult normal = linalg::solve_active_set(Fnn, gn, 100, quiet, &guess, held);
   if (normal.converged) {
     lambda.head(m) = normal.z;
@@ -88,8 +90,8 @@ bool first_sets_from_coarse(const SparseMatrix& F, const InterfaceQp& qp, const 
 // multipliers: open rows fixed at 0, slip rows tied to their normal) of rank below their count. Each row is
 // scaled to unit length first (forces and moments have different units). Empty if every body is held row by row
 // (a group of bodies held by nothing together is not named).
-std::string bodies_held_by_nothing(const InterfaceQp& qp, const FrictionSets& sets, const std::vector<FrictionRow>& rows,
-                                   const std::vector<char>& mask) {
+std::string bodies_held_by_nothing(const InterfaceQp& qp, const FrictionSets& sets,
+                                   const std::vector<FrictionRow>& rows, const std::vector<char>& mask) {
   if (qp.equilibrium.G.rows() == 0 || sets.active.size() != static_cast<size_t>(qp.g.size())) return "";
   const linalg::FrictionParametrization p = linalg::parametrize(sets, rows, mask);
   const SparseMatrix GP = qp.equilibrium.G * p.P;
@@ -151,8 +153,7 @@ void describe_stop(const linalg::FrictionNewtonResult& r, const InterfaceQp& qp,
          << " the stick and slip sets it predicted, and every set between them and the last solved one, leave a "
             "floating body (or a group of them) held by nothing (a singular system"
          << (unheld.empty() ? std::string() : "; the predicted sets hold no contact node that fixes " + unheld)
-         << "); the complementarity residual of the last iterate is "
-         << complementarity
+         << "); the complementarity residual of the last iterate is " << complementarity
          << ". The statics check before the solve found no set of bodies that friction cannot hold along a flat "
             "joint, so either the solver failed (try smaller load steps) or the loads move a body that check cannot "
             "judge (a curved contact, bodies held only by frictionless contacts): check that every floating body is "
@@ -163,8 +164,8 @@ void describe_stop(const linalg::FrictionNewtonResult& r, const InterfaceQp& qp,
     case linalg::FrictionStop::max_steps: {
       std::ostringstream os;
       os.precision(3);
-      os << "the stick and slip sets did not settle within " << max_steps
-         << " steps (complementarity residual " << complementarity << " at the last iterate)";
+      os << "the stick and slip sets did not settle within " << max_steps << " steps (complementarity residual "
+         << complementarity << " at the last iterate)";
       result.message = os.str();
       return;
     }
@@ -193,13 +194,16 @@ linalg::ActiveSetResult FrictionDirectSolver::solve(const InterfaceQp& qp, const
   FrictionSets sets = sticking;
   const bool from_coarse = first_sets_from_coarse(F, qp, rows, mask, sets, context.note);
 
-  const linalg::FrictionNewtonProblem problem{rows, mask, c, [&](const linalg::FrictionParametrization& p, linalg::FrictionIterate& x) {
-                                                return linalg::solve_on_friction_sets(F, qp.g, qp.equilibrium, p, x);
-                                              },
-                                              [&] { return context.frame.stop_requested(); }};
+  const linalg::FrictionNewtonProblem problem{
+      rows, mask, c,
+      [&](const linalg::FrictionParametrization& p, linalg::FrictionIterate& x) {
+        return linalg::solve_on_friction_sets(F, qp.g, qp.equilibrium, p, x);
+      },
+      [&] { return context.frame.stop_requested(); }};
   linalg::FrictionNewtonSettings settings;
   settings.max_steps = context.max_steps;
-  const linalg::FrictionStepCallback on_step = [&](const linalg::FrictionIterate& x, const linalg::ActiveSetStep& info) {
+  const linalg::FrictionStepCallback on_step = [&](const linalg::FrictionIterate& x,
+                                                   const linalg::ActiveSetStep& info) {
     return context.on_step(x.lambda, x.h, info);
   };
   linalg::FrictionNewtonResult r = linalg::friction_newton(problem, sets, settings, on_step);
@@ -211,7 +215,9 @@ linalg::ActiveSetResult FrictionDirectSolver::solve(const InterfaceQp& qp, const
   result.h = r.iterate.h;
   result.alpha = r.iterate.other;
   if (r.iterate.lambda.size() == n) last_alpha_ = r.iterate.other;
-  const double residual = r.iterate.lambda.size() == n ? linalg::friction_complementarity(r.iterate.lambda, r.iterate.h, c, rows, mask) : 1.0;
+  const double residual = r.iterate.lambda.size() == n
+                              ? linalg::friction_complementarity(r.iterate.lambda, r.iterate.h, c, rows, mask)
+                              : 1.0;
   const std::string unheld =
       r.stop == linalg::FrictionStop::singular ? bodies_held_by_nothing(qp, r.unsolvable, rows, mask) : std::string();
   describe_stop(r, qp, context.max_steps, residual, unheld, result);

@@ -22,11 +22,12 @@ std::string InterfaceNewton::unheld_bodies(const std::vector<Eigen::Index>& rows
     for (const auto& c : problem.contacts)
       if (static_cast<size_t>(c.slave_body) == f.body || static_cast<size_t>(c.master_body) == f.body)
         pairs += (pairs.empty() ? "'" : ", '") + c.name + "'";
-    text += (text.empty() ? "" : "; ") + ("body '" + problem.bodies[f.body].name + "' floats (" + motions +
-                                          " free) and no contact holds it: its contact" +
-                                          (pairs.find(',') != std::string::npos ? "s " : " ") + pairs +
-                                          " would have to pull (the loads move it away), or it is open at the solution;"
-                                          " give it displacement conditions that hold it, or load it towards its contacts");
+    text +=
+        (text.empty() ? "" : "; ") +
+        ("body '" + problem.bodies[f.body].name + "' floats (" + motions +
+         " free) and no contact holds it: its contact" + (pairs.find(',') != std::string::npos ? "s " : " ") + pairs +
+         " would have to pull (the loads move it away), or it is open at the solution;"
+         " give it displacement conditions that hold it, or load it towards its contacts");
   }
   return text.empty() ? "the contact nodes in contact do not hold the floating bodies" : text;
 }
@@ -84,20 +85,23 @@ void InterfaceNewton::solve(RunFrame& frame) {
 
   std::vector<std::vector<char>> previous_active;
   const Eigen::VectorXd& penalty_diagonal = qp.penalty;  // theta area (0: exact)
-  const Eigen::VectorXd shift = qp.g - ip.free_gap();     // -theta area lambda
+  const Eigen::VectorXd shift = qp.g - ip.free_gap();    // -theta area lambda
   const std::string* solver_note = nullptr;  // what the solver says of its start (coarse solves), on the first report
   std::string solver_name = solver_->name();
   // The iterative solver's preconditioner, as `auto` resolved it (names.hpp's word).
   const std::string preconditioner_note =
       kind_ == InterfaceSolverKind::iterative
-          ? std::string(", preconditioner ") + (settings_.preconditioner == InterfacePreconditioner::none       ? "none"
-                                                : settings_.preconditioner == InterfacePreconditioner::lumped ? "lumped"
-                                                                                                              : "dirichlet")
+          ? std::string(", preconditioner ") + (settings_.preconditioner == InterfacePreconditioner::none ? "none"
+                                                : settings_.preconditioner == InterfacePreconditioner::lumped
+                                                    ? "lumped"
+                                                    : "dirichlet")
           : std::string();
-  const linalg::StepCallback on_step = [&](const Eigen::VectorXd& z, const Eigen::VectorXd& h, const linalg::ActiveSetStep& step) {
+  const linalg::StepCallback on_step = [&](const Eigen::VectorXd& z, const Eigen::VectorXd& h,
+                                           const linalg::ActiveSetStep& step) {
     // The reported gaps are the physical ones: h without the penalty's theta area z and the multipliers' shift.
     const Eigen::VectorXd gap = h - penalty_diagonal.cwiseProduct(z) - shift;
-    IterationReport r = system_.report_gaps(step.step, ip.split(z), ip.split(gap.cwiseQuotient(ip.weights())), previous_active);
+    IterationReport r =
+        system_.report_gaps(step.step, ip.split(z), ip.split(gap.cwiseQuotient(ip.weights())), previous_active);
     if (system_.has_friction()) system_.report_friction(ip.split(z), ip.split_tangential(z), r);
     r.measure = Measure::complementarity;
     r.complementarity = step.complementarity;

@@ -25,7 +25,8 @@ BodyRows body_rows(const ContactSystem& system, size_t a, const std::vector<Eige
     auto add = [&](const mortar::SparseRows& G, double sign, Eigen::Index first) {
       for (int r = 0; r < G.outerSize(); ++r) {
         std::vector<std::pair<int, double>> e;
-        for (mortar::SparseRows::InnerIterator it(G, r); it; ++it) e.emplace_back(static_cast<int>(it.col()), sign * it.value());
+        for (mortar::SparseRows::InnerIterator it(G, r); it; ++it)
+          e.emplace_back(static_cast<int>(it.col()), sign * it.value());
         out.rows.push_back(first + r);
         out.entries.push_back(std::move(e));
       }
@@ -59,7 +60,8 @@ void InterfaceProblem::compute_body(size_t a, BodyParts& out) const {
     const Eigen::MatrixXd& modes = body.rigid_modes();
     out.G = Eigen::MatrixXd::Zero(modes.cols(), k);
     for (size_t i = 0; i < R.rows.size(); ++i)
-      for (const auto& [dof, value] : R.entries[i]) out.G.col(static_cast<Eigen::Index>(i)) += value * modes.row(dof).transpose();
+      for (const auto& [dof, value] : R.entries[i])
+        out.G.col(static_cast<Eigen::Index>(i)) += value * modes.row(dof).transpose();
     out.e = -modes.transpose() * body.external_load();
   }
   // Free response: the body under its own loads only.
@@ -79,7 +81,8 @@ void InterfaceProblem::compute_body(size_t a, BodyParts& out) const {
     for (const auto& [dof, value] : R.entries[i])
       for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(T, dof); it; ++it) {
         const Eigen::Index p = position[static_cast<size_t>(it.col())];
-        if (p < 0) throw std::logic_error("interface problem: a contact dof depends on an unknown outside the interface");
+        if (p < 0)
+          throw std::logic_error("interface problem: a contact dof depends on an unknown outside the interface");
         BzT(p, static_cast<Eigen::Index>(i)) += value * it.value();
       }
   if (Z.empty()) {  // every contact dof of this body is prescribed: it adds no compliance
@@ -98,7 +101,8 @@ void InterfaceProblem::compute_body(size_t a, BodyParts& out) const {
   } else if (options_.preconditioner == InterfacePreconditioner::lumped) {
     // K_ZZ: the reduced stiffness on Z alone (no interior elimination).
     const auto& K = body.reduced_stiffness();
-    Eigen::MatrixXd Kzz = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(Z.size()), static_cast<Eigen::Index>(Z.size()));
+    Eigen::MatrixXd Kzz =
+        Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(Z.size()), static_cast<Eigen::Index>(Z.size()));
     for (size_t j = 0; j < Z.size(); ++j)
       for (Eigen::SparseMatrix<double>::InnerIterator it(K, Z[j]); it; ++it) {
         const Eigen::Index p = position[static_cast<size_t>(it.row())];
@@ -138,22 +142,23 @@ InterfaceProblem::InterfaceProblem(const ContactSystem& system, parallel::TaskRu
   // Each body's part on its owner; the blocks move to every process only when they are replicated.
   const bool replicate = options_.replicate_blocks;
   const parallel::BodyShare share{[&](size_t a, parallel::Packer& out) {
-                          out.put(replicate ? parts[a].F : Eigen::MatrixXd());
-                          out.put(replicate ? parts[a].preconditioner : Eigen::MatrixXd());
-                          out.put(parts[a].G);
-                          out.put(parts[a].g);
-                          out.put(parts[a].e);
-                          out.put(parts[a].diagonal);
-                        },
-                        [&](size_t a, parallel::Unpacker& in) {
-                          parts[a].F = in.get_matrix();
-                          parts[a].preconditioner = in.get_matrix();
-                          parts[a].G = in.get_matrix();
-                          parts[a].g = in.get_vector();
-                          parts[a].e = in.get_vector();
-                          parts[a].diagonal = in.get_vector();
-                        }};
-  runner.run_bodies(n_bodies, [&](size_t a) { compute_body(a, parts[a]); }, share);
+                                    out.put(replicate ? parts[a].F : Eigen::MatrixXd());
+                                    out.put(replicate ? parts[a].preconditioner : Eigen::MatrixXd());
+                                    out.put(parts[a].G);
+                                    out.put(parts[a].g);
+                                    out.put(parts[a].e);
+                                    out.put(parts[a].diagonal);
+                                  },
+                                  [&](size_t a, parallel::Unpacker& in) {
+                                    parts[a].F = in.get_matrix();
+                                    parts[a].preconditioner = in.get_matrix();
+                                    parts[a].G = in.get_matrix();
+                                    parts[a].g = in.get_vector();
+                                    parts[a].e = in.get_vector();
+                                    parts[a].diagonal = in.get_vector();
+                                  }};
+  runner.run_bodies(
+      n_bodies, [&](size_t a) { compute_body(a, parts[a]); }, share);
   g_loads_ = Eigen::VectorXd::Zero(m);
   diagonal_ = Eigen::VectorXd::Zero(m);
   blocks_.resize(n_bodies);
@@ -270,7 +275,8 @@ bool InterfaceProblem::apply(const Eigen::VectorXd& x, Eigen::VectorXd& y, paral
   return apply_blocks(x, y, runner, false);
 }
 
-bool InterfaceProblem::apply_preconditioner(const Eigen::VectorXd& x, Eigen::VectorXd& y, parallel::TaskRunner& runner) const {
+bool InterfaceProblem::apply_preconditioner(const Eigen::VectorXd& x, Eigen::VectorXd& y,
+                                            parallel::TaskRunner& runner) const {
   CONTACT_ASSERT_SIZE(x.size(), size(), "the interface vector");
   const bool stop = apply_blocks(inverse_weight_.cwiseProduct(x), y, runner, true);
   y = inverse_weight_.cwiseProduct(y);
@@ -290,23 +296,26 @@ void InterfaceProblem::refresh_loads(parallel::TaskRunner& runner) {
   const size_t n_bodies = system_.n_bodies();
   std::vector<Eigen::VectorXd> g(n_bodies), e(n_bodies);
   const parallel::BodyShare share{[&](size_t a, parallel::Packer& out) {
-                          out.put(g[a]);
-                          out.put(e[a]);
-                        },
-                        [&](size_t a, parallel::Unpacker& in) {
-                          g[a] = in.get_vector();
-                          e[a] = in.get_vector();
-                        }};
+                                    out.put(g[a]);
+                                    out.put(e[a]);
+                                  },
+                                  [&](size_t a, parallel::Unpacker& in) {
+                                    g[a] = in.get_vector();
+                                    e[a] = in.get_vector();
+                                  }};
   std::vector<BodyRows> rows(n_bodies);
   for (size_t a = 0; a < n_bodies; ++a) rows[a] = body_rows(system_, a, offset_, tangential_offset_);
-  runner.run_bodies(n_bodies, [&](size_t a) {
-    const auto& body = system_.body(a);
-    const Eigen::VectorXd u_free = body.solve(Eigen::VectorXd());
-    g[a] = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(rows[a].rows.size()));
-    for (size_t i = 0; i < rows[a].rows.size(); ++i)
-      for (const auto& [dof, value] : rows[a].entries[i]) g[a][static_cast<Eigen::Index>(i)] += value * u_free[dof];
-    if (body.floating()) e[a] = -body.rigid_modes().transpose() * body.external_load();
-  }, share);
+  runner.run_bodies(
+      n_bodies,
+      [&](size_t a) {
+        const auto& body = system_.body(a);
+        const Eigen::VectorXd u_free = body.solve(Eigen::VectorXd());
+        g[a] = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(rows[a].rows.size()));
+        for (size_t i = 0; i < rows[a].rows.size(); ++i)
+          for (const auto& [dof, value] : rows[a].entries[i]) g[a][static_cast<Eigen::Index>(i)] += value * u_free[dof];
+        if (body.floating()) e[a] = -body.rigid_modes().transpose() * body.external_load();
+      },
+      share);
   g_loads_.setZero();
   for (size_t a = 0; a < n_bodies; ++a)
     for (size_t i = 0; i < rows[a].rows.size(); ++i) g_loads_[rows[a].rows[i]] += g[a][static_cast<Eigen::Index>(i)];

@@ -48,7 +48,8 @@ class InterfaceProblem {
 
   // Needs a system built with Factorization::interface. Free responses and Schur complements, bodies in
   // parallel through `runner`.
-  InterfaceProblem(const ContactSystem& system, parallel::TaskRunner& runner) : InterfaceProblem(system, runner, Options{}) {}
+  InterfaceProblem(const ContactSystem& system, parallel::TaskRunner& runner)
+      : InterfaceProblem(system, runner, Options{}) {}
   InterfaceProblem(const ContactSystem& system, parallel::TaskRunner& runner, const Options& options);
 
   Eigen::Index size() const { return size_; }
@@ -61,7 +62,7 @@ class InterfaceProblem {
   // Recomputes the bodies' free responses for the current loads: needed when a step's loads are not a multiple of
   // the previous ones (conditions with their own history). One solve per body.
   void refresh_loads(parallel::TaskRunner& runner);
-  const Eigen::VectorXd& weights() const { return D_; }       // area of every row, stacked
+  const Eigen::VectorXd& weights() const { return D_; }  // area of every row, stacked
   Eigen::Index offset(size_t pair) const { return offset_[pair]; }
   const ContactSystem& system() const { return system_; }
 
@@ -107,7 +108,8 @@ class InterfaceProblem {
   struct BodyParts;  // what one body's task computes
   void compute_body(size_t a, BodyParts& out) const;
   void assemble_equilibrium(const std::vector<BodyParts>& parts);
-  bool apply_blocks(const Eigen::VectorXd& x, Eigen::VectorXd& y, parallel::TaskRunner& runner, bool preconditioner) const;
+  bool apply_blocks(const Eigen::VectorXd& x, Eigen::VectorXd& y, parallel::TaskRunner& runner,
+                    bool preconditioner) const;
   // apply_blocks' split of the blocks this process applies over its threads: runs [first[c], first[c + 1]) of
   // `blocks`, and a vector per run to sum into. Made at the first product with a runner and kept (the products are
   // the iterative solver's hot path: thousands per solve); one per kind (F, preconditioner). The products of one

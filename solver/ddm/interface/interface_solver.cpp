@@ -16,7 +16,6 @@ constexpr Eigen::Index max_direct_rows = 40000;
 // Beyond this many floating-body rows (ten floating bodies) the `auto` preconditioner is none (resolved_settings).
 constexpr Eigen::Index max_dirichlet_floating_rows = 30;
 
-
 Eigen::Index floating_rows(const ContactSystem& system) {
   Eigen::Index rows = 0;
   for (size_t a = 0; a < system.n_bodies(); ++a) rows += system.body(a).rigid_modes().cols();
@@ -56,9 +55,10 @@ InterfaceProblem::Options interface_options(InterfaceSolverKind kind, const Inte
   return options;
 }
 
-std::unique_ptr<InterfaceSolver> make_interface_solver(InterfaceSolverKind kind, const InterfaceSolverSettings& settings,
-                                                       bool friction) {
-  if (kind == InterfaceSolverKind::iterative) return std::make_unique<FetiSolver>(settings);  // with or without friction
+std::unique_ptr<InterfaceSolver> make_interface_solver(InterfaceSolverKind kind,
+                                                       const InterfaceSolverSettings& settings, bool friction) {
+  if (kind == InterfaceSolverKind::iterative)
+    return std::make_unique<FetiSolver>(settings);  // with or without friction
   if (friction) return std::make_unique<FrictionDirectSolver>();
   return std::make_unique<SparseDirectSolver>();
 }

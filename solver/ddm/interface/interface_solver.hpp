@@ -67,7 +67,8 @@ class InterfaceSolver {
   virtual ~InterfaceSolver() = default;
   virtual const char* name() const = 0;  // "direct" or "iterative": the job's and the result's word
   // z0: the warm start (the previous load step's or update's pressures), or null.
-  virtual linalg::ActiveSetResult solve(const InterfaceQp& qp, const Eigen::VectorXd* z0, InterfaceSolveContext& context) = 0;
+  virtual linalg::ActiveSetResult solve(const InterfaceQp& qp, const Eigen::VectorXd* z0,
+                                        InterfaceSolveContext& context) = 0;
 };
 
 // The solver to use for `system` under `settings`: the one asked for, or, automatically, the iterative solver
@@ -88,7 +89,7 @@ InterfaceProblem::Options interface_options(InterfaceSolverKind kind, const Inte
                                             bool friction = false);
 // With friction: direct is the semismooth Newton on stick and slip sets (friction_direct.hpp), iterative FETI on
 // the box of the normal and tangential multipliers (feti.hpp).
-std::unique_ptr<InterfaceSolver> make_interface_solver(InterfaceSolverKind kind, const InterfaceSolverSettings& settings,
-                                                       bool friction = false);
+std::unique_ptr<InterfaceSolver> make_interface_solver(InterfaceSolverKind kind,
+                                                       const InterfaceSolverSettings& settings, bool friction = false);
 
 }  // namespace contact::ddm

@@ -132,7 +132,8 @@ bool Smalbe::report(int step, const Solve& how, ActiveSetResult& out) {
   for (Eigen::Index j = 0; j < normal; ++j) {
     active[static_cast<size_t>(j)] = out.z[j] > 0;
     r.active += active[static_cast<size_t>(j)];
-    if (!previous_active_.empty()) r.changes += active[static_cast<size_t>(j)] != previous_active_[static_cast<size_t>(j)];
+    if (!previous_active_.empty())
+      r.changes += active[static_cast<size_t>(j)] != previous_active_[static_cast<size_t>(j)];
     C[j] = out.z[j] - std::max(0.0, out.z[j] - out.h[j] / diagonal_[j]);
   }
   if (previous_active_.empty()) r.changes = r.active;
@@ -221,8 +222,7 @@ void Smalbe::solve(const Bounds& bounds, const Eigen::VectorXd* z0, const Solve&
       // SMALBE's (hertz_force.json: pressures 1.7e-8 from the monolithic reference against 7.5e-10). The
       // intermediate solves of Coulomb's outer iteration need only their own tolerance (a tenth there too cost the
       // 8 x 8 wall 30 % more products).
-      const double target =
-          how.tolerance <= tuning.face_finest_factor * s_.tolerance ? tuning.face_target_finest : 1.0;
+      const double target = how.tolerance <= tuning.face_finest_factor * s_.tolerance ? tuning.face_target_finest : 1.0;
       const FaceSolve f = solve_face(x, how.tolerance * scale_g, target * how.tolerance * scale_g, out);
       if (f == FaceSolve::cancelled) {
         out.cancelled = true;
@@ -247,8 +247,8 @@ void Smalbe::solve(const Bounds& bounds, const Eigen::VectorXd* z0, const Solve&
       os << "FETI (projected MPRGP, SMALBE) converged: " << out.inner_iterations << " MPRGP iterations in " << outer
          << " outer iterations (" << r.cg_steps << " CG, " << r.expansion_steps << " expansion, "
          << r.proportioning_steps << " proportioning steps in the last; " << face_steps_
-         << " products in CG on settled faces; F products " << seconds_F_
-         << " s, coarse projections " << seconds_coarse_ << " s)";
+         << " products in CG on settled faces; F products " << seconds_F_ << " s, coarse projections "
+         << seconds_coarse_ << " s)";
       out.message = out.converged ? os.str() : "the contact nodes in contact do not hold every floating body";
       return;
     }

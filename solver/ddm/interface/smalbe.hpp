@@ -70,7 +70,7 @@ class Smalbe {
   Eigen::VectorXd z_I_, Pc_, diagonal_, nu_, last_z_;
   Eigen::VectorXd range_;  // Q x of the last x apply_A took
   double rho_ = 1.0, norm_A_ = 1.0, norm_PHP_ = 1.0;
-  long face_steps_ = 0;  // products with H in solve_face, over the object's life
+  long face_steps_ = 0;                            // products with H in solve_face, over the object's life
   double seconds_F_ = 0.0, seconds_coarse_ = 0.0;  // products with F (and their sum over processes), P and Q
   bool ready_ = false;
   linalg::BoundQp bound_;

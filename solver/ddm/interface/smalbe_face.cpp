@@ -52,8 +52,7 @@ Smalbe::FaceSolve Smalbe::solve_face(Eigen::VectorXd& x_inout, double tolerance,
       return false;
     }
     Eigen::VectorXd Mr;
-    const bool stop =
-        qp_.problem.apply_preconditioner(r, Mr, ctx_.frame.runner()) || ctx_.frame.stop_requested();
+    const bool stop = qp_.problem.apply_preconditioner(r, Mr, ctx_.frame.runner()) || ctx_.frame.stop_requested();
     y = projected(Mr);
     return stop;
   };

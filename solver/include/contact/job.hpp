@@ -26,19 +26,19 @@ struct Limits {
   // 8,128 pairs); validation and pair set-up are linear in them. contactd sets its own (--max-bodies, --max-contacts).
   int max_bodies = 16384;
   int max_contacts = 65536;
-  int max_threads = 64;                // solver.threads
-  int max_iterations = 100'000;        // solver.max_iterations
-  int max_updates = 1'000;             // solver.augmented_lagrangian.max_updates
-  int max_adaptive_steps = 100;        // adaptivity.max_steps
-  int max_load_steps = 1000;           // loading.steps, or the number of loading.factors
+  int max_threads = 64;          // solver.threads
+  int max_iterations = 100'000;  // solver.max_iterations
+  int max_updates = 1'000;       // solver.augmented_lagrangian.max_updates
+  int max_adaptive_steps = 100;  // adaptivity.max_steps
+  int max_load_steps = 1000;     // loading.steps, or the number of loading.factors
   // The result file's size (the disk a job takes; its steps are streamed to it as solved), as estimated before
   // the job runs (io::estimated_result_bytes: nodes x kept steps); 0: no limit (the command line), contactd's
   // --max-result-bytes otherwise.
   double max_result_bytes = 0;
-  std::string result_bytes_hint;       // the setting named when a job is over max_result_bytes
-  int max_ranks = 4096;                // parallel.ranks (contactd: its --max-ranks, 1 without an MPI launcher)
-  std::string ranks_hint;              // appended to the message when parallel.ranks is over max_ranks
-  std::size_t max_name_length = 64;    // body, edge and contact names (identifiers)
+  std::string result_bytes_hint;     // the setting named when a job is over max_result_bytes
+  int max_ranks = 4096;              // parallel.ranks (contactd: its --max-ranks, 1 without an MPI launcher)
+  std::string ranks_hint;            // appended to the message when parallel.ranks is over max_ranks
+  std::size_t max_name_length = 64;  // body, edge and contact names (identifiers)
   std::size_t max_job_name_length = 256;
   // Gmsh meshes given as {"file": ...} are read relative to this directory (the job file's: parse_file sets it).
   // Unset, a job may not name a file (the server: a job sends the .msh text as "data").

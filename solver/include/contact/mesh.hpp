@@ -38,9 +38,7 @@ class Cell {
   int* end() { return nodes_.data() + size_; }
   const int* begin() const { return nodes_.data(); }
   const int* end() const { return nodes_.data() + size_; }
-  bool operator==(const Cell& o) const {
-    return size_ == o.size_ && std::equal(begin(), end(), o.begin());
-  }
+  bool operator==(const Cell& o) const { return size_ == o.size_ && std::equal(begin(), end(), o.begin()); }
   bool operator!=(const Cell& o) const { return !(*this == o); }
 
  private:
@@ -75,8 +73,8 @@ struct Curve {
 
 struct Mesh {
   std::vector<Point> nodes;
-  std::vector<Cell> cells;                 // node indices, counter-clockwise
-  std::vector<int> level;                  // refinement level per cell (0 = initial mesh)
+  std::vector<Cell> cells;  // node indices, counter-clockwise
+  std::vector<int> level;   // refinement level per cell (0 = initial mesh)
   // Boundary edge sets by name, each ordered along the edge (consecutive entries share a node), counter-clockwise
   // along the boundary (the body on the left). An edge set is an open chain (two ends) or a closed loop (the last
   // side ends where the first begins: a bore, a shaft's rim, the whole outline of a body); see edge_set_closed().
@@ -145,8 +143,7 @@ std::optional<std::string> fit_curve(Curve& curve, const Point& p, const Point& 
 // from its one end, a closed loop from the first node (counter-clockwise) of the side given first, `pairs[0]`.
 // Returns an error message naming the offending pair (by its index in `pairs`), or saying why the set is not one
 // piece.
-std::optional<std::string> add_edge_set(Mesh& m, const std::string& name,
-                                        const std::vector<std::array<int, 2>>& pairs);
+std::optional<std::string> add_edge_set(Mesh& m, const std::string& name, const std::vector<std::array<int, 2>>& pairs);
 
 // ---------------------------------------------------------------------------------------------------------
 // Refinement (quadtree): a marked cell splits into four (a quadrilateral by its side midpoints and its centre, a

@@ -75,8 +75,8 @@ struct Body {
 // off) plus optional analytic terms, e.g. the paper's d = r0 (x - x0)^2.
 struct GapSpec {
   bool geometric = true;
-  double constant = 0.0;                       // added everywhere
-  std::optional<double> parabola_r0;           // adds r0 (x - x0)^2, x the slave point's x coordinate
+  double constant = 0.0;              // added everywhere
+  std::optional<double> parabola_r0;  // adds r0 (x - x0)^2, x the slave point's x coordinate
   double parabola_x0 = 0.0;
 };
 
@@ -91,8 +91,8 @@ struct FrictionSpec {
 };
 
 struct ContactPair {
-  std::string name;      // "slave_body.edge-master_body.edge" unless the job names it
-  int slave_body = -1;   // index into Problem::bodies
+  std::string name;     // "slave_body.edge-master_body.edge" unless the job names it
+  int slave_body = -1;  // index into Problem::bodies
   std::string slave_edge;
   int master_body = -1;
   std::string master_edge;
@@ -143,7 +143,8 @@ struct RobinSettings {
 // Uzawa updates of the contact pressure around the penalty solve: stop when the relative change of the
 // pressures between two updates is below tolerance.
 struct AugmentedLagrangianSettings {
-  double tolerance = 1e-6;  // at least ~100 times the inner solve's tolerance: the inner solves bound the attainable change
+  double tolerance =
+      1e-6;  // at least ~100 times the inner solve's tolerance: the inner solves bound the attainable change
   int max_updates = 100;
 };
 
@@ -158,8 +159,8 @@ enum class InterfacePreconditioner { none, lumped, dirichlet, automatic };
 struct InterfaceSolverSettings {
   InterfaceSolverKind solver = InterfaceSolverKind::automatic;
   InterfacePreconditioner preconditioner = InterfacePreconditioner::automatic;  // iterative only
-  double tolerance = 1e-12;        // iterative: projected gradient and equilibrium, relative
-  long max_iterations = 300000;    // iterative: products with the interface operator, in all
+  double tolerance = 1e-12;      // iterative: projected gradient and equilibrium, relative
+  long max_iterations = 300000;  // iterative: products with the interface operator, in all
 };
 
 // Defaults: exact contact by interface Newton. The job parser fills the defaults that depend on the method
@@ -169,13 +170,13 @@ struct InterfaceSolverSettings {
 struct SolverSettings {
   Method method = Method::interface_newton;
   PenaltySpec penalty;
-  double gamma = 0.02;        // relaxation of (17) when gamma_auto is false
-  bool gamma_auto = true;     // estimate the interface compliance and choose gamma (overrides gamma)
-  double tolerance = 1e-8;    // eps of the chosen criterion (fixed-point methods)
+  double gamma = 0.02;      // relaxation of (17) when gamma_auto is false
+  bool gamma_auto = true;   // estimate the interface compliance and choose gamma (overrides gamma)
+  double tolerance = 1e-8;  // eps of the chosen criterion (fixed-point methods)
   Criterion criterion = Criterion::residual;
   int max_iterations = 2000;  // iterations (fixed-point methods) or active-set / Newton steps
   InitialGuess initial_guess = InitialGuess::elastic_layer;
-  int threads = 0;            // worker threads for the per-body solves; 0 = one per body up to the cores
+  int threads = 0;  // worker threads for the per-body solves; 0 = one per body up to the cores
   Acceleration acceleration = Acceleration::anderson;
   int anderson_depth = 10;
   RobinSettings robin;
@@ -219,7 +220,7 @@ struct AdaptivitySettings {
   Normalization normalization = Normalization::rms;
   double delta = 0.1;
   MarkingRule marking = MarkingRule::contact;
-  double grading = 0.0;     // marking contact: cells below grading x distance to the contact zone are not refined (0: off)
+  double grading = 0.0;  // marking contact: cells below grading x distance to the contact zone are not refined (0: off)
   std::vector<int> bodies;  // indices of the adaptive bodies; empty = all
   int max_level = 8;        // refinement levels above the initial mesh
   long max_dofs = 400000;   // per body; refinement that would exceed it is cut back (and reported)
@@ -232,7 +233,7 @@ struct AdaptivitySettings {
   // not made (refinement is cut back, as by max_total_dofs).
   double max_kept_nodes = 0;
   AdaptStrategy strategy = AdaptStrategy::converge_then_refine;
-  int max_steps = 20;       // refinement steps (converge_then_refine)
+  int max_steps = 20;  // refinement steps (converge_then_refine)
   // converge_then_refine stops once a step changed the total contact force, the peak contact pressure and the
   // global estimate each by less than this, relatively (0: never stop for that reason).
   double stop_tolerance = 0.005;

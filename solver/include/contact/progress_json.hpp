@@ -34,9 +34,9 @@ struct ProgressSelection {
   std::vector<std::string> patterns;  // shell globs on pair names (fnmatch: * ? [..]); empty: the default
   bool all = false;                   // every pair whatever their number (contactd asks its MPI runs for this)
 };
-inline constexpr std::size_t kPairsListedAll = 16;   // by default, up to this many pairs every pair is listed
-inline constexpr std::size_t kMaxPairsSelected = 64; // at most this many pairs matched by the patterns are listed
-inline constexpr std::size_t kBodiesListedAll = 64;  // past this many bodies only their totals
+inline constexpr std::size_t kPairsListedAll = 16;    // by default, up to this many pairs every pair is listed
+inline constexpr std::size_t kMaxPairsSelected = 64;  // at most this many pairs matched by the patterns are listed
+inline constexpr std::size_t kBodiesListedAll = 64;   // past this many bodies only their totals
 
 bool matches_any(const std::string& name, const std::vector<std::string>& patterns);
 

@@ -18,22 +18,22 @@ const char* to_string(StopReason r);
 struct BodyReport {
   std::string name;
   int elements = 0;
-  int dofs = 0;             // unknowns after constraints
-  int elements_refined = 0; // in this iteration (0 without adaptivity)
+  int dofs = 0;              // unknowns after constraints
+  int elements_refined = 0;  // in this iteration (0 without adaptivity)
 };
 
 // Contact pressure is positive in compression; it is the nodal multiplier of the dual mortar discretisation
 // (mortar/pair.hpp), one value per slave node (0 where a node carries none).
 struct PairReport {
   std::string name;
-  double force = 0.0;          // total normal contact force (per unit thickness in plane strain)
+  double force = 0.0;  // total normal contact force (per unit thickness in plane strain)
   Eigen::Vector2d resultant = Eigen::Vector2d::Zero();  // the force vector on the slave (PairField::resultant)
   double max_pressure = 0.0;
-  double extent_begin = 0.0;   // arc lengths along the slave edge where the contact zone begins and ends,
-  double extent_end = 0.0;     // interpolated between nodes (solver/contact_extent.hpp; both 0 without contact)
-  int active_nodes = 0;        // slave nodes in contact (pressure > 0)
-  int changed_nodes = 0;       // slave nodes whose contact status changed since the last iteration
-  double theta = 0.0;          // penalty parameter (0 when contact is enforced exactly)
+  double extent_begin = 0.0;      // arc lengths along the slave edge where the contact zone begins and ends,
+  double extent_end = 0.0;        // interpolated between nodes (solver/contact_extent.hpp; both 0 without contact)
+  int active_nodes = 0;           // slave nodes in contact (pressure > 0)
+  int changed_nodes = 0;          // slave nodes whose contact status changed since the last iteration
+  double theta = 0.0;             // penalty parameter (0 when contact is enforced exactly)
   double max_penetration = 0.0;   // largest overlap max(0, -g) of the nodal gaps
   std::vector<double> positions;  // arc length along the slave edge of each slave node
   std::vector<double> pressures;  // contact pressure at each slave node
@@ -53,17 +53,17 @@ enum class Measure { fixed_point, complementarity, gradient };
 const char* to_string(Measure m);
 
 struct IterationReport {
-  int iteration = 0;                // 1-based
+  int iteration = 0;  // 1-based
   Measure measure = Measure::fixed_point;
-  double paper_criterion = 0.0;     // max over bodies of ||u_n^k - u_n^{k-1}|| / ||u_n^k|| (paper, section 4)
-  double fixed_point_residual = 0.0;// ||u~_n^{k+1} - u_n^k|| / ||u_n^k|| over all contact zones (fixed-point
-                                    // methods); the relative energy gradient (monolithic penalty Newton)
-  double complementarity = 0.0;     // active-set methods: ||z - max(0, z - c g)|| / ||z|| over all contact nodes
-  int active_nodes = 0;             // contact nodes in contact, all pairs
-  int active_set_changes = 0;       // contact nodes whose status changed since the last iteration, all pairs
-  double gamma = 0.0;               // relaxation in use (0 for methods without one)
-  int update = 0;                   // augmented-Lagrangian update (0 for the pure penalty method)
-  std::string note;                 // what changed in this iteration, if anything (e.g. "gamma reduced")
+  double paper_criterion = 0.0;       // max over bodies of ||u_n^k - u_n^{k-1}|| / ||u_n^k|| (paper, section 4)
+  double fixed_point_residual = 0.0;  // ||u~_n^{k+1} - u_n^k|| / ||u_n^k|| over all contact zones (fixed-point
+                                      // methods); the relative energy gradient (monolithic penalty Newton)
+  double complementarity = 0.0;       // active-set methods: ||z - max(0, z - c g)|| / ||z|| over all contact nodes
+  int active_nodes = 0;               // contact nodes in contact, all pairs
+  int active_set_changes = 0;         // contact nodes whose status changed since the last iteration, all pairs
+  double gamma = 0.0;                 // relaxation in use (0 for methods without one)
+  int update = 0;                     // augmented-Lagrangian update (0 for the pure penalty method)
+  std::string note;                   // what changed in this iteration, if anything (e.g. "gamma reduced")
   std::vector<BodyReport> bodies;
   std::vector<PairReport> pairs;
   double elapsed_seconds = 0.0;
@@ -77,13 +77,13 @@ struct BodyField {
   Eigen::MatrixX4d stress_cell;   // per cell, mean over Gauss points: sxx, syy, sxy, szz
   Eigen::MatrixX4d stress_node;   // recovered per node (average of Gauss values extrapolated to the nodes)
   Eigen::VectorXd von_mises_cell;
-  Eigen::VectorXd indicator_cell; // error indicator per cell (empty without adaptivity)
-  Eigen::MatrixX2d reaction;      // per node: force the supports exert (zero where nothing is prescribed)
+  Eigen::VectorXd indicator_cell;  // error indicator per cell (empty without adaptivity)
+  Eigen::MatrixX2d reaction;       // per node: force the supports exert (zero where nothing is prescribed)
   // Per displacement condition (edge or vertex, in the job's order): the sum of the reactions at its nodes in the
   // components it prescribes (a corner component prescribed by two conditions counts in both); and the sum over
   // all nodes, each once.
   struct SupportReaction {
-    std::string where;            // the edge or vertex name
+    std::string where;  // the edge or vertex name
     Eigen::Vector2d force = Eigen::Vector2d::Zero();
   };
   std::vector<SupportReaction> support_reactions;
@@ -100,22 +100,22 @@ struct BodyField {
 struct PairField {
   std::string name;
   std::string slave_body, slave_edge, master_body, master_edge;
-  std::string enforcement;       // "exact", "penalty" or "augmented_lagrangian"
-  double theta = 0.0;            // penalty parameter (0 for exact enforcement)
-  Eigen::VectorXi node;          // the slave nodes' indices in the slave body's mesh
-  Eigen::MatrixX2d position;     // slave node coordinates
-  Eigen::MatrixX2d normal;       // unit contact normal (outward of the slave); 0 where no multiplier
-  Eigen::VectorXd arc_length;    // along the slave edge from its first node
-  Eigen::VectorXd weight;        // D of the node's multiplier (length x thickness); 0 where none
-  Eigen::VectorXd gap;           // initial nodal gap d (geometric + analytic)
-  Eigen::VectorXd normal_gap;    // d - u_1n - u_2n after deformation (negative = penetration)
-  Eigen::VectorXd pressure;      // the nodal multiplier z (exact) or max(0, lambda - normal_gap / theta)
-  Eigen::VectorXd penetration;   // max(0, -normal_gap) (0 where no multiplier)
-  Eigen::VectorXi active;        // 1 where the pressure is positive
-  Eigen::VectorXi status;        // 0 contact node, 1 not opposite the master, 2 crosspoint, 3 barely covered,
-                                 // 4 inside a multiplier segment, 5 carried by another pair of its group
-  double force = 0.0;            // sum of weight x pressure: the total normal force (a scalar sum of normal
-                                 // pressures: on a curved slave more than the load it carries)
+  std::string enforcement;      // "exact", "penalty" or "augmented_lagrangian"
+  double theta = 0.0;           // penalty parameter (0 for exact enforcement)
+  Eigen::VectorXi node;         // the slave nodes' indices in the slave body's mesh
+  Eigen::MatrixX2d position;    // slave node coordinates
+  Eigen::MatrixX2d normal;      // unit contact normal (outward of the slave); 0 where no multiplier
+  Eigen::VectorXd arc_length;   // along the slave edge from its first node
+  Eigen::VectorXd weight;       // D of the node's multiplier (length x thickness); 0 where none
+  Eigen::VectorXd gap;          // initial nodal gap d (geometric + analytic)
+  Eigen::VectorXd normal_gap;   // d - u_1n - u_2n after deformation (negative = penetration)
+  Eigen::VectorXd pressure;     // the nodal multiplier z (exact) or max(0, lambda - normal_gap / theta)
+  Eigen::VectorXd penetration;  // max(0, -normal_gap) (0 where no multiplier)
+  Eigen::VectorXi active;       // 1 where the pressure is positive
+  Eigen::VectorXi status;       // 0 contact node, 1 not opposite the master, 2 crosspoint, 3 barely covered,
+                                // 4 inside a multiplier segment, 5 carried by another pair of its group
+  double force = 0.0;           // sum of weight x pressure: the total normal force (a scalar sum of normal
+                                // pressures: on a curved slave more than the load it carries)
   // The resultant contact force vector on the slave body (the master exerts it; the master receives its
   // opposite): the sum over the slave's nodes of its discrete contact forces -Gs^T z (with friction also the
   // tangential ones, -Ts^T q). Equal and opposite to the slave's other loads and reactions in equilibrium.
@@ -137,7 +137,7 @@ struct PairField {
 // One mesh state of the adaptive loop, or one load step; without either there is a single step.
 struct Step {
   int index = 0;
-  int iteration = 0;  // the DDM iteration at which this step's mesh was final
+  int iteration = 0;         // the DDM iteration at which this step's mesh was final
   double load_factor = 1.0;  // the load factor of this step (Problem::loading)
   // Whether this step's solve converged. A step that did not is kept only as the last one of a run that stopped on
   // it (its iterate, flagged), never as an answer: the steps before it all converged.
@@ -170,17 +170,17 @@ struct RunOutcome {
   StopReason stop_reason = StopReason::error;
   std::string message;  // human-readable detail of the stop (error text when stop_reason == error)
   int iterations = 0;
-  double gamma = 0.0;   // relaxation used (0 for monolithic)
-  int subdomain_solves = 0;  // back-substitutions per body (the DDM's unit of work), initial guess included
-  int updates = 0;           // augmented-Lagrangian updates (0 for the pure penalty method)
-  std::string interface_solver;   // interface_newton: "direct" or "iterative" (solver.interface.solver)
-  long interface_iterations = 0;  // the iterative interface solver's MPRGP iterations, all solves together
-  double indicator_seconds = 0.0;   // adaptivity: estimating (for fem_bem: the boundary-element work)
+  double gamma = 0.0;              // relaxation used (0 for monolithic)
+  int subdomain_solves = 0;        // back-substitutions per body (the DDM's unit of work), initial guess included
+  int updates = 0;                 // augmented-Lagrangian updates (0 for the pure penalty method)
+  std::string interface_solver;    // interface_newton: "direct" or "iterative" (solver.interface.solver)
+  long interface_iterations = 0;   // the iterative interface solver's MPRGP iterations, all solves together
+  double indicator_seconds = 0.0;  // adaptivity: estimating (for fem_bem: the boundary-element work)
   std::vector<IterationReport> history;
 };
 
 struct Result : RunOutcome {
-  std::string method;   // "interface_newton", "neumann", "robin" or "monolithic"
+  std::string method;       // "interface_newton", "neumann", "robin" or "monolithic"
   std::string enforcement;  // "exact", "penalty" or "augmented_lagrangian"
   // The steps whose fields are kept; the last one is the final solution; with StepOutput::last the only one. When
   // the observer stored the steps as they came (Observer::step_sink, streamed_steps > 0) only the last is here.
@@ -191,7 +191,7 @@ struct Result : RunOutcome {
   // load steps that held, not the last iterate (...)"); empty when it converged or nothing was solved.
   std::string kept;
   double wall_seconds = 0.0;
-  double setup_seconds = 0.0;       // assembly + factorisations
+  double setup_seconds = 0.0;  // assembly + factorisations
   double factorization_seconds = 0.0;
 };
 
@@ -200,8 +200,8 @@ struct Result : RunOutcome {
 struct AdaptiveStepReport {
   int step = 0;                    // 0: the initial meshes
   std::vector<BodyReport> bodies;  // cells (elements), unknowns (dofs) and cells refined after this step, per body
-  double estimate = 0.0;   // global: sqrt(sum ||sigma_R - sigma_F||^2 / sum ||sigma_R||^2) over the adaptive bodies
-  double force = 0.0;      // total normal contact force, all pairs
+  double estimate = 0.0;       // global: sqrt(sum ||sigma_R - sigma_F||^2 / sum ||sigma_R||^2) over the adaptive bodies
+  double force = 0.0;          // total normal contact force, all pairs
   double peak_pressure = 0.0;  // largest contact pressure, all pairs
   double force_change = 0.0, peak_change = 0.0, estimate_change = 0.0;
   // The estimated relative L2 error of the contact pressure over all pairs (adapt/pressure_estimate.hpp); NaN

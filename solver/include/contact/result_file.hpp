@@ -23,7 +23,8 @@
 namespace contact::io {
 
 inline constexpr const char* kFormatName = "contact-ddm-result";
-inline constexpr int kFormatVersion = 3;  // 2: mortar contact (per-node multipliers, contact surfaces); 3: contact tables
+inline constexpr int kFormatVersion =
+    3;  // 2: mortar contact (per-node multipliers, contact surfaces); 3: contact tables
 
 struct WriteInfo {
   std::string job_id;   // "" for the CLI
@@ -47,10 +48,10 @@ void write_xdmf(const std::string& xmf_path, const std::string& hdf_file_name, c
 
 // The result file and its XDMF sidecar written as the run goes: handed to solve() as the observer's StepSink
 // (Observer::step_sink), it writes each step's fields (/steps/<k>) when the solver reaches it, so that a job
-// that keeps every step holds one step in memory (two while one is written, below), not all (solve() then returns the last step only,
-// Result::streamed_steps); finish() writes the rest when the run ends. The file is built under "<path>.tmp" and
-// renamed over `path` by finish() only: a crash, an error or abandon() (and destruction before finish) never leave
-// a partial file under the final name. Not thread safe: one run feeds it, from one thread.
+// that keeps every step holds one step in memory (two while one is written, below), not all (solve() then returns the
+// last step only, Result::streamed_steps); finish() writes the rest when the run ends. The file is built under
+// "<path>.tmp" and renamed over `path` by finish() only: a crash, an error or abandon() (and destruction before finish)
+// never leave a partial file under the final name. Not thread safe: one run feeds it, from one thread.
 //
 // A step is written on a thread of the stream's own while the run goes on to the next step (the HDF5 calls are
 // serialised by the library): on a wall of thousands of bricks a step's 200,000 small datasets take seconds,
@@ -82,7 +83,7 @@ class ResultStream : public StepSink {
 
  private:
   struct Open;
-  void wait();                          // for the write in flight
+  void wait();                         // for the write in flight
   void write_taken(const Step& step);  // on the writer thread (or here when no thread can be started)
   std::thread writer_;
   std::string path_, xmf_path_, xmf_hdf_name_;
@@ -96,9 +97,9 @@ class ResultStream : public StepSink {
 std::string xdmf_path_for(const std::string& hdf_path);
 
 // About how many bytes the result file of a job takes (its steps are streamed to it, ResultStream, so this bounds
-// the disk, not the memory): `kept_steps` steps' fields (and the final step's copy for ParaView, /VTKHDF) over `nodes` mesh nodes,
-// `bodies` bodies and `pairs` contact pairs. Measured (format version 2): 270-280 bytes a node and step on two
-// 40 x 40 to 80 x 80 blocks, and some 25 kB a body and step in metadata and small datasets (a 22 x 22 brick wall,
+// the disk, not the memory): `kept_steps` steps' fields (and the final step's copy for ParaView, /VTKHDF) over `nodes`
+// mesh nodes, `bodies` bodies and `pairs` contact pairs. Measured (format version 2): 270-280 bytes a node and step on
+// two 40 x 40 to 80 x 80 blocks, and some 25 kB a body and step in metadata and small datasets (a 22 x 22 brick wall,
 // 496 bodies: 30 MB for 2 steps). A pair (format version 3, the contact tables) is 770 bytes a step on the 64 x 64
 // wall, and its columns of the iteration history 2 kB over the run's 32 iterations: 2 kB a pair and step keeps
 // the estimate above the file (160 MB for 2 steps of 4,129 bodies and 12,192 pairs; 5 kB a pair in version 2).
