@@ -73,6 +73,11 @@ void add_job_limit_flags(CLI::App& app, Config& c) {
       ->envname("CONTACTD_SMALL_JOB_DOFS")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  app.add_option("--small-job-seconds", c.queue.small_job_seconds,
+                 "a run on the small-job lane longer than this is stopped and queued again for a general worker")
+      ->envname("CONTACTD_SMALL_JOB_SECONDS")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   app.add_option("--max-queued", c.queue.max_queued, "queued jobs beyond which submissions get 503")
       ->envname("CONTACTD_MAX_QUEUED")
       ->check(CLI::Range(1, 1000000))

@@ -79,6 +79,10 @@ void Janitor::watch_running(std::chrono::steady_clock::time_point now) {
   std::vector<std::string> stuck;
   // stuck_ is written by this thread only: read here without the lock.
   pool_.for_each_running([&](Job& job) {
+    if (now >= job.lane_deadline && job.cancel_reason.load() == static_cast<int>(CancelReason::none)) {
+      job.request_cancel(CancelReason::lane);
+      log_line("job " + job.record.id + ": ran past the small-job lane's time; moving it to the general lane");
+    }
     if (now >= job.deadline && job.cancel_reason.load() == static_cast<int>(CancelReason::none)) {
       job.request_cancel(CancelReason::time_limit);
       char limit[32];

@@ -19,7 +19,8 @@
 namespace contactd {
 
 // Why a running job's CancelToken was set; the first reason wins.
-enum class CancelReason : int { none = 0, user = 1, time_limit = 2, shutdown = 3 };
+// `lane`: a small-lane run past --small-job-seconds, stopped to run again on a general worker.
+enum class CancelReason : int { none = 0, user = 1, time_limit = 2, shutdown = 3, lane = 4 };
 
 // A job in memory. `record`, `disk_bytes` and `cancelling_queued` are guarded by the JobRegistry's mutex;
 // `deadline` and `cancel_requested_at` by the WorkerPool's (the pool's lock is taken before the registry's, never
@@ -33,6 +34,8 @@ struct Job {
   contact::CancelToken cancel;
   std::atomic<int> cancel_reason{static_cast<int>(CancelReason::none)};
   std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
+  // A run on a small-lane worker past this is moved to the general lane (max: not on the small lane).
+  std::chrono::steady_clock::time_point lane_deadline = std::chrono::steady_clock::time_point::max();
   EventLog events;
   std::mutex persist_mutex;
   std::atomic<bool> settled{false};  // done and its `end` event written: it may be deleted

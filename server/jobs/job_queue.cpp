@@ -23,6 +23,7 @@ JobQueue::JobQueue(JobStore& store, Metrics& metrics, BodyBudget& budget, QueueS
       metrics_(metrics),
       registry_(store, settings_.max_event_log_bytes),
       pool_(registry_, settings_.workers, settings_.small_workers, settings_.time_limit_seconds,
+            settings_.small_job_seconds,
             [this](const std::shared_ptr<Job>& job) { JobRun(run_context_, job).execute(); }),
       janitor_(registry_, pool_, store, settings_),
       run_context_{registry_,

@@ -69,6 +69,10 @@ void JobRun::execute() {
     requeue_after_shutdown();
     return;
   }
+  if (result.stop_reason == contact::StopReason::cancelled && reason == CancelReason::lane) {
+    requeue_in_general_lane();
+    return;
+  }
   JobRecord outcome = outcome_of(result, reason);
   // The result file: written before the job is marked done, so that `end` means "downloadable now".
   write_result_files(result, outcome);
@@ -258,26 +262,43 @@ void JobRun::finish(JobRecord outcome) {
 }
 
 void JobRun::requeue_after_shutdown() {
+  if (store_queued_again("interrupted by a shutdown; it runs again when the server restarts", false))
+    log_line("job " + id_ + ": interrupted by the shutdown, stored as QUEUED");
+}
+
+// A run on the small-job lane past --small-job-seconds: sized small, it is not, and it held the lane that keeps
+// small jobs from waiting behind long ones. Stored QUEUED as a general job; the worker pool puts it first in line for
+// a general worker (WorkerPool::release), where it runs again from the start.
+void JobRun::requeue_in_general_lane() {
+  char seconds[32];
+  std::snprintf(seconds, sizeof seconds, "%g", context_.settings.small_job_seconds);
+  if (store_queued_again(std::string("moved to the general lane: it ran past the small-job lane's ") + seconds +
+                             " s; it runs again from the start on a general worker",
+                         true))
+    log_line("job " + id_ + ": moved from the small-job lane to the general lane");
+}
+
+// Stored QUEUED again (its partial result files removed), with `message` on its stream; false if the store could
+// not take the change (then it is RUNNING on disk, and the next start queues it again as interrupted).
+bool JobRun::store_queued_again(const std::string& message, bool general) {
   job_->set_pair_detail(nullptr);
   stream_.reset();  // its partial file is removed
   context_.store.remove_result(id_);
-  const std::string message = "interrupted by a shutdown; it runs again when the server restarts";
-  if (!context_.registry.commit(
-          job_,
-          [&message](JobRecord& r) {
-            r.state = JobState::queued;
-            r.started_us = 0;
-            r.iterations = 0;
-            r.progress = nullptr;
-            r.message = message;
-          },
-          /*durable=*/true)) {
-    return;  // RUNNING on disk: the next start queues it again (as interrupted)
-  }
+  const JobRegistry::Change change = [&message, general](JobRecord& r) {
+    r.state = JobState::queued;
+    r.started_us = 0;
+    r.iterations = 0;
+    r.progress = nullptr;
+    r.message = message;
+    if (general) r.small = false;  // read by the pool only after this (it queues the job once the run ends)
+  };
+  // A shutdown does not wait for the disk; a move to the general lane does (a job RUNNING in the store but in no
+  // worker's hands would be lost until the next start).
+  if (general ? !commit_patiently(change) : !context_.registry.commit(job_, change, /*durable=*/true)) return false;
   const int attempts = context_.registry.snapshot(*job_).attempts;
   job_->events.append("state", state_event(JobState::queued, message, attempts));
   job_->events.sync_and_close();
-  log_line("job " + id_ + ": interrupted by the shutdown, stored as QUEUED");
+  return true;
 }
 
 bool JobRun::commit_patiently(const JobRegistry::Change& change) {

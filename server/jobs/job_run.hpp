@@ -65,6 +65,8 @@ class JobRun {
   void keep_pair_detail();
   void finish(JobRecord outcome);
   void requeue_after_shutdown();
+  void requeue_in_general_lane();
+  bool store_queued_again(const std::string& message, bool general);
   // commit() until it succeeds or the workers stop; false if stopped.
   bool commit_patiently(const JobRegistry::Change& change);
 

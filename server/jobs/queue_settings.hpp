@@ -17,6 +17,9 @@ struct QueueSettings {
   // never waits behind long ones; and the size below which a job is small: unknowns x load steps.
   int small_workers = 1;
   long small_job_dofs = 20'000;
+  // A run on the small lane that takes longer than this is stopped and queued again for a general worker (its size
+  // said small, its solve was not: a tight tolerance, a slow method), so that the lane stays free for small jobs.
+  double small_job_seconds = 10.0;
   std::size_t max_queued = 100;  // QUEUED jobs beyond which submissions are refused (503)
   long max_dofs = 2'000'000;     // job::Limits::max_dofs
   // job::Limits::max_bodies and max_contacts: a server's share of the machine, a setting. The 64 x 64 frictional

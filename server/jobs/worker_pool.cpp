@@ -11,11 +11,13 @@
 
 namespace contactd {
 
-WorkerPool::WorkerPool(JobRegistry& registry, int workers, int small_workers, double time_limit_seconds, Run run)
+WorkerPool::WorkerPool(JobRegistry& registry, int workers, int small_workers, double time_limit_seconds,
+                       double small_job_seconds, Run run)
     : registry_(registry),
       workers_(workers),
       small_workers_(small_workers),
       time_limit_seconds_(time_limit_seconds),
+      small_job_seconds_(small_job_seconds),
       run_(std::move(run)) {}
 
 WorkerPool::~WorkerPool() {
@@ -142,7 +144,8 @@ bool WorkerPool::general_lane_full() const {
 
 std::shared_ptr<Job> WorkerPool::take(bool small_lane) {
   std::unique_lock<std::mutex> lock(mutex_);
-  // JobRecord::small is set before a job is queued and never changed: read without the registry's lock.
+  // JobRecord::small is set before a job is queued and changed only while it is out of the queue (a run moved to the
+  // general lane, before release() queues it again): read without the registry's lock.
   const auto mine = [small_lane](const std::shared_ptr<Job>& job) { return !small_lane || job->record.small; };
   while (true) {
     const auto ready = [&] {
@@ -191,10 +194,13 @@ bool WorkerPool::store_running(const std::shared_ptr<Job>& job, bool small_lane)
     stop_.wait_for(lock, std::chrono::seconds(1), [this] { return stopping_.load(); });
     return false;
   }
-  job->deadline = time_limit_seconds_ > 0
-                      ? std::chrono::steady_clock::now() +
-                            std::chrono::microseconds(static_cast<std::int64_t>(time_limit_seconds_ * 1e6))
-                      : std::chrono::steady_clock::time_point::max();
+  const auto after = [](double seconds) {
+    return seconds > 0
+               ? std::chrono::steady_clock::now() + std::chrono::microseconds(static_cast<std::int64_t>(seconds * 1e6))
+               : std::chrono::steady_clock::time_point::max();
+  };
+  job->deadline = after(time_limit_seconds_);
+  job->lane_deadline = small_lane ? after(small_job_seconds_) : std::chrono::steady_clock::time_point::max();
   return true;
 }
 
@@ -203,6 +209,14 @@ void WorkerPool::release(const std::shared_ptr<Job>& job, bool small_lane) {
     std::lock_guard<std::mutex> lock(mutex_);
     running_.erase(std::remove(running_.begin(), running_.end(), job), running_.end());
     general_running_ -= small_lane ? 0 : 1;
+    job->lane_deadline = std::chrono::steady_clock::time_point::max();
+    // Moved out of the small lane (its run stored it QUEUED and no longer small): first in line for a general
+    // worker, where it would have been had it not been classed small.
+    if (job->cancel_reason.load() == static_cast<int>(CancelReason::lane) && registry_.is_queued(*job)) {
+      job->cancel_reason.store(static_cast<int>(CancelReason::none));
+      job->cancel.reset();
+      queue_.push_front(job);
+    }
   }
   idle_.notify_all();
   work_.notify_all();  // a general worker may have waited for room

@@ -36,7 +36,10 @@ class WorkerPool {
 
   // `workers` general threads and `small_workers` for small jobs; a run is stopped by its time limit after
   // `time_limit_seconds` (0: none).
-  WorkerPool(JobRegistry& registry, int workers, int small_workers, double time_limit_seconds, Run run);
+  // A small-lane run past `small_job_seconds` is given lane_deadline (the janitor stops it; its run queues it again
+  // as a general job, and release() puts it back in the queue).
+  WorkerPool(JobRegistry& registry, int workers, int small_workers, double time_limit_seconds, double small_job_seconds,
+             Run run);
   ~WorkerPool();  // threads shutdown() gave up on are left to the exiting process
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
@@ -74,7 +77,7 @@ class WorkerPool {
 
   JobRegistry& registry_;
   const int workers_, small_workers_;
-  const double time_limit_seconds_;
+  const double time_limit_seconds_, small_job_seconds_;
   const Run run_;
 
   mutable std::mutex mutex_;

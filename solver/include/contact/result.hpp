@@ -238,6 +238,8 @@ class CancelToken {
  public:
   void cancel() { cancelled_.store(true); }
   bool cancelled() const { return cancelled_.load(); }
+  // For a token that serves another run after the one it stopped (contactd: a job moved out of its lane).
+  void reset() { cancelled_.store(false); }
 
  private:
   std::atomic<bool> cancelled_{false};
