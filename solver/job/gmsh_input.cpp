@@ -202,11 +202,32 @@ const GmshMeshes::Parsed* GmshMeshes::from_table(const std::string& name, const 
   return entry.parsed;
 }
 
-std::optional<GmshBody> GmshMeshes::read(const json& value, const std::string& pointer, read::Errors& errors,
-                                         json& out) {
+const GmshMeshes::BuiltSurface& GmshMeshes::surface_of(const Parsed& parsed, const std::string& surface) {
+  const auto key = std::make_pair(&parsed, surface);
+  auto it = surfaces_.find(key);
+  if (it != surfaces_.end()) return it->second;
+  BuiltSurface built;
+  mesh::gmsh::Surface s = mesh::gmsh::surface(parsed.file, surface);
+  built.found = s.found;
+  built.errors = std::move(s.errors);
+  if (built.errors.empty()) {
+    auto body = std::make_shared<GmshBody>();
+    body->mesh = std::move(s.mesh);
+    body->edges = std::move(s.edges);
+    body->elsewhere = std::move(s.elsewhere);
+    body->vertices = std::move(s.vertices);
+    body->points_elsewhere = std::move(s.points_elsewhere);
+    body->surface = surface;
+    built.body = std::move(body);
+  }
+  return surfaces_.emplace(key, std::move(built)).first->second;
+}
+
+std::shared_ptr<const GmshBody> GmshMeshes::read(const json& value, const std::string& pointer, read::Errors& errors,
+                                                 json& out) {
   const size_t before = errors.size();
   read::Fields f(value, pointer, "gmsh", {"file", "data", "mesh", "surface"}, errors);
-  if (!f.ok()) return std::nullopt;
+  if (!f.ok()) return nullptr;
   std::optional<std::string> surface;
   if (const json* s = f.require("surface", "the name of the physical surface that is this body"))
     surface = read::string(*s, f.at("surface"), "surface", errors);
@@ -216,11 +237,11 @@ std::optional<GmshBody> GmshMeshes::read(const json& value, const std::string& p
     errors.add(pointer,
                "give exactly one of mesh (the name of an entry of the job's \"meshes\" table), file (the "
                ".msh file's path, relative to the job file) or data (the .msh file's text)");
-    return std::nullopt;
+    return nullptr;
   }
   const std::string key = f.has("mesh") ? "mesh" : f.has("file") ? "file" : "data";
   const auto text = read::string(*f.find(key), f.at(key), key, errors);
-  if (!text || !surface || errors.size() != before) return std::nullopt;
+  if (!text || !surface || errors.size() != before) return nullptr;
 
   // The job's own string (text is a copy): the cache refers to it, and the job outlives the parse.
   const std::string& given = f.find(key)->get_ref<const std::string&>();
@@ -228,20 +249,11 @@ std::optional<GmshBody> GmshMeshes::read(const json& value, const std::string& p
   const Parsed* parsed = key == "mesh" ? from_table(given, f.at(key), errors, label)
                                        : resolve(Source{key == "file", &given}, f.at(key), errors, label);
   if (key == "data") leave_out_data(out, given);
-  if (!parsed) return std::nullopt;
-  mesh::gmsh::Surface s = mesh::gmsh::surface(parsed->file, *surface);
-  if (!s.errors.empty()) {
-    for (const auto& e : s.errors) errors.add(s.found ? pointer : f.at("surface"), "the mesh " + label + ": " + e);
-    return std::nullopt;
-  }
-  GmshBody body;
-  body.mesh = std::move(s.mesh);
-  body.edges = std::move(s.edges);
-  body.elsewhere = std::move(s.elsewhere);
-  body.vertices = std::move(s.vertices);
-  body.points_elsewhere = std::move(s.points_elsewhere);
-  body.surface = *surface;
-  return body;
+  if (!parsed) return nullptr;
+  const BuiltSurface& built = surface_of(*parsed, *surface);
+  for (const auto& e : built.errors)
+    errors.add(built.found ? pointer : f.at("surface"), "the mesh " + label + ": " + e);
+  return built.body;
 }
 
 }  // namespace contact::job

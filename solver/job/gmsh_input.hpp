@@ -32,13 +32,15 @@ class GmshMeshes {
   // lives while one job is parsed).
   explicit GmshMeshes(const Limits& limits) : limits_(limits) {}
 
-  // Reads the "gmsh" object at `pointer` (a body's /mesh/gmsh) and builds the surface's mesh; nullopt after
+  // Reads the "gmsh" object at `pointer` (a body's /mesh/gmsh) and builds the surface's mesh; nullptr after
   // reporting every problem at its pointer: the fields, a file that cannot be read or is not allowed (no
   // Limits::mesh_directory: the server), the MSH text (with its line), the surface and its curves.
   // `out` is the object's normalized copy: a "data" text is left out of it (it is in the submitted job), its size
-  // given as "data_bytes".
-  std::optional<GmshBody> read(const nlohmann::json& value, const std::string& pointer, read::Errors& errors,
-                               nlohmann::json& out);
+  // given as "data_bytes". A surface is built once however many bodies name it (the bodies share it until their
+  // meshes are built, after the job's size is checked against its limit: 8,192 bodies of one table entry cost one
+  // surface, not 8,192, before a too large job is refused).
+  std::shared_ptr<const GmshBody> read(const nlohmann::json& value, const std::string& pointer, read::Errors& errors,
+                                       nlohmann::json& out);
 
   // Reads the job's "meshes" table at `pointer` (before the bodies): each entry's name and its one field, file
   // or data; the text is parsed when a body first uses the entry. `out` is the table's normalized copy.
@@ -73,6 +75,14 @@ class GmshMeshes {
   const Parsed* from_table(const std::string& name, const std::string& pointer, read::Errors& errors,
                            std::string& label);
 
+  // A surface of one parsed text, built once: its mesh, or the errors found (reported at each body that names it).
+  struct BuiltSurface {
+    std::shared_ptr<const GmshBody> body;
+    std::vector<std::string> errors;
+    bool found = false;  // the surface exists (its errors are the mesh's, not the name's)
+  };
+  const BuiltSurface& surface_of(const Parsed& parsed, const std::string& surface);
+
   struct TableEntry {
     std::string pointer;           // /meshes/<name>
     std::optional<Source> source;  // unset when the entry's fields are bad (reported at its pointer)
@@ -83,10 +93,11 @@ class GmshMeshes {
   };
 
   const Limits& limits_;
-  std::map<std::string, std::unique_ptr<Parsed>> files_;      // by resolved path
-  std::multimap<std::size_t, std::unique_ptr<Parsed>> data_;  // by the hash of the text
-  std::map<std::string, TableEntry> table_;                   // the job's "meshes", by name
-  bool table_given_ = false;                                  // the job has "meshes" (maybe malformed)
+  std::map<std::string, std::unique_ptr<Parsed>> files_;                    // by resolved path
+  std::multimap<std::size_t, std::unique_ptr<Parsed>> data_;                // by the hash of the text
+  std::map<std::string, TableEntry> table_;                                 // the job's "meshes", by name
+  std::map<std::pair<const Parsed*, std::string>, BuiltSurface> surfaces_;  // by text and surface name
+  bool table_given_ = false;                                                // the job has "meshes" (maybe malformed)
   bool table_incomplete_ = false;  // "meshes" not an object, or an entry refused for its name: reported there
 };
 

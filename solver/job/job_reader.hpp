@@ -67,8 +67,9 @@ struct MeshInput {
   std::map<std::string, int> vertices;             // named vertices of an explicit mesh: name -> node
   std::map<std::string, mesh::Curve> edge_curves;  // "curves" given as an arc or a parabola, by edge
   std::set<std::string> chord_edges;               // "curves" given as "chords"
-  // gmsh: the surface's mesh, built while reading (gmsh_input.hpp)
-  std::optional<GmshBody> gmsh;
+  // gmsh: the surface's mesh, built while reading (gmsh_input.hpp), shared by the bodies that name it until
+  // build_mesh copies it
+  std::shared_ptr<const GmshBody> gmsh;
 };
 
 struct BodyInput {

@@ -48,13 +48,23 @@ void JobReader::read_bodies(const Fields& top) {
 
   // Phase 2: the size limit, from the declared sizes alone, before anything is allocated.
   double total = 0.0;
-  std::vector<std::string> parts;
+  std::vector<const BodyInput*> sized;
   for (const auto& in : inputs_) {
     if (in.mesh.dofs < 0) continue;
     total += in.mesh.dofs;
-    parts.push_back((in.has_name ? "'" + in.body.name + "'" : in.pointer) + " " + format_number(in.mesh.dofs));
+    sized.push_back(&in);
   }
   if (total > static_cast<double>(limits_.max_dofs)) {
+    // The largest bodies first, at most eight of them named (a job of 8,192 bodies gets one line, not 8,192).
+    constexpr size_t kNamed = 8;
+    std::stable_sort(sized.begin(), sized.end(),
+                     [](const BodyInput* a, const BodyInput* b) { return a->mesh.dofs > b->mesh.dofs; });
+    std::vector<std::string> parts;
+    for (size_t k = 0; k < std::min(kNamed, sized.size()); ++k)
+      parts.push_back((sized[k]->has_name ? "'" + sized[k]->body.name + "'" : sized[k]->pointer) + " " +
+                      format_number(sized[k]->mesh.dofs));
+    if (sized.size() > kNamed)
+      parts.push_back(std::to_string(sized.size() - kNamed) + " more bod" + (sized.size() - kNamed == 1 ? "y" : "ies"));
     errors_.add("/bodies", "the meshes would have " + format_number(total) + " degrees of freedom (" +
                                join_names(parts) + "), more than the limit of " +
                                format_number(static_cast<double>(limits_.max_dofs)));
@@ -297,7 +307,7 @@ namespace {
 // every node of its contact edges (a frictionless contact pushes only along it); a contact with friction may also
 // hold along the tangent, so at best in every direction.
 std::vector<mesh::HeldDirection> best_held_directions(const Body& body, const std::vector<ContactPair>& contacts,
-                                                      size_t i) {
+                                                      const std::vector<int>& its_pairs, size_t i) {
   std::vector<mesh::HeldDirection> held;
   for (const auto& bc : body.boundary) {
     if (!prescribes_displacement(bc)) continue;
@@ -306,46 +316,48 @@ std::vector<mesh::HeldDirection> best_held_directions(const Body& body, const st
       if (bc.uy) held.push_back({node, Eigen::Vector2d(0, 1)});
     }
   }
-  for (const auto& c : contacts) {
-    std::vector<std::string> edges;
-    if (c.slave_body == static_cast<int>(i)) edges.push_back(c.slave_edge);
-    if (c.master_body == static_cast<int>(i)) edges.push_back(c.master_edge);
-    for (const auto& edge : edges) {
-      // A node's normal: perpendicular to the chord through its neighbours (on a uniformly divided arc, exactly
-      // radial). An end node has one neighbour: its one-sided normal is kept where the edge is straight there (it
-      // equals its neighbour's), not where it is curved (it would hold a roller's spin that its end nodes, far
-      // from the contact, never do). A closed loop has no ends: its nodes' neighbours wrap round.
-      const std::vector<int> nodes = body.mesh.edge_set_nodes(edge);
-      const size_t n = nodes.size();
-      const bool closed = body.mesh.edge_set_closed(edge);
-      const auto at = [&](size_t j) { return body.mesh.nodes[static_cast<size_t>(nodes[j])]; };
-      const auto normal = [&](size_t j) {
-        const size_t next = closed ? (j + 1) % n : std::min(j + 1, n - 1);
-        const size_t previous = closed ? (j + n - 1) % n : (j == 0 ? 0 : j - 1);
-        const Eigen::Vector2d t = at(next) - at(previous);
-        return t.norm() > 0 ? Eigen::Vector2d(Eigen::Vector2d(-t.y(), t.x()).normalized()) : Eigen::Vector2d::Zero();
-      };
-      for (size_t j = 0; j < n && n > 1; ++j) {
-        const Eigen::Vector2d nu = normal(j);
-        if (!(nu.norm() > 0)) continue;
-        const bool end = !closed && (j == 0 || j + 1 == n);
-        if (end && n > 2) {
-          const Eigen::Vector2d inner = normal(j == 0 ? 1 : n - 2);
-          if (std::abs(nu.x() * inner.y() - nu.y() * inner.x()) > 1e-9) continue;  // curved at the end
-        }
-        held.push_back({nodes[j], nu});
-        if (c.friction.active()) held.push_back({nodes[j], Eigen::Vector2d(-nu.y(), nu.x())});
+  // Each edge of the body once, however many pairs use it (a strip under 400 pairs, all on its top, would be
+  // walked 400 times: pairs x nodes), with tangents too where any of its pairs has friction.
+  std::map<std::string, bool> edges;  // edge -> a pair on it has friction
+  for (const int k : its_pairs) {
+    const ContactPair& c = contacts[static_cast<size_t>(k)];
+    if (c.slave_body == static_cast<int>(i)) edges[c.slave_edge] |= c.friction.active();
+    if (c.master_body == static_cast<int>(i)) edges[c.master_edge] |= c.friction.active();
+  }
+  for (const auto& [edge, friction] : edges) {
+    // A node's normal: perpendicular to the chord through its neighbours (on a uniformly divided arc, exactly
+    // radial). An end node has one neighbour: its one-sided normal is kept where the edge is straight there (it
+    // equals its neighbour's), not where it is curved (it would hold a roller's spin that its end nodes, far
+    // from the contact, never do). A closed loop has no ends: its nodes' neighbours wrap round.
+    const std::vector<int> nodes = body.mesh.edge_set_nodes(edge);
+    const size_t n = nodes.size();
+    const bool closed = body.mesh.edge_set_closed(edge);
+    const auto at = [&](size_t j) { return body.mesh.nodes[static_cast<size_t>(nodes[j])]; };
+    const auto normal = [&](size_t j) {
+      const size_t next = closed ? (j + 1) % n : std::min(j + 1, n - 1);
+      const size_t previous = closed ? (j + n - 1) % n : (j == 0 ? 0 : j - 1);
+      const Eigen::Vector2d t = at(next) - at(previous);
+      return t.norm() > 0 ? Eigen::Vector2d(Eigen::Vector2d(-t.y(), t.x()).normalized()) : Eigen::Vector2d::Zero();
+    };
+    for (size_t j = 0; j < n && n > 1; ++j) {
+      const Eigen::Vector2d nu = normal(j);
+      if (!(nu.norm() > 0)) continue;
+      const bool end = !closed && (j == 0 || j + 1 == n);
+      if (end && n > 2) {
+        const Eigen::Vector2d inner = normal(j == 0 ? 1 : n - 2);
+        if (std::abs(nu.x() * inner.y() - nu.y() * inner.x()) > 1e-9) continue;  // curved at the end
       }
+      held.push_back({nodes[j], nu});
+      if (friction) held.push_back({nodes[j], Eigen::Vector2d(-nu.y(), nu.x())});
     }
   }
   return held;
 }
 
-std::string contact_names(const Problem& problem, size_t i) {
+std::string contact_names(const Problem& problem, const std::vector<int>& its_pairs) {
   std::string out;
-  for (const auto& c : problem.contacts)
-    if (c.slave_body == static_cast<int>(i) || c.master_body == static_cast<int>(i))
-      out += (out.empty() ? "'" : ", '") + c.name + "'";
+  for (const int k : its_pairs)
+    out += (out.empty() ? "'" : ", '") + problem.contacts[static_cast<size_t>(k)].name + "'";
   return out;
 }
 
@@ -359,23 +371,27 @@ void JobReader::check_floating_bodies() {
   // whether a body floats is then not known, and its error would only repeat the contacts'.
   if (!contacts_complete_) return;
   const Method method = problem_.solver.method;
-  std::vector<char> touches(inputs_.size(), 0);
-  for (const auto& c : problem_.contacts)
+  std::vector<std::vector<int>> pairs_of(inputs_.size());  // each body's contact pairs, by index
+  for (size_t k = 0; k < problem_.contacts.size(); ++k) {
+    const ContactPair& c = problem_.contacts[k];
     for (const int b : {c.slave_body, c.master_body})
-      if (b >= 0 && static_cast<size_t>(b) < touches.size()) touches[static_cast<size_t>(b)] = 1;
+      if (b >= 0 && static_cast<size_t>(b) < pairs_of.size() &&
+          (pairs_of[static_cast<size_t>(b)].empty() || pairs_of[static_cast<size_t>(b)].back() != static_cast<int>(k)))
+        pairs_of[static_cast<size_t>(b)].push_back(static_cast<int>(k));
+  }
   for (size_t i = 0; i < inputs_.size(); ++i) {
     const BodyInput& in = inputs_[i];
     if (in.free_motions.empty()) continue;
     const std::string free = join_names(in.free_motions) + (in.free_motions.size() == 1 ? " is" : " are") + " free";
-    const bool in_contact = touches[i];
+    const bool in_contact = !pairs_of[i].empty();
     if (!in_contact) {
       errors_.add(child(in.pointer, "boundary"),
                   "body '" + in.body.name + "' is not restrained against rigid motion (" + free +
                       ") and touches no other body: prescribe a displacement component on one of its edges or "
                       "vertices, or give it a contact that can hold it");
-    } else if (const auto loose =
-                   mesh::free_rigid_modes_along(in.body.mesh, best_held_directions(in.body, problem_.contacts, i))
-                       .names;
+    } else if (const auto loose = mesh::free_rigid_modes_along(
+                                      in.body.mesh, best_held_directions(in.body, problem_.contacts, pairs_of[i], i))
+                                      .names;
                !loose.empty()) {
       // Frictionless contacts push only along their normals: a motion no normal resists is free whatever the
       // loads (a plate sliding along a flat contact, a roller spinning about its centre, where all its normals
@@ -387,7 +403,8 @@ void JobReader::check_floating_bodies() {
                   : m.rfind("rotation about", 0) == 0 ? " (it spins: every contact normal passes through that point)"
                                                       : "");
       errors_.add(child(in.pointer, "boundary"), "body '" + in.body.name + "' floats (" + free +
-                                                     ") and its frictionless contacts " + contact_names(problem_, i) +
+                                                     ") and its frictionless contacts " +
+                                                     contact_names(problem_, pairs_of[i]) +
                                                      " cannot hold it whatever the loads, since they push only along "
                                                      "their normals: nothing resists its " +
                                                      modes +

@@ -462,7 +462,7 @@ void JobReader::build_mesh(BodyInput& in) {
   if (m.kind == MeshInput::Kind::block) {
     mesh = mesh::make_block(m.block);
   } else if (m.kind == MeshInput::Kind::gmsh) {
-    mesh = std::move(m.gmsh->mesh);  // checked while reading (cells and edges, with Gmsh's element tags)
+    mesh = m.gmsh->mesh;  // checked while reading (cells and edges, with Gmsh's element tags)
   } else {
     mesh.nodes = std::move(m.nodes);
     mesh.cells = std::move(m.quads);
