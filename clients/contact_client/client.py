@@ -324,7 +324,7 @@ class Client:
             headers = {"Accept": "text/event-stream", "Cache-Control": "no-cache"}
             if last is not None:
                 headers["Last-Event-ID"] = str(last)
-            problem, wait = None, None
+            problem, wait, delivered = None, None, False
             try:
                 conn, resp = self._open("GET", path, headers=headers, timeout=read_timeout)
                 try:
@@ -338,7 +338,7 @@ class Client:
                             if last is not None and seq <= last:
                                 continue  # never repeat an event
                             last = seq
-                        failures = 0
+                        failures, delivered = 0, True
                         yield event
                         if event.get("type") == "end":
                             return
@@ -355,6 +355,15 @@ class Client:
                 problem = f"no event or heartbeat for {read_timeout:g} s"
             except (OSError, http.client.HTTPException, ValueError) as exc:
                 problem = f"connection lost ({one_line(exc)[:200] or type(exc).__name__})"
+            # A connection that brought nothing new, of a job that has ended: there is nothing more to wait for,
+            # whatever cut the stream (a proxy that cuts it each time, a log that lost its end); the job's resource
+            # is the answer. (One that brought events is resumed: the rest of them may still come.)
+            if not delivered:
+                ended = self._ended(job_id)
+                if ended:
+                    self.log(f"{problem}; the job has ended ({ended}) and its stream brings no more events: "
+                             "not waiting for its end event")
+                    return
             failures += 1
             if failures > max_retries:
                 raise ConnectionFailed(f"progress stream of {one_line(job_id)} lost after {max_retries} reconnections: "
@@ -365,6 +374,15 @@ class Client:
             where = f"after event {last}" if last is not None else "from the start"
             self.log(f"{problem}; reconnecting in {delay:g} s ({failures}/{max_retries}), resuming {where}")
             time.sleep(delay)
+
+    def _ended(self, job_id):
+        """The job's state when it has ended (SUCCEEDED, FAILED or CANCELLED), else None (also when it cannot be
+        read now: the stream's own retries decide then)."""
+        try:
+            job = self.status(job_id)
+        except ClientError:
+            return None
+        return job.get("state") if job.get("done") else None
 
     def wait(self, job_id, on_event=None, max_retries=5, read_timeout=None):
         """Follows the job's events to its end (on_event(event) is called for each) and returns the final job

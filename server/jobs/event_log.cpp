@@ -332,9 +332,13 @@ std::vector<Event> EventLog::read_after(std::int64_t after, std::size_t max_coun
   std::int64_t last = static_cast<std::int64_t>(offsets_.size());
   if (unreadable_from_ > 0) last = std::min(last, unreadable_from_ - 1);
   if (discarded_ || after >= last || max_count == 0) return events;
-  const std::int64_t until = std::min<std::int64_t>(last, after + static_cast<std::int64_t>(max_count));
   const std::int64_t first_recent = last - static_cast<std::int64_t>(recent_.size()) + 1;
+  // Events a write error lost (a full disk) and memory no longer holds are stepped over: counted from the first
+  // event that can be served, so that a run of more than max_count of them does not answer "nothing new" for ever
+  // (a stream would wait there, heartbeats and all, also after its job ended).
   std::int64_t seq = after + 1;
+  while (seq < first_recent && offsets_[static_cast<std::size_t>(seq - 1)] == kUnwritten) ++seq;
+  const std::int64_t until = std::min<std::int64_t>(last, seq - 1 + static_cast<std::int64_t>(max_count));
 
   // Older events come from the file: one read of the byte range [offsets_[seq-1], end of the last wanted one).
   if (seq < first_recent) {

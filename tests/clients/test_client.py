@@ -111,10 +111,11 @@ def free_port():
 
 class DroppingProxy:
     """A TCP proxy in front of contactd that cuts the first progress stream (/events) after `cut_after` bytes of
-    answer and forwards everything else untouched; it keeps the head of every request."""
+    answer and forwards everything else untouched; it keeps the head of every request. With `cut_before` (bytes),
+    every progress stream is cut instead where that text first comes (a stream that never shows its end)."""
 
-    def __init__(self, port, cut_after):
-        self.port, self.cut_after = port, cut_after
+    def __init__(self, port, cut_after=None, cut_before=None):
+        self.port, self.cut_after, self.cut_before = port, cut_after, cut_before
         self.cut_done = False
         self.requests = []
         self.sock = socket.socket()
@@ -161,9 +162,12 @@ class DroppingProxy:
                 if not data:
                     break
                 if cut is None:  # the request has been forwarded whole before any answer comes
-                    cut = b"/events" in self.requests[index] and not self.cut_done
+                    cut = b"/events" in self.requests[index] and (self.cut_before is not None or not self.cut_done)
                     self.cut_done = self.cut_done or cut
-                if cut and sent + len(data) >= self.cut_after:
+                if cut and self.cut_before is not None and self.cut_before in data:
+                    client.sendall(data[:data.index(self.cut_before)])
+                    break
+                if cut and self.cut_after is not None and sent + len(data) >= self.cut_after:
                     client.sendall(data[:self.cut_after - sent])
                     break  # the drop: both sides closed mid-stream
                 client.sendall(data)
@@ -324,6 +328,23 @@ def test_module(server, tmp):
         check("resume: reconnected with Last-Event-ID of the last event received",
               m is not None and 1 <= int(m.group(1)) < len(seqs) and first_part is not None, stream_requests[1][:300])
     check("resume: the reconnection was reported", any("reconnecting" in n for n in notes), notes)
+
+    # A stream that closes without its end event, each time (a proxy in the way), of a job that has ended: wait()
+    # returns the ended job once a reconnection brings nothing new, instead of reconnecting to the same close until
+    # it gives up.
+    proxy = DroppingProxy(server.port, cut_before=b"event: end")
+    notes = []
+    try:
+        pc = cc.Client(proxy.url, timeout=30, log=notes.append)
+        ended = pc.wait(rid, max_retries=2)
+    except cc.ClientError as e:
+        ended = {"error": str(e)}
+    finally:
+        proxy.close()
+    check("a stream without its end, of an ended job: wait() returns the job once a reconnection brings nothing",
+          ended.get("id") == rid and ended.get("done") is True and len([r for r in proxy.requests if b"/events" in r]) == 2,
+          (ended, notes))
+    check("... and says why", any("has ended" in n for n in notes), notes)
 
     # Adaptivity: several steps, refined meshes; the plot shows them.
     aid = c.submit(ADAPTIVE)["id"]
