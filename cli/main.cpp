@@ -22,6 +22,8 @@
 #include <iostream>
 #include <sstream>
 
+#include <unistd.h>
+
 namespace {
 
 // A stop request (SIGINT, SIGTERM, or SIGUSR1 which mpirun forwards to every rank): the solver sees it at its
@@ -386,6 +388,11 @@ int main(int argc, char** argv) {
   app.add_flag("--validate", validate_only, "only validate the job and exit");
   app.add_flag("-q,--quiet", quiet, "no per-iteration lines");
   app.add_option("--max-dofs", max_dofs, "reject jobs with more unknowns than this")->check(CLI::PositiveNumber);
+  double max_interface_bytes = -1;
+  app.add_option("--max-interface-bytes", max_interface_bytes,
+                 "reject jobs whose interface problem (method interface_newton) is estimated to take more memory "
+                 "than this (default: this machine's memory; 0: no limit)")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--threads", threads,
                  "threads for the per-body solves (per rank under mpirun; overrides the job; "
                  "0 = automatic)")
@@ -418,6 +425,13 @@ int main(int argc, char** argv) {
   if (!read_job(session, job_path, text)) return 2;
   contact::job::Limits limits;
   limits.max_dofs = max_dofs;
+  // A job that cannot fit is refused with the estimate, not started to be killed for memory (a long contact's dense
+  // blocks grow with the square of its nodes).
+  limits.max_interface_bytes = max_interface_bytes >= 0 ? max_interface_bytes
+                                                        : static_cast<double>(sysconf(_SC_PHYS_PAGES)) *
+                                                              static_cast<double>(sysconf(_SC_PAGE_SIZE));
+  limits.interface_bytes_hint =
+      max_interface_bytes >= 0 ? "--max-interface-bytes" : "this machine's memory; --max-interface-bytes sets another";
   // Gmsh mesh files are read relative to the job file's directory (by every rank).
   if (!no_mesh_files) limits.mesh_directory = contact::job::job_directory(job_path);
   auto parsed = contact::job::parse_text(text, limits);

@@ -21,6 +21,8 @@ contact::job::ParseResult validate_job(const QueueSettings& settings, const std:
   limits.max_load_steps = settings.max_load_steps;
   limits.max_result_bytes = settings.max_result_bytes;
   limits.result_bytes_hint = "contactd --max-result-bytes";
+  limits.max_interface_bytes = settings.max_interface_bytes;
+  limits.interface_bytes_hint = "contactd --max-interface-bytes";
   limits.max_ranks = settings.mpi.launcher.empty() ? 1 : settings.mpi.max_ranks;
   limits.ranks_hint = settings.mpi.launcher.empty()
                           ? "this server solves every job in its own process: it was started without --mpi-launcher"

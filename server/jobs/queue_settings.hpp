@@ -28,6 +28,7 @@ struct QueueSettings {
   int max_contacts = 32768;
   int max_load_steps = 1000;           // job::Limits::max_load_steps
   double max_result_bytes = 2e9;       // job::Limits::max_result_bytes: the estimated result (and kept steps)
+  double max_interface_bytes = 4e9;    // job::Limits::max_interface_bytes: the interface problem's dense blocks
   double time_limit_seconds = 3600.0;  // per run; 0 = none
   int max_attempts = 3;                // runs cut short by the server dying, after which a job ends FAILED
   std::uint64_t max_event_log_bytes = 256u << 20;  // per job; iteration events beyond are not recorded

@@ -131,6 +131,7 @@ class JobReader {
   void read_loading_steps(const json& value, const std::string& pointer);
   void read_output(const Fields& top);
   void check_result_size();
+  void check_interface_memory();
   void read_progress_pairs(const json& value, const std::string& pointer);
 
   // read_bodies.cpp: bodies, materials, boundary conditions; the checks on the built bodies

@@ -9,12 +9,18 @@ Two small jobs made validation cost gigabytes:
    the job's size was checked (149 s and 864 MB before the 400 for 27.5M unknowns). Now a surface is built once
    however many bodies name it, and the total is checked before any body's mesh is built.
 
+3. A long contact (issue 51, item 3): two strips of N cells in contact, a 540-byte job, took N = 16,000 to an OOM
+   kill (about 30 GB: the interface problem's dense blocks grow with the square of the contact's nodes) far below
+   --max-dofs. Now its memory is estimated before it runs and a job over --max-interface-bytes is refused with the
+   estimate and the limit that would admit it; the estimate is checked against a run's measured peak (N = 1,000).
+
 Each bomb is measured against its twin (the same strip with one brick and one pair; the same mesh named by 16 bodies):
 the growth of the peak memory of `contact-solve --validate` (its maximum resident set, from wait4) and of contactd
 (VmHWM) must stay within a small multiple of the twin's. The bugs made it hundreds of MB more at these sizes; CPU
 times are printed, not bounded (a loaded machine)."""
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -47,7 +53,9 @@ def strip_job(bricks):
                        "mesh": {"block": {"corners": [[x0, 0], [x1, 0], [x1, 1], [x0, 1]], "nx": 2, "ny": 1}},
                        "boundary": [{"edge": "top", "displacement": {"x": 0, "y": -0.001}}]})
         contacts.append({"name": f"b{b}", "slave": f"brick{b}.bottom", "master": "strip.top"})
-    return {"name": "strip-under-bricks", "bodies": bodies, "contacts": contacts}
+    # Monolithic: interface_newton would hold a dense block over the strip's 100,002 contact unknowns (80 GB), and
+    # the job would be refused for that (item 3 below) before the checks measured here.
+    return {"name": "strip-under-bricks", "bodies": bodies, "contacts": contacts, "solver": {"method": "monolithic"}}
 
 
 def table_job(msh_text, bodies):
@@ -56,6 +64,27 @@ def table_job(msh_text, bodies):
             "bodies": [{"name": f"s{k}", "material": MATERIAL,
                         "mesh": {"gmsh": {"mesh": "square", "surface": "square"}},
                         "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]} for k in range(bodies)]}
+
+
+def strips_job(cells, friction=False):
+    """Two strips of `cells` x 1 cells in contact along their length, the lower clamped, the upper pressed down."""
+    length = float(cells)
+    job = {"name": f"strips-{cells}", "bodies": [
+        {"name": "lower", "material": MATERIAL,
+         "mesh": {"block": {"corners": [[0, -1], [length, -1], [length, 0], [0, 0]], "nx": cells, "ny": 1}},
+         "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]},
+        {"name": "upper", "material": MATERIAL,
+         "mesh": {"block": {"corners": [[0, 0], [length, 0], [length, 1], [0, 1]], "nx": cells, "ny": 1}},
+         "boundary": [{"edge": "top", "displacement": {"x": 0, "y": -0.001}}]}],
+        "contacts": [{"slave": "upper.bottom", "master": "lower.top"}]}
+    if friction:
+        job["contacts"][0]["friction"] = {"coefficient": 0.3}
+    return job
+
+
+def estimate_mb(message):
+    m = re.search(r"would take about ([0-9.]+) (MB|GB)", message)
+    return float(m.group(1)) * (1000.0 if m.group(2) == "GB" else 1.0) if m else None
 
 
 def square_msh(tmp):
@@ -73,12 +102,12 @@ def square_msh(tmp):
         return f.read()
 
 
-def validate_cli(job, tmp, name):
-    """contact-solve --validate: (exit code, its output, peak RSS in MB, CPU seconds)."""
+def validate_cli(job, tmp, name, extra=("--validate",)):
+    """contact-solve --validate (or `extra`): (exit code, its output, peak RSS in MB, CPU seconds)."""
     path = os.path.join(tmp, name + ".json")
     with open(path, "w") as f:
         json.dump(job, f)
-    proc = subprocess.Popen([CONTACT_SOLVE, path, "--validate", "--no-mesh-files"], stdout=subprocess.PIPE,
+    proc = subprocess.Popen([CONTACT_SOLVE, path, "--no-mesh-files", "-q", *extra], stdout=subprocess.PIPE,
                             stderr=subprocess.STDOUT)
     out = proc.stdout.read().decode(errors="replace")
     _, status, usage = os.wait4(proc.pid, 0)
@@ -127,6 +156,22 @@ if msh:
 else:
     print("no gmsh command: the table bomb is not built (Debian's gmsh)", flush=True)
 
+section("a long contact: its interface memory estimated before it runs")
+code, out, rss, _ = validate_cli(strips_job(1000), tmp, "strips-1000", ("--validate", "--max-interface-bytes", "1e6"))
+estimate = estimate_mb(out)
+check("two strips of 1,000 cells over a 1 MB limit: refused (exit 2) at /contacts with the estimate, the limit "
+      "and the limit that would admit it", code == 2 and "/contacts:" in out and estimate is not None and
+      "--max-interface-bytes" in out and "would admit it" in out, out[-600:])
+code, out, rss, _ = validate_cli(strips_job(1000), tmp, "strips-1000-run", ("-o", os.path.join(tmp, "s.hdf")))
+print(f"two strips of 1,000 cells: estimated {estimate} MB, measured peak {rss:.0f} MB", flush=True)
+check("... and run, its measured peak is within a factor 2 of the estimate", code == 0 and estimate is not None and
+      0.5 <= rss / estimate <= 2.0, (code, rss, estimate, out[-300:]))
+code, out, rss, _ = validate_cli(strips_job(16000), tmp, "strips-16000",
+                                 ("--validate", "--max-interface-bytes", "4e9"))
+print(f"two strips of 16,000 cells: {estimate_mb(out)} MB estimated, validation peak {rss:.0f} MB", flush=True)
+check("two strips of 16,000 cells (the OOM kill): refused (exit 2) by the CLI with an estimate of tens of GB, "
+      "validation itself small", code == 2 and (estimate_mb(out) or 0) > 20000 and rss < 200, (code, rss, out[-600:]))
+
 section("contactd /v1/validate")
 with Server(args=["--max-request-bytes", "67108864"]) as server:
     r = server.request("POST", "/v1/validate", body=json.dumps(twin).encode(),
@@ -148,5 +193,15 @@ with Server(args=["--max-request-bytes", "67108864"]) as server:
         check("the table bomb: 400 naming the size and the limit",
               r.status == 400 and "more than the limit" in r.body.decode(errors="replace"), r)
         compare("table bomb (contactd)", peak_mb(server) - base, max(base, 1.0))
+    for path in ("/v1/validate", "/v1/jobs"):
+        r = server.request("POST", path, body=json.dumps(strips_job(16000)).encode(),
+                           headers={"Content-Type": "application/json"})
+        text = r.body.decode(errors="replace")
+        check(f"POST {path} two strips of 16,000 cells: 400 at /contacts naming contactd --max-interface-bytes",
+              r.status == 400 and '"/contacts"' in text and "contactd --max-interface-bytes" in text, r)
+    r = server.request("POST", "/v1/validate", body=json.dumps(strips_job(2000, friction=True)).encode(),
+                       headers={"Content-Type": "application/json"})
+    check("two strips of 2,000 cells with friction (about 2 GB): within the default 4 GB, 200", r.status == 200, r)
+    check("the server is up", server.get("/healthz").status == 200)
 
 finish()

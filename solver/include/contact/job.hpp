@@ -35,7 +35,13 @@ struct Limits {
   // the job runs (io::estimated_result_bytes: nodes x kept steps); 0: no limit (the command line), contactd's
   // --max-result-bytes otherwise.
   double max_result_bytes = 0;
-  std::string result_bytes_hint;     // the setting named when a job is over max_result_bytes
+  std::string result_bytes_hint;  // the setting named when a job is over max_result_bytes
+  // The memory of the interface problem (method interface_newton: dense blocks over each body's contact unknowns
+  // and its pairs' rows), as estimated from the contact edges' nodes before anything is factorised; 0: no limit.
+  // A long contact made it grow with the square of its nodes (two strips of 16,000 elements: about 30 GB, an OOM
+  // kill) far below max_dofs. contact-solve sets this machine's memory, contactd its --max-interface-bytes.
+  double max_interface_bytes = 0;
+  std::string interface_bytes_hint;  // the setting named when a job is over max_interface_bytes
   int max_ranks = 4096;              // parallel.ranks (contactd: its --max-ranks, 1 without an MPI launcher)
   std::string ranks_hint;            // appended to the message when parallel.ranks is over max_ranks
   std::size_t max_name_length = 64;  // body, edge and contact names (identifiers)
