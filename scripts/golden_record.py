@@ -82,19 +82,28 @@ def record_of(path, code):
     return out
 
 
+def absolute_mesh_files(value):
+    """The job with every Gmsh "file" (a path relative to api/examples/) made absolute."""
+    if isinstance(value, dict):
+        return {k: (os.path.join(EXAMPLES, v) if k == "file" and isinstance(v, str) else absolute_mesh_files(v))
+                for k, v in value.items()}
+    if isinstance(value, list):
+        return [absolute_mesh_files(v) for v in value]
+    return value
+
+
 def run_all(binary):
     records = {}
     with tempfile.TemporaryDirectory(prefix="golden-") as tmp:
         for name, job in jobs().items():
-            path = os.path.join(EXAMPLES, f".golden_{name}.json")  # beside the examples: their mesh files
+            # Written to the temporary folder (not beside the examples, where a test lists the folder's files), its
+            # mesh files named by absolute paths.
+            path = os.path.join(tmp, name + ".json")
             with open(path, "w") as f:
-                json.dump(job, f)
+                json.dump(absolute_mesh_files(job), f)
             result = os.path.join(tmp, name + ".hdf")
-            try:
-                run = subprocess.run([binary, "-q", "--keep-iterate", "--threads", "1", "-o", result, path],
-                                     capture_output=True, text=True, timeout=600)
-            finally:
-                os.remove(path)
+            run = subprocess.run([binary, "-q", "--keep-iterate", "--threads", "1", "-o", result, path],
+                                 capture_output=True, text=True, timeout=600)
             records[name] = record_of(result, run.returncode)
             print(f"{name}: exit {run.returncode}, {records[name].get('message', run.stderr.strip()[-200:])}",
                   flush=True)
