@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <functional>
 #include <regex>
+#include <string_view>
 
 namespace contactd {
 
@@ -208,6 +209,26 @@ void handle_validate(RouteContext& ctx, const Request& req, Response& res, const
              {"normalized", p.normalized}});
 }
 
+// If-None-Match (RFC 9110, 13.1.2): "*" or a list of entity tags, compared weakly (W/ is ignored on both sides).
+bool if_none_match_matches(const std::string& header, const std::string& etag) {
+  const auto opaque = [](std::string_view tag) {
+    while (!tag.empty() && (tag.front() == ' ' || tag.front() == '\t')) tag.remove_prefix(1);
+    while (!tag.empty() && (tag.back() == ' ' || tag.back() == '\t')) tag.remove_suffix(1);
+    if (tag.substr(0, 2) == "W/") tag.remove_prefix(2);
+    return tag;
+  };
+  const std::string_view mine = opaque(etag);
+  std::string_view rest = header;
+  while (!rest.empty()) {
+    const std::size_t comma = rest.find(',');
+    const std::string_view tag = opaque(rest.substr(0, comma));
+    if (tag == "*" || (!tag.empty() && tag == mine)) return true;
+    if (comma == std::string_view::npos) break;
+    rest.remove_prefix(comma + 1);
+  }
+  return false;
+}
+
 void handle_list(RouteContext& ctx, const Request& req, Response& res) {
   std::optional<JobState> state;
   if (req.has_param("state")) {
@@ -252,14 +273,22 @@ void handle_list(RouteContext& ctx, const Request& req, Response& res) {
     }
   }
   // A poller (the web page, every 2 s) that sends the page's ETag back gets 304 and no body while nothing in it
-  // changed: a page of 50 walls is some 50 kB.
+  // changed: a page of 50 walls is some 50 kB. The ETag is weak (RFC 9110, 8.8.1): it follows the jobs, their states
+  // and outcomes, not the figures of a running or queued job (its iterations, progress and timings change with
+  // every iteration and every second, and a strong tag never gave a poller a 304 while any job ran). A poller that
+  // shows those figures live reads the job or its events, or asks without If-None-Match (the web page does while a
+  // job runs).
   const nlohmann::json answer = {{"jobs", jobs},
                                  {"next_page_token", page.next ? encode_cursor(*page.next) : std::string()}};
-  char etag[24];
-  std::snprintf(etag, sizeof etag, "\"%016zx\"", std::hash<std::string>{}(answer.dump()));
+  nlohmann::json significant = answer;
+  for (auto& job : significant["jobs"])
+    if (job.value("done", false) == false)
+      for (const char* live : {"iterations", "progress", "timings"}) job.erase(live);
+  char etag[32];
+  std::snprintf(etag, sizeof etag, "W/\"%016zx\"", std::hash<std::string>{}(significant.dump()));
   res.set_header("ETag", etag);
   res.set_header("Cache-Control", "private, no-cache");
-  if (req.get_header_value("If-None-Match") == etag) {
+  if (if_none_match_matches(req.get_header_value("If-None-Match"), etag)) {
     res.status = 304;
     return;
   }

@@ -9,7 +9,9 @@ const $ = (id) => document.getElementById(id);
 const LIST_PERIOD_MS = 2000;
 
 let listTimer = null;
-let listTag = "";  // the ETag of the list drawn: sent back, the server answers 304 while nothing changed
+// The ETag of the list drawn: sent back, the server answers 304 while no job was added, removed or changed state.
+// It is weak: it does not follow a running job's iterations, so while a listed job runs the list is asked for whole.
+let listTag = "";
 const view = new JobView({onChange: () => refreshList()});
 
 function banner(text) {
@@ -50,8 +52,10 @@ function select(id) {
 async function refreshList() {
   clearTimeout(listTimer);
   try {
+    const running = [...$("jobs").children].some((tr) => tr.dataset.state === "RUNNING");
+    const conditional = listTag && !running;
     const response = await fetch("v1/jobs?page_size=50", {
-      headers: headers(listTag ? {"Accept": "application/json", "If-None-Match": listTag} : {"Accept": "application/json"}),
+      headers: headers(conditional ? {"Accept": "application/json", "If-None-Match": listTag} : {"Accept": "application/json"}),
       cache: "no-store"});
     if (response.status === 304) {
       banner("");

@@ -14,7 +14,7 @@ import sys
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))  # tests/
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from checks import check, finish  # noqa: E402
-from harness import Server, example, read_all_events  # noqa: E402
+from harness import Server, example, long_job, read_all_events  # noqa: E402
 
 with Server(args=["--workers", "1"]) as server:
     wall = example("brick_wall.json")  # 69 bodies, 120 contact pairs, frictionless: about a second
@@ -71,6 +71,27 @@ with Server(args=["--workers", "1"]) as server:
     changed = server.get("/v1/jobs?page_size=50", headers={"If-None-Match": tag})
     check("a changed list: 200 with the new job and a new ETag", changed.status == 200
           and changed.json()["jobs"][0]["id"] == new_id and changed.headers.get("etag") not in ("", tag), changed.status)
+
+    # The ETag is weak and follows the jobs and their states, not a running job's figures (a strong tag changed on
+    # every iteration and every second, so a poller never got 304 while a job ran).
+    check("the list's ETag is weak", changed.headers.get("etag", "").startswith('W/"'), changed.headers)
+    long_id = server.submit_id(long_job(name="runs-while-polled"))
+    running = server.wait_for(long_id, lambda j: j["state"] == "RUNNING" and j["iterations"] >= 3, 60)
+    first = server.get("/v1/jobs?page_size=50")
+    tag = first.headers.get("etag", "")
+    server.wait_for(long_id, lambda j: j["iterations"] >= running["iterations"] + 20, 60)
+    again = server.get("/v1/jobs?page_size=50", headers={"If-None-Match": tag})
+    fresh = server.get("/v1/jobs?page_size=50")
+    check("while a job runs: 304 for the same jobs and states, though its iterations moved",
+          again.status == 304 and fresh.json()["jobs"][0]["iterations"] > first.json()["jobs"][0]["iterations"],
+          (again.status, first.json()["jobs"][0]["iterations"], fresh.json()["jobs"][0]["iterations"]))
+    check("... also for the tag sent strong, in a list of tags (weak comparison)",
+          server.get("/v1/jobs?page_size=50", headers={"If-None-Match": '"x", ' + tag[2:]}).status == 304)
+    server.request("POST", f"/v1/jobs/{long_id}/cancel")
+    server.wait_done(long_id)
+    after = server.get("/v1/jobs?page_size=50", headers={"If-None-Match": tag})
+    check("its state changed (CANCELLED): 200 and a new ETag", after.status == 200 and
+          after.headers.get("etag") not in ("", tag) and after.json()["jobs"][0]["state"] == "CANCELLED", after.status)
 
     small = listed[patch_id]["progress"]
     check("a small job is listed with its pairs and bodies as they are",
