@@ -358,6 +358,7 @@ void run_penalty(const ContactSystem& system, RunFrame& frame) {
   zone_change(system, to_bodies(system, s, x), zone, false);  // the start's zones
   const double b_norm = std::max(s.b.norm(), 1e-300);
   Eigen::CholmodDecomposition<SpMat, Eigen::Lower> factor;
+  factor.cholmod().print = 0;  // a failed factorisation is reported by info(), not by CHOLMOD's text on stdout
   const int max_newton = std::max(frame.settings().max_iterations, 1);
   for (int k = 1; k <= max_newton; ++k) {
     if (frame.stop_requested()) {

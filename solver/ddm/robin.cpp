@@ -132,6 +132,7 @@ class RobinMap final : public BodyMap {
     const Eigen::SparseMatrix<double> A =
         body.reduced_stiffness() + Eigen::SparseMatrix<double>(T.transpose() * Psi * T);
     auto f = std::make_unique<Factor>();
+    f->cholmod().print = 0;  // a failed factorisation is reported by info(), not by CHOLMOD's text on stdout
     f->compute(A);
     factor_[a] = std::move(f);
   }

@@ -129,7 +129,9 @@ Eigen::VectorXd solve_on(const SparseMatrix& H, const Eigen::VectorXd& g, const 
   Eigen::VectorXd rhs(na);
   for (Eigen::Index i = 0; i < na; ++i) rhs[i] = -g[A[static_cast<size_t>(i)]];
   const SparseMatrix HAA = restrict_to(H, A);
-  Factor llt(HAA);
+  Factor llt;
+  llt.cholmod().print = 0;  // a failed factorisation is reported by info(), not by CHOLMOD's text on stdout
+  llt.compute(HAA);
   if (llt.info() != Eigen::Success) {
     ok = false;
     return z;

@@ -39,6 +39,7 @@ CoarseSpace::CoarseSpace(const InterfaceProblem& problem, const Equalities& equi
   const SparseMatrix GGt = G_ * Gt_;
   unheld_ = dependent_rows(problem, GGt);
   if (!unheld_.empty()) return;
+  factor_->llt.cholmod().print = 0;  // reported by info(), not by CHOLMOD's text on stdout
   factor_->llt.compute(GGt);
   if (factor_->llt.info() != Eigen::Success)  // dependent across bodies: name every floating body's rows
     for (Eigen::Index i = 0; i < G_.rows(); ++i) unheld_.push_back(i);
