@@ -981,3 +981,4 @@ TEST(ResultFile, FrictionFieldsRoundTripAndShowInTheSidecarAndVtkhdf) {
   io::h5::Handle file = io::h5::open_file(hdf.string());
   EXPECT_TRUE(io::h5::has_link(io::h5::open_group(file, "VTKHDF/PointData"), "tangential_traction"));
 }
+

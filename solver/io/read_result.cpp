@@ -4,8 +4,10 @@
 #include "contact_tables.hpp"
 #include "h5.hpp"
 #include "h5_eigen.hpp"
+#include "history_layout.hpp"
 
 #include <stdexcept>
+#include <type_traits>
 
 namespace contact::io {
 
@@ -67,57 +69,50 @@ void read_input_and_provenance(hid_t file, ResultFile& r) {
   p.theta = h5::read_vector<double>(prov, "theta");
 }
 
+// One dataset of a history table (history_layout.hpp) into its member; an optional one older files lack is left
+// empty.
+struct ColumnReader {
+  hid_t group;
+  Eigen::Index bodies, pairs;
+  bool absent(const HistoryColumn& c) const { return c.optional && !h5::has_link(group, c.name); }
+  void operator()(const HistoryColumn& c, std::vector<int>& v) const {
+    if (absent(c)) return;
+    if (c.stored == HistoryColumn::Stored::int8) {
+      const auto stored = h5::read_vector<std::int8_t>(group, c.name);
+      v.assign(stored.begin(), stored.end());
+    } else {
+      v = h5::read_vector<int>(group, c.name);
+    }
+  }
+  void operator()(const HistoryColumn& c, std::vector<double>& v) const {
+    if (!absent(c)) v = h5::read_vector<double>(group, c.name);
+  }
+  void operator()(const HistoryColumn& c, std::vector<std::string>& v) const {
+    if (!absent(c)) v = h5::read_strings_dataset(group, c.name);
+  }
+  template <class T>
+  void operator()(const HistoryColumn& c, Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>& m) const {
+    if (!absent(c)) m = read_matrix<T>(group, c.name, c.across == HistoryColumn::Across::bodies ? bodies : pairs);
+  }
+};
+
+template <class History>
+void read_table(hid_t history, const char* name, History& h) {
+  Handle g = h5::open_group(history, name);
+  h.body_names = h5::read_strings_attribute(g, "body_names");
+  h.pair_names = h5::read_strings_attribute(g, "pair_names");
+  const ColumnReader reader{g, static_cast<Eigen::Index>(h.body_names.size()),
+                            static_cast<Eigen::Index>(h.pair_names.size())};
+  if constexpr (std::is_same_v<History, IterationHistory>)
+    iteration_columns(h, reader);
+  else
+    step_columns(h, reader);
+}
+
 void read_history(hid_t file, ResultFile& r) {
   Handle history = h5::open_group(file, "history");
-  {
-    Handle g = h5::open_group(history, "iterations");
-    IterationHistory& h = r.history;
-    h.body_names = h5::read_strings_attribute(g, "body_names");
-    h.pair_names = h5::read_strings_attribute(g, "pair_names");
-    const auto nb = static_cast<Eigen::Index>(h.body_names.size());
-    const auto np = static_cast<Eigen::Index>(h.pair_names.size());
-    h.iteration = h5::read_vector<int>(g, "iteration");
-    h.update = h5::read_vector<int>(g, "update");
-    h.measure = h5::read_strings_dataset(g, "measure");
-    h.active_nodes_total = h5::read_vector<int>(g, "active_nodes_total");
-    h.active_set_changes = h5::read_vector<int>(g, "active_set_changes");
-    h.paper_criterion = h5::read_vector<double>(g, "paper_criterion");
-    h.fixed_point_residual = h5::read_vector<double>(g, "fixed_point_residual");
-    h.complementarity = h5::read_vector<double>(g, "complementarity");
-    h.elapsed_seconds = h5::read_vector<double>(g, "elapsed_seconds");
-    h.elements = read_matrix<int>(g, "elements", nb);
-    h.dofs = read_matrix<int>(g, "dofs", nb);
-    h.elements_refined = read_matrix<int>(g, "elements_refined", nb);
-    h.force = read_matrix<double>(g, "force", np);
-    h.max_pressure = read_matrix<double>(g, "max_pressure", np);
-    h.extent_begin = read_matrix<double>(g, "extent_begin", np);
-    h.extent_end = read_matrix<double>(g, "extent_end", np);
-    h.active_nodes = read_matrix<int>(g, "active_nodes", np);
-    h.changed_nodes = read_matrix<int>(g, "changed_nodes", np);
-    h.theta = read_matrix<double>(g, "theta", np);
-    h.max_penetration = read_matrix<double>(g, "max_penetration", np);
-  }
-  {
-    Handle g = h5::open_group(history, "steps");
-    StepHistory& s = r.step_history;
-    s.body_names = h5::read_strings_attribute(g, "body_names");
-    s.pair_names = h5::read_strings_attribute(g, "pair_names");
-    const auto nb = static_cast<Eigen::Index>(s.body_names.size());
-    const auto np = static_cast<Eigen::Index>(s.pair_names.size());
-    s.step = h5::read_vector<int>(g, "step");
-    s.iteration = h5::read_vector<int>(g, "iteration");
-    s.load_factor = h5::read_vector<double>(g, "load_factor");
-    if (h5::has_link(g, "converged")) {  // (older files: absent)
-      for (auto c : h5::read_vector<std::int8_t>(g, "converged")) s.converged.push_back(c);
-    }
-    s.elements = read_matrix<int>(g, "elements", nb);
-    s.dofs = read_matrix<int>(g, "dofs", nb);
-    s.force = read_matrix<double>(g, "force", np);
-    s.contact_begin = read_matrix<double>(g, "contact_begin", np);
-    s.contact_end = read_matrix<double>(g, "contact_end", np);
-    if (h5::has_link(g, "tangential_force"))  // (older files: absent)
-      s.tangential_force = read_matrix<double>(g, "tangential_force", np);
-  }
+  read_table(history, "iterations", r.history);
+  read_table(history, "steps", r.step_history);
 }
 
 BodyField read_body(hid_t bodies, const std::string& name) {

@@ -10,6 +10,7 @@
 #include "contact/files.hpp"
 #include "h5.hpp"
 #include "h5_eigen.hpp"
+#include "history_layout.hpp"
 #include "contact_tables.hpp"
 #include "vtkhdf.hpp"
 
@@ -118,84 +119,83 @@ void write_provenance(hid_t file, const Result& result, const WriteInfo& info) {
 
 // ---- history ------------------------------------------------------------------------------------------
 
-void write_iteration_history(hid_t history, const Problem& problem, const Result& result) {
-  Handle g = h5::create_group(history, "iterations");
-  const auto& rows = result.history;
-  const auto n = static_cast<Eigen::Index>(rows.size());
-
-  // Columns are named by the first row (or by the problem when there is no row).
-  std::vector<std::string> body_names, pair_names;
-  if (!rows.empty()) {
-    for (const auto& b : rows.front().bodies) body_names.push_back(b.name);
-    for (const auto& p : rows.front().pairs) pair_names.push_back(p.name);
-  } else {
-    for (const auto& b : problem.bodies) body_names.push_back(b.name);
-    for (const auto& c : problem.contacts) pair_names.push_back(c.name);
+// One dataset of a history table (history_layout.hpp), as the table says it is stored.
+struct ColumnWriter {
+  hid_t group;
+  void operator()(const HistoryColumn& c, const std::vector<int>& v) const {
+    if (c.stored == HistoryColumn::Stored::int8)
+      h5::write_vector(group, c.name, std::vector<std::int8_t>(v.begin(), v.end()));
+    else
+      h5::write_vector(group, c.name, v);
   }
-  const auto nb = static_cast<Eigen::Index>(body_names.size());
-  const auto np = static_cast<Eigen::Index>(pair_names.size());
+  void operator()(const HistoryColumn& c, const std::vector<double>& v) const { h5::write_vector(group, c.name, v); }
+  void operator()(const HistoryColumn& c, const std::vector<std::string>& v) const {
+    h5::write_strings_dataset(group, c.name, v);
+  }
+  void operator()(const HistoryColumn& c, const Eigen::MatrixXi& m) const { write_matrix(group, c.name, m); }
+  void operator()(const HistoryColumn& c, const Eigen::MatrixXd& m) const { write_matrix(group, c.name, m); }
+};
 
-  std::vector<std::int32_t> iteration, update, active_total, changes;
-  std::vector<std::string> measure;
-  std::vector<double> paper, residual, complementarity, elapsed;
-  Eigen::MatrixXi elements(n, nb), dofs(n, nb), refined(n, nb), active(n, np), changed(n, np);
-  Eigen::MatrixXd force(n, np), max_pressure(n, np), extent_begin(n, np), extent_end(n, np), theta(n, np),
-      penetration(n, np);
+// The iteration rows as the columns of /history/iterations.
+IterationHistory iteration_table(const Problem& problem, const std::vector<IterationReport>& rows) {
+  IterationHistory h;
+  // Columns are named by the first row (or by the problem when there is no row).
+  if (!rows.empty()) {
+    for (const auto& b : rows.front().bodies) h.body_names.push_back(b.name);
+    for (const auto& p : rows.front().pairs) h.pair_names.push_back(p.name);
+  } else {
+    for (const auto& b : problem.bodies) h.body_names.push_back(b.name);
+    for (const auto& c : problem.contacts) h.pair_names.push_back(c.name);
+  }
+  const auto n = static_cast<Eigen::Index>(rows.size());
+  const auto nb = static_cast<Eigen::Index>(h.body_names.size());
+  const auto np = static_cast<Eigen::Index>(h.pair_names.size());
+  for (Eigen::MatrixXi* m : {&h.elements, &h.dofs, &h.elements_refined}) m->resize(n, nb);
+  for (Eigen::MatrixXi* m : {&h.active_nodes, &h.changed_nodes}) m->resize(n, np);
+  for (Eigen::MatrixXd* m : {&h.force, &h.max_pressure, &h.extent_begin, &h.extent_end, &h.theta, &h.max_penetration})
+    m->resize(n, np);
   for (Eigen::Index i = 0; i < n; ++i) {
     const IterationReport& r = rows[static_cast<size_t>(i)];
     if (static_cast<Eigen::Index>(r.bodies.size()) != nb || static_cast<Eigen::Index>(r.pairs.size()) != np)
       throw std::runtime_error("history row " + rows_text(i) + " (iteration " + std::to_string(r.iteration) + ") has " +
                                std::to_string(r.bodies.size()) + " bodies and " + std::to_string(r.pairs.size()) +
                                " pairs; the first row has " + rows_text(nb) + " and " + rows_text(np));
-    iteration.push_back(r.iteration);
-    measure.push_back(to_string(r.measure));
-    update.push_back(r.update);
-    active_total.push_back(r.active_nodes);
-    changes.push_back(r.active_set_changes);
-    paper.push_back(r.paper_criterion);
-    residual.push_back(r.fixed_point_residual);
-    complementarity.push_back(r.complementarity);
-    elapsed.push_back(r.elapsed_seconds);
+    h.iteration.push_back(r.iteration);
+    h.measure.push_back(to_string(r.measure));
+    h.update.push_back(r.update);
+    h.active_nodes_total.push_back(r.active_nodes);
+    h.active_set_changes.push_back(r.active_set_changes);
+    h.paper_criterion.push_back(r.paper_criterion);
+    h.fixed_point_residual.push_back(r.fixed_point_residual);
+    h.complementarity.push_back(r.complementarity);
+    h.elapsed_seconds.push_back(r.elapsed_seconds);
     for (Eigen::Index b = 0; b < nb; ++b) {
       const BodyReport& body = r.bodies[static_cast<size_t>(b)];
-      elements(i, b) = body.elements;
-      dofs(i, b) = body.dofs;
-      refined(i, b) = body.elements_refined;
+      h.elements(i, b) = body.elements;
+      h.dofs(i, b) = body.dofs;
+      h.elements_refined(i, b) = body.elements_refined;
     }
     for (Eigen::Index p = 0; p < np; ++p) {
       const PairReport& pair = r.pairs[static_cast<size_t>(p)];
-      force(i, p) = pair.force;
-      max_pressure(i, p) = pair.max_pressure;
-      extent_begin(i, p) = pair.extent_begin;
-      extent_end(i, p) = pair.extent_end;
-      active(i, p) = pair.active_nodes;
-      changed(i, p) = pair.changed_nodes;
-      theta(i, p) = pair.theta;
-      penetration(i, p) = pair.max_penetration;
+      h.force(i, p) = pair.force;
+      h.max_pressure(i, p) = pair.max_pressure;
+      h.extent_begin(i, p) = pair.extent_begin;
+      h.extent_end(i, p) = pair.extent_end;
+      h.active_nodes(i, p) = pair.active_nodes;
+      h.changed_nodes(i, p) = pair.changed_nodes;
+      h.theta(i, p) = pair.theta;
+      h.max_penetration(i, p) = pair.max_penetration;
     }
   }
-  h5::write_attribute(g, "body_names", body_names);
-  h5::write_attribute(g, "pair_names", pair_names);
-  h5::write_vector(g, "iteration", iteration);
-  h5::write_vector(g, "update", update);
-  h5::write_strings_dataset(g, "measure", measure);
-  h5::write_vector(g, "paper_criterion", paper);
-  h5::write_vector(g, "fixed_point_residual", residual);
-  h5::write_vector(g, "complementarity", complementarity);
-  h5::write_vector(g, "active_nodes_total", active_total);
-  h5::write_vector(g, "active_set_changes", changes);
-  h5::write_vector(g, "elapsed_seconds", elapsed);
-  write_matrix(g, "elements", elements);
-  write_matrix(g, "dofs", dofs);
-  write_matrix(g, "elements_refined", refined);
-  write_matrix(g, "force", force);
-  write_matrix(g, "max_pressure", max_pressure);
-  write_matrix(g, "extent_begin", extent_begin);
-  write_matrix(g, "extent_end", extent_end);
-  write_matrix(g, "active_nodes", active);
-  write_matrix(g, "changed_nodes", changed);
-  write_matrix(g, "theta", theta);
-  write_matrix(g, "max_penetration", penetration);
+  return h;
+}
+
+void write_iteration_history(hid_t history, const Problem& problem, const Result& result) {
+  Handle g = h5::create_group(history, "iterations");
+  const IterationHistory h = iteration_table(problem, result.history);
+  h5::write_attribute(g, "body_names", h.body_names);
+  h5::write_attribute(g, "pair_names", h.pair_names);
+  iteration_columns(h, ColumnWriter{g});
 }
 
 std::vector<std::string> body_names_of(const Step& s) {
@@ -218,51 +218,49 @@ std::vector<StepSummary> step_rows(const Result& result) {
   return rows;
 }
 
-void write_step_history(hid_t history, const std::vector<StepSummary>& rows) {
-  Handle g = h5::create_group(history, "steps");
+// The step rows as the columns of /history/steps.
+StepHistory step_table(const std::vector<StepSummary>& rows) {
+  StepHistory h;
+  if (!rows.empty()) {
+    h.body_names = rows.front().body_names;
+    h.pair_names = rows.front().pair_names;
+  }
   const auto n = static_cast<Eigen::Index>(rows.size());
-  const std::vector<std::string> names = rows.empty() ? std::vector<std::string>{} : rows.front().body_names;
-  const std::vector<std::string> pairs = rows.empty() ? std::vector<std::string>{} : rows.front().pair_names;
-  const auto nb = static_cast<Eigen::Index>(names.size());
-  const auto np = static_cast<Eigen::Index>(pairs.size());
-  std::vector<std::int32_t> step, iteration;
-  std::vector<std::int8_t> converged;
-  std::vector<double> load_factor;
-  Eigen::MatrixXi elements(n, nb), dofs(n, nb);
-  Eigen::MatrixXd force(n, np), contact_begin(n, np), contact_end(n, np), tangential_force(n, np);
+  const auto nb = static_cast<Eigen::Index>(h.body_names.size());
+  const auto np = static_cast<Eigen::Index>(h.pair_names.size());
+  h.elements.resize(n, nb);
+  h.dofs.resize(n, nb);
+  for (Eigen::MatrixXd* m : {&h.force, &h.contact_begin, &h.contact_end, &h.tangential_force}) m->resize(n, np);
   for (Eigen::Index k = 0; k < n; ++k) {
     const StepSummary& s = rows[static_cast<size_t>(k)];
-    if (s.body_names != names)
+    if (s.body_names != h.body_names)
       throw std::runtime_error("step " + rows_text(k) + " does not have the bodies of step 0 in the same order");
-    if (s.pair_names != pairs)
+    if (s.pair_names != h.pair_names)
       throw std::runtime_error("step " + rows_text(k) + " does not have the pairs of step 0 in the same order");
-    step.push_back(static_cast<std::int32_t>(k));
-    iteration.push_back(s.iteration);
-    load_factor.push_back(s.load_factor);
-    converged.push_back(s.converged ? 1 : 0);
+    h.step.push_back(static_cast<int>(k));
+    h.iteration.push_back(s.iteration);
+    h.load_factor.push_back(s.load_factor);
+    h.converged.push_back(s.converged ? 1 : 0);
     for (Eigen::Index b = 0; b < nb; ++b) {
-      elements(k, b) = s.elements[static_cast<size_t>(b)];
-      dofs(k, b) = 2 * s.nodes[static_cast<size_t>(b)];
+      h.elements(k, b) = s.elements[static_cast<size_t>(b)];
+      h.dofs(k, b) = 2 * s.nodes[static_cast<size_t>(b)];
     }
     for (Eigen::Index p = 0; p < np; ++p) {
-      force(k, p) = s.force[static_cast<size_t>(p)];
-      tangential_force(k, p) = s.tangential_force[static_cast<size_t>(p)];  // 0 for a frictionless pair
-      contact_begin(k, p) = s.contact_begin[static_cast<size_t>(p)];
-      contact_end(k, p) = s.contact_end[static_cast<size_t>(p)];
+      h.force(k, p) = s.force[static_cast<size_t>(p)];
+      h.tangential_force(k, p) = s.tangential_force[static_cast<size_t>(p)];  // 0 for a frictionless pair
+      h.contact_begin(k, p) = s.contact_begin[static_cast<size_t>(p)];
+      h.contact_end(k, p) = s.contact_end[static_cast<size_t>(p)];
     }
   }
-  h5::write_attribute(g, "body_names", names);
-  h5::write_attribute(g, "pair_names", pairs);
-  h5::write_vector(g, "step", step);
-  h5::write_vector(g, "iteration", iteration);
-  h5::write_vector(g, "load_factor", load_factor);
-  h5::write_vector(g, "converged", converged);
-  write_matrix(g, "elements", elements);
-  write_matrix(g, "dofs", dofs);
-  write_matrix(g, "force", force);
-  write_matrix(g, "contact_begin", contact_begin);
-  write_matrix(g, "contact_end", contact_end);
-  write_matrix(g, "tangential_force", tangential_force);
+  return h;
+}
+
+void write_step_history(hid_t history, const std::vector<StepSummary>& rows) {
+  Handle g = h5::create_group(history, "steps");
+  const StepHistory h = step_table(rows);
+  h5::write_attribute(g, "body_names", h.body_names);
+  h5::write_attribute(g, "pair_names", h.pair_names);
+  step_columns(h, ColumnWriter{g});
 }
 
 // ---- steps --------------------------------------------------------------------------------------------

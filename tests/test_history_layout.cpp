@@ -1,0 +1,118 @@
+// The result file's history tables, declared once (solver/io/history_layout.hpp): what the format document says,
+// name, shape and type, and what is written is what is read.
+#include "contact/job.hpp"
+#include "contact/result_file.hpp"
+#include "contact/solve.hpp"
+#include "io/history_layout.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <string>
+
+// ---- the history tables: declared once (io/history_layout.hpp), documented once (docs/results-format.md) ----
+
+namespace {
+
+// A history table as a set of "name shape type" lines, e.g. "force (I, P) float64".
+using ColumnSet = std::set<std::string>;
+
+template <class Walk>
+ColumnSet declared_columns(Walk walk, const char* rows) {
+  ColumnSet out;
+  walk([&](const contact::io::HistoryColumn& c, const auto&) {
+    using A = contact::io::HistoryColumn::Across;
+    using S = contact::io::HistoryColumn::Stored;
+    const std::string shape = std::string("(") + rows +
+                              (c.across == A::none     ? ",)"
+                               : c.across == A::bodies ? ", B)"
+                                                       : ", P)");
+    const std::string type = c.stored == S::int32     ? "int32"
+                             : c.stored == S::int8    ? "int8"
+                             : c.stored == S::float64 ? "float64"
+                                                      : "str";
+    out.insert(std::string(c.name) + " " + shape + " " + type);
+  });
+  return out;
+}
+
+// The dataset table under the heading that starts with `heading` in docs/results-format.md: each row's names (one
+// or more, in backticks, in its first cell) with its shape and type (its second cell).
+ColumnSet documented_columns(const std::string& heading) {
+  std::ifstream in(std::string(CONTACT_SOURCE_DIR) + "/docs/results-format.md");
+  std::string line;
+  bool inside = false;
+  ColumnSet out;
+  while (std::getline(in, line)) {
+    if (line.rfind("### ", 0) == 0) {
+      if (inside) break;
+      inside = line.rfind(heading, 0) == 0;
+      continue;
+    }
+    if (!inside || line.rfind("| `", 0) != 0) continue;
+    const size_t first_end = line.find(" | ", 2);
+    const size_t second_end = line.find(" | ", first_end + 3);
+    if (first_end == std::string::npos || second_end == std::string::npos) continue;
+    const std::string names = line.substr(2, first_end - 2);
+    const std::string shape_type = line.substr(first_end + 3, second_end - first_end - 3);
+    static const std::regex name("`([a-z_]+)`");
+    for (std::sregex_iterator it(names.begin(), names.end(), name), end; it != end; ++it)
+      out.insert((*it)[1].str() + " " + shape_type);
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST(ResultLayout, TheIterationHistoryIsTheDocumentsTableNameShapeAndType) {
+  contact::io::IterationHistory h;
+  const ColumnSet declared = declared_columns([&](auto visit) { contact::io::iteration_columns(h, visit); }, "I");
+  const ColumnSet documented = documented_columns("### `/history/iterations`");
+  EXPECT_EQ(declared.size(), 20u);
+  EXPECT_EQ(declared, documented);
+}
+
+TEST(ResultLayout, TheStepHistoryIsTheDocumentsTableNameShapeAndType) {
+  contact::io::StepHistory h;
+  const ColumnSet declared = declared_columns([&](auto visit) { contact::io::step_columns(h, visit); }, "S");
+  const ColumnSet documented = documented_columns("### `/history/steps`");
+  EXPECT_EQ(declared.size(), 10u);
+  EXPECT_EQ(declared, documented);
+}
+
+TEST(ResultLayout, TheHistoryTablesReadBackAsWritten) {
+  // Written by the one table and read by it: every column comes back (two load steps, Coulomb on one pair).
+  std::ifstream in(std::string(CONTACT_SOURCE_DIR) + "/tests/data/result_format_v2.json");
+  const auto parsed = contact::job::parse(nlohmann::json::parse(in));
+  ASSERT_TRUE(parsed.ok()) << contact::job::format_errors(parsed.errors);
+  contact::Observer quiet;
+  contact::CancelToken cancel;
+  const contact::Result result = contact::solve(*parsed.problem, quiet, cancel);
+  ASSERT_TRUE(result.converged) << result.message;
+  const std::string path = (std::filesystem::temp_directory_path() / "history_layout_roundtrip.hdf").string();
+  contact::io::write_result(path, *parsed.problem, result);
+  const contact::io::ResultFile file = contact::io::read_result(path);
+  std::filesystem::remove(path);
+  ASSERT_EQ(file.history.iteration.size(), result.history.size());
+  for (size_t i = 0; i < result.history.size(); ++i) {
+    const auto row = static_cast<Eigen::Index>(i);
+    EXPECT_EQ(file.history.iteration[i], result.history[i].iteration);
+    EXPECT_EQ(file.history.measure[i], contact::to_string(result.history[i].measure));
+    EXPECT_EQ(file.history.complementarity[i], result.history[i].complementarity);
+    EXPECT_EQ(file.history.force(row, 1), result.history[i].pairs[1].force);
+    EXPECT_EQ(file.history.changed_nodes(row, 0), result.history[i].pairs[0].changed_nodes);
+    EXPECT_EQ(file.history.dofs(row, 1), result.history[i].bodies[1].dofs);
+  }
+  ASSERT_EQ(file.step_history.step.size(), 2u);
+  EXPECT_EQ(file.step_history.converged, (std::vector<int>{1, 1}));
+  EXPECT_EQ(file.step_history.load_factor.back(), result.steps.back().load_factor);
+  double tangential = 0.0;
+  for (Eigen::Index p = 0; p < file.step_history.tangential_force.cols(); ++p)
+    tangential += std::abs(file.step_history.tangential_force(1, p));
+  EXPECT_GT(tangential, 0.0) << "the Coulomb pair's tangential force";
+  EXPECT_EQ(file.step_history.dofs.cols(), static_cast<Eigen::Index>(parsed.problem->bodies.size()));
+}
