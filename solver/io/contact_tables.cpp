@@ -3,6 +3,7 @@
 
 #include "h5.hpp"
 #include "h5_eigen.hpp"
+#include "result_layout.hpp"
 #include "view_layout.hpp"
 
 #include <cstdint>
@@ -45,73 +46,68 @@ void check_pair_rows(const PairField& p, const std::string& where) {
   }
 }
 
-// The tables of one step, filled pair by pair. Two-column quantities are row-major (N x 2), as HDF5 stores them.
-struct Tables {
-  // per node
-  std::vector<std::int64_t> node;
-  std::vector<std::int32_t> pair;
-  std::vector<double> position, normal, tangent;
-  std::vector<double> arc_length, weight, gap, normal_gap, pressure, penetration, tangential_traction, slip;
-  std::vector<std::int8_t> active, status, stick;
-  // per segment: rows of the node tables
-  std::vector<std::int64_t> segments;
-  // per pair
-  std::vector<std::int64_t> offsets{0}, segment_offsets{0};
-  std::vector<std::string> slave_body, slave_edge, master_body, master_edge, enforcement, friction;
-  std::vector<double> theta, force, resultant, friction_coefficient, friction_bound, tangential_force;
+// Appends pair p to the tables of its step (result_layout.hpp).
+void add_pair(ContactTables& t, const PairField& p, bool closed) {
+  const Eigen::Index n = p.position.rows();
+  const auto first = static_cast<std::int64_t>(t.node.size());
+  const bool frictional = p.friction != "none";
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (Eigen::Index j = 0; j < n; ++j) {
+    t.node.push_back(p.node[j]);
+    t.pair.push_back(static_cast<std::int32_t>(t.offsets.size() - 1));
+    t.position.insert(t.position.end(), {p.position(j, 0), p.position(j, 1)});
+    t.normal.insert(t.normal.end(), {p.normal(j, 0), p.normal(j, 1)});
+    t.arc_length.push_back(p.arc_length[j]);
+    t.weight.push_back(p.weight[j]);
+    t.gap.push_back(p.gap[j]);
+    t.normal_gap.push_back(p.normal_gap[j]);
+    t.pressure.push_back(p.pressure[j]);
+    t.penetration.push_back(p.penetration[j]);
+    t.active.push_back(static_cast<std::int8_t>(p.active[j]));
+    t.status.push_back(static_cast<std::int8_t>(p.status[j]));
+    // A frictionless pair's rows: its tangent (the normal turned a quarter anticlockwise), no traction, no slip
+    // measured (NaN), not sticking.
+    if (frictional)
+      t.tangent.insert(t.tangent.end(), {p.tangent(j, 0), p.tangent(j, 1)});
+    else
+      t.tangent.insert(t.tangent.end(), {-p.normal(j, 1), p.normal(j, 0)});
+    t.tangential_traction.push_back(frictional ? p.tangential_traction[j] : 0.0);
+    t.slip.push_back(frictional ? p.slip[j] : nan);
+    t.stick.push_back(frictional ? static_cast<std::int8_t>(p.stick[j]) : std::int8_t{0});
+  }
+  const auto lines = pair_segments(n, closed);
+  for (Eigen::Index j = 0; j < lines.rows(); ++j)
+    t.segments.insert(t.segments.end(), {first + lines(j, 0), first + lines(j, 1)});
+  t.offsets.push_back(static_cast<std::int64_t>(t.node.size()));
+  t.segment_offsets.push_back(static_cast<std::int64_t>(t.segments.size() / 2));
+  t.slave_body.push_back(p.slave_body);
+  t.slave_edge.push_back(p.slave_edge);
+  t.master_body.push_back(p.master_body);
+  t.master_edge.push_back(p.master_edge);
+  t.enforcement.push_back(p.enforcement);
+  t.friction.push_back(p.friction);
+  t.theta.push_back(p.theta);
+  t.force.push_back(p.force);
+  t.resultant.insert(t.resultant.end(), {p.resultant.x(), p.resultant.y()});
+  t.friction_coefficient.push_back(frictional ? p.friction_coefficient : 0.0);
+  t.friction_bound.push_back(frictional ? p.friction_bound : 0.0);
+  t.tangential_force.push_back(frictional ? p.tangential_force : 0.0);
+}
 
-  void add(const PairField& p, bool closed) {
-    const Eigen::Index n = p.position.rows();
-    const auto first = static_cast<std::int64_t>(node.size());
-    const bool frictional = p.friction != "none";
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    for (Eigen::Index j = 0; j < n; ++j) {
-      node.push_back(p.node[j]);
-      pair.push_back(static_cast<std::int32_t>(offsets.size() - 1));
-      position.insert(position.end(), {p.position(j, 0), p.position(j, 1)});
-      normal.insert(normal.end(), {p.normal(j, 0), p.normal(j, 1)});
-      arc_length.push_back(p.arc_length[j]);
-      weight.push_back(p.weight[j]);
-      gap.push_back(p.gap[j]);
-      normal_gap.push_back(p.normal_gap[j]);
-      pressure.push_back(p.pressure[j]);
-      penetration.push_back(p.penetration[j]);
-      active.push_back(static_cast<std::int8_t>(p.active[j]));
-      status.push_back(static_cast<std::int8_t>(p.status[j]));
-      // A frictionless pair's rows: its tangent (the normal turned a quarter anticlockwise), no traction, no slip
-      // measured (NaN), not sticking.
-      if (frictional)
-        tangent.insert(tangent.end(), {p.tangent(j, 0), p.tangent(j, 1)});
-      else
-        tangent.insert(tangent.end(), {-p.normal(j, 1), p.normal(j, 0)});
-      tangential_traction.push_back(frictional ? p.tangential_traction[j] : 0.0);
-      slip.push_back(frictional ? p.slip[j] : nan);
-      stick.push_back(frictional ? static_cast<std::int8_t>(p.stick[j]) : std::int8_t{0});
-    }
-    const auto lines = pair_segments(n, closed);
-    for (Eigen::Index j = 0; j < lines.rows(); ++j)
-      segments.insert(segments.end(), {first + lines(j, 0), first + lines(j, 1)});
-    offsets.push_back(static_cast<std::int64_t>(node.size()));
-    segment_offsets.push_back(static_cast<std::int64_t>(segments.size() / 2));
-    slave_body.push_back(p.slave_body);
-    slave_edge.push_back(p.slave_edge);
-    master_body.push_back(p.master_body);
-    master_edge.push_back(p.master_edge);
-    enforcement.push_back(p.enforcement);
-    friction.push_back(p.friction);
-    theta.push_back(p.theta);
-    force.push_back(p.force);
-    resultant.insert(resultant.end(), {p.resultant.x(), p.resultant.y()});
-    friction_coefficient.push_back(frictional ? p.friction_coefficient : 0.0);
-    friction_bound.push_back(frictional ? p.friction_bound : 0.0);
-    tangential_force.push_back(frictional ? p.tangential_force : 0.0);
+// One dataset of the contact tables (result_layout.hpp): a text per pair, or values in one or two columns.
+struct TableWriter {
+  hid_t group;
+  void operator()(const ContactColumn& c, const std::vector<std::string>& v) const {
+    h5::write_strings_dataset(group, c.name, v);
+  }
+  template <class T>
+  void operator()(const ContactColumn& c, const std::vector<T>& v) const {
+    if (c.width == 2)
+      h5::write_dataset(group, c.name, v, {static_cast<hsize_t>(v.size() / 2), 2});
+    else
+      h5::write_vector(group, c.name, v);
   }
 };
-
-template <class T>
-void write_pairs_of(hid_t g, const std::string& name, const std::vector<T>& data) {
-  h5::write_dataset(g, name, data, {static_cast<hsize_t>(data.size() / 2), 2});
-}
 
 // ---- reading ------------------------------------------------------------------------------------------------
 
@@ -148,62 +144,71 @@ std::vector<std::string> strings(hid_t g, const std::string& name, size_t count)
   return v;
 }
 
+// One dataset of the contact tables into its member, its rows checked (result_layout.hpp).
+struct TableReader {
+  hid_t group;
+  std::int64_t pairs, nodes, segments;
+  std::int64_t rows(const ContactColumn& c) const {
+    using R = ContactColumn::Rows;
+    return c.rows == R::pair_offsets ? pairs + 1 : c.rows == R::pairs ? pairs : c.rows == R::nodes ? nodes : segments;
+  }
+  void operator()(const ContactColumn& c, std::vector<std::string>& v) const {
+    v = strings(group, c.name, static_cast<size_t>(pairs));
+  }
+  template <class T>
+  void operator()(const ContactColumn& c, std::vector<T>& v) const {
+    v = table<T>(group, c.name, rows(c), c.width == 2 ? 2 : 0);
+  }
+};
+
+// The offsets of one kind of row (nodes or segments): from 0, never decreasing; their last is the row count.
+std::int64_t checked_offsets(hid_t g, const char* name, std::int64_t pairs) {
+  const auto offsets = table<std::int64_t>(g, name, pairs + 1, 0);
+  bool rising = offsets[0] == 0;
+  for (std::int64_t p = 0; p < pairs; ++p)
+    rising = rising && offsets[static_cast<size_t>(p)] <= offsets[static_cast<size_t>(p + 1)];
+  if (!rising) throw std::runtime_error("dataset '" + h5::object_name(g) + "/" + name + "' does not increase from 0");
+  return offsets.back();
+}
+
 std::vector<PairField> read_tables(hid_t g, const std::vector<std::string>& names) {
   const size_t count = names.size();
-  const auto offsets = table<std::int64_t>(g, "offsets", static_cast<std::int64_t>(count) + 1, 0);
-  const std::int64_t n = offsets.back();
-  bool rising = offsets[0] == 0;
-  for (size_t p = 0; p < count; ++p) rising = rising && offsets[p] <= offsets[p + 1];
-  if (!rising) throw std::runtime_error("dataset '" + h5::object_name(g) + "/offsets' does not increase from 0");
-  const auto node = table<std::int64_t>(g, "node", n, 0);
-  const auto position = table<double>(g, "position", n, 2), normal = table<double>(g, "normal", n, 2),
-             tangent = table<double>(g, "tangent", n, 2);
-  const auto arc_length = table<double>(g, "arc_length", n, 0), weight = table<double>(g, "weight", n, 0),
-             gap = table<double>(g, "gap", n, 0), normal_gap = table<double>(g, "normal_gap", n, 0),
-             pressure = table<double>(g, "pressure", n, 0), penetration = table<double>(g, "penetration", n, 0),
-             traction = table<double>(g, "tangential_traction", n, 0), slip = table<double>(g, "slip", n, 0);
-  const auto active = table<int>(g, "active", n, 0), status = table<int>(g, "status", n, 0),
-             stick = table<int>(g, "stick", n, 0);
-  const auto slave_body = strings(g, "slave_body", count), slave_edge = strings(g, "slave_edge", count),
-             master_body = strings(g, "master_body", count), master_edge = strings(g, "master_edge", count),
-             enforcement = strings(g, "enforcement", count), friction = strings(g, "friction", count);
   const auto P = static_cast<std::int64_t>(count);
-  const auto theta = table<double>(g, "theta", P, 0), force = table<double>(g, "force", P, 0),
-             resultant = table<double>(g, "resultant", P, 2), mu = table<double>(g, "friction_coefficient", P, 0),
-             bound = table<double>(g, "friction_bound", P, 0), tforce = table<double>(g, "tangential_force", P, 0);
+  ContactTables t;
+  contact_columns(t, TableReader{g, P, checked_offsets(g, "offsets", P), checked_offsets(g, "segment_offsets", P)});
   std::vector<PairField> out(count);
   for (size_t p = 0; p < count; ++p) {
     PairField& f = out[p];
-    const std::int64_t b = offsets[p], e = offsets[p + 1];
+    const std::int64_t b = t.offsets[p], e = t.offsets[p + 1];
     f.name = names[p];
-    f.slave_body = slave_body[p];
-    f.slave_edge = slave_edge[p];
-    f.master_body = master_body[p];
-    f.master_edge = master_edge[p];
-    f.enforcement = enforcement[p];
-    f.theta = theta[p];
-    f.force = force[p];
-    f.resultant = Eigen::Vector2d(resultant[2 * p], resultant[2 * p + 1]);
-    f.node = slice(node, b, e).cast<int>();
-    f.position = slice2(position, b, e);
-    f.normal = slice2(normal, b, e);
-    f.arc_length = slice(arc_length, b, e);
-    f.weight = slice(weight, b, e);
-    f.gap = slice(gap, b, e);
-    f.normal_gap = slice(normal_gap, b, e);
-    f.pressure = slice(pressure, b, e);
-    f.penetration = slice(penetration, b, e);
-    f.active = slice(active, b, e);
-    f.status = slice(status, b, e);
-    f.friction = friction[p];
+    f.slave_body = t.slave_body[p];
+    f.slave_edge = t.slave_edge[p];
+    f.master_body = t.master_body[p];
+    f.master_edge = t.master_edge[p];
+    f.enforcement = t.enforcement[p];
+    f.theta = t.theta[p];
+    f.force = t.force[p];
+    f.resultant = Eigen::Vector2d(t.resultant[2 * p], t.resultant[2 * p + 1]);
+    f.node = slice(t.node, b, e).cast<int>();
+    f.position = slice2(t.position, b, e);
+    f.normal = slice2(t.normal, b, e);
+    f.arc_length = slice(t.arc_length, b, e);
+    f.weight = slice(t.weight, b, e);
+    f.gap = slice(t.gap, b, e);
+    f.normal_gap = slice(t.normal_gap, b, e);
+    f.pressure = slice(t.pressure, b, e);
+    f.penetration = slice(t.penetration, b, e);
+    f.active = slice(t.active, b, e).cast<int>();
+    f.status = slice(t.status, b, e).cast<int>();
+    f.friction = t.friction[p];
     if (f.friction != "none") {  // a frictionless pair's friction fields stay empty, as the solver leaves them
-      f.friction_coefficient = mu[p];
-      f.friction_bound = bound[p];
-      f.tangential_force = tforce[p];
-      f.tangent = slice2(tangent, b, e);
-      f.tangential_traction = slice(traction, b, e);
-      f.slip = slice(slip, b, e);
-      f.stick = slice(stick, b, e);
+      f.friction_coefficient = t.friction_coefficient[p];
+      f.friction_bound = t.friction_bound[p];
+      f.tangential_force = t.tangential_force[p];
+      f.tangent = slice2(t.tangent, b, e);
+      f.tangential_traction = slice(t.tangential_traction, b, e);
+      f.slip = slice(t.slip, b, e);
+      f.stick = slice(t.stick, b, e).cast<int>();
     }
   }
   return out;
@@ -252,43 +257,13 @@ PairField read_pair_group(hid_t contacts, const std::string& name) {
 }  // namespace
 
 void write_contact_tables(hid_t step, const Step& s, const std::string& where) {
-  Tables t;
+  ContactTables t;
   for (const auto& p : s.pairs) {
     check_pair_rows(p, where);
-    t.add(p, slave_is_closed(s, p));
+    add_pair(t, p, slave_is_closed(s, p));
   }
   Handle g = h5::create_group(step, "contacts");
-  h5::write_vector(g, "offsets", t.offsets);
-  h5::write_vector(g, "segment_offsets", t.segment_offsets);
-  h5::write_strings_dataset(g, "slave_body", t.slave_body);
-  h5::write_strings_dataset(g, "slave_edge", t.slave_edge);
-  h5::write_strings_dataset(g, "master_body", t.master_body);
-  h5::write_strings_dataset(g, "master_edge", t.master_edge);
-  h5::write_strings_dataset(g, "enforcement", t.enforcement);
-  h5::write_strings_dataset(g, "friction", t.friction);
-  h5::write_vector(g, "theta", t.theta);
-  h5::write_vector(g, "force", t.force);
-  write_pairs_of(g, "resultant", t.resultant);
-  h5::write_vector(g, "friction_coefficient", t.friction_coefficient);
-  h5::write_vector(g, "friction_bound", t.friction_bound);
-  h5::write_vector(g, "tangential_force", t.tangential_force);
-  h5::write_vector(g, "pair", t.pair);
-  h5::write_vector(g, "node", t.node);
-  write_pairs_of(g, "position", t.position);
-  write_pairs_of(g, "normal", t.normal);
-  h5::write_vector(g, "arc_length", t.arc_length);
-  h5::write_vector(g, "status", t.status);
-  h5::write_vector(g, "weight", t.weight);
-  h5::write_vector(g, "gap", t.gap);
-  h5::write_vector(g, "normal_gap", t.normal_gap);
-  h5::write_vector(g, "pressure", t.pressure);
-  h5::write_vector(g, "penetration", t.penetration);
-  h5::write_vector(g, "active", t.active);
-  write_pairs_of(g, "tangent", t.tangent);
-  h5::write_vector(g, "tangential_traction", t.tangential_traction);
-  h5::write_vector(g, "slip", t.slip);
-  h5::write_vector(g, "stick", t.stick);
-  write_pairs_of(g, "segments", t.segments);
+  contact_columns(t, TableWriter{g});
 }
 
 std::vector<PairField> read_contact_tables(hid_t contacts, const std::vector<std::string>& names, int format_version) {

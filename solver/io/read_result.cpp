@@ -4,7 +4,7 @@
 #include "contact_tables.hpp"
 #include "h5.hpp"
 #include "h5_eigen.hpp"
-#include "history_layout.hpp"
+#include "result_layout.hpp"
 
 #include <stdexcept>
 #include <type_traits>
@@ -69,7 +69,7 @@ void read_input_and_provenance(hid_t file, ResultFile& r) {
   p.theta = h5::read_vector<double>(prov, "theta");
 }
 
-// One dataset of a history table (history_layout.hpp) into its member; an optional one older files lack is left
+// One dataset of a history table (result_layout.hpp) into its member; an optional one older files lack is left
 // empty.
 struct ColumnReader {
   hid_t group;

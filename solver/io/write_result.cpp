@@ -10,7 +10,7 @@
 #include "contact/files.hpp"
 #include "h5.hpp"
 #include "h5_eigen.hpp"
-#include "history_layout.hpp"
+#include "result_layout.hpp"
 #include "contact_tables.hpp"
 #include "vtkhdf.hpp"
 
@@ -119,7 +119,7 @@ void write_provenance(hid_t file, const Result& result, const WriteInfo& info) {
 
 // ---- history ------------------------------------------------------------------------------------------
 
-// One dataset of a history table (history_layout.hpp), as the table says it is stored.
+// One dataset of a history table (result_layout.hpp), as the table says it is stored.
 struct ColumnWriter {
   hid_t group;
   void operator()(const HistoryColumn& c, const std::vector<int>& v) const {

@@ -1,9 +1,9 @@
-// The result file's history tables, declared once (solver/io/history_layout.hpp): what the format document says,
-// name, shape and type, and what is written is what is read.
+// The result file's tables, declared once (solver/io/result_layout.hpp): what the format document says, name, shape
+// and type, and what is written is what is read.
 #include "contact/job.hpp"
 #include "contact/result_file.hpp"
 #include "contact/solve.hpp"
-#include "io/history_layout.hpp"
+#include "io/result_layout.hpp"
 
 #include <gtest/gtest.h>
 
@@ -13,8 +13,9 @@
 #include <regex>
 #include <set>
 #include <string>
+#include <type_traits>
 
-// ---- the history tables: declared once (io/history_layout.hpp), documented once (docs/results-format.md) ----
+// ---- the history tables: declared once (io/result_layout.hpp), documented once (docs/results-format.md) ----
 
 namespace {
 
@@ -40,20 +41,21 @@ ColumnSet declared_columns(Walk walk, const char* rows) {
   return out;
 }
 
-// The dataset table under the heading that starts with `heading` in docs/results-format.md: each row's names (one
-// or more, in backticks, in its first cell) with its shape and type (its second cell).
-ColumnSet documented_columns(const std::string& heading) {
+// The dataset tables of docs/results-format.md from the line that starts with `from` to the next heading (or the
+// line that starts with `until`): each row's names (one or more, in backticks, in its first cell) with its shape
+// and type (its second cell).
+ColumnSet documented_columns(const std::string& from, const std::string& until = "### ") {
   std::ifstream in(std::string(CONTACT_SOURCE_DIR) + "/docs/results-format.md");
   std::string line;
   bool inside = false;
   ColumnSet out;
   while (std::getline(in, line)) {
-    if (line.rfind("### ", 0) == 0) {
-      if (inside) break;
-      inside = line.rfind(heading, 0) == 0;
+    if (inside && (line.rfind("### ", 0) == 0 || line.rfind(until, 0) == 0)) break;
+    if (!inside) {
+      inside = line.rfind(from, 0) == 0;
       continue;
     }
-    if (!inside || line.rfind("| `", 0) != 0) continue;
+    if (line.rfind("| `", 0) != 0) continue;
     const size_t first_end = line.find(" | ", 2);
     const size_t second_end = line.find(" | ", first_end + 3);
     if (first_end == std::string::npos || second_end == std::string::npos) continue;
@@ -84,6 +86,28 @@ TEST(ResultLayout, TheStepHistoryIsTheDocumentsTableNameShapeAndType) {
   EXPECT_EQ(declared, documented);
 }
 
+TEST(ResultLayout, TheContactTablesAreTheDocumentsTablesNameShapeAndType) {
+  contact::io::ContactTables t;
+  ColumnSet declared;
+  contact::io::contact_columns(t, [&](const contact::io::ContactColumn& c, const auto& member) {
+    using R = contact::io::ContactColumn::Rows;
+    using T = typename std::decay_t<decltype(member)>::value_type;
+    const std::string rows = c.rows == R::pair_offsets ? "P+1"
+                             : c.rows == R::pairs      ? "P"
+                             : c.rows == R::nodes      ? "N"
+                                                       : "L";
+    const std::string type = std::is_same_v<T, std::string>    ? "str"
+                             : std::is_same_v<T, double>       ? "float64"
+                             : std::is_same_v<T, std::int64_t> ? "int64"
+                             : std::is_same_v<T, std::int32_t> ? "int32"
+                                                               : "int8";
+    declared.insert(std::string(c.name) + " (" + rows + (c.width == 2 ? ", 2)" : ",)") + " " + type);
+  });
+  const ColumnSet documented = documented_columns("`/steps/<k>/contacts/` holds", "A version 2 file");
+  EXPECT_EQ(declared.size(), 31u);
+  EXPECT_EQ(declared, documented);
+}
+
 TEST(ResultLayout, TheHistoryTablesReadBackAsWritten) {
   // Written by the one table and read by it: every column comes back (two load steps, Coulomb on one pair).
   std::ifstream in(std::string(CONTACT_SOURCE_DIR) + "/tests/data/result_format_v2.json");
@@ -93,7 +117,7 @@ TEST(ResultLayout, TheHistoryTablesReadBackAsWritten) {
   contact::CancelToken cancel;
   const contact::Result result = contact::solve(*parsed.problem, quiet, cancel);
   ASSERT_TRUE(result.converged) << result.message;
-  const std::string path = (std::filesystem::temp_directory_path() / "history_layout_roundtrip.hdf").string();
+  const std::string path = (std::filesystem::temp_directory_path() / "result_tables_roundtrip.hdf").string();
   contact::io::write_result(path, *parsed.problem, result);
   const contact::io::ResultFile file = contact::io::read_result(path);
   std::filesystem::remove(path);

@@ -6,6 +6,10 @@
 
 #include "contact/result_file.hpp"
 
+#include <cstdint>
+#include <string>
+#include <vector>
+
 namespace contact::io {
 
 struct HistoryColumn {
@@ -59,6 +63,69 @@ void step_columns(History& h, Visit&& visit) {
   visit(HistoryColumn{"contact_begin", A::pairs, S::float64, false}, h.contact_begin);
   visit(HistoryColumn{"contact_end", A::pairs, S::float64, false}, h.contact_end);
   visit(HistoryColumn{"tangential_force", A::pairs, S::float64, true}, h.tangential_force);
+}
+
+// ---- /steps/<k>/contacts ---------------------------------------------------------------------------------
+
+// A step's contact pairs as tables (format version 3): every pair's slave nodes one after the other, the pairs'
+// row offsets, every pair's scalars in one dataset each. Two-column quantities are row-major (N x 2), as stored.
+struct ContactTables {
+  // per pair: P rows (offsets: P + 1)
+  std::vector<std::int64_t> offsets{0}, segment_offsets{0};
+  std::vector<std::string> slave_body, slave_edge, master_body, master_edge, enforcement, friction;
+  std::vector<double> theta, force, resultant, friction_coefficient, friction_bound, tangential_force;
+  // per slave node: N rows
+  std::vector<std::int32_t> pair;
+  std::vector<std::int64_t> node;
+  std::vector<double> position, normal, arc_length, weight, gap, normal_gap, pressure, penetration;
+  std::vector<std::int8_t> status, active, stick;
+  std::vector<double> tangent, tangential_traction, slip;
+  // per segment: L rows of two node rows
+  std::vector<std::int64_t> segments;
+};
+
+struct ContactColumn {
+  enum class Rows { pair_offsets, pairs, nodes, segments };  // P + 1, P, N or L rows
+  const char* name;
+  Rows rows;
+  int width;  // 1: one value a row; 2: two columns
+};
+
+// visit(column, member) for every dataset of a contacts group; Tables is ContactTables or its const.
+template <class Tables, class Visit>
+void contact_columns(Tables& t, Visit&& visit) {
+  using R = ContactColumn::Rows;
+  visit(ContactColumn{"offsets", R::pair_offsets, 1}, t.offsets);
+  visit(ContactColumn{"segment_offsets", R::pair_offsets, 1}, t.segment_offsets);
+  visit(ContactColumn{"slave_body", R::pairs, 1}, t.slave_body);
+  visit(ContactColumn{"slave_edge", R::pairs, 1}, t.slave_edge);
+  visit(ContactColumn{"master_body", R::pairs, 1}, t.master_body);
+  visit(ContactColumn{"master_edge", R::pairs, 1}, t.master_edge);
+  visit(ContactColumn{"enforcement", R::pairs, 1}, t.enforcement);
+  visit(ContactColumn{"friction", R::pairs, 1}, t.friction);
+  visit(ContactColumn{"theta", R::pairs, 1}, t.theta);
+  visit(ContactColumn{"force", R::pairs, 1}, t.force);
+  visit(ContactColumn{"resultant", R::pairs, 2}, t.resultant);
+  visit(ContactColumn{"friction_coefficient", R::pairs, 1}, t.friction_coefficient);
+  visit(ContactColumn{"friction_bound", R::pairs, 1}, t.friction_bound);
+  visit(ContactColumn{"tangential_force", R::pairs, 1}, t.tangential_force);
+  visit(ContactColumn{"pair", R::nodes, 1}, t.pair);
+  visit(ContactColumn{"node", R::nodes, 1}, t.node);
+  visit(ContactColumn{"position", R::nodes, 2}, t.position);
+  visit(ContactColumn{"normal", R::nodes, 2}, t.normal);
+  visit(ContactColumn{"arc_length", R::nodes, 1}, t.arc_length);
+  visit(ContactColumn{"status", R::nodes, 1}, t.status);
+  visit(ContactColumn{"weight", R::nodes, 1}, t.weight);
+  visit(ContactColumn{"gap", R::nodes, 1}, t.gap);
+  visit(ContactColumn{"normal_gap", R::nodes, 1}, t.normal_gap);
+  visit(ContactColumn{"pressure", R::nodes, 1}, t.pressure);
+  visit(ContactColumn{"penetration", R::nodes, 1}, t.penetration);
+  visit(ContactColumn{"active", R::nodes, 1}, t.active);
+  visit(ContactColumn{"tangent", R::nodes, 2}, t.tangent);
+  visit(ContactColumn{"tangential_traction", R::nodes, 1}, t.tangential_traction);
+  visit(ContactColumn{"slip", R::nodes, 1}, t.slip);
+  visit(ContactColumn{"stick", R::nodes, 1}, t.stick);
+  visit(ContactColumn{"segments", R::segments, 2}, t.segments);
 }
 
 }  // namespace contact::io
