@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <exception>
+#include <limits>
 #include <sstream>
 
 namespace contact {
@@ -77,6 +78,41 @@ void refuse_tension(Result& result) {
   result.stop_reason = StopReason::error;
   result.converged = false;
   result.message = "the solve stopped on a state that is not an answer: " + what + " (" + result.message + ")";
+  result.steps.clear();
+  result.streamed_steps = 0;
+  result.step_history.clear();
+  result.kept.clear();
+}
+
+// Contact gaps are computed from the coordinates, to about 1e-16 of the model's size: displacements within a few
+// hundred times that make every gap, penetration and contact force rounding (E = 1e25 under a traction of 1e-25, or
+// a prescribed displacement of 1e-25, converged with contact forces 1e18 times what the load can make, and pressures
+// of either sign). A step that moved the bodies by less than kResolution of the model's size, but not by nothing (no
+// load: an exact zero), is refused with the figures; a linear solve without contact is exact at any scale.
+constexpr double kResolution = 1e-13;
+
+void refuse_below_resolution(const Problem& problem, Result& result) {
+  if (problem.contacts.empty() || result.steps.empty() || !result.converged) return;
+  Eigen::Vector2d low = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity()), high = -low;
+  for (const auto& body : problem.bodies)
+    for (const auto& x : body.mesh.nodes) {
+      low = low.cwiseMin(x);
+      high = high.cwiseMax(x);
+    }
+  const double size = (high - low).norm();
+  double moved = 0.0;
+  for (const auto& step : result.steps)
+    for (const auto& body : step.bodies)
+      if (body.displacement.size()) moved = std::max(moved, body.displacement.cwiseAbs().maxCoeff());
+  if (!(size > 0) || moved == 0.0 || moved >= kResolution * size) return;
+  std::ostringstream os;
+  os << "the loads move the bodies by at most " << moved << ", below what the contact geometry resolves (about "
+     << kResolution << " of the model's size " << size << ", " << kResolution * size
+     << "): its gaps, penetrations and contact forces would be rounding, not an answer. Scale the units (Young's "
+        "moduli and loads together, e.g. MPa with N/mm) so that the loads move the bodies by more than that";
+  result.stop_reason = StopReason::error;
+  result.converged = false;
+  result.message = os.str();
   result.steps.clear();
   result.streamed_steps = 0;
   result.step_history.clear();
@@ -184,6 +220,7 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
     if (facts.checks_held_bodies)
       refuse_unheld_bodies(active, result, steps.dropped_iterate() ? &steps.dropped_step() : nullptr);
     if (result.stop_reason != StopReason::error && result.stop_reason != StopReason::cancelled) refuse_tension(result);
+    refuse_below_resolution(active, result);
     if (result.updates > 0 && !result.steps.empty()) {
       std::ostringstream os;
       os << "; remaining penetration " << max_penetration(result.steps.back());

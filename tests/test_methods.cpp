@@ -325,3 +325,34 @@ TEST(EmptyInterface, APairThatNeverFacesOrHasNoContactNodeIsAnErrorNamingItForEv
   const Result swapped = solve_quietly(facing);
   EXPECT_TRUE(swapped.converged) << swapped.message;
 }
+
+TEST(Resolution, LoadsThatMoveTheBodiesBelowTheGeometrysPrecisionAreRefusedAtEveryScaleOfTheSameJob) {
+  // The flat patch pressed by a traction t on E: displacements t L / E. E = 1e25 under t = 1e-25 moves the bodies by
+  // about 1e-50 against coordinates resolved to 1e-16: every gap is rounding. The same job scaled back (E = 1,
+  // t = 1e-12: 1e-12, above 1e-13 of the size) is an ordinary answer: the contact carries the load, p = t.
+  const auto patch = [](double E, double t) {
+    json job = json::parse(R"({"bodies": [
+      {"name": "lower", "material": {"E": 1, "nu": 0.3},
+       "mesh": {"block": {"corners": [[0, -1], [2, -1], [2, 0], [0, 0]], "nx": 4, "ny": 2}},
+       "boundary": [{"edge": "left", "displacement": {"x": 0}}, {"edge": "bottom", "displacement": {"y": 0}}]},
+      {"name": "upper", "material": {"E": 1, "nu": 0.3},
+       "mesh": {"block": {"corners": [[0, 0], [2, 0], [2, 1], [0, 1]], "nx": 4, "ny": 2}},
+       "boundary": [{"edge": "left", "displacement": {"x": 0}}, {"edge": "top", "traction": [0, -1]}]}],
+      "contacts": [{"slave": "upper.bottom", "master": "lower.top"}]})");
+    for (auto& body : job["bodies"]) body["material"]["E"] = E;
+    job["bodies"][1]["boundary"][1]["traction"] = json::array({0, -t});
+    return parse_or_fail(job);
+  };
+  const Result noise = solve_quietly(patch(1e25, 1e-25));
+  EXPECT_EQ(noise.stop_reason, StopReason::error);
+  EXPECT_FALSE(noise.converged);
+  EXPECT_TRUE(noise.steps.empty());
+  EXPECT_NE(noise.message.find("below what the contact geometry resolves"), std::string::npos) << noise.message;
+  EXPECT_NE(noise.message.find("Scale the units"), std::string::npos) << noise.message;
+  const Result scaled = solve_quietly(patch(1.0, 1e-12));
+  ASSERT_TRUE(scaled.converged) << scaled.message;
+  ASSERT_FALSE(scaled.steps.empty());
+  const PairField& pair = scaled.steps.back().pairs.at(0);
+  EXPECT_NEAR(pair.force, 2e-12, 1e-6 * 2e-12);  // t over the contact's length 2
+  EXPECT_NEAR(pair.pressure.maxCoeff(), 1e-12, 1e-6 * 1e-12);
+}
