@@ -37,8 +37,8 @@ TEST(ActiveSet, SolutionSatisfiesComplementarityAndEqualsTheQpMethod) {
     const Eigen::MatrixXd H = A * A.transpose() + n * Eigen::MatrixXd::Identity(n, n);
     Eigen::VectorXd g(n);
     for (int i = 0; i < n; ++i) g[i] = normal(rng);
-    const ActiveSetResult r = solve_active_set(H.sparseView(), g, 100, always);
-    ASSERT_TRUE(r.converged) << r.message;
+    const QpSolution r = solve_active_set(H.sparseView(), g, 100, always);
+    ASSERT_TRUE(r.report.converged()) << r.report.message;
     const Eigen::VectorXd h = g + H * r.z;
     const double scale = g.cwiseAbs().maxCoeff();
     for (int i = 0; i < n; ++i) {
@@ -63,16 +63,16 @@ TEST(ActiveSet, NestedGuessIsNonNegativeAndLeavesAHandfulOfFineStepsAtEverySize)
       g[i] = -(1.0 - x * x / 0.64) / n;
     }
     const std::vector<int> line(static_cast<size_t>(n), 0);
-    const ActiveSetResult plain = solve_active_set(H, g, 100, always);
+    const QpSolution plain = solve_active_set(H, g, 100, always);
     std::vector<std::pair<Eigen::Index, int>> levels;
     const Eigen::VectorXd z0 = nested_initial_guess(H, g, line, position, {}, &levels);
     EXPECT_GE(z0.minCoeff(), 0.0);
     EXPECT_FALSE(levels.empty());
-    const ActiveSetResult nested = solve_active_set(H, g, 100, always, &z0);
-    ASSERT_TRUE(plain.converged && nested.converged);
+    const QpSolution nested = solve_active_set(H, g, 100, always, &z0);
+    ASSERT_TRUE(plain.report.converged() && nested.report.converged());
     EXPECT_LE((nested.z - plain.z).cwiseAbs().maxCoeff(), 1e-10 * plain.z.cwiseAbs().maxCoeff());
-    EXPECT_LE(nested.steps, 3) << n << " nodes (without the guess: " << plain.steps << ")";
-    EXPECT_GT(plain.steps, 2 * nested.steps) << n;  // the edge moving a few nodes per step from the plain guess
+    EXPECT_LE(nested.report.iterations, 3) << n << " nodes (without the guess: " << plain.report.iterations << ")";
+    EXPECT_GT(plain.report.iterations, 2 * nested.report.iterations) << n;  // the edge moving a few nodes per step from the plain guess
     for (const auto& [size, steps] : levels) EXPECT_LE(steps, 4) << size;
   }
 }

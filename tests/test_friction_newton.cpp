@@ -147,7 +147,7 @@ TEST(FrictionNewton, CoulombAnswerSatisfiesTheConditionsFromEveryStart) {
     FrictionNewtonSettings settings;
     settings.max_steps = 200;
     const FrictionNewtonResult r = friction_newton(newton_problem(p), all_sticking(p), settings);
-    ASSERT_EQ(r.stop, FrictionStop::settled) << "seed " << seed << " after " << r.steps << " steps";
+    ASSERT_EQ(r.report.stop, contact::SolveStop::converged) << "seed " << seed << " after " << r.report.iterations << " steps";
     expect_coulomb_conditions(p, r.iterate, 1e-10);
   }
 }
@@ -157,7 +157,7 @@ TEST(FrictionNewton, TrescaAnswerIsTheMinimiserOfItsConvexProblem) {
     const double bound = 0.1 + 0.05 * seed;
     const Problem p = random_problem(100 + seed, 8, false, bound);
     const FrictionNewtonResult r = friction_newton(newton_problem(p), all_sticking(p), FrictionNewtonSettings{});
-    ASSERT_EQ(r.stop, FrictionStop::settled) << seed;
+    ASSERT_EQ(r.report.stop, contact::SolveStop::converged) << seed;
     const Eigen::VectorXd reference = tresca_minimiser(p, bound);
     EXPECT_LE((r.iterate.lambda - reference).cwiseAbs().maxCoeff(),
               1e-9 * std::max(1.0, reference.cwiseAbs().maxCoeff()))
@@ -176,7 +176,7 @@ TEST(FrictionNewton, ConvergesWhereTheFullStepsCycle) {
     FrictionNewtonSettings settings;
     settings.max_steps = 400;
     const FrictionNewtonResult r = friction_newton(newton_problem(p), all_sticking(p), settings);
-    ASSERT_EQ(r.stop, FrictionStop::settled) << "seed " << seed << " after " << r.steps << " steps";
+    ASSERT_EQ(r.report.stop, contact::SolveStop::converged) << "seed " << seed << " after " << r.report.iterations << " steps";
     EXPECT_GT(r.damped_steps, 0) << seed;
     expect_coulomb_conditions(p, r.iterate, 1e-9);
   }

@@ -188,15 +188,15 @@ TEST(HBemGmres, SolvesANonsymmetricSystemToTheToleranceAndStopsWhenCancelled) {
   GmresOptions options;
   options.restart = 20;  // restarts happen
   Eigen::VectorXd x;
-  const GmresResult r = gmres(multiply, jacobi, b, x, options);
-  EXPECT_TRUE(r.converged);
+  const contact::SolveReport r = gmres(multiply, jacobi, b, x, options);
+  EXPECT_TRUE(r.converged());
   EXPECT_LE((b - a * x).norm(), 1e-9 * b.norm());
   EXPECT_LE((x - exact).norm(), 1e-8 * exact.norm());
   int calls = 0;
   options.cancelled = [&] { return ++calls > 5; };
   x.setZero();
-  const GmresResult c = gmres(multiply, jacobi, b, x, options);
-  EXPECT_TRUE(c.cancelled);
+  const contact::SolveReport c = gmres(multiply, jacobi, b, x, options);
+  EXPECT_TRUE(c.cancelled());
   EXPECT_EQ(c.iterations, 5);
 }
 

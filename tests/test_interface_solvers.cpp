@@ -135,8 +135,8 @@ TEST(Mprgp, SolvesBoundConstrainedQpsLikeTheActiveSetQpMethod) {
       linalg::MprgpSettings settings;
       settings.alpha_bar = 1.9 / H.eigenvalues().real().maxCoeff();
       const auto r = linalg::solve_mprgp(qp, Eigen::VectorXd::Zero(n), settings,
-                                         [&](const linalg::MprgpResult& state) { return state.projected_gradient <= 1e-12 * g.norm(); });
-      ASSERT_TRUE(r.converged) << trial;
+                                         [&](const linalg::MprgpResult& state) { return state.projected_gradient() <= 1e-12 * g.norm(); });
+      ASSERT_TRUE(r.report.converged()) << trial;
       EXPECT_GE(r.x.minCoeff(), 0.0);
       EXPECT_LE((r.x - reference).cwiseAbs().maxCoeff(), 1e-9 * std::max(1.0, reference.cwiseAbs().maxCoeff()))
           << "trial " << trial << (jacobi ? " (Jacobi)" : "");

@@ -114,7 +114,7 @@ linalg::MprgpResult solve(const BoxProblem& p, bool jacobi, bool with_upper, con
   settings.alpha_bar = 1.9 / p.A.selfadjointView<Eigen::Lower>().eigenvalues().maxCoeff();
   const double scale = p.b.norm();
   return linalg::solve_mprgp(qp, x0, settings,
-                             [&](const linalg::MprgpResult& state) { return state.projected_gradient <= 1e-13 * scale; });
+                             [&](const linalg::MprgpResult& state) { return state.projected_gradient() <= 1e-13 * scale; });
 }
 
 }  // namespace
@@ -128,7 +128,7 @@ TEST(MprgpBox, SolvesRandomBoxConstrainedQpsLikeTheEnumerationOfEveryActiveSet) 
       // From zero (projected onto the box) and from a start outside the box on both sides.
       for (double start : {0.0, 5.0, -5.0}) {
         const auto r = solve(p, jacobi, true, Eigen::VectorXd::Constant(p.b.size(), start));
-        ASSERT_TRUE(r.converged) << trial;
+        ASSERT_TRUE(r.report.converged()) << trial;
         EXPECT_TRUE(((r.x - p.l).array() >= 0).all() && ((p.u - r.x).array() >= 0).all()) << trial;
         EXPECT_LE((r.x - reference).cwiseAbs().maxCoeff(), 1e-9 * std::max(1.0, reference.cwiseAbs().maxCoeff()))
             << "trial " << trial << (jacobi ? " (Jacobi)" : "") << " start " << start;
@@ -146,7 +146,7 @@ TEST(MprgpBox, LargerBoxProblemsConvergeWithTheirBoundsOnBothSidesActive) {
   for (int n : {40, 120}) {
     const BoxProblem p = random_problem(n, rng);
     const auto r = solve(p, true, true, Eigen::VectorXd::Zero(n));
-    ASSERT_TRUE(r.converged) << n;
+    ASSERT_TRUE(r.report.converged()) << n;
     const Eigen::VectorXd g = p.A * r.x - p.b;
     int at_lower = 0, at_upper = 0;
     for (int i = 0; i < n; ++i) {
@@ -174,8 +174,8 @@ TEST(MprgpBox, AnAbsentOrInfiniteUpperBoundIsTheOneSidedMethod) {
     const auto absent = solve(p, true, false, Eigen::VectorXd::Zero(30));
     p.u = Eigen::VectorXd::Constant(30, inf);
     const auto infinite = solve(p, true, true, Eigen::VectorXd::Zero(30));
-    ASSERT_TRUE(absent.converged);
-    EXPECT_EQ(absent.iterations, infinite.iterations);
+    ASSERT_TRUE(absent.report.converged());
+    EXPECT_EQ(absent.report.iterations, infinite.report.iterations);
     EXPECT_EQ((absent.x - infinite.x).cwiseAbs().maxCoeff(), 0.0);
     // x >= l alone: the enumeration with u = +inf (no upper assignments possible).
     if (trial < 2) {
@@ -219,15 +219,15 @@ TEST(MprgpBox, CarriesTheImageOfItsIterateUnderTheCallersLinearMap) {
       const Eigen::VectorXd exact = L * s.x;
       worst = std::max(worst, (s.image - exact).norm() / std::max(1.0, L.norm() * s.x.norm()));
       ++tests;
-      return s.projected_gradient <= 1e-13 * scale;
+      return s.projected_gradient() <= 1e-13 * scale;
     });
-    ASSERT_TRUE(r.converged) << n;
+    ASSERT_TRUE(r.report.converged()) << n;
     EXPECT_GT(r.cg_steps, 0);
     EXPECT_GT(r.expansion_steps + r.proportioning_steps, 0) << n;
     EXPECT_EQ(tests, r.cg_steps + r.expansion_steps + r.proportioning_steps + 1);
     EXPECT_LE(worst, 1e-12) << n;
     const auto plain = solve(p, false, true, Eigen::VectorXd::Zero(n));
-    EXPECT_EQ(plain.iterations, r.iterations) << n;
+    EXPECT_EQ(plain.report.iterations, r.report.iterations) << n;
     EXPECT_EQ((plain.x - r.x).cwiseAbs().maxCoeff(), 0.0) << n;
   }
 }

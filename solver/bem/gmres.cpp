@@ -26,15 +26,15 @@ void rotate_column(Eigen::MatrixXd& h, Eigen::VectorXd& cs, Eigen::VectorXd& sn,
 
 }  // namespace
 
-GmresResult gmres(const LinearOperator& A, const LinearOperator& M, const Eigen::VectorXd& b, Eigen::VectorXd& x,
+SolveReport gmres(const LinearOperator& A, const LinearOperator& M, const Eigen::VectorXd& b, Eigen::VectorXd& x,
                   const GmresOptions& options) {
-  GmresResult result;
+  SolveReport result;
   const Eigen::Index n = b.size();
   const double b_norm = b.norm();
   if (x.size() != n) x = Eigen::VectorXd::Zero(n);
   if (b_norm == 0.0) {
     x.setZero();
-    result.converged = true;
+    result.stop = SolveStop::converged;
     return result;
   }
   const int m = options.restart;
@@ -45,9 +45,9 @@ GmresResult gmres(const LinearOperator& A, const LinearOperator& M, const Eigen:
     A(x, w);
     r = b - w;
     double beta = r.norm();
-    result.relative_residual = beta / b_norm;
-    if (result.relative_residual <= options.relative_tolerance) {
-      result.converged = true;
+    result.measure = beta / b_norm;
+    if (result.measure <= options.relative_tolerance) {
+      result.stop = SolveStop::converged;
       return result;
     }
     Eigen::MatrixXd h = Eigen::MatrixXd::Zero(m + 1, m);
@@ -58,7 +58,7 @@ GmresResult gmres(const LinearOperator& A, const LinearOperator& M, const Eigen:
     int k = 0;
     for (; k < m && result.iterations < options.max_iterations; ++k) {
       if (options.cancelled && options.cancelled()) {
-        result.cancelled = true;
+        result.stop = SolveStop::cancelled;
         break;
       }
       M(basis[static_cast<std::size_t>(k)], z);
@@ -72,8 +72,8 @@ GmresResult gmres(const LinearOperator& A, const LinearOperator& M, const Eigen:
       h(k + 1, k) = next_norm;
       if (next_norm > 0.0) basis[static_cast<std::size_t>(k) + 1] = w / next_norm;
       rotate_column(h, cs, sn, g, k);
-      result.relative_residual = std::abs(g(k + 1)) / b_norm;
-      if (result.relative_residual <= options.relative_tolerance || next_norm == 0.0) {  // converged, or breakdown
+      result.measure = std::abs(g(k + 1)) / b_norm;
+      if (result.measure <= options.relative_tolerance || next_norm == 0.0) {  // converged, or breakdown
         ++k;
         break;
       }
@@ -86,13 +86,13 @@ GmresResult gmres(const LinearOperator& A, const LinearOperator& M, const Eigen:
       M(update, z);
       x += z;
     }
-    if (result.cancelled) return result;
-    if (result.relative_residual <= options.relative_tolerance) {
+    if (result.cancelled()) return result;
+    if (result.measure <= options.relative_tolerance) {
       // Confirm with the true residual (the rotated one can drift slightly).
       A(x, w);
-      result.relative_residual = (b - w).norm() / b_norm;
-      if (result.relative_residual <= 10.0 * options.relative_tolerance) {
-        result.converged = true;
+      result.measure = (b - w).norm() / b_norm;
+      if (result.measure <= 10.0 * options.relative_tolerance) {
+        result.stop = SolveStop::converged;
         return result;
       }
     }

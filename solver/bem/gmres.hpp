@@ -5,6 +5,8 @@
 #include <Eigen/Core>
 #include <functional>
 
+#include "../common/solve_report.hpp"
+
 namespace contact::bem {
 
 // y = A x (y pre-sized by the caller).
@@ -17,15 +19,10 @@ struct GmresOptions {
   std::function<bool()> cancelled;    // checked before every product; true stops at once
 };
 
-struct GmresResult {
-  int iterations = 0;
-  double relative_residual = 0.0;
-  bool converged = false;
-  bool cancelled = false;
-};
-
-// Solves A x = b from the initial guess in x, with the preconditioner M ~ A^-1 applied as x = M (M y).
-GmresResult gmres(const LinearOperator& A, const LinearOperator& M, const Eigen::VectorXd& b, Eigen::VectorXd& x,
+// Solves A x = b from the initial guess in x, with the preconditioner M ~ A^-1 applied as x = M (M y). The report's
+// iterations are products with A, its measure the relative residual |b - A x| / |b|; it stops converged,
+// max_iterations or cancelled.
+SolveReport gmres(const LinearOperator& A, const LinearOperator& M, const Eigen::VectorXd& b, Eigen::VectorXd& x,
                   const GmresOptions& options);
 
 }  // namespace contact::bem

@@ -109,8 +109,8 @@ class HierarchicalCollocation {
       stats->mean_rank = far_blocks_ > 0 ? static_cast<double>(rank_sum_) / far_blocks_ : 0.0;
       stats->matrix_bytes = matrix.bytes();
       stats->preconditioner_bytes = matrix.preconditioner_bytes();
-      stats->iterations = gmres_.iterations;
-      stats->relative_residual = gmres_.relative_residual;
+      stats->iterations = static_cast<int>(gmres_.iterations);
+      stats->relative_residual = gmres_.measure;
       stats->setup_seconds = setup;
       stats->solve_seconds = seconds_since(t0) - setup;
     }
@@ -360,10 +360,10 @@ class HierarchicalCollocation {
     gmres_ = gmres([&](const Eigen::VectorXd& in, Eigen::VectorXd& out) { matrix.multiply(in, out); },
                    [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) { matrix.precondition(in, out); }, rhs_, y,
                    gmres_options);
-    if (gmres_.cancelled) throw Cancelled();
-    if (!gmres_.converged)
+    if (gmres_.cancelled()) throw Cancelled();
+    if (!gmres_.converged())
       throw std::runtime_error("bem: GMRES did not converge in " + std::to_string(gmres_.iterations) +
-                               " iterations (relative residual " + std::to_string(gmres_.relative_residual) + ")");
+                               " iterations (relative residual " + std::to_string(gmres_.measure) + ")");
     Eigen::VectorXd x(num_.unknowns);
     for (int u = 0; u < num_.unknowns; ++u) x(u) = y(unknown_position_[static_cast<std::size_t>(u)]);
     return x;
@@ -384,7 +384,7 @@ class HierarchicalCollocation {
   Eigen::MatrixX2d rigid_;
   int near_blocks_ = 0, far_blocks_ = 0, largest_rank_ = 0;
   long rank_sum_ = 0;
-  GmresResult gmres_;
+  SolveReport gmres_;
 };
 
 }  // namespace

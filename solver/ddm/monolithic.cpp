@@ -251,9 +251,9 @@ void run_exact(const ContactSystem& system, RunFrame& frame) {
     return frame.stop_requested();
   };
   const linalg::FrictionNewtonResult result = linalg::friction_newton(problem, std::move(sets), newton, on_step);
-  out.iterations = result.steps;
-  switch (result.stop) {
-    case linalg::FrictionStop::settled: {
+  out.iterations = static_cast<int>(result.report.iterations);
+  switch (result.report.stop) {
+    case SolveStop::converged: {
       out.converged = true;
       out.stop_reason = StopReason::converged;
       int na = 0;
@@ -265,18 +265,18 @@ void run_exact(const ContactSystem& system, RunFrame& frame) {
       out.message = os.str();
       break;
     }
-    case linalg::FrictionStop::stopped:
+    case SolveStop::cancelled:
       out.stop_reason = StopReason::cancelled;
       out.message = "cancelled";
       break;
-    case linalg::FrictionStop::singular:
+    case SolveStop::singular:
       out.stop_reason = StopReason::error;
       out.message = std::string("monolithic: the saddle-point system of the ") +
                     (s.friction.empty() ? "active set" : "stick and slip sets") + " is singular at step " +
-                    std::to_string(result.steps) +
+                    std::to_string(result.report.iterations) +
                     (floating ? ": a floating body is held by none of the contact nodes in contact" : "");
       return;
-    case linalg::FrictionStop::max_steps:
+    case SolveStop::max_iterations:
       out.stop_reason = StopReason::max_iterations;
       out.message = "monolithic: the active set did not settle within max_iterations";
       break;

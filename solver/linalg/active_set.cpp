@@ -251,11 +251,11 @@ Eigen::VectorXd nested_initial_guess(const SparseMatrix& H, const Eigen::VectorX
   const size_t at = levels ? levels->size() : 0;
   if (levels) levels->emplace_back(nc, 0);
   const Eigen::VectorXd guess = nested_initial_guess(Hc, gc, line_c, position_c, coarse_eq, levels, coarsest);
-  const ActiveSetResult coarse = solve_active_set(
+  const QpSolution coarse = solve_active_set(
       Hc, gc, 50, [](const Eigen::VectorXd&, const Eigen::VectorXd&, const ActiveSetStep&) { return false; },
       guess.cwiseAbs().maxCoeff() > 0 ? &guess : nullptr, coarse_eq);
-  if (levels) (*levels)[at].second = coarse.steps;
-  if (!coarse.converged) return Eigen::VectorXd::Zero(n);  // no guess: the fine problem starts as without one
+  if (levels) (*levels)[at].second = static_cast<int>(coarse.report.iterations);
+  if (!coarse.report.converged()) return Eigen::VectorXd::Zero(n);  // no guess: the fine problem starts as without one
   return P * coarse.z.cwiseMax(0.0);
 }
 
@@ -268,7 +268,7 @@ class PrimalDualActiveSet {
   PrimalDualActiveSet(const SparseMatrix& H, const Eigen::VectorXd& g, const Equalities& eq)
       : H_(H), g_(g), eq_(eq), n_(g.size()), c_over_D_(H.diagonal().cwiseInverse()) {}  // c_j / D_j = 1 / H_jj
 
-  ActiveSetResult run(int max_steps, const StepCallback& on_step, const Eigen::VectorXd* z0);
+  QpSolution run(int max_steps, const StepCallback& on_step, const Eigen::VectorXd* z0);
 
  private:
   std::vector<char> predict(const Eigen::VectorXd& z, const Eigen::VectorXd& h) const {
@@ -298,8 +298,8 @@ class PrimalDualActiveSet {
     return active;
   }
   // Solves on `active`, fills out's z, alpha, h and the step's report; `next` receives the predicted set. False
-  // when the step cannot be taken (out.message says why).
-  bool step(int k, const std::vector<char>& active, ActiveSetResult& out, ActiveSetStep& report,
+  // when the step cannot be taken (out.report.message says why).
+  bool step(int k, const std::vector<char>& active, QpSolution& out, ActiveSetStep& report,
             std::vector<char>& next) const {
     std::vector<Eigen::Index> A;
     for (Eigen::Index j = 0; j < n_; ++j)
@@ -308,11 +308,13 @@ class PrimalDualActiveSet {
     Eigen::VectorXd alpha;
     const Eigen::VectorXd z = solve_on(H_, g_, A, eq_, alpha, ok, out.unrestrained);
     if (!ok) {
-      out.message = "the active-set system is not positive definite";
+      out.report.stop = SolveStop::singular;
+      out.report.message = "the active-set system is not positive definite";
       return false;
     }
     if (!out.unrestrained.empty()) {
-      out.message = "the contact nodes in contact do not hold every floating body";
+      out.report.stop = SolveStop::singular;
+      out.report.message = "the contact nodes in contact do not hold every floating body";
       return false;
     }
     const Eigen::VectorXd h = gap(z, alpha);
@@ -325,10 +327,10 @@ class PrimalDualActiveSet {
     out.z = z;
     out.alpha = alpha;
     out.h = h;
-    out.steps = k;
+    out.report.iterations = k;
     return true;
   }
-  void fallback(const StepCallback& on_step, ActiveSetResult& out) const;
+  void fallback(const StepCallback& on_step, QpSolution& out) const;
 
   const SparseMatrix& H_;
   const Eigen::VectorXd& g_;
@@ -338,36 +340,36 @@ class PrimalDualActiveSet {
 };
 
 // Cycling or max_steps: the primal active-set QP method, which terminates.
-void PrimalDualActiveSet::fallback(const StepCallback& on_step, ActiveSetResult& out) const {
+void PrimalDualActiveSet::fallback(const StepCallback& on_step, QpSolution& out) const {
   out.used_fallback = true;
   out.z = solve_nonnegative_qp(H_, g_);
   out.h = g_ + H_ * out.z;
   ActiveSetStep step;
-  step.step = out.steps + 1;
+  step.step = static_cast<int>(out.report.iterations) + 1;
   for (Eigen::Index j = 0; j < n_; ++j) step.active += out.z[j] > 0;
   step.complementarity = complementarity(out.z, out.h);
-  out.steps = step.step;
+  out.report.iterations = step.step;
   if (on_step(out.z, out.h, step)) {
-    out.cancelled = true;
-    out.message = "cancelled";
+    out.report.stop = SolveStop::cancelled;
+    out.report.message = "cancelled";
     return;
   }
-  out.converged = step.complementarity <= 1e-10;
+  out.report.stop = step.complementarity <= 1e-10 ? SolveStop::converged : SolveStop::max_iterations;
   std::ostringstream os;
   os << "the primal-dual active set cycled or did not settle; the active-set QP method "
-     << (out.converged ? "solved" : "did not solve") << " the interface problem (complementarity "
+     << (out.report.converged() ? "solved" : "did not solve") << " the interface problem (complementarity "
      << step.complementarity << ", " << step.active << " of " << n_ << " contact nodes in contact)";
-  out.message = os.str();
+  out.report.message = os.str();
 }
 
-ActiveSetResult PrimalDualActiveSet::run(int max_steps, const StepCallback& on_step, const Eigen::VectorXd* z0) {
-  ActiveSetResult out;
+QpSolution PrimalDualActiveSet::run(int max_steps, const StepCallback& on_step, const Eigen::VectorXd* z0) {
+  QpSolution out;
   out.alpha = Eigen::VectorXd::Zero(eq_.G.rows());
   out.z = z0 && z0->size() == n_ ? *z0 : Eigen::VectorXd::Zero(n_);
   out.h = g_ + H_ * out.z;
   if (n_ == 0 && eq_.empty()) {
-    out.converged = true;
-    out.message = "no contact nodes";
+    out.report.stop = SolveStop::converged;
+    out.report.message = "no contact nodes";
     return out;
   }
   std::vector<char> active = first_set(z0);
@@ -378,39 +380,39 @@ ActiveSetResult PrimalDualActiveSet::run(int max_steps, const StepCallback& on_s
     std::vector<char> next;
     if (!step(k, active, out, report, next)) return out;
     if (on_step(out.z, out.h, report)) {
-      out.cancelled = true;
-      out.message = "cancelled";
+      out.report.stop = SolveStop::cancelled;
+      out.report.message = "cancelled";
       return out;
     }
     // Settled: the set repeats, or the complementarity function vanishes to round-off (a grazing node, with
     // z = 0 and h = 0 up to rounding, may flip without changing the solution).
     if (report.changes == 0 || report.complementarity <= 1e-13) {
-      out.converged = true;
+      out.report.stop = SolveStop::converged;
       std::ostringstream os;
       os << "active set settled (" << report.active << " of " << n_ << " contact nodes in contact)";
-      out.message = os.str();
+      out.report.message = os.str();
       return out;
     }
     if (seen.count(next)) break;  // a cycle: hand over to the QP method
     active = std::move(next);
   }
   if (!eq_.empty()) {
-    out.message = "the primal-dual active set cycled or did not settle with floating bodies";
+    out.report.message = "the primal-dual active set cycled or did not settle with floating bodies";
     return out;
   }
   fallback(on_step, out);
   return out;
 }
 
-ActiveSetResult solve_active_set_on(const SparseMatrix& H, const Eigen::VectorXd& g, int max_steps,
-                                    const StepCallback& on_step, const Eigen::VectorXd* z0, const Equalities& eq) {
+QpSolution solve_active_set_on(const SparseMatrix& H, const Eigen::VectorXd& g, int max_steps,
+                               const StepCallback& on_step, const Eigen::VectorXd* z0, const Equalities& eq) {
   return PrimalDualActiveSet(H, g, eq).run(max_steps, on_step, z0);
 }
 
 }  // namespace
 
-ActiveSetResult solve_active_set(const SparseMatrix& H, const Eigen::VectorXd& g, int max_steps,
-                                 const StepCallback& on_step, const Eigen::VectorXd* z0, const Equalities& eq) {
+QpSolution solve_active_set(const SparseMatrix& H, const Eigen::VectorXd& g, int max_steps, const StepCallback& on_step,
+                            const Eigen::VectorXd* z0, const Equalities& eq) {
   CONTACT_ASSERT_SIZE(H.rows(), g.size(), "H");
   CONTACT_ASSERT_SIZE(H.cols(), g.size(), "H");
   if (z0) CONTACT_ASSERT_SIZE(z0->size(), g.size(), "the start z0");

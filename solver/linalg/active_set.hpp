@@ -23,6 +23,8 @@
 // of bodies or meshes.
 #pragma once
 
+#include "../common/solve_report.hpp"
+
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
@@ -49,19 +51,21 @@ struct Equalities {
   bool empty() const { return G.rows() == 0; }
 };
 
-struct ActiveSetResult {
+// A bound-constrained QP's solution as its solvers return it (the primal-dual active set here, every interface
+// solver of ddm/interface/): the multipliers, the equalities' multipliers and the gradient, and how the solve
+// stopped, in the solver's one vocabulary (common/solve_report.hpp).
+struct QpSolution {
   Eigen::VectorXd z;
-  Eigen::VectorXd alpha;  // the equalities' multipliers (empty without)
-  Eigen::VectorXd h;      // g + H z + G^T alpha
-  bool converged = false;
-  bool cancelled = false;
-  int steps = 0;              // active-set steps (direct) or outer iterations (iterative solvers)
+  Eigen::VectorXd alpha;      // the equalities' multipliers (empty without)
+  Eigen::VectorXd h;          // g + H z + G^T alpha
   long inner_iterations = 0;  // iterative solvers: products with H (0 for the direct one)
   bool used_fallback = false;
   // The equalities could not be met by the active nodes (a floating body held by nothing): the rows of G that
   // the active set leaves unrestrained (empty otherwise).
   std::vector<Eigen::Index> unrestrained;
-  std::string message;
+  // iterations: active-set steps (direct) or outer iterations (iterative solvers); the stop: converged,
+  // max_iterations, singular (the active set leaves rows of G unrestrained) or cancelled; the message says more.
+  SolveReport report;
 };
 
 using StepCallback = std::function<bool(const Eigen::VectorXd& z, const Eigen::VectorXd& h, const ActiveSetStep&)>;
@@ -70,9 +74,8 @@ using StepCallback = std::function<bool(const Eigen::VectorXd& z, const Eigen::V
 // callback of the solver returns. `z0` (optional, same
 // size as g) gives the first active set {z0 - h(z0) / H_jj > 0} ({z0 > 0} with equalities: a floating body's
 // own position is not known before the solve); without it, the nodes where g < 0, or every node with equalities.
-ActiveSetResult solve_active_set(const SparseMatrix& H, const Eigen::VectorXd& g, int max_steps,
-                                 const StepCallback& on_step, const Eigen::VectorXd* z0 = nullptr,
-                                 const Equalities& equalities = {});
+QpSolution solve_active_set(const SparseMatrix& H, const Eigen::VectorXd& g, int max_steps, const StepCallback& on_step,
+                            const Eigen::VectorXd* z0 = nullptr, const Equalities& equalities = {});
 
 // The QP method on its own (for the fallback and for tests): min 1/2 z^T H z + g^T z, z >= 0.
 Eigen::VectorXd solve_nonnegative_qp(const SparseMatrix& H, const Eigen::VectorXd& g, int max_steps = 0);

@@ -88,11 +88,11 @@ Coarsening coarsen(const FrictionLevel& level) {
 // pressures can meet), every node in contact sticking (what the fine solver starts from without a guess).
 bool sticking_sets(const FrictionLevel& level, const std::vector<char>& mask, FrictionSets& sets) {
   const SparseMatrix Fnn = level.F.topLeftCorner(level.m, level.m);
-  const ActiveSetResult normal = solve_active_set(
+  const QpSolution normal = solve_active_set(
       Fnn, level.g.head(level.m), 100,
       [](const Eigen::VectorXd&, const Eigen::VectorXd&, const ActiveSetStep&) { return false; }, nullptr,
       normal_equalities(level.eq, level.m));
-  if (!normal.converged) return false;
+  if (!normal.report.converged()) return false;
   sets.active.assign(mask.size(), 0);
   for (Eigen::Index j = 0; j < level.m; ++j) sets.active[static_cast<size_t>(j)] = normal.z[j] > 0;
   stick_where_in_contact(sets, level.rows);
@@ -109,9 +109,9 @@ bool newton_on_level(const FrictionLevel& level, const Eigen::VectorXd& c, const
   settings.max_steps = max_steps;
   settings.tolerance = 0.0;  // the sets repeating, as the fine level's start needs them
   const FrictionNewtonResult r = friction_newton(problem, std::move(sets), settings);
-  steps = r.steps;
+  steps = static_cast<int>(r.report.iterations);
   solution = r.iterate;
-  return r.stop == FrictionStop::settled;
+  return r.report.converged();
 }
 
 // M y = rhs by UMFPACK with a step of refinement (refined_solve.hpp); false when M is singular or so nearly that

@@ -105,7 +105,7 @@ class Newton {
       cancelled_ = true;
       return false;
     }
-    ++result_.steps;
+    ++result_.report.iterations;
     return p_.solve(parametrize(sets, p_.rows, p_.mask), out);
   }
   // The system of `target`, or, where it is singular, of a set part of the way from the current sets to it.
@@ -135,7 +135,7 @@ bool Newton::solve_towards(FrictionSets& target, FrictionIterate& out) {
   size_t lo = 0, hi = changes.size();
   FrictionSets best;
   FrictionIterate best_out;
-  while (hi - lo > 1 && result_.steps < s_.max_steps && !cancelled_) {
+  while (hi - lo > 1 && result_.report.iterations < s_.max_steps && !cancelled_) {
     const size_t mid = lo + (hi - lo) / 2;
     FrictionSets partial = apply_changes(result_.sets, target, changes, mid, p_.rows);
     FrictionIterate candidate;
@@ -152,7 +152,7 @@ bool Newton::solve_towards(FrictionSets& target, FrictionIterate& out) {
     out = std::move(best_out);
     return true;
   }
-  if (tied_retreat_ || cancelled_ || result_.steps >= s_.max_steps) return false;
+  if (tied_retreat_ || cancelled_ || result_.report.iterations >= s_.max_steps) return false;
   // Not even one change is solvable: once, the target's contact with every node in it sticking.
   tied_retreat_ = true;
   FrictionSets tied = target;
@@ -193,13 +193,13 @@ void Newton::record_merit(double theta) {
 
 FrictionNewtonResult Newton::run(FrictionSets sets) {
   std::set<std::vector<signed char>> visited;
-  while (result_.steps < s_.max_steps) {
+  while (result_.report.iterations < s_.max_steps) {
     FrictionIterate n;
     if (!solve_towards(sets, n)) {
-      result_.stop = cancelled_                      ? FrictionStop::stopped
-                     : result_.steps >= s_.max_steps ? FrictionStop::max_steps
-                                                     : FrictionStop::singular;
-      if (result_.stop == FrictionStop::singular) result_.unsolvable = sets;
+      result_.report.stop = cancelled_                                  ? SolveStop::cancelled
+                            : result_.report.iterations >= s_.max_steps ? SolveStop::max_iterations
+                                                                        : SolveStop::singular;
+      if (result_.report.stop == SolveStop::singular) result_.unsolvable = sets;
       if (have_x_) result_.iterate = x_;
       return result_;
     }
@@ -213,22 +213,22 @@ FrictionNewtonResult Newton::run(FrictionSets sets) {
     record_merit(merit(x_));
     const FrictionSets next = predict_friction_sets(x_.lambda, x_.h, p_.c, p_.rows, p_.mask);
     ActiveSetStep info;
-    info.step = result_.steps;
+    info.step = static_cast<int>(result_.report.iterations);
     info.changes = next.changes(sets);
     for (size_t j = 0; j < next.active.size(); ++j) info.active += next.active[j] && !p_.mask[j];
     info.complementarity = friction_complementarity(x_.lambda, x_.h, p_.c, p_.rows, p_.mask);
     result_.iterate = x_;
     if (on_step_ && on_step_(x_, info)) {
-      result_.stop = FrictionStop::stopped;
+      result_.report.stop = SolveStop::cancelled;
       return result_;
     }
     if ((!damped && next == sets) || info.complementarity <= s_.tolerance) {
-      result_.stop = FrictionStop::settled;
+      result_.report.stop = SolveStop::converged;
       return result_;
     }
     sets = next;
   }
-  result_.stop = FrictionStop::max_steps;
+  result_.report.stop = SolveStop::max_iterations;
   return result_;
 }
 

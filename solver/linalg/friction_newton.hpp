@@ -23,6 +23,8 @@
 // Pure linear algebra.
 #pragma once
 
+#include "../common/solve_report.hpp"
+
 #include <functional>
 
 #include "active_set.hpp"
@@ -53,20 +55,16 @@ struct FrictionNewtonSettings {
   double tolerance = 1e-13;  // friction_complementarity at which an iterate is taken as the solution
 };
 
-enum class FrictionStop {
-  settled,    // the sets repeated (the iterate is the exact solution of its sets) or the complementarity vanished
-  singular,   // no set on the way to the predicted one had a solvable system
-  max_steps,  // not settled within max_steps
-  stopped,    // the step callback asked to stop (cancel)
-};
-
 struct FrictionNewtonResult {
   FrictionIterate iterate;  // the last (for singular: the last solvable one; empty if none was)
   FrictionSets sets;        // the sets of the last solve
   FrictionSets unsolvable;  // singular: the predicted sets whose system (and every one towards them) was singular
-  int steps = 0;            // linear systems solved (each step's, the halvings included)
   int damped_steps = 0;     // steps the line search shortened
-  FrictionStop stop = FrictionStop::max_steps;
+  // iterations: linear systems solved (each step's, the halvings included). converged: the sets repeated (the
+  // iterate is the exact solution of its sets) or the complementarity vanished; singular: no set on the way to the
+  // predicted one had a solvable system; max_iterations: not settled within max_steps; cancelled: the step
+  // callback asked to stop.
+  SolveReport report;
 };
 
 // After every accepted step: the iterate and the step's counts; true stops.

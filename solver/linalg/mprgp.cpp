@@ -73,7 +73,7 @@ class Mprgp {
 
   // A v, and L v in Lv_ when the problem tracks an image.
   bool product(const Eigen::VectorXd& v, Eigen::VectorXd& Av) {
-    ++out_.iterations;
+    ++out_.report.iterations;
     const bool stop = qp_.apply(v, Av);
     if (qp_.image) Lv_ = qp_.image();
     return stop;
@@ -173,22 +173,21 @@ MprgpResult solve_mprgp(const BoundQp& qp, const Eigen::VectorXd& x0, const Mprg
   Mprgp method(qp, settings, out);
   out.x = method.box().project(x0);
   if (method.restart()) {
-    out.cancelled = true;
+    out.report.stop = SolveStop::cancelled;
     return out;
   }
   for (;;) {
     const Box& box = method.box();
-    out.projected_gradient =
-        (free_gradient(out.x, out.gradient, box) + chopped_gradient(out.x, out.gradient, box)).norm();
+    out.report.measure = (free_gradient(out.x, out.gradient, box) + chopped_gradient(out.x, out.gradient, box)).norm();
     if (done(out)) {
-      out.converged = true;
+      out.report.stop = SolveStop::converged;
       return out;
     }
-    if (out.iterations >= settings.max_iterations) return out;
+    if (out.report.iterations >= settings.max_iterations) return out;
     const Eigen::VectorXd beta = chopped_gradient(out.x, out.gradient, box);
     const bool stop = method.proportional(beta) ? method.cg_or_expansion() : method.proportioning(beta);
     if (stop) {
-      out.cancelled = true;
+      out.report.stop = SolveStop::cancelled;
       return out;
     }
   }

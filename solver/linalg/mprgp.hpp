@@ -23,6 +23,8 @@
 // Pure linear algebra: nothing here knows of contact.
 #pragma once
 
+#include "../common/solve_report.hpp"
+
 #include <Eigen/Core>
 
 #include <functional>
@@ -50,12 +52,13 @@ struct MprgpSettings {
 };
 
 struct MprgpResult {
-  Eigen::VectorXd x, gradient;      // the last iterate and its gradient A x - b
-  Eigen::VectorXd image;            // L x when the problem gives `image`, else empty
-  double projected_gradient = 0.0;  // ||g^P(x)||
-  long iterations = 0;              // products with A
+  Eigen::VectorXd x, gradient;  // the last iterate and its gradient A x - b
+  Eigen::VectorXd image;        // L x when the problem gives `image`, else empty
   long cg_steps = 0, expansion_steps = 0, proportioning_steps = 0;
-  bool converged = false, cancelled = false;
+  // How it stopped: iterations are products with A, the measure is ||g^P(x)||; converged (done said so),
+  // max_iterations or cancelled (a product asked to stop).
+  SolveReport report;
+  double projected_gradient() const { return report.measure; }
 };
 
 // Starts from x0 (projected onto the box) and stops when `done(state)` says so (converged), after max_iterations,

@@ -4,10 +4,9 @@
 
 namespace contact::ddm {
 
-linalg::ActiveSetResult FetiSolver::solve(const InterfaceQp& qp, const Eigen::VectorXd* z0,
-                                          InterfaceSolveContext& context) {
+linalg::QpSolution FetiSolver::solve(const InterfaceQp& qp, const Eigen::VectorXd* z0, InterfaceSolveContext& context) {
   if (qp.problem.size() > qp.problem.normal_size()) return solve_friction(qp, z0, context);
-  linalg::ActiveSetResult out;
+  linalg::QpSolution out;
   Smalbe smalbe(qp, settings_, context);
   if (!smalbe.prepare(out)) return out;
   const Smalbe::Bounds bounds{Eigen::VectorXd::Zero(qp.problem.size()), Eigen::VectorXd()};  // z >= 0

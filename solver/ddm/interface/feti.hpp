@@ -37,12 +37,10 @@ class FetiSolver final : public InterfaceSolver {
  public:
   explicit FetiSolver(const InterfaceSolverSettings& settings) : settings_(settings) {}
   const char* name() const override { return "iterative"; }
-  linalg::ActiveSetResult solve(const InterfaceQp& qp, const Eigen::VectorXd* z0,
-                                InterfaceSolveContext& context) override;
+  linalg::QpSolution solve(const InterfaceQp& qp, const Eigen::VectorXd* z0, InterfaceSolveContext& context) override;
 
  private:
-  linalg::ActiveSetResult solve_friction(const InterfaceQp& qp, const Eigen::VectorXd* z0,
-                                         InterfaceSolveContext& context);
+  linalg::QpSolution solve_friction(const InterfaceQp& qp, const Eigen::VectorXd* z0, InterfaceSolveContext& context);
   InterfaceSolverSettings settings_;
 };
 

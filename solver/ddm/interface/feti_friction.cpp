@@ -21,9 +21,9 @@ namespace contact::ddm {
 
 namespace {
 
-using linalg::ActiveSetResult;
 using linalg::FrictionRow;
 using linalg::FrictionState;
+using linalg::QpSolution;
 
 constexpr double infinity = std::numeric_limits<double>::infinity();
 
@@ -84,7 +84,7 @@ Eigen::VectorXd coulomb_bounds(const FrictionData& d, const Eigen::VectorXd& z) 
   return b;
 }
 
-std::string settled_message(const FrictionData& d, const ActiveSetResult& out, int outer, const Smalbe& smalbe) {
+std::string settled_message(const FrictionData& d, const QpSolution& out, int outer, const Smalbe& smalbe) {
   const linalg::FrictionSets sets = linalg::predict_friction_sets(out.z, out.h, d.c, d.rows, d.mask);
   int active = 0, stick = 0, slip = 0;
   for (char a : sets.active) active += a;
@@ -109,7 +109,7 @@ double bound_change(const Eigen::VectorXd& before, const Eigen::VectorXd& after)
 }
 
 // The report of an outer iteration: nodes in contact, changes of the stick and slip sets, the complementarity.
-linalg::ActiveSetStep outer_step(int outer, const FrictionData& d, const ActiveSetResult& out,
+linalg::ActiveSetStep outer_step(int outer, const FrictionData& d, const QpSolution& out,
                                  linalg::FrictionSets& previous) {
   linalg::FrictionSets sets = linalg::predict_friction_sets(out.z, out.h, d.c, d.rows, d.mask);
   linalg::ActiveSetStep info;
@@ -133,7 +133,7 @@ linalg::ActiveSetStep outer_step(int outer, const FrictionData& d, const ActiveS
 // bounds moved by less than 1e3 x the tolerance and the Coulomb complementarity is below that too, or the bounds have
 // settled (below): reduced quantities only, so every process takes the same decision.
 void coulomb_outer(Smalbe& smalbe, const FrictionData& d, const Eigen::VectorXd* z0, Smalbe::Solve how,
-                   double tolerance, InterfaceSolveContext& context, ActiveSetResult& out) {
+                   double tolerance, InterfaceSolveContext& context, QpSolution& out) {
   const Eigen::Index n = smalbe.diagonal().size();
   const policy::CoulombOuter& tuning = policy::kFrictionPolicy.coulomb;
   const double outer_tolerance = tuning.stop_factor * tolerance;
@@ -155,27 +155,27 @@ void coulomb_outer(Smalbe& smalbe, const FrictionData& d, const Eigen::VectorXd*
     // a tolerance from that zero change would loosen the next one again.
     how.tolerance = std::clamp(tuning.tolerance_per_change * change, tuning.tolerance_floor * tolerance, how.tolerance);
     smalbe.solve(friction_box(n, d, b), outer == 1 ? z0 : nullptr, how, out);
-    if (out.cancelled) return;
-    if (!out.converged && outer == 1 && b.allFinite()) {  // the warm start's bounds do not hold a body: tied
+    if (out.report.cancelled()) return;
+    if (!out.report.converged() && outer == 1 && b.allFinite()) {  // the warm start's bounds do not hold a body: tied
       b = tied;
       smalbe.solve(friction_box(n, d, b), z0, how, out);
-      if (out.cancelled) return;
+      if (out.report.cancelled()) return;
     }
-    if (!out.converged && mixed) {  // the extrapolated bounds do not hold a body: the plain update instead
+    if (!out.report.converged() && mixed) {  // the extrapolated bounds do not hold a body: the plain update instead
       mixing.reset();
       b = plain;
       smalbe.solve(friction_box(n, d, b), nullptr, how, out);
-      if (out.cancelled) return;
+      if (out.report.cancelled()) return;
     }
-    if (!out.converged) return;  // unheld or out of iterations: out says which
-    out.converged = false;
+    if (!out.report.converged()) return;  // unheld or out of iterations: out says which
+    out.report.stop = SolveStop::max_iterations;
     const Eigen::VectorXd next = coulomb_bounds(d, out.z);
     change = bound_change(b, next);
     const linalg::ActiveSetStep info = outer_step(outer, d, out, previous);
-    out.steps = outer;
+    out.report.iterations = outer;
     if (context.on_step(out.z, out.h, info)) {
-      out.cancelled = true;
-      out.message = "cancelled";
+      out.report.stop = SolveStop::cancelled;
+      out.report.message = "cancelled";
       return;
     }
     // Settled: the bounds stopped moving in two outer iterations at the finest inner tolerance. The complementarity
@@ -191,19 +191,19 @@ void coulomb_outer(Smalbe& smalbe, const FrictionData& d, const Eigen::VectorXd*
       os.precision(3);
       os << "FETI with Coulomb friction: the slip bounds settled, but the Coulomb complementarity stays at "
          << info.complementarity << " (a node slips against its friction force) after " << outer << " outer iterations";
-      out.message = os.str();
+      out.report.message = os.str();
       return;
     }
     if (change <= outer_tolerance &&
         (info.complementarity <= outer_tolerance || settled >= tuning.settled_iterations)) {
-      out.converged = true;
-      out.message = settled_message(d, out, outer, smalbe);
+      out.report.stop = SolveStop::converged;
+      out.report.message = settled_message(d, out, outer, smalbe);
       if (info.complementarity > outer_tolerance) {
         std::ostringstream os;
         os.precision(3);
         os << "; the bounds settled with the complementarity at " << info.complementarity
            << " (the slips' rounding on rows of tiny tangential compliance)";
-        out.message += os.str();
+        out.report.message += os.str();
       }
       return;
     }
@@ -219,14 +219,14 @@ void coulomb_outer(Smalbe& smalbe, const FrictionData& d, const Eigen::VectorXd*
   std::ostringstream os;
   os << "FETI with Coulomb friction: the slip bounds did not settle within " << context.max_steps
      << " outer iterations (last relative change " << change << ")";
-  out.message = os.str();
+  out.report.message = os.str();
 }
 
 }  // namespace
 
-linalg::ActiveSetResult FetiSolver::solve_friction(const InterfaceQp& qp, const Eigen::VectorXd* z0,
-                                                   InterfaceSolveContext& context) {
-  ActiveSetResult out;
+linalg::QpSolution FetiSolver::solve_friction(const InterfaceQp& qp, const Eigen::VectorXd* z0,
+                                              InterfaceSolveContext& context) {
+  QpSolution out;
   Smalbe smalbe(qp, settings_, context);
   if (!smalbe.prepare(out)) return out;
   const Eigen::Index n = qp.problem.size();
@@ -239,7 +239,8 @@ linalg::ActiveSetResult FetiSolver::solve_friction(const InterfaceQp& qp, const 
   const Eigen::VectorXd* start = z0 && z0->size() == n ? z0 : nullptr;
   if (!d.coulomb) {  // Tresca: one convex QP, reported per SMALBE outer iteration
     smalbe.solve(friction_box(n, d, Eigen::VectorXd()), start, how, out);
-    if (out.converged) out.message = settled_message(d, out, out.steps, smalbe);
+    if (out.report.converged())
+      out.report.message = settled_message(d, out, static_cast<int>(out.report.iterations), smalbe);
     return out;
   }
   coulomb_outer(smalbe, d, start, how, settings_.tolerance, context, out);

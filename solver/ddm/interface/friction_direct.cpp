@@ -37,10 +37,11 @@ FrictionSets first_sets(const SparseMatrix& F, const InterfaceQp& qp, const Eige
   const linalg::StepCallback quiet = [](const Eigen::VectorXd&, const Eigen::VectorXd&, const linalg::ActiveSetStep&) {
     return false;
   };
-  const linalg::ActiveSetResult normal = linalg::solve_active_set(Fnn, gn, 100, quiet, &guess, held);
-  if (normal.converged) {
+  const linalg::QpSolution normal = linalg::solve_active_set(Fnn, gn, 100, quiet, &guess, held);
+  if (normal.report.converged()) {
     lambda.head(m) = normal.z;
-    note = "first sets from the frictionless solution (" + std::to_string(normal.steps) + " active-set steps)";
+    note =
+        "first sets from the frictionless solution (" + std::to_string(normal.report.iterations) + " active-set steps)";
   }
   const bool solved = lambda.cwiseAbs().maxCoeff() > 0;
   if (!solved && z0 && z0->size() == n && z0->cwiseAbs().maxCoeff() > 0) {
@@ -123,10 +124,11 @@ std::string bodies_held_by_nothing(const InterfaceQp& qp, const FrictionSets& se
 
 // The stop of the Newton as the interface solver's answer.
 void describe_stop(const linalg::FrictionNewtonResult& r, const InterfaceQp& qp, int max_steps, double complementarity,
-                   const std::string& unheld, linalg::ActiveSetResult& result) {
-  result.steps = r.steps;
-  switch (r.stop) {
-    case linalg::FrictionStop::settled: {
+                   const std::string& unheld, linalg::QpSolution& result) {
+  result.report.iterations = r.report.iterations;
+  result.report.stop = r.report.stop;
+  switch (r.report.stop) {
+    case SolveStop::converged: {
       int stick = 0, slip = 0, active = 0;
       for (auto st : r.sets.state) {
         stick += st == FrictionState::stick;
@@ -134,22 +136,22 @@ void describe_stop(const linalg::FrictionNewtonResult& r, const InterfaceQp& qp,
       }
       for (Eigen::Index j = 0; j < qp.problem.normal_size(); ++j) active += r.sets.active[static_cast<size_t>(j)];
       std::ostringstream os;
-      os << "stick and slip sets settled in " << r.steps << " steps (" << active << " nodes in contact: " << stick
-         << " sticking, " << slip << " slipping)";
+      os << "stick and slip sets settled in " << r.report.iterations << " steps (" << active
+         << " nodes in contact: " << stick << " sticking, " << slip << " slipping)";
       if (r.damped_steps > 0) os << "; " << r.damped_steps << " steps damped by the line search";
-      result.converged = true;
-      result.message = os.str();
+      result.report.stop = SolveStop::converged;
+      result.report.message = os.str();
       return;
     }
-    case linalg::FrictionStop::stopped:
-      result.cancelled = true;
+    case SolveStop::cancelled:
+      result.report.stop = SolveStop::cancelled;
       return;
-    case linalg::FrictionStop::singular: {
+    case SolveStop::singular: {
       // Statics has refused the loads that friction cannot carry along flat joints before the solve
       // (friction_statics.hpp); what is left is the solver failing or a motion that check cannot judge.
       std::ostringstream os;
       os.precision(3);
-      os << "the friction Newton did not converge: at step " << r.steps
+      os << "the friction Newton did not converge: at step " << r.report.iterations
          << " the stick and slip sets it predicted, and every set between them and the last solved one, leave a "
             "floating body (or a group of them) held by nothing (a singular system"
          << (unheld.empty() ? std::string() : "; the predicted sets hold no contact node that fixes " + unheld)
@@ -158,15 +160,15 @@ void describe_stop(const linalg::FrictionNewtonResult& r, const InterfaceQp& qp,
             "joint, so either the solver failed (try smaller load steps) or the loads move a body that check cannot "
             "judge (a curved contact, bodies held only by frictionless contacts): check that every floating body is "
             "held";
-      result.message = os.str();
+      result.report.message = os.str();
       return;
     }
-    case linalg::FrictionStop::max_steps: {
+    case SolveStop::max_iterations: {
       std::ostringstream os;
       os.precision(3);
       os << "the stick and slip sets did not settle within " << max_steps << " steps (complementarity residual "
          << complementarity << " at the last iterate)";
-      result.message = os.str();
+      result.report.message = os.str();
       return;
     }
   }
@@ -174,8 +176,8 @@ void describe_stop(const linalg::FrictionNewtonResult& r, const InterfaceQp& qp,
 
 }  // namespace
 
-linalg::ActiveSetResult FrictionDirectSolver::solve(const InterfaceQp& qp, const Eigen::VectorXd* z0,
-                                                    InterfaceSolveContext& context) {
+linalg::QpSolution FrictionDirectSolver::solve(const InterfaceQp& qp, const Eigen::VectorXd* z0,
+                                               InterfaceSolveContext& context) {
   const Eigen::Index n = qp.problem.size();
   const SparseMatrix& F = compliance_.of(qp.problem);
   const Eigen::VectorXd diagonal = F.diagonal();
@@ -207,10 +209,10 @@ linalg::ActiveSetResult FrictionDirectSolver::solve(const InterfaceQp& qp, const
     return context.on_step(x.lambda, x.h, info);
   };
   linalg::FrictionNewtonResult r = linalg::friction_newton(problem, sets, settings, on_step);
-  if (r.stop == linalg::FrictionStop::singular && r.iterate.lambda.size() == 0 && from_coarse)
+  if (r.report.stop == SolveStop::singular && r.iterate.lambda.size() == 0 && from_coarse)
     r = linalg::friction_newton(problem, sticking, settings, on_step);  // the coarse guess leaves a body unheld
 
-  linalg::ActiveSetResult result;
+  linalg::QpSolution result;
   result.z = r.iterate.lambda.size() == n ? r.iterate.lambda : Eigen::VectorXd(Eigen::VectorXd::Zero(n));
   result.h = r.iterate.h;
   result.alpha = r.iterate.other;
@@ -219,7 +221,7 @@ linalg::ActiveSetResult FrictionDirectSolver::solve(const InterfaceQp& qp, const
                               ? linalg::friction_complementarity(r.iterate.lambda, r.iterate.h, c, rows, mask)
                               : 1.0;
   const std::string unheld =
-      r.stop == linalg::FrictionStop::singular ? bodies_held_by_nothing(qp, r.unsolvable, rows, mask) : std::string();
+      r.report.stop == SolveStop::singular ? bodies_held_by_nothing(qp, r.unsolvable, rows, mask) : std::string();
   describe_stop(r, qp, context.max_steps, residual, unheld, result);
   return result;
 }

@@ -21,8 +21,7 @@ namespace contact::ddm {
 class FrictionDirectSolver final : public InterfaceSolver {
  public:
   const char* name() const override { return "direct"; }
-  linalg::ActiveSetResult solve(const InterfaceQp& qp, const Eigen::VectorXd* z0,
-                                InterfaceSolveContext& context) override;
+  linalg::QpSolution solve(const InterfaceQp& qp, const Eigen::VectorXd* z0, InterfaceSolveContext& context) override;
 
  private:
   AssembledCompliance compliance_;

@@ -119,10 +119,10 @@ void InterfaceNewton::solve(RunFrame& frame) {
   // over (below; the chain and the budget's rule: ddm/friction_policy.hpp).
   const bool may_take_over = system_.has_friction() && kind_ == InterfaceSolverKind::direct;
   if (may_take_over) ctx.max_steps = std::min(ctx.max_steps, policy::kFrictionPolicy.direct.budget);
-  linalg::ActiveSetResult result = solver_->solve(qp, z0, ctx);
+  linalg::QpSolution result = solver_->solve(qp, z0, ctx);
   ctx.max_steps = std::max(1, settings.max_iterations);
   bool took_over = false;
-  if (may_take_over && !result.converged && !result.cancelled) {
+  if (may_take_over && !result.report.converged() && !result.report.cancelled()) {
     // The direct solver's semismooth Newton can cycle where friction holds (its stick and slip sets oscillating:
     // an 8 x 8 wall with mu = 0.05 under its precompression alone); the iterative solver's outer fixed point on
     // convex Tresca problems cannot cycle that way, and gives the same answer where both converge. It takes the
@@ -130,40 +130,40 @@ void InterfaceNewton::solve(RunFrame& frame) {
     // solver's problem has none).
     InterfaceSolverSettings iterative = settings_;
     iterative.preconditioner = InterfacePreconditioner::none;
-    const int direct_steps = result.steps;
+    const long direct_steps = result.report.iterations;
     solver_name = "iterative (the direct solver's friction Newton did not settle)";
     ctx.note.clear();
-    linalg::ActiveSetResult second = FetiSolver(iterative).solve(qp, z0, ctx);
-    if (second.converged || second.cancelled) {
+    linalg::QpSolution second = FetiSolver(iterative).solve(qp, z0, ctx);
+    if (second.report.converged() || second.report.cancelled()) {
       result = std::move(second);
       took_over = true;
-      if (result.converged)
-        result.message = "the direct solver's friction Newton did not settle (" + std::to_string(direct_steps) +
-                         " steps); the iterative solver took the step over: " + result.message;
+      if (result.report.converged())
+        result.report.message = "the direct solver's friction Newton did not settle (" + std::to_string(direct_steps) +
+                                " steps); the iterative solver took the step over: " + result.report.message;
     } else {
       solver_name = solver_->name();
-      result.message += "; the iterative solver did not settle it either: " + second.message;
+      result.report.message += "; the iterative solver did not settle it either: " + second.report.message;
     }
   }
   const int max_steps = ctx.max_steps;
   last_z_ = result.z;
-  out.iterations = result.steps;
+  out.iterations = static_cast<int>(result.report.iterations);
   out.interface_solver = took_over ? "iterative" : solver_->name();
   out.interface_iterations = result.inner_iterations;
-  if (result.cancelled) {
+  if (result.report.cancelled()) {
     out.stop_reason = StopReason::cancelled;
     out.message = "cancelled";
-  } else if (result.converged) {
+  } else if (result.report.converged()) {
     out.converged = true;
     out.stop_reason = StopReason::converged;
-    out.message = "interface Newton: " + result.message;
+    out.message = "interface Newton: " + result.report.message;
   } else if (!result.unrestrained.empty()) {
     out.stop_reason = StopReason::error;
     out.message = "interface Newton: " + unheld_bodies(result.unrestrained);
     return;
   } else {
-    out.stop_reason = result.steps >= max_steps ? StopReason::max_iterations : StopReason::error;
-    out.message = "interface Newton: " + result.message;
+    out.stop_reason = result.report.iterations >= max_steps ? StopReason::max_iterations : StopReason::error;
+    out.message = "interface Newton: " + result.report.message;
   }
   out.z = ip.split(result.z);
   if (system_.has_friction()) out.q = ip.split_tangential(result.z);

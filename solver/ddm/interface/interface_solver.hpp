@@ -67,8 +67,8 @@ class InterfaceSolver {
   virtual ~InterfaceSolver() = default;
   virtual const char* name() const = 0;  // "direct" or "iterative": the job's and the result's word
   // z0: the warm start (the previous load step's or update's pressures), or null.
-  virtual linalg::ActiveSetResult solve(const InterfaceQp& qp, const Eigen::VectorXd* z0,
-                                        InterfaceSolveContext& context) = 0;
+  virtual linalg::QpSolution solve(const InterfaceQp& qp, const Eigen::VectorXd* z0,
+                                   InterfaceSolveContext& context) = 0;
 };
 
 // The solver to use for `system` under `settings`: the one asked for, or, automatically, the iterative solver

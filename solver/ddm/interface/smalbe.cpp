@@ -9,15 +9,16 @@
 
 namespace contact::ddm {
 
-using linalg::ActiveSetResult;
+using linalg::QpSolution;
 
 Smalbe::Smalbe(const InterfaceQp& qp, const InterfaceSolverSettings& settings, InterfaceSolveContext& context)
     : qp_(qp), s_(settings), ctx_(context), coarse_(qp.problem, qp.equilibrium), m_(qp.problem.size()) {}
 
-bool Smalbe::prepare(ActiveSetResult& out) {
+bool Smalbe::prepare(QpSolution& out) {
   if (!coarse_.ok()) {
     out.unrestrained = coarse_.unheld();
-    out.message = "the contact nodes cannot hold every floating body";
+    out.report.stop = SolveStop::singular;
+    out.report.message = "the contact nodes cannot hold every floating body";
     return false;
   }
   if (!ready_) setup();
@@ -87,7 +88,7 @@ void Smalbe::setup() {
 // solver would report them. A row is at its bound exactly where MPRGP holds it there (x on the shifted bound), so
 // the rows that enter the rigid amplitudes' least squares (the free ones: a closed gap or a sticking node) do
 // not depend on the rounding of x + z_I.
-bool Smalbe::finish(const Eigen::VectorXd& x, const Bounds& bounds, ActiveSetResult& out) {
+bool Smalbe::finish(const Eigen::VectorXd& x, const Bounds& bounds, QpSolution& out) {
   std::vector<char> active(static_cast<size_t>(m_));
   out.z = x + z_I_;
   const bool upper = bounds.upper.size() == m_;
@@ -123,7 +124,7 @@ bool Smalbe::finish(const Eigen::VectorXd& x, const Bounds& bounds, ActiveSetRes
   return stop;
 }
 
-bool Smalbe::report(int step, const Solve& how, ActiveSetResult& out) {
+bool Smalbe::report(int step, const Solve& how, QpSolution& out) {
   linalg::ActiveSetStep r;
   r.step = step;
   const Eigen::Index normal = qp_.problem.normal_size();
@@ -139,7 +140,7 @@ bool Smalbe::report(int step, const Solve& how, ActiveSetResult& out) {
   if (previous_active_.empty()) r.changes = r.active;
   previous_active_ = std::move(active);
   r.complementarity = how.measure ? how.measure(out.z, out.h) : C.norm() / std::max(out.z.norm(), 1e-300);
-  out.steps = step;
+  out.report.iterations = step;
   return ctx_.on_step(out.z, out.h, r);
 }
 
@@ -174,9 +175,9 @@ void Smalbe::scales(double& scale_g) const {
   scale_g = penetration > 0 ? penetration : std::max(Pc_.norm(), 1e-300);
 }
 
-void Smalbe::solve(const Bounds& bounds, const Eigen::VectorXd* z0, const Solve& how, ActiveSetResult& out) {
+void Smalbe::solve(const Bounds& bounds, const Eigen::VectorXd* z0, const Solve& how, QpSolution& out) {
   if (!ready_) setup();
-  out.converged = false;
+  out.report.stop = SolveStop::max_iterations;
   out.unrestrained.clear();
   bound_.lower = bounds.lower - z_I_;
   bound_.upper = bounds.upper.size() == m_ ? Eigen::VectorXd(bounds.upper - z_I_) : Eigen::VectorXd();
@@ -201,7 +202,7 @@ void Smalbe::solve(const Bounds& bounds, const Eigen::VectorXd* z0, const Solve&
     inner.max_iterations = std::max<long>(1, s_.max_iterations - out.inner_iterations);
     bool global = false;
     const auto done = [&](const linalg::MprgpResult& state) {
-      const double norm_gp = state.projected_gradient;
+      const double norm_gp = state.projected_gradient();
       const double feasibility = state.image.norm();  // ||Q x||
       const double z_scale = std::max((state.x + z_I_).norm(), 1e-300);
       if (norm_gp <= how.tolerance * scale_g && feasibility <= how.tolerance * z_scale) return global = true;
@@ -209,13 +210,13 @@ void Smalbe::solve(const Bounds& bounds, const Eigen::VectorXd* z0, const Solve&
     };
     last_inner_ = linalg::solve_mprgp(bound_, x, inner, done);
     const linalg::MprgpResult& r = last_inner_;
-    out.inner_iterations += r.iterations;
+    out.inner_iterations += r.report.iterations;
     x = r.x;
-    out.steps = outer;
+    out.report.iterations = outer;
     // A face that the last inner solve kept throughout (CG steps only) after a multiplier update: solved on the
     // face directly (smalbe_face.cpp), at most twice a solve (a face that was not the answer's costs its products).
-    if (!global && r.converged && outer >= 2 && face_attempts < tuning.face_attempts && r.expansion_steps == 0 &&
-        r.proportioning_steps == 0) {
+    if (!global && r.report.converged() && outer >= 2 && face_attempts < tuning.face_attempts &&
+        r.expansion_steps == 0 && r.proportioning_steps == 0) {
       ++face_attempts;
       // CG to a tenth of the tolerance where it is the finest the solve is asked for, as SMALBE's inner solves go
       // (their floor, in `done`): stopped at the tolerance itself the answer was 20x less accurate than
@@ -225,8 +226,8 @@ void Smalbe::solve(const Bounds& bounds, const Eigen::VectorXd* z0, const Solve&
       const double target = how.tolerance <= tuning.face_finest_factor * s_.tolerance ? tuning.face_target_finest : 1.0;
       const FaceSolve f = solve_face(x, how.tolerance * scale_g, target * how.tolerance * scale_g, out);
       if (f == FaceSolve::cancelled) {
-        out.cancelled = true;
-        out.message = "cancelled";
+        out.report.stop = SolveStop::cancelled;
+        out.report.message = "cancelled";
         return;
       }
       global = f == FaceSolve::solved;
@@ -234,40 +235,43 @@ void Smalbe::solve(const Bounds& bounds, const Eigen::VectorXd* z0, const Solve&
     // The answer's pressures, gradient and rigid amplitudes (a product with F and a least squares on the free
     // rows) where someone reads them: a report, or the solve's end. Between two multiplier updates nobody does
     // (Coulomb's Tresca solves report nothing: about 8 % of a 64 x 64 wall's run went here).
-    const bool last = global || r.cancelled || !r.converged || out.inner_iterations >= s_.max_iterations;
-    const bool stop = ((last || how.report) && finish(x, bounds, out)) || r.cancelled;
+    const bool last =
+        global || r.report.cancelled() || !r.report.converged() || out.inner_iterations >= s_.max_iterations;
+    const bool stop = ((last || how.report) && finish(x, bounds, out)) || r.report.cancelled();
     if (stop || (how.report && report(outer, how, out))) {
-      out.cancelled = true;
-      out.message = "cancelled";
+      out.report.stop = SolveStop::cancelled;
+      out.report.message = "cancelled";
       return;
     }
     if (global) {
-      out.converged = out.unrestrained.empty();
+      out.report.stop = out.unrestrained.empty() ? SolveStop::converged : SolveStop::singular;
       std::ostringstream os;
       os << "FETI (projected MPRGP, SMALBE) converged: " << out.inner_iterations << " MPRGP iterations in " << outer
          << " outer iterations (" << r.cg_steps << " CG, " << r.expansion_steps << " expansion, "
          << r.proportioning_steps << " proportioning steps in the last; " << face_steps_
          << " products in CG on settled faces; F products " << seconds_F_ << " s, coarse projections "
          << seconds_coarse_ << " s)";
-      out.message = out.converged ? os.str() : "the contact nodes in contact do not hold every floating body";
+      out.report.message =
+          out.report.converged() ? os.str() : "the contact nodes in contact do not hold every floating body";
       return;
     }
     if (last) break;
     if (!update_multipliers(x, r, outer, M, previous_L, violation)) {
       if (!how.report && finish(x, bounds, out)) {
-        out.cancelled = true;
-        out.message = "cancelled";
+        out.report.stop = SolveStop::cancelled;
+        out.report.message = "cancelled";
         return;
       }
       if (out.unrestrained.empty()) out.unrestrained = unbalanced_rows(out.z);
-      out.message = "the contact nodes in contact do not hold every floating body";
+      out.report.stop = SolveStop::singular;
+      out.report.message = "the contact nodes in contact do not hold every floating body";
       return;
     }
   }
   std::ostringstream os;
-  os << "FETI did not converge within " << out.inner_iterations << " MPRGP iterations and " << out.steps
+  os << "FETI did not converge within " << out.inner_iterations << " MPRGP iterations and " << out.report.iterations
      << " outer iterations (interface.max_iterations " << s_.max_iterations << ")";
-  out.message = os.str();
+  out.report.message = os.str();
 }
 
 // SMALBE's update after an inner solve: the multipliers, and M halved when the Lagrangian did not grow by
@@ -297,7 +301,7 @@ bool Smalbe::update_multipliers(const Eigen::VectorXd& x, const linalg::MprgpRes
   };
   const policy::Smalbe& tuning = policy::kFrictionPolicy.smalbe;
   const bool crawling = fell_little_thrice(tuning.rho_crawl);
-  const bool stalled = fell_little_thrice(tuning.rho_stall) && r.iterations <= tuning.rho_stall_inner;
+  const bool stalled = fell_little_thrice(tuning.rho_stall) && r.report.iterations <= tuning.rho_stall_inner;
   if (crawling && rho_ < (stalled ? tuning.rho_stall_cap : tuning.rho_cap) * norm_PHP_) {
     rho_ *= tuning.rho_raise;
     norm_A_ = std::max(norm_PHP_, rho_);

@@ -20,7 +20,7 @@ class Smalbe {
   Smalbe(const InterfaceQp& qp, const InterfaceSolverSettings& settings, InterfaceSolveContext& context);
 
   // Whether every floating body's equilibrium rows are independent; otherwise `out` says which are not.
-  bool prepare(linalg::ActiveSetResult& out);
+  bool prepare(linalg::QpSolution& out);
 
   struct Bounds {
     Eigen::VectorXd lower, upper;  // on z (upper: +inf where absent; lower = upper fixes a row)
@@ -34,7 +34,7 @@ class Smalbe {
   };
   // Solves over the box from z0 (or from the last solve's answer, or zero); `out` gets z, h, alpha, the outer
   // iterations (steps) and converged or why not; its inner_iterations keep counting over the solves.
-  void solve(const Bounds& bounds, const Eigen::VectorXd* z0, const Solve& how, linalg::ActiveSetResult& out);
+  void solve(const Bounds& bounds, const Eigen::VectorXd* z0, const Solve& how, linalg::QpSolution& out);
 
   // y = H x (one product with F, summed over the processes); true: cancelled.
   bool apply_H(const Eigen::VectorXd& x, Eigen::VectorXd& y);
@@ -50,12 +50,12 @@ class Smalbe {
   bool apply_A(const Eigen::VectorXd& x, Eigen::VectorXd& y);
   bool precondition(const Eigen::VectorXd& r, Eigen::VectorXd& y);
   void setup();
-  bool finish(const Eigen::VectorXd& x, const Bounds& bounds, linalg::ActiveSetResult& out);
+  bool finish(const Eigen::VectorXd& x, const Bounds& bounds, linalg::QpSolution& out);
   enum class FaceSolve { solved, not_solved, cancelled };
   // The equality-constrained QP on x's face, by CG to the projected gradient `target`; solved: x is the answer to
   // `tolerance` (smalbe_face.cpp).
-  FaceSolve solve_face(Eigen::VectorXd& x, double tolerance, double target, linalg::ActiveSetResult& out);
-  bool report(int step, const Solve& how, linalg::ActiveSetResult& out);  // true: stop (the step callback asked)
+  FaceSolve solve_face(Eigen::VectorXd& x, double tolerance, double target, linalg::QpSolution& out);
+  bool report(int step, const Solve& how, linalg::QpSolution& out);  // true: stop (the step callback asked)
   bool update_multipliers(const Eigen::VectorXd& x, const linalg::MprgpResult& r, int outer, double& M,
                           double& previous_L, std::vector<double>& violation);
   bool stagnating(const std::vector<double>& violation) const;

@@ -23,7 +23,7 @@
 namespace contact::ddm {
 
 Smalbe::FaceSolve Smalbe::solve_face(Eigen::VectorXd& x_inout, double tolerance, double target,
-                                     linalg::ActiveSetResult& out) {
+                                     linalg::QpSolution& out) {
   const bool upper = bound_.upper.size() == m_;
   std::vector<char> free(static_cast<size_t>(m_));
   Eigen::VectorXd mask(m_), x = x_inout;

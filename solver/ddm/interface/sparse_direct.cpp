@@ -4,8 +4,8 @@
 
 namespace contact::ddm {
 
-linalg::ActiveSetResult SparseDirectSolver::solve(const InterfaceQp& qp, const Eigen::VectorXd* z0,
-                                                  InterfaceSolveContext& context) {
+linalg::QpSolution SparseDirectSolver::solve(const InterfaceQp& qp, const Eigen::VectorXd* z0,
+                                             InterfaceSolveContext& context) {
   const Eigen::Index m = qp.problem.size();
   SparseMatrix H = F_.of(qp.problem);
   // (m == 0: no contact row at all, every slave node a crosspoint; Eigen's maxCoeff is undefined on an empty vector.)
