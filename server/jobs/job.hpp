@@ -23,9 +23,9 @@ namespace contactd {
 enum class CancelReason : int { none = 0, user = 1, time_limit = 2, shutdown = 3, lane = 4 };
 
 // A job in memory. `record`, `disk_bytes` and `cancelling_queued` are guarded by the JobRegistry's mutex;
-// `deadline` and `cancel_requested_at` by the WorkerPool's (the pool's lock is taken before the registry's, never
-// after). persist_mutex serialises writes of state.json (a writer takes a snapshot of the record after locking
-// it, so the last write carries the latest state).
+// `deadline`, `lane_deadline`, `disk_wait` and `cancel_requested_at` by the WorkerPool's (the pool's lock is taken
+// before the registry's, never after). persist_mutex serialises writes of state.json (a writer takes a snapshot of the
+// record after locking it, so the last write carries the latest state).
 struct Job {
   Job(JobRecord r, const std::string& events_path, std::uint64_t max_event_bytes)
       : record(std::move(r)), events(events_path, max_event_bytes) {}
@@ -36,6 +36,7 @@ struct Job {
   std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
   // A run on a small-lane worker past this is moved to the general lane (max: not on the small lane).
   std::chrono::steady_clock::time_point lane_deadline = std::chrono::steady_clock::time_point::max();
+  std::string disk_wait;  // why the disk budget holds it back, as last put in its record ("" when it was not)
   EventLog events;
   std::mutex persist_mutex;
   std::atomic<bool> settled{false};  // done and its `end` event written: it may be deleted

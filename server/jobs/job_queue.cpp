@@ -24,6 +24,8 @@ JobQueue::JobQueue(JobStore& store, Metrics& metrics, BodyBudget& budget, QueueS
       registry_(store, settings_.max_event_log_bytes),
       pool_(registry_, settings_.workers, settings_.small_workers, settings_.time_limit_seconds,
             settings_.small_job_seconds,
+            WorkerPool::Disk{[&store] { return store.free_bytes(); },
+                             [&store](const std::string& id) { return store.disk_usage(id); }},
             [this](const std::shared_ptr<Job>& job) { JobRun(run_context_, job).execute(); }),
       janitor_(registry_, pool_, store, settings_),
       run_context_{registry_,
@@ -80,6 +82,7 @@ JobQueue::Submission JobQueue::submit(const std::string& body, contact::job::Par
   }
   const std::shared_ptr<Job> job = admission.job;
   job->record.small = small_job(settings_, *parsed.problem);  // not yet visible: nobody reads it concurrently
+  job->record.result_estimate = estimated_result(*parsed.problem);
   const JobRecord record = job->record;  // nobody changes it before it is stored (persist lock held)
   try {
     store_.create(record, body);

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "contact/result_file.hpp"
+
 namespace contactd {
 
 bool small_job(const QueueSettings& settings, const contact::Problem& problem) {
@@ -11,6 +13,21 @@ bool small_job(const QueueSettings& settings, const contact::Problem& problem) {
   for (const auto& b : problem.bodies) dofs += 2.0 * b.mesh.num_nodes();
   return dofs * static_cast<double>(std::max<std::size_t>(1, problem.loading.factors.size())) <=
          static_cast<double>(settings.small_job_dofs);
+}
+
+std::int64_t estimated_result(const contact::Problem& problem) {
+  double nodes = 0;
+  for (const auto& b : problem.bodies) nodes += b.mesh.num_nodes();
+  const bool all = problem.output.steps == contact::StepOutput::all;
+  double kept = 1;
+  if (problem.adaptivity.enabled) {
+    kept = all ? problem.adaptivity.max_steps + 1.0 : 1.0;
+    nodes = std::max(nodes, problem.adaptivity.max_kept_nodes);
+  } else if (all) {
+    kept = static_cast<double>(std::max<std::size_t>(1, problem.loading.factors.size()));
+  }
+  return static_cast<std::int64_t>(contact::io::estimated_result_bytes(
+      nodes, static_cast<double>(problem.bodies.size()), static_cast<double>(problem.contacts.size()), kept));
 }
 
 contact::job::ParseResult validate_job(const QueueSettings& settings, const std::string& body) {

@@ -43,6 +43,11 @@ struct QueueSettings {
 // small_job_dofs unknowns times load steps.
 bool small_job(const QueueSettings& settings, const contact::Problem& problem);
 
+// The bytes the job's result file is estimated to take, as the job reader checks it against --max-result-bytes
+// (contact::io::estimated_result_bytes: the nodes of the steps kept; an adaptive job's at the most it may refine to).
+// What the workers' disk budget reserves for a running job.
+std::int64_t estimated_result(const contact::Problem& problem);
+
 // Parses and validates a job body within the settings' limits (the ranks a job may ask for depend on
 // whether MPI jobs are possible).
 contact::job::ParseResult validate_job(const QueueSettings& settings, const std::string& body);

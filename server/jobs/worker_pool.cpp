@@ -8,16 +8,18 @@
 #include <malloc.h>
 
 #include <algorithm>
+#include <cstdio>
 
 namespace contactd {
 
 WorkerPool::WorkerPool(JobRegistry& registry, int workers, int small_workers, double time_limit_seconds,
-                       double small_job_seconds, Run run)
+                       double small_job_seconds, Disk disk, Run run)
     : registry_(registry),
       workers_(workers),
       small_workers_(small_workers),
       time_limit_seconds_(time_limit_seconds),
       small_job_seconds_(small_job_seconds),
+      disk_(std::move(disk)),
       run_(std::move(run)) {}
 
 WorkerPool::~WorkerPool() {
@@ -138,6 +140,41 @@ void WorkerPool::worker_loop(bool small_lane) {
   idle_.notify_all();
 }
 
+namespace {
+
+std::string megabytes(std::int64_t bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f MB", static_cast<double>(bytes) / 1e6);
+  return text;
+}
+
+}  // namespace
+
+bool WorkerPool::fits_on_disk(const Job& job, std::string& why) const {
+  // result_estimate is set before a job is queued and never changed: read without the registry's lock.
+  const std::int64_t needed = job.record.result_estimate;
+  if (needed <= 0 || !disk_.free) return true;
+  const std::int64_t free = disk_.free();
+  if (free < 0) return true;  // cannot be asked: nothing is held back
+  std::int64_t pending = 0;   // what the running jobs' results will still write
+  for (const auto& running : running_)
+    pending += std::max<std::int64_t>(0, running->record.result_estimate - disk_.used(running->record.id));
+  if (needed <= free - pending) return true;
+  why = "waiting for disk space: its result is estimated at " + megabytes(needed) + ", and the data directory has " +
+        megabytes(free) + " free" +
+        (pending > 0 ? ", of which the running jobs' results will take " + megabytes(pending) : std::string()) +
+        "; it starts when there is room (free some, or delete finished jobs)";
+  return false;
+}
+
+void WorkerPool::note_waiting(const std::shared_ptr<Job>& job, const std::string& why) {
+  if (job->disk_wait == why) return;
+  job->disk_wait = why;
+  if (!registry_.commit(
+          job, [&why](JobRecord& r) { r.message = why; }, /*durable=*/false))
+    job->disk_wait.clear();  // not stored (the disk is full): said again at the next look
+}
+
 bool WorkerPool::general_lane_full() const {
   return general_running_ + contact::abandoned_background_work() >= workers_;
 }
@@ -159,8 +196,22 @@ std::shared_ptr<Job> WorkerPool::take(bool small_lane) {
       work_.wait(lock, ready);
     if (stopping_) return nullptr;
     if (!small_lane && general_lane_full()) continue;
-    const auto it = std::find_if(queue_.begin(), queue_.end(), mine);
-    if (it == queue_.end()) continue;
+    // The first of this lane's jobs whose result fits on the disk; the ones before it that do not are told why.
+    auto it = queue_.end();
+    for (auto candidate = queue_.begin(); candidate != queue_.end(); ++candidate) {
+      if (!mine(*candidate)) continue;
+      std::string why;
+      if (fits_on_disk(**candidate, why)) {
+        it = candidate;
+        break;
+      }
+      note_waiting(*candidate, why);
+    }
+    if (it == queue_.end()) {
+      if (std::any_of(queue_.begin(), queue_.end(), mine))  // all held back by the disk: look again in a while
+        stop_.wait_for(lock, std::chrono::seconds(2), [this] { return stopping_.load(); });
+      continue;
+    }
     std::shared_ptr<Job> job = *it;
     queue_.erase(it);
     if (!registry_.is_queued(*job)) continue;  // cancelled while waiting
@@ -200,6 +251,7 @@ bool WorkerPool::store_running(const std::shared_ptr<Job>& job, bool small_lane)
                : std::chrono::steady_clock::time_point::max();
   };
   job->deadline = after(time_limit_seconds_);
+  job->disk_wait.clear();
   job->lane_deadline = small_lane ? after(small_job_seconds_) : std::chrono::steady_clock::time_point::max();
   return true;
 }

@@ -38,8 +38,17 @@ class WorkerPool {
   // `time_limit_seconds` (0: none).
   // A small-lane run past `small_job_seconds` is given lane_deadline (the janitor stops it; its run queues it again
   // as a general job, and release() puts it back in the queue).
+  //
+  // The disk budget: a job starts only when its estimated result (JobRecord::result_estimate) fits in what the data
+  // directory has free (`disk.free`) less what the running jobs' results will still take (their estimates less what
+  // their directories hold, `disk.used`). A job that does not fit waits, its record's message saying why, and the
+  // jobs behind it that fit go first; it is looked at again every few seconds (another job's end, a file deleted).
+  struct Disk {
+    std::function<std::int64_t()> free;                    // bytes free (-1: unknown, then nothing is held back)
+    std::function<std::int64_t(const std::string&)> used;  // bytes a job's directory holds
+  };
   WorkerPool(JobRegistry& registry, int workers, int small_workers, double time_limit_seconds, double small_job_seconds,
-             Run run);
+             Disk disk, Run run);
   ~WorkerPool();  // threads shutdown() gave up on are left to the exiting process
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
@@ -72,12 +81,17 @@ class WorkerPool {
   std::shared_ptr<Job> take(bool small_lane);  // null once stopping
   // With the lock held: the general lane has no room while abandoned factorisations and its running jobs fill it.
   bool general_lane_full() const;
+  // With the lock held: whether `job`'s result fits on the disk beside the running jobs'; if not, `why` says so.
+  bool fits_on_disk(const Job& job, std::string& why) const;
+  // Puts `why` in a waiting job's record (once per change; with the pool's lock held: the registry's is taken after).
+  void note_waiting(const std::shared_ptr<Job>& job, const std::string& why);
   bool store_running(const std::shared_ptr<Job>& job, bool small_lane);
   void release(const std::shared_ptr<Job>& job, bool small_lane);
 
   JobRegistry& registry_;
   const int workers_, small_workers_;
   const double time_limit_seconds_, small_job_seconds_;
+  const Disk disk_;
   const Run run_;
 
   mutable std::mutex mutex_;

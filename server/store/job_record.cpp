@@ -44,6 +44,7 @@ nlohmann::json to_state_json(const JobRecord& r) {
                       {"idempotency_key", r.idempotency_key},
                       {"body_bytes", r.body_bytes},
                       {"small", r.small},
+                      {"result_estimate_bytes", r.result_estimate},
                       {"stop_reason", r.stop_reason},
                       {"message", r.message},
                       {"iterations", r.iterations},
@@ -74,6 +75,7 @@ JobRecord from_state_json(const nlohmann::json& j) {
   r.idempotency_key = j.value("idempotency_key", "");
   r.body_bytes = j.value("body_bytes", std::int64_t{0});
   r.small = j.value("small", false);
+  r.result_estimate = j.value("result_estimate_bytes", std::int64_t{0});
   r.stop_reason = j.value("stop_reason", "");
   r.message = j.value("message", "");
   r.iterations = j.value("iterations", 0);

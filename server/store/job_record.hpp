@@ -30,8 +30,12 @@ struct JobRecord {
   int interruptions = 0;        // runs cut short by the server dying (found RUNNING at start-up)
   std::string idempotency_key;  // "" when none was given
   std::int64_t body_bytes = 0;
-  // Small enough for the small-job lane (queue_settings.hpp, small_job); set at submission, never changed after.
+  // Small enough for the small-job lane (queue_settings.hpp, small_job); set at submission, changed only when a run
+  // overran the lane and moved to the general one (while it is out of the queue).
   bool small = false;
+  // The bytes its result is estimated to take (queue_settings.hpp, estimated_result); set at submission, never
+  // changed. 0: not known (a record stored before the estimate was kept). The disk budget of the workers reads it.
+  std::int64_t result_estimate = 0;
   // The outcome, set when the job is done.
   std::string stop_reason;  // converged, max_iterations, stagnation, cancelled, error, time_limit
   std::string message;

@@ -210,6 +210,12 @@ std::int64_t JobStore::disk_usage(const std::string& id) const {
   return total;
 }
 
+std::int64_t JobStore::free_bytes() const {
+  struct statvfs fs {};
+  if (::statvfs(data_dir_.c_str(), &fs) != 0) return -1;
+  return static_cast<std::int64_t>(static_cast<unsigned long long>(fs.f_bavail) * fs.f_frsize);
+}
+
 JobStore::Contents JobStore::load_all() {
   Contents contents;
   std::error_code ec;

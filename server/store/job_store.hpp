@@ -69,6 +69,9 @@ class JobStore {
   int open_result(const std::string& id, bool sidecar) const;
   // The bytes the job's directory holds (its files' sizes).
   std::int64_t disk_usage(const std::string& id) const;
+  // The bytes the data directory's file system has free for this process (statvfs's f_bavail); -1 when it cannot
+  // be asked. The reserve is not counted: it is not free.
+  std::int64_t free_bytes() const;
 
   struct Damaged {
     std::string id;

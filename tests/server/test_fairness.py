@@ -134,7 +134,9 @@ with Server(args=["--workers", "1", "--small-job-seconds", "2"]) as server:
     hog_id = server.submit_id(hog)
     running = server.wait_for(hog_id, lambda j: j["state"] == "RUNNING", 30)
     check("the long-running small job starts on the small-job lane", running.get("lane") == "small", running)
-    moved = server.wait_for(hog_id, lambda j: j["lane"] == "general", 60)
+    # Stored QUEUED (lane general) when its run ends, then put back in the queue by the pool: its position shows once
+    # it is there.
+    moved = server.wait_for(hog_id, lambda j: j["lane"] == "general" and j["queue_position"] is not None, 60)
     check("past --small-job-seconds it is moved to the general lane, stored QUEUED first in line",
           moved.get("lane") == "general" and moved.get("state") == "QUEUED" and moved.get("queue_position") == 1
           and "moved to the general lane" in (moved.get("message") or ""), moved)
