@@ -62,7 +62,12 @@ StepSummary summarize(const Step& step) {
     s.pair_names.push_back(p.name);
     s.force.push_back(p.force);
     s.tangential_force.push_back(p.tangential_force);
-    const ContactExtent extent = contact_extent(p.arc_length, p.pressure, loop_length(step, p));
+    // The zone this pair carries: a node another pair of its group carries (status 5) lists that pair's pressure,
+    // and belongs to that pair's zone.
+    Eigen::VectorXd carried = p.pressure;
+    for (Eigen::Index j = 0; j < carried.size() && j < p.status.size(); ++j)
+      if (p.status[j] == 5) carried[j] = 0.0;
+    const ContactExtent extent = contact_extent(p.arc_length, carried, loop_length(step, p));
     s.contact_begin.push_back(extent.begin);
     s.contact_end.push_back(extent.end);
   }

@@ -251,3 +251,38 @@ TEST(CurvedGroups, AClosedCurveCutIntoFourPairsIsTheClosedCurvesOnePairAgain) {
     }
   }
 }
+
+TEST(PairGroupTables, EveryNodeOfAGroupedPairCarriesLamesPressureOrTheCarryingPairsValue) {
+  // The quarter fit with the ring's bore (100 cells per 90 degrees) the slave of both shaft arcs (32 cells per 45):
+  // each pair's table lists all 101 bore nodes. The half opposite the other pair's arc is that pair's: status 5,
+  // with its values. They were listed with status 4 or 5 and pressure 0 (48 of 101 in each pair) while the contact
+  // itself was exact. Lame's pressure everywhere, since the fit is uniform.
+  const Result r = solve_quietly(parse_or_fail(quarter_fit(32, 100, true)));
+  ASSERT_TRUE(r.converged) << r.message;
+  const auto& pairs = r.steps.back().pairs;
+  ASSERT_EQ(pairs.size(), 2u);
+  const double p = lame();
+  std::map<int, double> carried;  // slave node -> the pressure of the pair that carries it
+  int own = 0, elsewhere = 0;
+  for (const PairField& pair : pairs)
+    for (Eigen::Index i = 0; i < pair.status.size(); ++i)
+      if (pair.status[i] == 0 || pair.status[i] == 4) {
+        EXPECT_NEAR(pair.pressure[i], p, 0.02 * p) << pair.name << " node " << pair.node[i];
+        carried[pair.node[i]] = pair.pressure[i];
+        ++own;
+      }
+  for (const PairField& pair : pairs)
+    for (Eigen::Index i = 0; i < pair.status.size(); ++i)
+      if (pair.status[i] == 5) {
+        ++elsewhere;
+        ASSERT_TRUE(carried.count(pair.node[i])) << pair.name << " node " << pair.node[i] << " is carried by no pair";
+        EXPECT_EQ(pair.pressure[i], carried[pair.node[i]]) << pair.name << " node " << pair.node[i];
+        EXPECT_EQ(pair.active[i], 1) << pair.name << " node " << pair.node[i];
+        EXPECT_TRUE(std::isfinite(pair.normal_gap[i])) << pair.name << " node " << pair.node[i];
+      }
+  EXPECT_EQ(static_cast<int>(carried.size()), 101) << "every bore node carried by a pair";
+  EXPECT_GT(elsewhere, 90) << "about half of each pair's nodes are the other's";
+  EXPECT_GE(own, 101);
+  // The pairs' forces add their own rows only: a node is counted once.
+  EXPECT_NEAR(pairs[0].force + pairs[1].force, p * 0.5 * 3.14159265358979323846 * 500.0, 0.005 * p * 785.4);
+}

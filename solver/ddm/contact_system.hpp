@@ -136,6 +136,8 @@ class ContactSystem {
   BodyField body_field(size_t a, const Eigen::VectorXd& u, fem::StressFields stress, const Eigen::VectorXd& reaction,
                        const Eigen::VectorXd* rigid_amplitudes) const;
   PairField pair_field(size_t k, const Displacements& u, const Eigen::VectorXd& z, const Eigen::VectorXd* q) const;
+  // Status-5 nodes (carried by another pair of their group) take the carrying pair's values (system_fields.cpp).
+  void share_carried_values(std::vector<PairField>& pairs) const;
 
   void discretize_pairs();
   void check_some_row();

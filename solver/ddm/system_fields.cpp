@@ -4,12 +4,14 @@
 #include "contact_system.hpp"
 
 #include "../contact_extent.hpp"
+#include "../mortar/pair_group.hpp"
 #include "../mortar/segments.hpp"
 
 #include <Eigen/QR>
 
 #include <cmath>
 #include <limits>
+#include <map>
 
 namespace contact::ddm {
 
@@ -267,7 +269,47 @@ Step ContactSystem::fields(const Displacements& u, const Pressures& z, int itera
   }
   for (size_t k = 0; k < pairs_.size(); ++k)
     step.pairs.push_back(pair_field(k, u, z[k], q && k < q->size() ? &(*q)[k] : nullptr));
+  share_carried_values(step.pairs);
   return step;
+}
+
+// In a group of pairs that share one contact surface (mortar/pair_group.hpp) each slave node is carried by one pair;
+// the others list it with status 5 (other_pair). Its values there are the carrying pair's: the one that lists the
+// same slave node carrying a multiplier (status 0) or inside one of its multiplier segments (4). Without this a
+// reader of one pair saw half its nodes at pressure 0 where the contact is closed.
+void ContactSystem::share_carried_values(std::vector<PairField>& pairs) const {
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    PairField& f = pairs[k];
+    if ((f.status.array() != static_cast<int>(mortar::NodeStatus::other_pair)).all()) continue;
+    // The carrying entries of the group's other pairs, by slave node.
+    std::map<int, std::pair<size_t, Eigen::Index>> carried;
+    for (const int other : mortar::pair_group(problem_, static_cast<int>(k)).pairs) {
+      const auto o = static_cast<size_t>(other);
+      if (o == k || o >= pairs.size()) continue;
+      const PairField& g = pairs[o];
+      for (Eigen::Index j = 0; j < g.status.size(); ++j)
+        if (g.status[j] == static_cast<int>(mortar::NodeStatus::contact) ||
+            g.status[j] == static_cast<int>(mortar::NodeStatus::inner))
+          carried.emplace(g.node[j], std::make_pair(o, j));
+    }
+    for (Eigen::Index j = 0; j < f.status.size(); ++j) {
+      if (f.status[j] != static_cast<int>(mortar::NodeStatus::other_pair)) continue;
+      const auto it = carried.find(f.node[j]);
+      if (it == carried.end()) continue;
+      const PairField& g = pairs[it->second.first];
+      const Eigen::Index i = it->second.second;
+      f.gap[j] = g.gap[i];
+      f.normal_gap[j] = g.normal_gap[i];
+      f.pressure[j] = g.pressure[i];
+      f.penetration[j] = g.penetration[i];
+      f.active[j] = g.active[i];
+      if (f.tangential_traction.size() == f.status.size() && g.tangential_traction.size() == g.status.size()) {
+        f.tangential_traction[j] = g.tangential_traction[i];
+        f.slip[j] = g.slip[i];
+        f.stick[j] = g.stick[i];
+      }
+    }
+  }
 }
 
 }  // namespace contact::ddm

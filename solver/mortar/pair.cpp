@@ -374,6 +374,16 @@ class PairBuilder {
         d_.tangential_dropped.push_back(tangential_dropped_.count(i) ? 1 : 0);
       }
     if (closed_ && n_ > 0) d_.row_of_node[n_ - 1] = d_.row_of_node[0];  // the start again: its row
+    // A run between two nodes this pair does not carry, one of them carried by another pair of its group, lies in
+    // that pair's part of the surface: its inner nodes are that pair's too (their values are its), not this
+    // pair's coarse-grained interior with no value.
+    for (size_t m = 0; m < n_runs_; ++m) {
+      const size_t a = d_.multiplier_nodes[m], b = d_.multiplier_nodes[m + 1];
+      const bool elsewhere = d_.status[a] == NodeStatus::other_pair || d_.status[b] == NodeStatus::other_pair;
+      if (!elsewhere || d_.row_of_node[a] >= 0 || d_.row_of_node[b] >= 0) continue;
+      for (size_t i = a + 1; i < b; ++i)
+        if (d_.status[i] == NodeStatus::inner) d_.status[i] = NodeStatus::other_pair;
+    }
     d_.node_from_rows.assign(n_, {});
     for (size_t m = 0; m < n_runs_; ++m) {
       const size_t a = d_.multiplier_nodes[m], b = d_.multiplier_nodes[m + 1];
