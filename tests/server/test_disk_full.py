@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""A full disk (issue 10, item 7): the data directory (a 3 MB tmpfs in a private mount namespace) fills up while a
-job runs; the job ends FAILED (its result cannot be written), and state.json says FAILED too (the server gives up
+"""A full disk (issue 10, item 7): the data directory (a 12 MB tmpfs in a private mount namespace: room for the
+running job's estimated result, which the disk budget of tests/server/test_disk_budget.py wants before it starts)
+fills up while a job runs; the job ends FAILED (its result cannot be written), and state.json says FAILED too (the server gives up
 its 1 MiB reserve to store that), so a restart does not run it again; its message says why and leaks no memory
 address or path; /readyz says the disk filled up.
 
@@ -28,7 +29,7 @@ from checks import check, finish, skip  # noqa: E402
 
 mount_point = tempfile.mkdtemp(prefix="contactd-full-")
 holder = subprocess.Popen(["unshare", "--mount", "--propagation", "private", "sh", "-c",
-                           f"mount -t tmpfs -o size=3m tmpfs {mount_point} && echo mounted && exec sleep 600"],
+                           f"mount -t tmpfs -o size=12m tmpfs {mount_point} && echo mounted && exec sleep 600"],
                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 line = holder.stdout.readline().strip()
 if line != "mounted":
