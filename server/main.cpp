@@ -105,6 +105,11 @@ void add_job_limit_flags(CLI::App& app, Config& c) {
       ->envname("CONTACTD_MAX_RESULT_BYTES")
       ->check(CLI::Range(1e6, 1e15))
       ->capture_default_str();
+  app.add_option("--max-validation-seconds", c.queue.max_validation_seconds,
+                 "longest a request's validation of a job may take (400 beyond, naming the time)")
+      ->envname("CONTACTD_MAX_VALIDATION_SECONDS")
+      ->check(CLI::Range(0.001, 3600.0))
+      ->capture_default_str();
   app.add_option("--max-interface-bytes", c.queue.max_interface_bytes,
                  "most memory a job's interface problem (method interface_newton: dense blocks over each body's "
                  "contact unknowns) may take, estimated before it runs from its contact edges' nodes")

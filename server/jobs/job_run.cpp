@@ -111,7 +111,7 @@ std::optional<contact::Problem> JobRun::parse_again(contact::Result& result) {
   const std::string body = context_.store.read_job(id_);
   BodyBudget::Slot slot = context_.budget.for_validation_until(body.size(), [&job] { return job.cancel.cancelled(); });
   if (slot) {
-    auto parsed = validate_job(context_.settings, body);
+    auto parsed = validate_job(context_.settings, body, /*time_limited=*/false);
     slot.release();
     if (!parsed.ok()) {
       // Valid when submitted; invalid now (a smaller --max-dofs since, or another solver version).

@@ -30,7 +30,7 @@ std::int64_t estimated_result(const contact::Problem& problem) {
       nodes, static_cast<double>(problem.bodies.size()), static_cast<double>(problem.contacts.size()), kept));
 }
 
-contact::job::ParseResult validate_job(const QueueSettings& settings, const std::string& body) {
+contact::job::ParseResult validate_job(const QueueSettings& settings, const std::string& body, bool time_limited) {
   contact::job::Limits limits;
   limits.max_dofs = settings.max_dofs;
   limits.max_bodies = settings.max_bodies;
@@ -40,6 +40,8 @@ contact::job::ParseResult validate_job(const QueueSettings& settings, const std:
   limits.result_bytes_hint = "contactd --max-result-bytes";
   limits.max_interface_bytes = settings.max_interface_bytes;
   limits.interface_bytes_hint = "contactd --max-interface-bytes";
+  limits.max_validation_seconds = time_limited ? settings.max_validation_seconds : 0.0;
+  limits.validation_seconds_hint = "contactd --max-validation-seconds";
   limits.max_ranks = settings.mpi.launcher.empty() ? 1 : settings.mpi.max_ranks;
   limits.ranks_hint = settings.mpi.launcher.empty()
                           ? "this server solves every job in its own process: it was started without --mpi-launcher"

@@ -29,6 +29,7 @@ struct QueueSettings {
   int max_load_steps = 1000;           // job::Limits::max_load_steps
   double max_result_bytes = 2e9;       // job::Limits::max_result_bytes: the estimated result (and kept steps)
   double max_interface_bytes = 4e9;    // job::Limits::max_interface_bytes: the interface problem's dense blocks
+  double max_validation_seconds = 30;  // job::Limits::max_validation_seconds: a request's validation
   double time_limit_seconds = 3600.0;  // per run; 0 = none
   int max_attempts = 3;                // runs cut short by the server dying, after which a job ends FAILED
   std::uint64_t max_event_log_bytes = 256u << 20;  // per job; iteration events beyond are not recorded
@@ -49,7 +50,9 @@ bool small_job(const QueueSettings& settings, const contact::Problem& problem);
 std::int64_t estimated_result(const contact::Problem& problem);
 
 // Parses and validates a job body within the settings' limits (the ranks a job may ask for depend on
-// whether MPI jobs are possible).
-contact::job::ParseResult validate_job(const QueueSettings& settings, const std::string& body);
+// whether MPI jobs are possible). `time_limited`: within --max-validation-seconds too (a request's validation; a
+// worker's parse again of a job validated at submission is not, so that a loaded machine does not fail it).
+contact::job::ParseResult validate_job(const QueueSettings& settings, const std::string& body,
+                                       bool time_limited = true);
 
 }  // namespace contactd

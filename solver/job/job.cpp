@@ -43,9 +43,12 @@ ParseResult JobReader::run() {
   if (const json* m = top.find("meshes"))
     gmsh_.read_table(*m, top.at("meshes"), errors_, sub_object(normalized_, "meshes"));
   read_bodies(top);
+  if (out_of_time("reading the bodies and building their meshes")) return finish();
   if (!inputs_.empty()) gmsh_.check_table_used(errors_);  // not when the bodies could not be read at all
   read_contacts(top);
+  if (out_of_time("reading the contact pairs")) return finish();
   check_pairs_face();
+  if (out_of_time("checking that the pairs' edges face each other")) return finish();
   read_solver(top);
   if (const json* a = top.find("adaptivity")) read_adaptivity(*a, top.at("adaptivity"));
   read_loading(top);
@@ -54,8 +57,24 @@ ParseResult JobReader::run() {
   resolve_method_defaults();
   check_friction_and_histories();
   check_floating_bodies();
+  if (out_of_time("checking the floating bodies")) return finish();
   check_work_limits();
   return finish();
+}
+
+bool JobReader::out_of_time(const char* during) {
+  if (timed_out_) return true;
+  if (limits_.max_validation_seconds <= 0) return false;
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+  if (seconds <= limits_.max_validation_seconds) return false;
+  timed_out_ = true;
+  char text[160];
+  std::snprintf(text, sizeof text, "validation took %.3g s (stopped while %s), more than the %g s allowed", seconds,
+                during, limits_.max_validation_seconds);
+  errors_.add("", std::string(text) +
+                      (limits_.validation_seconds_hint.empty() ? "" : " (" + limits_.validation_seconds_hint + ")") +
+                      ": the job is larger than this server validates; split it, or take coarser meshes");
+  return true;
 }
 
 // The upper bounds of Limits on the values read (a default is always within them). Separate from the readers so

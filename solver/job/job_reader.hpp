@@ -16,6 +16,7 @@
 
 #include <array>
 #include <cstddef>
+#include <chrono>
 #include <map>
 #include <optional>
 #include <set>
@@ -96,8 +97,12 @@ struct NodeIndex {
 
 class JobReader {
  public:
-  JobReader(const json& job, const Limits& limits) : job_(job), limits_(limits), normalized_(job), gmsh_(limits) {}
+  JobReader(const json& job, const Limits& limits)
+      : job_(job), limits_(limits), normalized_(job), started_(std::chrono::steady_clock::now()), gmsh_(limits) {}
   ParseResult run();
+  // Validation ran past Limits::max_validation_seconds: the job is refused (once, naming `during`), and true
+  // from then on, so that each phase (and the loops over bodies and pairs) stops.
+  bool out_of_time(const char* during);
 
  private:
   // job.cpp: the frame, the header and the model, the normalized copy's parts
@@ -209,6 +214,8 @@ class JobReader {
   std::vector<std::string> contact_pointers_;   // per contact pair of problem_.contacts: /contacts/k
   // One error for one cause: what a part refused whole (over a limit, of the wrong type) or read only in part
   // leaves unknown, so the checks that depend on it are not run (docs/job-format.md, "Validation and errors").
+  const std::chrono::steady_clock::time_point started_;
+  bool timed_out_ = false;
   bool bodies_listed_ = false;     // the bodies' list was read (not refused whole); names may still be missing
   bool contacts_complete_ = true;  // every contact pair was read and resolved: the bodies' contacts are known
   bool loading_read_ = true;       // the load steps were read without error: their number is known

@@ -9,6 +9,8 @@ Two small jobs made validation cost gigabytes:
    the job's size was checked (149 s and 864 MB before the 400 for 27.5M unknowns). Now a surface is built once
    however many bodies name it, and the total is checked before any body's mesh is built.
 
+Validation itself is bounded in time too (--max-validation-seconds): a job past it is refused with the time.
+
 3. A long contact (issue 51, item 3): two strips of N cells in contact, a 540-byte job, took N = 16,000 to an OOM
    kill (about 30 GB: the interface problem's dense blocks grow with the square of the contact's nodes) far below
    --max-dofs. Now its memory is estimated before it runs and a job over --max-interface-bytes is refused with the
@@ -203,5 +205,16 @@ with Server(args=["--max-request-bytes", "67108864"]) as server:
                        headers={"Content-Type": "application/json"})
     check("two strips of 2,000 cells with friction (about 2 GB): within the default 4 GB, 200", r.status == 200, r)
     check("the server is up", server.get("/healthz").status == 200)
+
+section("validation under a time budget")
+# A job that validation cannot finish within --max-validation-seconds is refused with the time it took, not
+# validated for as long as it takes (every check is linear now: a budget of 1 ms stands in for a pathological job).
+if msh:
+    with Server(args=["--max-request-bytes", "67108864", "--max-validation-seconds", "0.001"]) as server:
+        r = server.request("POST", "/v1/validate", body=json.dumps(table_job(msh, TABLE_BODIES)).encode(),
+                           headers={"Content-Type": "application/json"})
+        text = r.body.decode(errors="replace")
+        check("past --max-validation-seconds: 400 naming the time, where it stopped and the flag",
+              r.status == 400 and "validation took" in text and "contactd --max-validation-seconds" in text, r)
 
 finish()

@@ -42,9 +42,14 @@ struct Limits {
   // kill) far below max_dofs. contact-solve sets this machine's memory, contactd its --max-interface-bytes.
   double max_interface_bytes = 0;
   std::string interface_bytes_hint;  // the setting named when a job is over max_interface_bytes
-  int max_ranks = 4096;              // parallel.ranks (contactd: its --max-ranks, 1 without an MPI launcher)
-  std::string ranks_hint;            // appended to the message when parallel.ranks is over max_ranks
-  std::size_t max_name_length = 64;  // body, edge and contact names (identifiers)
+  // Validation's own time (s; 0: none). Every check is linear or n log n in the job's size, so a job within the
+  // other limits validates in a second or two; this bounds what a pathological one costs a server: past it the
+  // reader stops at its next phase (or every 64 bodies or pairs) and refuses the job with the time it took.
+  double max_validation_seconds = 0;
+  std::string validation_seconds_hint;  // the setting named when validation runs out of time
+  int max_ranks = 4096;                 // parallel.ranks (contactd: its --max-ranks, 1 without an MPI launcher)
+  std::string ranks_hint;               // appended to the message when parallel.ranks is over max_ranks
+  std::size_t max_name_length = 64;     // body, edge and contact names (identifiers)
   std::size_t max_job_name_length = 256;
   // Gmsh meshes given as {"file": ...} are read relative to this directory (the job file's: parse_file sets it).
   // Unset, a job may not name a file (the server: a job sends the .msh text as "data").
