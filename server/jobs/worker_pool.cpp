@@ -150,16 +150,21 @@ std::string megabytes(std::int64_t bytes) {
 
 }  // namespace
 
-bool WorkerPool::fits_on_disk(const Job& job, std::string& why) const {
+WorkerPool::DiskRoom WorkerPool::disk_room() const {
+  DiskRoom room;
+  if (!disk_.free) return room;
+  room.free = disk_.free();
+  if (room.free < 0) return room;  // cannot be asked: nothing is held back
+  room.known = true;
   // result_estimate is set before a job is queued and never changed: read without the registry's lock.
-  const std::int64_t needed = job.record.result_estimate;
-  if (needed <= 0 || !disk_.free) return true;
-  const std::int64_t free = disk_.free();
-  if (free < 0) return true;  // cannot be asked: nothing is held back
-  std::int64_t pending = 0;   // what the running jobs' results will still write
   for (const auto& running : running_)
-    pending += std::max<std::int64_t>(0, running->record.result_estimate - disk_.used(running->record.id));
-  if (needed <= free - pending) return true;
+    room.pending += std::max<std::int64_t>(0, running->record.result_estimate - disk_.used(running->record.id));
+  return room;
+}
+
+bool WorkerPool::fits_on_disk(const Job& job, const DiskRoom& room, std::string& why) const {
+  const std::int64_t needed = job.record.result_estimate, free = room.free, pending = room.pending;
+  if (needed <= 0 || !room.known || needed <= free - pending) return true;
   why = "waiting for disk space: its result is estimated at " + megabytes(needed) + ", and the data directory has " +
         megabytes(free) + " free" +
         (pending > 0 ? ", of which the running jobs' results will take " + megabytes(pending) : std::string()) +
@@ -168,7 +173,9 @@ bool WorkerPool::fits_on_disk(const Job& job, std::string& why) const {
 }
 
 void WorkerPool::note_waiting(const std::shared_ptr<Job>& job, const std::string& why) {
-  if (job->disk_wait == why) return;
+  // Once a wait: its figures are those of when it began (stored again at every look, a full disk's state.json
+  // would be rewritten every few seconds).
+  if (!job->disk_wait.empty()) return;
   job->disk_wait = why;
   if (!registry_.commit(
           job, [&why](JobRecord& r) { r.message = why; }, /*durable=*/false))
@@ -198,10 +205,11 @@ std::shared_ptr<Job> WorkerPool::take(bool small_lane) {
     if (!small_lane && general_lane_full()) continue;
     // The first of this lane's jobs whose result fits on the disk; the ones before it that do not are told why.
     auto it = queue_.end();
+    const DiskRoom room = disk_room();
     for (auto candidate = queue_.begin(); candidate != queue_.end(); ++candidate) {
       if (!mine(*candidate)) continue;
       std::string why;
-      if (fits_on_disk(**candidate, why)) {
+      if (fits_on_disk(**candidate, room, why)) {
         it = candidate;
         break;
       }

@@ -81,8 +81,15 @@ class WorkerPool {
   std::shared_ptr<Job> take(bool small_lane);  // null once stopping
   // With the lock held: the general lane has no room while abandoned factorisations and its running jobs fill it.
   bool general_lane_full() const;
-  // With the lock held: whether `job`'s result fits on the disk beside the running jobs'; if not, `why` says so.
-  bool fits_on_disk(const Job& job, std::string& why) const;
+  // With the lock held: what the data directory has free and what the running jobs' results will still write (their
+  // estimates less what their directories hold), asked once per look at the queue.
+  struct DiskRoom {
+    bool known = false;
+    std::int64_t free = 0, pending = 0;
+  };
+  DiskRoom disk_room() const;
+  // Whether `job`'s result fits in that room; if not, `why` says so.
+  bool fits_on_disk(const Job& job, const DiskRoom& room, std::string& why) const;
   // Puts `why` in a waiting job's record (once per change; with the pool's lock held: the registry's is taken after).
   void note_waiting(const std::shared_ptr<Job>& job, const std::string& why);
   bool store_running(const std::shared_ptr<Job>& job, bool small_lane);
