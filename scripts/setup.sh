@@ -23,7 +23,7 @@ TEST_PACKAGES=(
   iproute2                                  # ss: tests/server/test_connections.py reads the listen backlog
   chromium chromium-driver python3-selenium # tests/clients/test_web_page.py drives the web page
   gmsh libgmsh-dev                          # scripts/make_gmsh_examples.sh; the MSH reader checked against libgmsh
-  clang-format                              # tests/py/test_format.py: the code as .clang-format says (Debian's 14)
+  clang-format                              # tests/unit/test_format.py: the code as .clang-format says (Debian's 14)
 )
 RUNTIME_PACKAGES=(
   libcholmod3 libumfpack5 libopenblas0-pthread libhdf5-103-1 libcpp-httplib0.11 ca-certificates curl

@@ -1,5 +1,5 @@
-// Boundary-element test problems with exact solutions, shared by tests/test_bem.cpp (the dense BEM),
-// tests/test_hbem.cpp (the hierarchical one against the dense) and bench/bench_hbem.cpp.
+// Boundary-element test problems with exact solutions, shared by tests/unit/test_bem.cpp (the dense BEM),
+// tests/unit/test_hbem.cpp (the hierarchical one against the dense) and bench/bench_hbem.cpp.
 #pragma once
 
 #include <Eigen/Core>

@@ -1,4 +1,4 @@
-"""The check harness of every Python test (tests/py, tests/server, tests/clients, tests/mpi): named checks counted
+"""The check harness of every Python test (tests/unit, tests/integration, tests/server, tests/clients, tests/mpi): named checks counted
 in one process, a skip CTest understands, and the summary and exit code at the end.
 
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))  # tests/

@@ -1,6 +1,6 @@
 // The result file's two history tables, declared once (docs/results-format.md, "/history/iterations" and
 // "/history/steps"): write_result.cpp and read_result.cpp walk these lists, in this order (the order in which the
-// datasets are created), and tests/test_io.cpp compares them, name, shape and type, with the format document's
+// datasets are created), and tests/unit/test_io.cpp compares them, name, shape and type, with the format document's
 // tables. A column added here is written, read and checked against the document; nowhere else names it.
 #pragma once
 

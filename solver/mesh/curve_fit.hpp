@@ -3,7 +3,7 @@
 // the job says otherwise, each side gets the arc through its two nodes whose curvature is the mean of the circles
 // through its node triples (k - 1, k, k + 1) and (k, k + 1, k + 2) (at a piece's ends the one triple there). Two
 // meshes of one curve then see nearly the same curve: the arc's distance from the true curve falls as h^3 (the
-// chord's as h^2: its sag h^2 kappa / 8), measured on an ellipse in tests/test_edge_curves.cpp. A straight stretch
+// chord's as h^2: its sag h^2 kappa / 8), measured on an ellipse in tests/unit/test_edge_curves.cpp. A straight stretch
 // (a sag below 1e-7 of the side) keeps its chord, so flat edges compute exactly what they did.
 //
 // Corners: a chain of nodes may turn sharply where the body has a corner (an explicit edge round two sides of a

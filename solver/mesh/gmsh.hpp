@@ -6,7 +6,7 @@
 // without a global lock), reads only files (the server takes the mesh's text inside the job), and brings about
 // 100 MB of OpenCASCADE, FLTK and OpenGL libraries into the runtime image for what is five sections of a text
 // format. The reader bounds its memory by the text's size and the job's degree-of-freedom limit and reports
-// every problem with a line number or a Gmsh element tag. tests/test_gmsh.cpp checks it against libgmsh's own
+// every problem with a line number or a Gmsh element tag. tests/unit/test_gmsh.cpp checks it against libgmsh's own
 // reading of the examples where the library is installed (docs/job-format.md, "Gmsh meshes").
 //
 // Layering: like the rest of mesh/, nothing here knows of finite elements or of the job format.

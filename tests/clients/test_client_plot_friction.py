@@ -34,7 +34,7 @@ ROLLER_PAIRS = ("roller.bottom-base.top", "roller.top-plate.bottom")
 
 def pushed_job():
     """A half cylinder (R = 2) pressed on a block, then pushed sideways by a force at its top left corner (0, 0.5,
-    1 in three steps): partial slip, Coulomb mu = 0.2 (tests/test_friction.cpp's pushed_cylinder)."""
+    1 in three steps): partial slip, Coulomb mu = 0.2 (tests/integration/test_friction.cpp's pushed_cylinder)."""
     block = {"name": "block", "material": {"E": 1000, "nu": 0.3},
              "mesh": {"block": {"corners": [[-2, -2], [2, -2], [2, 0], [-2, 0]], "nx": 37, "ny": 9}},
              "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]}
@@ -51,7 +51,7 @@ def pushed_job():
 
 def tresca_job():
     """A block pressed on a foundation and moved sideways until it slides under Tresca's bound g = 5
-    (tests/test_friction.cpp's tresca_job): increasing load factors, so the figure has its load curve too."""
+    (tests/integration/test_friction.cpp's tresca_job): increasing load factors, so the figure has its load curve too."""
     ground = {"name": "ground", "material": {"E": 1000, "nu": 0.3},
               "mesh": {"block": {"corners": [[-1, -0.5], [1, -0.5], [1, 0], [-1, 0]], "nx": 20, "ny": 5}},
               "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]}

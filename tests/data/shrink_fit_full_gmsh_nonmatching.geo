@@ -1,4 +1,4 @@
-// The shrink fit of shrink_fit_full_gmsh.geo on NON-matching meshes (tests/test_curved_contact.cpp): a solid shaft
+// The shrink fit of shrink_fit_full_gmsh.geo on NON-matching meshes (tests/integration/test_curved_contact.cpp): a solid shaft
 // of radius a = 500 in a ring a .. b = 1000, one closed physical curve per body round the interface ("rim" on the
 // shaft, "bore" on the ring), the shaft's cut into 4 n_shaft arcs and the ring's into 4 n_ring, so no node but the
 // four on the axes is shared. The supports as in shrink_fit_full_gmsh.geo. Generated, coarse and fine, by

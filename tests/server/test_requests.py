@@ -38,7 +38,7 @@ def pointers(response):
 
 
 def explicit_square():
-    """A unit square as two quads with its sides named (the explicit mesh of tests/test_job.cpp)."""
+    """A unit square as two quads with its sides named (the explicit mesh of tests/unit/test_job.cpp)."""
     return {"nodes": [[0, 0], [1, 0], [2, 0], [0, 1], [1, 1], [2, 1]],
             "quads": [[0, 1, 4, 3], [1, 2, 5, 4]],
             "edges": {"base": [[0, 1], [1, 2]], "side": [[2, 5]], "cap": [[5, 4], [4, 3]], "wall": [[3, 0]]}}

@@ -42,8 +42,10 @@ ROOT_FILES = {
 }
 # Include directories of each tree, in the compiler's order (CMakeLists.txt, server/CMakeLists.txt).
 # tests/ and bench/ may use everything (contact_solver_internals): only their includes' resolution is checked.
+# (The GoogleTests in tests/unit/ and tests/integration/ find the headers they share in tests/.)
 INCLUDE_DIRS = {"solver": ["solver/include", "solver"], "server": ["server", "solver/include"],
-                "cli": ["solver/include"], "tests": ["solver", "solver/include"], "bench": ["solver", "solver/include"]}
+                "cli": ["solver/include"], "tests": ["solver", "solver/include", "tests"],
+                "bench": ["solver", "solver/include"]}
 SOURCE = (".cpp", ".hpp", ".h")
 INCLUDE = re.compile(r'^\s*#\s*include\s*"([^"]+)"', re.M)
 

@@ -4,7 +4,7 @@
 Runs the CLI on api/examples/seed_layers.json twice, with its own settings (the paper's penalty scheme) and with
 the default solver (exact contact), (CONTACT_BINARY_DIR and CONTACT_SOURCE_DIR come from ctest) and checks the
 files it writes and the XDMF sidecars next to them. With a path argument, checks that file instead:
-    python3 tests/py/test_result_layout.py some/result.hdf
+    python3 tests/integration/test_result_layout.py some/result.hdf
 Prints one line per check and "N passed, M failed"; exits non-zero on any failure.
 """
 import json
