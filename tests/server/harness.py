@@ -317,6 +317,43 @@ class Server:
             return b"".join(chunks)
 
 
+class PrivateTmpfs:
+    """A tmpfs of `size` (e.g. "6m") in a private mount namespace held by a `sleep`: a data directory that can be
+    filled or grown without touching the machine's disks. contactd runs inside it with `prefix` (nsenter); the
+    test reads its files through path(). Needs root (mount) and util-linux (unshare, nsenter): without them the
+    test is skipped (exit 77) with the reason."""
+
+    def __init__(self, size, name="contactd-tmpfs-"):
+        self.mount_point = tempfile.mkdtemp(prefix=name)
+        self.holder = subprocess.Popen(
+            ["unshare", "--mount", "--propagation", "private", "sh", "-c",
+             f"mount -t tmpfs -o size={size} tmpfs {self.mount_point} && echo mounted && exec sleep 600"],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        if self.holder.stdout.readline().strip() != "mounted":
+            self.holder.kill()
+            reason = f"cannot mount a tmpfs in a private namespace here ({self.holder.stderr.read().strip()[:200]})"
+            os.rmdir(self.mount_point)
+            checks.skip(reason)
+        self.prefix = ["nsenter", "-t", str(self.holder.pid), "-m", "--"]
+
+    def path(self, *parts):
+        """A path inside the tmpfs as this process sees it."""
+        return os.path.join(f"/proc/{self.holder.pid}/root", self.mount_point.lstrip("/"), *parts)
+
+    def remount(self, size):
+        """Grows (or shrinks) the tmpfs; the completed process."""
+        return subprocess.run([*self.prefix, "mount", "-o", f"remount,size={size}", self.mount_point],
+                              capture_output=True, text=True)
+
+    def close(self):
+        self.holder.send_signal(signal.SIGKILL)
+        self.holder.wait(timeout=10)
+        try:
+            os.rmdir(self.mount_point)
+        except OSError:
+            pass
+
+
 class Stream:
     """A progress stream read incrementally: SSE (default) or NDJSON. next_event() returns the next event as a
     dict with the SSE fields attached (_id, _event), or None at the end of the stream."""

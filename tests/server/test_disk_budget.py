@@ -9,25 +9,13 @@ why; a small job submitted after it runs and succeeds meanwhile; once the tmpfs 
 large job starts and succeeds, its result downloadable. Needs root (mount) and util-linux (unshare, nsenter);
 without them it says so and exits 0 (skipped)."""
 import os
-import signal
-import subprocess
 import sys
-import tempfile
-import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))  # tests/: checks.py
-from harness import Server, flat_patch  # noqa: E402
-from checks import check, finish, skip  # noqa: E402
+from harness import PrivateTmpfs, Server, flat_patch  # noqa: E402
+from checks import check, finish  # noqa: E402
 
-mount_point = tempfile.mkdtemp(prefix="contactd-budget-")
-holder = subprocess.Popen(["unshare", "--mount", "--propagation", "private", "sh", "-c",
-                           f"mount -t tmpfs -o size=6m tmpfs {mount_point} && echo mounted && exec sleep 600"],
-                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-if holder.stdout.readline().strip() != "mounted":
-    holder.kill()
-    reason = f"cannot mount a tmpfs in a private namespace here ({holder.stderr.read().strip()[:200]})"
-    os.rmdir(mount_point)
-    skip(reason)
+disk = PrivateTmpfs("6m", "contactd-budget-")
 
 
 def blocks(n, steps):
@@ -41,8 +29,7 @@ def blocks(n, steps):
 
 
 try:
-    server = Server(data_dir=mount_point, args=["--workers", "1"],
-                    prefix=["nsenter", "-t", str(holder.pid), "-m", "--"]).start()
+    server = Server(data_dir=disk.mount_point, args=["--workers", "1"], prefix=disk.prefix).start()
     large = server.submit_id(blocks(60, 10))
     held = server.wait_for(large, lambda j: "waiting for disk space" in (j.get("message") or ""), 30)
     print("the large job's message:", held.get("message"), flush=True)
@@ -54,8 +41,7 @@ try:
     check("a small job behind it runs and succeeds meanwhile", done.get("state") == "SUCCEEDED", done)
     check("the large job still waits", server.job(large)["state"] == "QUEUED")
 
-    grown = subprocess.run(["nsenter", "-t", str(holder.pid), "-m", "--", "mount", "-o", "remount,size=96m",
-                            mount_point], capture_output=True, text=True)
+    grown = disk.remount("96m")
     check("the tmpfs grows to 96 MB", grown.returncode == 0, grown.stderr)
     end = server.wait_done(large, 300)
     check("with room, the large job starts and succeeds", end.get("state") == "SUCCEEDED", end)
@@ -66,11 +52,6 @@ try:
     print(f"its result: {end.get('result_bytes', 0) / 1e6:.1f} MB", flush=True)
     server.kill()
 finally:
-    holder.send_signal(signal.SIGKILL)
-    holder.wait(timeout=10)
-    try:
-        os.rmdir(mount_point)
-    except OSError:
-        pass
+    disk.close()
 
 finish()

@@ -18,37 +18,27 @@ import re
 import signal
 import subprocess
 import sys
-import tempfile
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))  # tests/: checks.py
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "clients"))
-from harness import Server, Stream, long_job  # noqa: E402
-from checks import check, finish, skip  # noqa: E402
+from harness import PrivateTmpfs, Server, Stream, long_job  # noqa: E402
+from checks import check, finish  # noqa: E402
 
-
-mount_point = tempfile.mkdtemp(prefix="contactd-full-")
-holder = subprocess.Popen(["unshare", "--mount", "--propagation", "private", "sh", "-c",
-                           f"mount -t tmpfs -o size=12m tmpfs {mount_point} && echo mounted && exec sleep 600"],
-                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-line = holder.stdout.readline().strip()
-if line != "mounted":
-    holder.kill()
-    reason = f"cannot mount a tmpfs in a private namespace here ({holder.stderr.read().strip()[:200]})"
-    os.rmdir(mount_point)
-    skip(reason)  # CTest reports it skipped (SKIP_RETURN_CODE)
+disk = PrivateTmpfs("12m", "contactd-full-")  # skipped (SKIP_RETURN_CODE) where it cannot be mounted
+mount_point = disk.mount_point
 
 
 class NamespacedServer(Server):
-    """contactd started inside the holder's mount namespace (nsenter); its files seen through /proc."""
+    """contactd started inside the tmpfs's mount namespace (nsenter); its files seen through /proc."""
 
     def __init__(self):
         # Heartbeats rarer than the streams' read timeout: a stream that stays open without an event times out.
         super().__init__(data_dir=mount_point, args=["--workers", "1", "--heartbeat-seconds", "120"],
-                         prefix=["nsenter", "-t", str(holder.pid), "-m", "--"])
+                         prefix=disk.prefix)
 
     def file(self, *parts):
-        return os.path.join(f"/proc/{holder.pid}/root", mount_point.lstrip("/"), *parts)
+        return disk.path(*parts)
 
 
 def stream_ends(server, job_id, what, ndjson=False):
@@ -158,11 +148,6 @@ try:
               stored_types(c, job_id)[-1:] == ["end"], stored_types(c, job_id)[-3:])
     c.kill()
 finally:
-    holder.send_signal(signal.SIGKILL)
-    holder.wait(timeout=10)
-    try:
-        os.rmdir(mount_point)
-    except OSError:
-        pass
+    disk.close()
 
 finish()
