@@ -24,8 +24,8 @@
 #include <vector>
 
 using namespace contact;
-using nlohmann::json;
 using contact::bench::now;
+using nlohmann::json;
 
 namespace {
 
@@ -83,7 +83,7 @@ Figures one_solve(const json& job) {
   const double t0 = now();
   parallel::ThreadTaskRunner runner(parallel::choose_threads(0, p.bodies.size()));
   ddm::ContactSystem system(p, runner, ddm::ContactSystem::Factorization::plain);
-  const auto u = system.solve_bodies(ddm::Displacements(p.bodies.size()));
+  const auto u = system.solve_bodies(ddm::Displacements(p.bodies.size()), fem::LoadPoint{});
   Figures f;
   f.seconds = now() - t0;
   f.setup = system.setup_seconds();
@@ -107,7 +107,6 @@ Figures solve_job(const json& job) {
   return f;
 }
 
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -115,9 +114,12 @@ int main(int argc, char** argv) {
   int monolithic_up_to = 512, exact_monolithic_up_to = 256;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string flag = argv[i];
-    if (flag == "--sizes") sizes = bench::parse_int_list(argv[i + 1]);
-    else if (flag == "--monolithic-up-to") monolithic_up_to = std::stoi(argv[i + 1]);
-    else if (flag == "--exact-monolithic-up-to") exact_monolithic_up_to = std::stoi(argv[i + 1]);
+    if (flag == "--sizes")
+      sizes = bench::parse_int_list(argv[i + 1]);
+    else if (flag == "--monolithic-up-to")
+      monolithic_up_to = std::stoi(argv[i + 1]);
+    else if (flag == "--exact-monolithic-up-to")
+      exact_monolithic_up_to = std::stoi(argv[i + 1]);
   }
   std::printf("seed_layers, nx x nx/4 Q1 elements per body, 2 bodies; %u hardware threads\n",
               std::thread::hardware_concurrency());
@@ -144,7 +146,8 @@ int main(int argc, char** argv) {
     row("neumann + Anderson + aug. Lagrangian (exact)", in_child([&] { return solve_job(neumann); }));
     if (nx <= monolithic_up_to) {
       json mono = base;
-      mono["solver"] = {{"method", "monolithic"}, {"enforcement", "penalty"}, {"penalty", {{"c", 0.05}, {"length", 1}}}};
+      mono["solver"] = {
+          {"method", "monolithic"}, {"enforcement", "penalty"}, {"penalty", {{"c", 0.05}, {"length", 1}}}};
       row("monolithic penalty Newton (reference)", in_child([&] { return solve_job(mono); }));
     }
     if (nx <= exact_monolithic_up_to) {
@@ -153,8 +156,9 @@ int main(int argc, char** argv) {
       row("monolithic exact, sparse LU (reference)", in_child([&] { return solve_job(mono); }));
     }
   }
-  std::printf("\nsteps: active-set steps (interface Newton, monolithic exact), iterations (neumann), Newton steps\n"
-              "(monolithic penalty). The paper's scheme and the penalty reference solve the penalty problem (c = 0.05):\n"
-              "their force is lower than the exact one.\n");
+  std::printf(
+      "\nsteps: active-set steps (interface Newton, monolithic exact), iterations (neumann), Newton steps\n"
+      "(monolithic penalty). The paper's scheme and the penalty reference solve the penalty problem (c = 0.05):\n"
+      "their force is lower than the exact one.\n");
   return 0;
 }

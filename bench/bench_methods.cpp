@@ -17,8 +17,8 @@
 #include <vector>
 
 using namespace contact;
-using nlohmann::json;
 using contact::bench::now;
+using nlohmann::json;
 
 namespace {
 
@@ -31,7 +31,7 @@ double one_solve_seconds(const Problem& p) {
   const double t0 = now();
   parallel::ThreadTaskRunner runner(parallel::choose_threads(0, p.bodies.size()));
   ddm::ContactSystem system(p, runner);
-  const auto u = system.solve_bodies(ddm::Displacements(p.bodies.size()));
+  const auto u = system.solve_bodies(ddm::Displacements(p.bodies.size()), fem::LoadPoint{});
   (void)u;
   return now() - t0;
 }
@@ -42,14 +42,18 @@ struct Row {
 };
 
 void run_table(const std::string& title, const json& job, bool sweep) {
-  const json tight = {{"criterion", "residual"}, {"tolerance", 1e-8}, {"max_iterations", 20000},
-                      {"acceleration", "none"}, {"enforcement", "penalty"}};
+  const json tight = {{"criterion", "residual"},
+                      {"tolerance", 1e-8},
+                      {"max_iterations", 20000},
+                      {"acceleration", "none"},
+                      {"enforcement", "penalty"}};
   Problem base = make(job, tight);
   long dofs = 0;
   for (const auto& b : base.bodies) dofs += 2L * b.mesh.num_nodes();
   const double one = one_solve_seconds(base);
-  std::printf("\n%s: %ld dofs, %zu bodies; one elastic solve (assemble + factorise + solve, bodies in parallel) %.4f s\n",
-              title.c_str(), dofs, base.bodies.size(), one);
+  std::printf(
+      "\n%s: %ld dofs, %zu bodies; one elastic solve (assemble + factorise + solve, bodies in parallel) %.4f s\n",
+      title.c_str(), dofs, base.bodies.size(), one);
   std::printf("  %-34s %8s %6s %9s %7s %14s  %s\n", "method", "solves", "iter", "wall s", "ratio", "force", "stop");
 
   std::vector<Row> rows = {{"paper scheme, gamma 0.02", {{"method", "neumann"}, {"gamma", 0.02}}}};
@@ -63,9 +67,11 @@ void run_table(const std::string& title, const json& job, bool sweep) {
     }
   }
   rows.push_back({"neumann, gamma auto", {{"method", "neumann"}, {"gamma", "auto"}}});
-  rows.push_back({"neumann, gamma auto + Anderson(10)", {{"method", "neumann"}, {"gamma", "auto"}, {"acceleration", "anderson"}}});
+  rows.push_back(
+      {"neumann, gamma auto + Anderson(10)", {{"method", "neumann"}, {"gamma", "auto"}, {"acceleration", "anderson"}}});
   rows.push_back({"robin psi=active_set, auto", {{"method", "robin"}, {"gamma", "auto"}}});
-  rows.push_back({"robin psi=active_set + Anderson", {{"method", "robin"}, {"gamma", "auto"}, {"acceleration", "anderson"}}});
+  rows.push_back(
+      {"robin psi=active_set + Anderson", {{"method", "robin"}, {"gamma", "auto"}, {"acceleration", "anderson"}}});
   rows.push_back({"interface Newton", {{"method", "interface_newton"}}});
   rows.push_back({"monolithic Newton", {{"method", "monolithic"}}});
   rows.push_back({"interface Newton + aug. Lagrangian",
@@ -105,6 +111,7 @@ int main(int argc, char** argv) {
     run_table("seed_layers " + std::to_string(nx) + "x" + std::to_string(ny) + " per body", job, true);
   }
   run_table("stack3", json::parse(std::ifstream(dir + "stack3.json")), false);
-  std::printf("\n(force: sum over the pairs; 'solves' for monolithic is 0: it factorises the coupled system instead)\n");
+  std::printf(
+      "\n(force: sum over the pairs; 'solves' for monolithic is 0: it factorises the coupled system instead)\n");
   return 0;
 }

@@ -205,7 +205,8 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
     // method whose solution is checked once the run ends (then every step is checked before any is kept).
     ddm::StepLog steps(problem.output, facts.checks_held_bodies ? nullptr : observer.step_sink());
     if (adaptive) {
-      system.set_load_step(problem.loading.factors.size() - 1, problem.loading.factors.back());
+      // Adaptivity refines at the loading's end (a load path, if any, is solved anew on each mesh).
+      frame.state().load = fem::LoadPoint::end_of(problem.loading.factors.size() - 1, problem.loading.factors.back());
       adapt::run_adaptive(working, system, frame, *method, steps);
     } else {
       ddm::run_load_steps(system, problem.loading.factors, frame, *method, steps);

@@ -29,8 +29,9 @@ bool adapts(const AdaptivitySettings& s, size_t body) {
 
 // Indicator of every adaptive body (empty vector for the others).
 std::vector<IndicatorResult> estimate(const Problem& problem, const ddm::ContactSystem& system,
-                                      const ddm::Displacements& u, const ddm::Displacements& contact_loads,
-                                      parallel::TaskRunner& runner, const std::function<bool()>& stop = {}) {
+                                      const fem::LoadPoint& at, const ddm::Displacements& u,
+                                      const ddm::Displacements& contact_loads, parallel::TaskRunner& runner,
+                                      const std::function<bool()>& stop = {}) {
   std::vector<IndicatorResult> out(problem.bodies.size());
   const parallel::BodyShare share{[&](size_t a, parallel::Packer& p) {
                                     p.put(out[a].eta);
@@ -59,7 +60,7 @@ std::vector<IndicatorResult> estimate(const Problem& problem, const ddm::Contact
         const Body& body = problem.bodies[a];
         const Normalization norm = problem.adaptivity.normalization;
         out[a] = problem.adaptivity.indicator == Indicator::fem_bem
-                     ? fem_bem_indicator(body, problem.model, system.body(a), u[a], contact_loads[a], norm, stop)
+                     ? fem_bem_indicator(body, problem.model, system.body(a), u[a], contact_loads[a], at, norm, stop)
                      : zz_indicator(body, system.body(a), u[a], norm);
       },
       share);
@@ -206,9 +207,11 @@ void transfer(ddm::Displacements& u, const Problem& problem, const RefineOutcome
   }
 }
 
-Step make_step(const ddm::ContactSystem& system, const ddm::Displacements& u, const ddm::Pressures& z, int iteration,
-               int index, const std::vector<IndicatorResult>& eta, const ddm::Pressures& q = {}) {
-  Step st = z.empty() ? system.fields(u, iteration) : system.fields(u, z, iteration, nullptr, q.empty() ? nullptr : &q);
+Step make_step(const ddm::ContactSystem& system, const ddm::RunState& state, const ddm::Displacements& u,
+               const ddm::Pressures& z, int iteration, int index, const std::vector<IndicatorResult>& eta,
+               const ddm::Pressures& q = {}) {
+  Step st = z.empty() ? system.fields(u, iteration, state)
+                      : system.fields(u, z, iteration, state, nullptr, q.empty() ? nullptr : &q);
   st.index = index;
   for (size_t a = 0; a < st.bodies.size() && a < eta.size(); ++a)
     if (eta[a].eta.size() == st.bodies[a].mesh.num_cells()) st.bodies[a].indicator_cell = eta[a].eta;
@@ -372,7 +375,7 @@ bool rebuild_refined(Problem& working, ddm::ContactSystem& system, ddm::RunFrame
                      const RefineOutcome& r, int step, ddm::Displacements& warm) {
   ddm::MethodOutcome& total = frame.outcome();
   transfer(warm, working, r);
-  system.rebuild(r.changed, frame.stop_check());
+  system.rebuild(r.changed, frame.state(), frame.stop_check());
   method.reset();
   if (system.cancelled()) {  // during the refined meshes' assembly or factorisation: they are not solved
     mark_cancelled(total);
@@ -413,7 +416,8 @@ PressureEstimate step_pressure_estimate(const ddm::ContactSystem& system, ddm::R
     none.note = "no pressure estimate: it solves each body alone, and the monolithic method factorises none";
     return none;
   }
-  return pressure_estimate(system, o.u, o.z.empty() ? system.penalty_pressures(o.u) : o.z, eta, frame.stop_check(),
+  return pressure_estimate(system, frame.state().load, o.u,
+                           o.z.empty() ? system.penalty_pressures(o.u, frame.state()) : o.z, eta, frame.stop_check(),
                            o.q.empty() ? nullptr : &o.q);
 }
 
@@ -431,18 +435,18 @@ void converge_then_refine(Problem& working, ddm::ContactSystem& system, ddm::Run
     const ddm::MethodOutcome& o = solve_step(system, frame, method, refined_last, warm, working.loading.factors);
     if (o.u.empty()) return;
     if (frame.stop_requested()) {  // stopped inside the solve: keep what it reached, skip the estimate
-      Step reached = make_step(system, o.u, o.z, total.iterations, step, {}, o.q);
+      Step reached = make_step(system, frame.state(), o.u, o.z, total.iterations, step, {}, o.q);
       reached.converged = false;
       steps.push_back(std::move(reached));
       mark_cancelled(total);
       return;
     }
     // The whole contact traction, the tangential one too where there is friction, is the bodies' Neumann data.
-    const ddm::Displacements loads =
-        o.z.empty() ? system.contact_loads(o.u) : system.loads_from_pressures(o.z, o.q.empty() ? nullptr : &o.q);
-    const auto eta = estimate(working, system, o.u, loads, frame.runner(), frame.stop_check());
+    const ddm::Displacements loads = o.z.empty() ? system.contact_loads(o.u, frame.state())
+                                                 : system.loads_from_pressures(o.z, o.q.empty() ? nullptr : &o.q);
+    const auto eta = estimate(working, system, frame.state().load, o.u, loads, frame.runner(), frame.stop_check());
     for (const auto& e : eta) total.indicator_seconds += e.seconds;
-    Step solved = make_step(system, o.u, o.z, total.iterations, step, eta, o.q);
+    Step solved = make_step(system, frame.state(), o.u, o.z, total.iterations, step, eta, o.q);
     solved.converged = o.converged;
     const StepMeasures now = measure(solved, eta);
     steps.push_back(std::move(solved));  // an unconverged one only if the job asks for its iterate (StepLog)
@@ -517,7 +521,7 @@ RelaxedUpdate relaxed_update(const ddm::ContactSystem& system, const ddm::Displa
 double paper_gamma(const ddm::ContactSystem& system, const ddm::RunFrame& frame, int& solves_per_body) {
   const SolverSettings& settings = frame.settings();
   if (!settings.gamma_auto) return settings.gamma;
-  ddm::NeumannMap map(system, frame.runner());
+  ddm::NeumannMap map(system, frame.state(), frame.runner());
   int solves = 0;
   const double gamma = std::min(1.0, 1.8 / (2.0 + ddm::estimate_spectral_radius(system, map, 12, solves)));
   solves_per_body += solves;
@@ -526,10 +530,10 @@ double paper_gamma(const ddm::ContactSystem& system, const ddm::RunFrame& frame,
 
 // After a refinement: the iterate carried to the new meshes and the system rebuilt on them. An empty message when
 // it went well, else why the loop stops (the reason in `reason`).
-std::string rebuild_after_refinement(Problem& working, ddm::ContactSystem& system, const ddm::RunFrame& frame,
+std::string rebuild_after_refinement(Problem& working, ddm::ContactSystem& system, ddm::RunFrame& frame,
                                      const RefineOutcome& r, ddm::Displacements& u, StopReason& reason) {
   transfer(u, working, r);
-  system.rebuild(r.changed, frame.stop_check());
+  system.rebuild(r.changed, frame.state(), frame.stop_check());
   if (system.cancelled()) {
     reason = StopReason::cancelled;
     return "cancelled during the refined meshes' assembly and factorisation (the result holds the steps before)";
@@ -558,20 +562,21 @@ void paper_interleaving(Problem& working, ddm::ContactSystem& system, ddm::RunFr
     }
     // (16) on the current meshes, then (17); the estimate on the body solutions of (16) with the contact tractions
     // they were solved with.
-    const ddm::Displacements loads = system.contact_loads(u);
-    const ddm::Displacements u_tilde = system.solve_bodies(loads);
+    const ddm::Displacements loads = system.contact_loads(u, frame.state());
+    const ddm::Displacements u_tilde = system.solve_bodies(loads, frame.state().load);
     ++out.subdomain_solves;
     RelaxedUpdate update = relaxed_update(system, u, u_tilde, out.gamma);
     const bool ddm_converged =
         (settings.criterion == Criterion::paper ? update.paper : update.residual) <= settings.tolerance;
-    const auto eta = estimate(working, system, u_tilde, loads, frame.runner());  // (not stopped within)
+    const auto eta =
+        estimate(working, system, frame.state().load, u_tilde, loads, frame.runner());  // (not stopped within)
     for (const auto& e : eta) out.indicator_seconds += e.seconds;
-    IterationReport rep = system.report(k, update.u_new, active);
+    IterationReport rep = system.report(k, update.u_new, frame.state(), active);
     rep.paper_criterion = update.paper;
     rep.fixed_point_residual = update.residual;
     rep.gamma = out.gamma;
     // Record the mesh state (before it is refined), then refine.
-    Step st = make_step(system, update.u_new, {}, k, step, eta);
+    Step st = make_step(system, frame.state(), update.u_new, {}, k, step, eta);
     double mesh_nodes = 0;  // st is kept (pushed below) if the meshes are refined
     for (const auto& body : st.bodies) mesh_nodes += static_cast<double>(body.mesh.num_nodes());
     const RefineOutcome r =
@@ -604,7 +609,7 @@ void paper_interleaving(Problem& working, ddm::ContactSystem& system, ddm::RunFr
     if (k == settings.max_iterations) {
       out.stop_reason = StopReason::max_iterations;
       out.message = "adaptive (paper): max_iterations reached";
-      Step reached = make_step(system, u, {}, k, step, {});
+      Step reached = make_step(system, frame.state(), u, {}, k, step, {});
       reached.converged = false;
       steps.push_back(std::move(reached));
     }

@@ -223,17 +223,18 @@ SideConditions side_conditions(const Body& body) {
 
 // The boundary-element problem on the boundary loop: on each side the prescribed displacement components take the
 // FE displacement, the others the applied traction plus the contact and point forces (nodal forces lumped over
-// the sides next to their node), all at the body's current load factor.
+// the sides next to their node), all at load point `at`.
 bem::BoundaryProblem boundary_problem(const Body& body, const Model& model, const fem::BodySolver& solver,
                                       const Eigen::VectorXd& u, const Eigen::VectorXd& contact_load,
-                                      const std::vector<int>& loop, SideConditions& sides) {
+                                      const fem::LoadPoint& at, const std::vector<int>& loop, SideConditions& sides) {
   const auto& m = body.mesh;
   // Each condition at its own factor now: the loading's, or its history's (BoundaryCondition::history).
   // Point loads join the contact forces: both are nodal forces, lumped over the sides next to their node.
   Eigen::VectorXd nodal_load = contact_load.size() ? contact_load : Eigen::VectorXd::Zero(2 * m.num_nodes());
   for (const auto& bc : body.boundary)
     if (!bc.vertex.empty() && bc.kind == BoundaryCondition::Kind::force)
-      for (int node : condition_nodes(m, bc)) nodal_load.segment<2>(2 * node) += solver.condition_factor(bc) * bc.force;
+      for (int node : condition_nodes(m, bc))
+        nodal_load.segment<2>(2 * node) += solver.condition_factor(bc, at) * bc.force;
   const size_t nb = loop.size();
   // Nodal forces to tractions, lumped over the boundary sides next to their node. Where one of the two sides has
   // a condition of its own and the other none (a contact edge meeting a symmetry line or a loaded edge), the
@@ -273,7 +274,7 @@ bem::BoundaryProblem boundary_problem(const Body& body, const Model& model, cons
     if (bc && bc->kind == BoundaryCondition::Kind::traction)
       traction = bc->normal_pressure ? Eigen::Vector2d(-bc->pressure * outward.normalized()) : bc->traction;
     if (bc && bc->kind == BoundaryCondition::Kind::force) traction = bc->force / (sides.edge_length[bc] * thickness);
-    if (bc) traction *= solver.condition_factor(*bc);
+    if (bc) traction *= solver.condition_factor(*bc, at);
     for (int comp = 0; comp < 2; ++comp) {
       const bool prescribed = bc && (comp == 0 ? bc->ux : bc->uy);
       el.displacement_prescribed[static_cast<size_t>(comp)] = prescribed;
@@ -374,7 +375,8 @@ IndicatorResult compare_with_bem(const Body& body, const fem::BodySolver& solver
 
 IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fem::BodySolver& solver,
                                   const Eigen::VectorXd& u, const Eigen::VectorXd& contact_load,
-                                  Normalization normalization, const std::function<bool()>& cancelled) {
+                                  const fem::LoadPoint& at, Normalization normalization,
+                                  const std::function<bool()>& cancelled) {
   const auto t0 = Clock::now();
   const std::vector<int> loop = boundary_loop(body.mesh);
   if (loop.size() < 3) {
@@ -383,7 +385,7 @@ IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fe
     return r;
   }
   SideConditions sides = side_conditions(body);
-  bem::BoundaryProblem bp = boundary_problem(body, model, solver, u, contact_load, loop, sides);
+  bem::BoundaryProblem bp = boundary_problem(body, model, solver, u, contact_load, at, loop, sides);
   pin_rigid_motions(body, u, contact_load, loop, bp);
   IndicatorResult r = compare_with_bem(body, solver, u, bp, loop, normalization, cancelled);
   r.seconds = seconds_since(t0);  // (r is replaced on the way: not a ScopedTimer)

@@ -41,14 +41,14 @@ IndicatorResult zz_indicator(const Body& body, const fem::BodySolver& solver, co
                              Normalization normalization = Normalization::rms);
 
 // The paper's FEM-BEM indicator. contact_load: the body's contact forces (all dofs) of the current iterate,
-// turned into boundary tractions by lumping over the boundary sides. Falls back to zz (with a note) where the
-// BEM cannot be set up (a body with a hole: its boundary is not one closed polygon). Rigid motions the body's
-// edge conditions leave free are fixed by the FE displacement on a few sides (indicator.cpp, pin_rigid_motions).
-// `cancelled` is polled inside the boundary-element work (between blocks and GMRES iterations of the hierarchical
-// path): true stops it and returns a result with cancelled set.
+// turned into boundary tractions by lumping over the boundary sides; the body's own loads are taken at `at`. Falls back
+// to zz (with a note) where the BEM cannot be set up (a body with a hole: its boundary is not one closed polygon).
+// Rigid motions the body's edge conditions leave free are fixed by the FE displacement on a few sides (indicator.cpp,
+// pin_rigid_motions). `cancelled` is polled inside the boundary-element work (between blocks and GMRES iterations of
+// the hierarchical path): true stops it and returns a result with cancelled set.
 IndicatorResult fem_bem_indicator(const Body& body, const Model& model, const fem::BodySolver& solver,
                                   const Eigen::VectorXd& u, const Eigen::VectorXd& contact_load,
-                                  Normalization normalization = Normalization::rms,
+                                  const fem::LoadPoint& at = {}, Normalization normalization = Normalization::rms,
                                   const std::function<bool()>& cancelled = {});
 
 struct Marking {

@@ -38,17 +38,18 @@ void axpy(double alpha, const Pressures& x, Pressures& y) {
 }
 
 // The FE bodies' contact compliance G: the change of the nodal gaps on the active rows from pressures v (zero on
-// the other rows), one solve per body; `free_gaps` are the gaps of the bodies' response to no contact force.
+// the other rows), one solve per body; `free_gaps` are the gaps of the bodies' response to no contact force (both
+// under the bodies' loads at `at`, which cancel in the difference).
 class Compliance {
  public:
-  Compliance(const ddm::ContactSystem& system, const std::vector<std::vector<char>>& active)
-      : system_(system), active_(active) {
+  Compliance(const ddm::ContactSystem& system, const fem::LoadPoint& at, const std::vector<std::vector<char>>& active)
+      : system_(system), at_(at), active_(active) {
     ddm::Displacements none(system.n_bodies());
     for (size_t a = 0; a < none.size(); ++a) none[a] = Eigen::VectorXd::Zero(system.body(a).n_dofs());
-    free_gaps_ = system.nodal_gaps(system.solve_bodies(none));
+    free_gaps_ = system.nodal_gaps(system.solve_bodies(none, at_));
   }
   Pressures apply(const Pressures& v) const {
-    Pressures g = system_.nodal_gaps(system_.solve_bodies(system_.loads_from_pressures(v)));
+    Pressures g = system_.nodal_gaps(system_.solve_bodies(system_.loads_from_pressures(v), at_));
     for (size_t k = 0; k < g.size(); ++k) {
       g[k] -= free_gaps_[k];
       for (Eigen::Index r = 0; r < g[k].size(); ++r)
@@ -59,15 +60,17 @@ class Compliance {
 
  private:
   const ddm::ContactSystem& system_;
+  const fem::LoadPoint at_;
   const std::vector<std::vector<char>>& active_;
   Pressures free_gaps_;
 };
 
 // G dz = rhs on the active rows by conjugate gradients (D-weighted); returns the iterations, -1 if not converged,
 // -2 if stopped.
-int solve_correction(const ddm::ContactSystem& system, const std::vector<std::vector<char>>& active,
-                     const Pressures& rhs, Pressures& dz, const std::function<bool()>& stop) {
-  const Compliance G(system, active);
+int solve_correction(const ddm::ContactSystem& system, const fem::LoadPoint& at,
+                     const std::vector<std::vector<char>>& active, const Pressures& rhs, Pressures& dz,
+                     const std::function<bool()>& stop) {
+  const Compliance G(system, at, active);
   dz = rhs;
   for (auto& v : dz) v.setZero();
   Pressures r = rhs, p = rhs;
@@ -220,7 +223,8 @@ Eigen::VectorXd slack_rows(const mortar::PairDiscretization& pair, const Eigen::
 
 }  // namespace
 
-PressureEstimate pressure_estimate(const ddm::ContactSystem& system, const ddm::Displacements& u, const Pressures& z,
+PressureEstimate pressure_estimate(const ddm::ContactSystem& system, const fem::LoadPoint& at,
+                                   const ddm::Displacements& u, const Pressures& z,
                                    const std::vector<IndicatorResult>& eta, const std::function<bool()>& stop,
                                    const Pressures* q) {
   PressureEstimate out;
@@ -248,7 +252,7 @@ PressureEstimate pressure_estimate(const ddm::ContactSystem& system, const ddm::
       if (!active[k][static_cast<size_t>(r)]) rhs[k][r] = 0.0;
   }
   Pressures dz;
-  out.iterations = solve_correction(system, active, rhs, dz, stop);
+  out.iterations = solve_correction(system, at, active, rhs, dz, stop);
   if (out.iterations < 0) {
     out.relative = std::nan("");
     out.note = out.iterations == -2 ? "no pressure estimate: cancelled"

@@ -47,8 +47,10 @@ struct PressureEstimate {
 // bem_displacement keep their FE displacements: they are not estimated).
 // `stop` is polled before each conjugate-gradient iteration (one solve per body): true ends it, the estimate NaN.
 // q: the tangential multipliers of a frictional solve (nullptr: frictionless), for the stick-slip term.
-PressureEstimate pressure_estimate(const ddm::ContactSystem& system, const ddm::Displacements& u,
-                                   const ddm::Pressures& z, const std::vector<IndicatorResult>& eta,
-                                   const std::function<bool()>& stop = {}, const ddm::Pressures* q = nullptr);
+// `at`: the load point the bodies' loads are taken at (they cancel in the compliance; the run's).
+PressureEstimate pressure_estimate(const ddm::ContactSystem& system, const fem::LoadPoint& at,
+                                   const ddm::Displacements& u, const ddm::Pressures& z,
+                                   const std::vector<IndicatorResult>& eta, const std::function<bool()>& stop = {},
+                                   const ddm::Pressures* q = nullptr);
 
 }  // namespace contact::adapt

@@ -38,11 +38,11 @@ class UzawaMultipliers {
     return scale > 0 ? residual.norm() / scale : 0.0;
   }
 
-  // lambda <- the Anderson-mixed image, projected onto lambda >= 0, and given to the system's pairs.
-  void update(ContactSystem& system, const Eigen::VectorXd& image, const Eigen::VectorXd& residual) {
+  // lambda <- the Anderson-mixed image, projected onto lambda >= 0, and given to the run state.
+  void update(RunState& state, const Eigen::VectorXd& image, const Eigen::VectorXd& residual) {
     lambda_ = mixing_.next(image, residual);
-    for (size_t k = 0; k < pairs_.size(); ++k)
-      system.set_multipliers(k, lambda_.segment(offset_[k], pairs_[k].n_rows()));
+    state.multipliers.resize(pairs_.size());
+    for (size_t k = 0; k < pairs_.size(); ++k) state.multipliers[k] = lambda_.segment(offset_[k], pairs_[k].n_rows());
   }
 
  private:
@@ -59,7 +59,7 @@ class UzawaMultipliers {
 // point has g >= 0 where lambda = 0 and g = 0 where lambda > 0: exact non-penetration, for any theta.
 // Plain Uzawa converges linearly and slowly where points at the edge of the contact zone have both gap and
 // multiplier near zero (100 updates on stack3), so the multiplier fixed point is Anderson-mixed (UzawaMultipliers).
-void run_augmented_lagrangian(ContactSystem& system, RunFrame& frame, ContactMethod& method) {
+void run_augmented_lagrangian(const ContactSystem& system, RunFrame& frame, ContactMethod& method) {
   MethodOutcome& total = frame.outcome();
   Displacements warm;
   const auto& al = frame.settings().augmented_lagrangian;
@@ -77,7 +77,8 @@ void run_augmented_lagrangian(ContactSystem& system, RunFrame& frame, ContactMet
       total.message = "augmented Lagrangian update " + std::to_string(update) + ": " + inner_message;
       return;
     }
-    const Eigen::VectorXd image = multipliers.image(total.z.empty() ? system.penalty_pressures(total.u) : total.z);
+    const Eigen::VectorXd image =
+        multipliers.image(total.z.empty() ? system.penalty_pressures(total.u, frame.state()) : total.z);
     const Eigen::VectorXd residual = multipliers.residual(image);
     const double change = multipliers.relative_change(image, residual);
     if (change <= al.tolerance) {
@@ -90,7 +91,7 @@ void run_augmented_lagrangian(ContactSystem& system, RunFrame& frame, ContactMet
       total.message = os.str();
       return;
     }
-    multipliers.update(system, image, residual);
+    multipliers.update(frame.state(), image, residual);
     warm = total.u;
     if (update == al.max_updates) {
       total.stop_reason = StopReason::max_iterations;

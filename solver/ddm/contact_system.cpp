@@ -53,7 +53,6 @@ std::unique_ptr<fem::BodySolver> ContactSystem::make_body(size_t a, bool local,
                                                           const std::function<bool()>& stop) const {
   auto b = std::make_unique<fem::BodySolver>(problem_.bodies[a], problem_.model, factorization_ != Factorization::none,
                                              interface_dofs(a), may_float(a), local, stop);
-  b->set_load_between(load_step_, previous_factor_, load_factor_, step_fraction_);
   return b;
 }
 
@@ -172,8 +171,9 @@ std::vector<int> ContactSystem::interface_dofs(size_t a) const {
   return dofs;
 }
 
-void ContactSystem::rebuild(const std::vector<char>& changed, const std::function<bool()>& stop) {
+void ContactSystem::rebuild(const std::vector<char>& changed, RunState& state, const std::function<bool()>& stop) {
   discretize_pairs();
+  state.drop_pair_values();
   std::vector<size_t> todo;
   for (size_t a = 0; a < bodies_.size(); ++a)
     if (changed[a] || (factorization_ == Factorization::interface && interface_dofs(a) != bodies_[a]->interface_dofs()))
@@ -181,12 +181,13 @@ void ContactSystem::rebuild(const std::vector<char>& changed, const std::functio
   build_bodies(todo, stop);
 }
 
-Pressures ContactSystem::penalty_pressures(const Displacements& u) const {
+Pressures ContactSystem::penalty_pressures(const Displacements& u, const RunState& state) const {
   Pressures z(pairs_.size());
   for (size_t k = 0; k < pairs_.size(); ++k) {
     const auto& pair = pairs_[k];
     z[k] = pair.penalty_pressure(
-        pair.nodal_gap(u[static_cast<size_t>(pair.slave_body)], u[static_cast<size_t>(pair.master_body)]));
+        pair.nodal_gap(u[static_cast<size_t>(pair.slave_body)], u[static_cast<size_t>(pair.master_body)]),
+        state.multipliers_of(k, pair.n_rows()));
   }
   return z;
 }
@@ -212,15 +213,17 @@ bool ContactSystem::has_histories() const {
   return false;
 }
 
-void ContactSystem::accept_step(const Displacements& u) {
-  for (auto& pair : pairs_)
-    if (pair.has_friction())
-      pair.jump_origin =
-          pair.weighted_jump(u[static_cast<size_t>(pair.slave_body)], u[static_cast<size_t>(pair.master_body)]);
+Pressures ContactSystem::tangential_jumps(const Displacements& u) const {
+  Pressures w(pairs_.size());
+  for (size_t k = 0; k < pairs_.size(); ++k)
+    if (pairs_[k].has_friction())
+      w[k] = pairs_[k].weighted_jump(u[static_cast<size_t>(pairs_[k].slave_body)],
+                                     u[static_cast<size_t>(pairs_[k].master_body)]);
+  return w;
 }
 
-Displacements ContactSystem::contact_loads(const Displacements& u, Pressures* pressures) const {
-  Pressures z = penalty_pressures(u);
+Displacements ContactSystem::contact_loads(const Displacements& u, const RunState& state, Pressures* pressures) const {
+  Pressures z = penalty_pressures(u, state);
   Displacements f = loads_from_pressures(z);
   if (pressures) *pressures = std::move(z);
   return f;
@@ -244,10 +247,10 @@ Eigen::VectorXd ContactSystem::zone_normals(size_t a, const Eigen::VectorXd& u_a
   return out;
 }
 
-Displacements ContactSystem::solve_bodies(const Displacements& loads) const {
+Displacements ContactSystem::solve_bodies(const Displacements& loads, const fem::LoadPoint& at) const {
   Displacements u(bodies_.size());
   runner_.run_bodies(
-      bodies_.size(), [&](size_t a) { u[a] = bodies_[a]->solve(loads[a]); }, share_vectors(u));
+      bodies_.size(), [&](size_t a) { u[a] = bodies_[a]->solve(loads[a], at); }, share_vectors(u));
   return u;
 }
 
@@ -256,12 +259,12 @@ parallel::BodyShare share_vectors(std::vector<Eigen::VectorXd>& v) {
           [&v](size_t a, parallel::Unpacker& in) { v[a] = in.get_vector(); }};
 }
 
-Displacements ContactSystem::elastic_layer_guess() const {
+Displacements ContactSystem::elastic_layer_guess(const fem::LoadPoint& at) const {
   // Each body's response to its own loads with free contact zones; where the rigid approach (the overlap of
   // these free responses) exceeds the gap, each layer of height h_a under uniaxial strain (modulus M_a)
   // carries the pressure (approach - d) / (h_1/M_1 + h_2/M_2); the initial displacements are each body's
   // response to that pressure.
-  const Displacements free_u = solve_bodies(Displacements(bodies_.size()));
+  const Displacements free_u = solve_bodies(Displacements(bodies_.size()), at);
   auto M = [&](int body) {
     const Material& m = problem_.bodies[static_cast<size_t>(body)].material;
     if (problem_.model.plane == Plane::strain) return m.E * (1 - m.nu) / ((1 + m.nu) * (1 - 2 * m.nu));
@@ -276,7 +279,7 @@ Displacements ContactSystem::elastic_layer_guess() const {
         pair.nodal_gap(free_u[static_cast<size_t>(pair.slave_body)], free_u[static_cast<size_t>(pair.master_body)]);
     z[k] = (-g).cwiseMax(0.0) / compliance;
   }
-  return solve_bodies(loads_from_pressures(z));
+  return solve_bodies(loads_from_pressures(z), at);
 }
 
 Pressures ContactSystem::nodal_gaps(const Displacements& u) const {

@@ -11,6 +11,7 @@
 #include "contact/problem.hpp"
 #include "contact/result.hpp"
 #include "../parallel/task_runner.hpp"
+#include "run_state.hpp"
 
 #include <functional>
 #include <memory>
@@ -18,9 +19,6 @@
 #include <vector>
 
 namespace contact::ddm {
-
-using Displacements = std::vector<Eigen::VectorXd>;  // one full dof vector per body
-using Pressures = std::vector<Eigen::VectorXd>;      // one row vector per contact pair
 
 class ContactSystem {
  public:
@@ -39,9 +37,10 @@ class ContactSystem {
 
   // After the meshes of the bodies flagged in `changed` were refined (in the Problem this system refers to):
   // rediscretises every pair and reassembles and refactorises the changed bodies, and any other body whose
-  // interface unknowns changed (an unchanged body keeps its factorisation). Multipliers are dropped. Check ok();
-  // a cancel (as for the constructor) leaves cancelled() true and the system unusable.
-  void rebuild(const std::vector<char>& changed, const std::function<bool()>& stop = {});
+  // interface unknowns changed (an unchanged body keeps its factorisation). The run state's per-pair values (slip
+  // origins, multipliers) belonged to the old pairs: they are dropped. Check ok(); a cancel (as for the constructor)
+  // leaves cancelled() true and the system unusable.
+  void rebuild(const std::vector<char>& changed, RunState& state, const std::function<bool()>& stop = {});
 
   bool ok() const { return error_.empty() && !cancelled_; }
   bool cancelled() const { return cancelled_; }
@@ -59,50 +58,32 @@ class ContactSystem {
   double setup_seconds() const { return setup_seconds_; }
   double factorization_seconds() const { return factorization_seconds_; }  // summed over bodies
 
-  // The load factor of every body (load steps): scales the bodies' loads and prescribed values; set_load_step also
-  // gives the conditions with their own history their factor of that step.
-  void set_load_factor(double factor) { set_load_step(0, factor); }
-  void set_load_step(size_t step, double factor) { set_load_between(step, 0.0, factor, 1.0); }
-  // A point t of the way through step `step` from the previous step's loads (fem::BodySolver::set_load_between).
-  void set_load_between(size_t step, double previous_factor, double factor, double t) {
-    load_step_ = step;
-    previous_factor_ = previous_factor;
-    load_factor_ = factor;
-    step_fraction_ = t;
-    for (auto& b : bodies_) b->set_load_between(step, previous_factor, factor, t);
-  }
-  // The loading's factor now (within a cut step: between the steps'), as each body has it.
-  double load_factor() const {
-    return step_fraction_ == 1.0 ? load_factor_ : previous_factor_ + step_fraction_ * (load_factor_ - previous_factor_);
-  }
   // Some condition has its own load history: the loads of a step are then not a multiple of another step's.
   bool has_histories() const;
   bool has_friction() const { return problem_.has_friction(); }
-  // Friction acts on slip increments: the tangential jump at displacements u becomes each friction pair's origin
-  // (the end of a load step).
-  void accept_step(const Displacements& u);
+  // The weighted tangential jump of every friction pair at displacements u (empty for the others): friction acts
+  // on slip increments, and the jump where a load step ends is the next step's slip origin (RunState).
+  Pressures tangential_jumps(const Displacements& u) const;
 
-  // Augmented-Lagrangian multipliers of pair k per row (an empty vector: none).
-  void set_multipliers(size_t k, Eigen::VectorXd rows) { pairs_[k].multiplier = std::move(rows); }
-
-  // The penalty pressures of displacements u (paper (16)'s last term, in nodal form).
-  Pressures penalty_pressures(const Displacements& u) const;
+  // The penalty pressures of displacements u (paper (16)'s last term, in nodal form), shifted by the state's
+  // augmented-Lagrangian multipliers.
+  Pressures penalty_pressures(const Displacements& u, const RunState& state) const;
   // Contact forces on every body from pressures: f_slave = -Gs^T z, f_master = Gm^T z; with tangential
   // multipliers q (friction pairs; pair.hpp) also f_slave -= Ts^T q, f_master += Tm^T q.
   Displacements loads_from_pressures(const Pressures& z, const Pressures* q = nullptr) const;
   // Contact forces from the penalty pressures of u (they go to *pressures if given).
-  Displacements contact_loads(const Displacements& u, Pressures* pressures = nullptr) const;
+  Displacements contact_loads(const Displacements& u, const RunState& state, Pressures* pressures = nullptr) const;
 
   // Body a's normal displacements at its contact zones' nodes (u_an of the paper's stopping test), stacked over
   // the pairs it belongs to: for a slave the displacement of the contact node along its normal; for a master
   // the mortar projection of its displacement onto the slave node, along the master's normal (-n).
   Eigen::VectorXd zone_normals(size_t a, const Eigen::VectorXd& u_a) const;
 
-  // Each body solved with the given loads, in parallel.
-  Displacements solve_bodies(const Displacements& loads) const;
+  // Each body solved under its own loads at load point `at` plus the given loads, in parallel.
+  Displacements solve_bodies(const Displacements& loads, const fem::LoadPoint& at) const;
 
-  // The "elastic layer" initial guess (paper section 4; docs/algorithm.md, "Initial guess").
-  Displacements elastic_layer_guess() const;
+  // The "elastic layer" initial guess (paper section 4; docs/algorithm.md, "Initial guess") at load point `at`.
+  Displacements elastic_layer_guess(const fem::LoadPoint& at) const;
 
   // Per-iteration report for pressures z and nodal gaps g (per pair, per row); `previous_active` holds each
   // pair's active flags of the previous report and is updated. The other forms take the gaps of displacements
@@ -113,8 +94,9 @@ class ContactSystem {
                          std::vector<std::vector<char>>& previous_active) const {
     return report_gaps(iteration, z, nodal_gaps(u), previous_active);
   }
-  IterationReport report(int iteration, const Displacements& u, std::vector<std::vector<char>>& previous_active) const {
-    return report(iteration, u, penalty_pressures(u), previous_active);
+  IterationReport report(int iteration, const Displacements& u, const RunState& state,
+                         std::vector<std::vector<char>>& previous_active) const {
+    return report(iteration, u, penalty_pressures(u, state), previous_active);
   }
   // Adds the friction pairs' tangential tractions, stick flags and tangential forces to a report.
   void report_friction(const Pressures& z, const Pressures& q, IterationReport& report) const;
@@ -122,16 +104,18 @@ class ContactSystem {
   Pressures nodal_gaps(const Displacements& u) const;
 
   // Final fields (one Step), the bodies' stresses and reactions computed on the runner the system was built with,
-  // for displacements u with pressures z (the penalty form computes z from u), and the
-  // floating bodies' rigid-mode amplitudes if known.
-  Step fields(const Displacements& u, const Pressures& z, int iteration,
+  // for displacements u with pressures z (the penalty form computes z from u) under the loads of the state's load
+  // point, and the floating bodies' rigid-mode amplitudes if known.
+  Step fields(const Displacements& u, const Pressures& z, int iteration, const RunState& state,
               const std::vector<Eigen::VectorXd>* rigid_amplitudes = nullptr, const Pressures* q = nullptr) const;
-  Step fields(const Displacements& u, int iteration) const { return fields(u, penalty_pressures(u), iteration); }
+  Step fields(const Displacements& u, int iteration, const RunState& state) const {
+    return fields(u, penalty_pressures(u, state), iteration, state);
+  }
 
  private:
   // fields() in phases (system_fields.cpp): the bodies' stresses and support reactions (on their owners), one
   // body's field, one pair's field.
-  void stresses_and_reactions(const Displacements& u, const Displacements& loads,
+  void stresses_and_reactions(const Displacements& u, const Displacements& loads, const fem::LoadPoint& at,
                               std::vector<fem::StressFields>& stress, std::vector<Eigen::VectorXd>& reaction) const;
   BodyField body_field(size_t a, const Eigen::VectorXd& u, fem::StressFields stress, const Eigen::VectorXd& reaction,
                        const Eigen::VectorXd* rigid_amplitudes) const;
@@ -161,8 +145,6 @@ class ContactSystem {
   std::string error_;
   bool cancelled_ = false;
   double setup_seconds_ = 0.0, factorization_seconds_ = 0.0;
-  double load_factor_ = 1.0, previous_factor_ = 0.0, step_fraction_ = 1.0;
-  size_t load_step_ = 0;
 };
 
 // How one full vector per body (displacements, loads) moves from its owner to the other processes.

@@ -8,7 +8,7 @@
 
 namespace contact::ddm {
 
-void run_enforced(ContactSystem& system, RunFrame& frame, ContactMethod& method) {
+void run_enforced(const ContactSystem& system, RunFrame& frame, ContactMethod& method) {
   const SolverSettings& settings = frame.settings();
   // The job reader reports this for a job; a Problem built in code meets it here, in the same words.
   if (std::string conflict = settings_conflict(settings); !conflict.empty()) {

@@ -7,6 +7,6 @@
 namespace contact::ddm {
 
 // The method, inside augmented-Lagrangian updates if the frame's settings ask for them (the outcome counts them).
-void run_enforced(ContactSystem& system, RunFrame& frame, ContactMethod& method);
+void run_enforced(const ContactSystem& system, RunFrame& frame, ContactMethod& method);
 
 }  // namespace contact::ddm

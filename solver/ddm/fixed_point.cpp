@@ -56,7 +56,9 @@ Pressures linear_pressures(const ContactSystem& system, const Displacements& du)
   return dz;
 }
 
-Displacements NeumannMap::apply(const Displacements& u) { return system_.solve_bodies(system_.contact_loads(u)); }
+Displacements NeumannMap::apply(const Displacements& u) {
+  return system_.solve_bodies(system_.contact_loads(u, state_), state_.load);
+}
 
 Displacements NeumannMap::linear_response(const Displacements& du) {
   const Displacements loads = system_.loads_from_pressures(linear_pressures(system_, du));
@@ -70,7 +72,7 @@ Displacements initial_iterate(const ContactSystem& system, const RunFrame& frame
   if (frame.warm_start()) return *frame.warm_start();
   if (frame.settings().initial_guess == InitialGuess::elastic_layer) {
     solves += 2;
-    return system.elastic_layer_guess();
+    return system.elastic_layer_guess(frame.state().load);
   }
   Displacements u(system.n_bodies());
   for (size_t a = 0; a < u.size(); ++a) u[a] = Eigen::VectorXd::Zero(system.body(a).n_dofs());
@@ -273,7 +275,7 @@ class FixedPointIteration {
   }
 
   void report(int k, double paper, double residual, const std::string& note) {
-    IterationReport rep = system_.report(k, u_, active_);
+    IterationReport rep = system_.report(k, u_, frame_.state(), active_);
     rep.paper_criterion = paper;
     rep.fixed_point_residual = residual;
     rep.gamma = gamma_;

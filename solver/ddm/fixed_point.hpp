@@ -36,15 +36,18 @@ void run_fixed_point(const ContactSystem& system, RunFrame& frame, BodyMap& map,
 // normal displacements; `solves` is increased by the solves per body spent.
 double estimate_spectral_radius(const ContactSystem& system, BodyMap& map, int iterations, int& solves);
 
-// The Neumann map of paper (16): each body with the penalty tractions of u.
+// The Neumann map of paper (16): each body with the penalty tractions of u, under the loads of the state's load
+// point and the penalty shifted by its multipliers.
 class NeumannMap final : public BodyMap {
  public:
-  NeumannMap(const ContactSystem& system, parallel::TaskRunner& runner) : system_(system), runner_(runner) {}
+  NeumannMap(const ContactSystem& system, const RunState& state, parallel::TaskRunner& runner)
+      : system_(system), state_(state), runner_(runner) {}
   Displacements apply(const Displacements& u) override;
   Displacements linear_response(const Displacements& du) override;
 
  private:
   const ContactSystem& system_;
+  const RunState& state_;
   parallel::TaskRunner& runner_;
 };
 

@@ -88,8 +88,8 @@ struct Sliding {
 };
 
 // The component `label` against `joint`, if friction cannot hold it (ratio > 0), else ratio 0.
-Sliding check_component(const ContactSystem& system, const Joint& joint, const std::vector<size_t>& label,
-                        size_t component) {
+Sliding check_component(const ContactSystem& system, const fem::LoadPoint& at, const Joint& joint,
+                        const std::vector<size_t>& label, size_t component) {
   Sliding s;
   for (size_t a = 0; a < system.n_bodies(); ++a)
     if (label[a] == component) {
@@ -121,7 +121,7 @@ Sliding check_component(const ContactSystem& system, const Joint& joint, const s
   if (s.pairs.empty() || !any_friction) return {};
   Vec load = Vec::Zero();
   for (size_t a : s.bodies) {
-    const Eigen::VectorXd f = system.body(a).external_load();
+    const Eigen::VectorXd f = system.body(a).external_load(at);
     for (Eigen::Index d = 0; d < f.size(); ++d) load[d % 2] += f[d];
   }
   const Vec m = side * joint.n;  // from the joint into the component: the direction the contact pushes it
@@ -200,7 +200,7 @@ std::string four_digits(double value) {
   return text;
 }
 
-std::string friction_cannot_hold(const ContactSystem& system) {
+std::string friction_cannot_hold(const ContactSystem& system, const fem::LoadPoint& at) {
   if (!system.has_friction()) return {};
   Sliding worst;
   for (const Joint& joint : flat_joints(system, length_scale(system))) {
@@ -211,7 +211,7 @@ std::string friction_cannot_hold(const ContactSystem& system) {
         const size_t c = label[static_cast<size_t>(body)];
         if (std::find(checked.begin(), checked.end(), c) != checked.end()) continue;
         checked.push_back(c);
-        Sliding s = check_component(system, joint, label, c);
+        Sliding s = check_component(system, at, joint, label, c);
         // The worst ratio; among equal ones (every course of a wall under a top load) the smallest set.
         const bool tie = std::abs(s.ratio - worst.ratio) <= 1e-9 * s.ratio;
         if ((s.ratio > worst.ratio && !tie) || (tie && s.ratio > 0 && s.bodies.size() < worst.bodies.size()))

@@ -19,8 +19,8 @@
 
 namespace contact::ddm {
 
-// The message for the worst set of bodies friction cannot hold under the current loads (load step), or empty.
-std::string friction_cannot_hold(const ContactSystem& system);
+// The message for the worst set of bodies friction cannot hold under the loads at load point `at`, or empty.
+std::string friction_cannot_hold(const ContactSystem& system, const fem::LoadPoint& at);
 
 // A ratio as the messages print it: four significant digits, trailing zeros kept (1.000, 1.083, 12.50).
 std::string four_digits(double value);

@@ -35,9 +35,10 @@ bool homogeneous_from_rest(const ContactSystem& system, size_t k, double done) {
 
 }  // namespace
 
-void run_load_steps(ContactSystem& system, const std::vector<double>& factors, RunFrame& frame, ContactMethod& method,
-                    StepLog& steps) {
+void run_load_steps(const ContactSystem& system, const std::vector<double>& factors, RunFrame& frame,
+                    ContactMethod& method, StepLog& steps) {
   MethodOutcome& total = frame.outcome();
+  RunState& state = frame.state();
   Displacements warm;
   for (size_t k = 0; k < factors.size(); ++k) {
     const double previous = k == 0 ? 0.0 : factors[k - 1];
@@ -46,11 +47,11 @@ void run_load_steps(ContactSystem& system, const std::vector<double>& factors, R
     bool not_cut = false;
     while (true) {
       const double t = std::min(1.0, done + increment);
-      system.set_load_between(k, previous, factors[k], t);
+      state.load = fem::LoadPoint{k, previous, factors[k], t};
       frame.nested(warm.empty() ? nullptr : &warm, InnerMarks{},
                    [&](RunFrame& inner) { run_enforced(system, inner, method); });
       if (total.converged && t < 1.0) {  // a sub-step held: its state is the next one's start
-        system.accept_step(total.u);
+        state.slip_origin = system.tangential_jumps(total.u);
         warm = total.u;
         done = t;
         ++sub_steps;
@@ -76,15 +77,15 @@ void run_load_steps(ContactSystem& system, const std::vector<double>& factors, R
                 "(not cut: from rest with every joint closed, a smaller increment is the same problem scaled)";
     if (!prefix.empty()) total.message = prefix + ": " + total.message;
     if (total.u.empty()) return;
-    Step step = total.z.empty() ? system.fields(total.u, total.iterations)
-                                : system.fields(total.u, total.z, total.iterations, &total.rigid_amplitudes,
+    Step step = total.z.empty() ? system.fields(total.u, total.iterations, state)
+                                : system.fields(total.u, total.z, total.iterations, state, &total.rigid_amplitudes,
                                                 total.q.empty() ? nullptr : &total.q);
     step.index = static_cast<int>(k);
-    step.load_factor = system.load_factor();  // factors[k], or where a cut step failed the fraction tried
+    step.load_factor = state.load.value();  // factors[k], or where a cut step failed the fraction tried
     step.converged = total.converged;
     steps.push_back(std::move(step));
     if (!total.converged) return;
-    system.accept_step(total.u);  // friction: the next step's slip is measured from here
+    state.slip_origin = system.tangential_jumps(total.u);  // friction: the next step's slip is measured from here
     warm = total.u;
   }
 }

@@ -1,10 +1,10 @@
 // Load steps (Problem::loading): the same contact problem under growing (or any) load factors. Every prescribed
-// displacement, traction, force and body force is scaled by the step's factor (BodySolver::set_load_factor: the
-// factorisations stay), each step is solved with the chosen method starting from the previous step's answer
-// (the fixed-point schemes: its displacements; interface Newton: its pressures under the penalty, nested coarse
-// solves with exact contact, sparse_direct.cpp), and each step's fields become
-// one result Step with its factor, recorded in `steps` (which keeps all or the last, StepLog). The iteration
-// reports run on across the steps.
+// displacement, traction, force and body force is scaled by the step's factor (the run state's load point,
+// run_state.hpp, which this loop moves; the factorisations stay), each step is solved with the chosen method starting
+// from the previous step's answer (the fixed-point schemes: its displacements; interface Newton: its pressures under
+// the penalty, nested coarse solves with exact contact, sparse_direct.cpp), and each step's fields become one result
+// Step with its factor, recorded in `steps` (which keeps all or the last, StepLog). The iteration reports run on across
+// the steps.
 #pragma once
 
 #include "driver.hpp"
@@ -12,7 +12,7 @@
 
 namespace contact::ddm {
 
-void run_load_steps(ContactSystem& system, const std::vector<double>& factors, RunFrame& frame, ContactMethod& method,
-                    StepLog& steps);
+void run_load_steps(const ContactSystem& system, const std::vector<double>& factors, RunFrame& frame,
+                    ContactMethod& method, StepLog& steps);
 
 }  // namespace contact::ddm

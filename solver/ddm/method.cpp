@@ -11,10 +11,10 @@ namespace {
 void solve_independent_bodies(const ContactSystem& system, RunFrame& frame) {
   MethodOutcome& out = frame.outcome();
   std::vector<std::vector<char>> active;
-  out.u = system.solve_bodies(Displacements(system.n_bodies()));
+  out.u = system.solve_bodies(Displacements(system.n_bodies()), frame.state().load);
   out.iterations = 1;
   out.subdomain_solves = 1;
-  frame.report(system.report(1, out.u, active));
+  frame.report(system.report(1, out.u, frame.state(), active));
   out.converged = true;
   out.stop_reason = StopReason::converged;
   out.message = "no contact pairs: each body solved once";
@@ -55,7 +55,8 @@ class InterfaceNewtonMethod final : public ContactMethod {
   void solve(RunFrame& frame) override {
     int setup = 0;
     if (!interface_newton_) {
-      interface_newton_ = std::make_unique<InterfaceNewton>(system_, frame.settings(), frame.runner());
+      interface_newton_ =
+          std::make_unique<InterfaceNewton>(system_, frame.settings(), frame.runner(), frame.state().load);
       setup = 1;  // the free response of every body
     }
     interface_newton_->solve(frame);

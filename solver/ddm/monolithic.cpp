@@ -45,10 +45,12 @@ struct Stacked {
   // Friction: the tangential rows follow the normal ones (tangential_offset per pair, -1 if frictionless).
   std::vector<Eigen::Index> tangential_offset;
   std::vector<linalg::FrictionRow> friction;
+  fem::LoadPoint at;  // the load point the loads (b) and prescribed values (g0, to_bodies) are taken at
 };
 
-Stacked stack(const ContactSystem& system, bool shift_by_multipliers) {
+Stacked stack(const ContactSystem& system, const RunState& state, bool shift_by_multipliers) {
   Stacked s;
+  s.at = state.load;
   const size_t n_bodies = system.n_bodies();
   s.offset.assign(n_bodies + 1, 0);
   for (size_t a = 0; a < n_bodies; ++a) s.offset[a + 1] = s.offset[a] + system.body(a).n_free();
@@ -60,7 +62,7 @@ Stacked stack(const ContactSystem& system, bool shift_by_multipliers) {
     for (int col = 0; col < K.outerSize(); ++col)
       for (SpMat::InnerIterator it(K, col); it; ++it)
         tk.emplace_back(s.offset[a] + it.row(), s.offset[a] + it.col(), it.value());
-    s.b.segment(s.offset[a], system.body(a).n_free()) = system.body(a).reduced_rhs();
+    s.b.segment(s.offset[a], system.body(a).n_free()) = system.body(a).reduced_rhs(s.at);
   }
   s.K.resize(n, n);
   s.K.setFromTriplets(tk.begin(), tk.end());
@@ -94,7 +96,7 @@ Stacked stack(const ContactSystem& system, bool shift_by_multipliers) {
     for (int col = 0; col < Bm.outerSize(); ++col)
       for (SpMat::InnerIterator it(Bm, col); it; ++it)
         tb.emplace_back(first + it.row(), s.offset[mb] + it.col(), it.value());
-    const Eigen::VectorXd g = Gm * system.body(mb).prescribed() - Gs * system.body(sb).prescribed();
+    const Eigen::VectorXd g = Gm * system.body(mb).prescribed(s.at) - Gs * system.body(sb).prescribed(s.at);
     s.g0.segment(first, pair.n_rows()) = g;
     s.D.segment(first, pair.n_rows()) = pair.area;
     // c = E' / h: a contact node's own stiffness scale (h its support length), for the active-set prediction.
@@ -109,12 +111,13 @@ Stacked stack(const ContactSystem& system, bool shift_by_multipliers) {
     const auto& pair = pairs[k];
     add_rows(k, s.row_offset[k], pair.Gs, pair.Gm);
     s.g0.segment(s.row_offset[k], pair.n_rows()) += pair.gap0;
-    if (shift_by_multipliers && pair.multiplier.size() == pair.n_rows())  // the augmented Lagrangian's shifted gap
-      s.g0.segment(s.row_offset[k], pair.n_rows()) -= pair.theta * pair.area.cwiseProduct(pair.multiplier);
+    const Eigen::VectorXd* lambda = state.multipliers_of(k, pair.n_rows());
+    if (shift_by_multipliers && lambda)  // the augmented Lagrangian's shifted gap
+      s.g0.segment(s.row_offset[k], pair.n_rows()) -= pair.theta * pair.area.cwiseProduct(*lambda);
     if (s.tangential_offset[k] < 0) continue;
     add_rows(k, s.tangential_offset[k], pair.Ts, pair.Tm);
-    if (pair.jump_origin.size() == pair.n_rows())
-      s.g0.segment(s.tangential_offset[k], pair.n_rows()) -= pair.jump_origin;
+    if (const Eigen::VectorXd* origin = state.slip_origin_of(k, pair.n_rows()))
+      s.g0.segment(s.tangential_offset[k], pair.n_rows()) -= *origin;
   }
   s.B.resize(m, n);
   s.B.setFromTriplets(tb.begin(), tb.end());
@@ -129,7 +132,8 @@ Stacked stack(const ContactSystem& system, bool shift_by_multipliers) {
 
 Displacements to_bodies(const ContactSystem& system, const Stacked& s, const Eigen::VectorXd& x) {
   Displacements u(system.n_bodies());
-  for (size_t a = 0; a < u.size(); ++a) u[a] = system.body(a).expand(x.segment(s.offset[a], system.body(a).n_free()));
+  for (size_t a = 0; a < u.size(); ++a)
+    u[a] = system.body(a).expand(x.segment(s.offset[a], system.body(a).n_free()), s.at);
   return u;
 }
 
@@ -208,13 +212,14 @@ double zone_change(const ContactSystem& system, const Displacements& u, std::vec
 
 void run_exact(const ContactSystem& system, RunFrame& frame) {
   MethodOutcome& out = frame.outcome();
-  if (std::string sliding = friction_cannot_hold(system); !sliding.empty()) {  // statics: no solver can hold it
+  if (std::string sliding = friction_cannot_hold(system, frame.state().load);
+      !sliding.empty()) {  // statics: no solver can hold it
     out.stop_reason = StopReason::error;
     out.refused = true;
     out.message = sliding;
     return;
   }
-  const Stacked s = stack(system, false);
+  const Stacked s = stack(system, frame.state(), false);
   const Eigen::Index m = s.g0.size();
   const std::vector<char> mask = tangential_unknowns(system, m, [&](size_t k) { return s.tangential_offset[k]; });
   const Eigen::VectorXd c = s.c.cwiseQuotient(s.D);  // prediction z - c g: g / D is the nodal gap
@@ -344,7 +349,7 @@ double line_search(const PenaltyEnergy& energy, Eigen::VectorXd& x, const Eigen:
 
 void run_penalty(const ContactSystem& system, RunFrame& frame) {
   MethodOutcome& out = frame.outcome();
-  const Stacked s = stack(system, true);
+  const Stacked s = stack(system, frame.state(), true);
   if (!s.friction.empty()) {  // (the job reader refuses it first, in the same words)
     out.stop_reason = StopReason::error;
     out.message = "monolithic: " + friction_conflict(frame.settings());
@@ -381,7 +386,7 @@ void run_penalty(const ContactSystem& system, RunFrame& frame) {
     const Displacements u = to_bodies(system, s, x);
     const double paper = zone_change(system, u, zone);
     const double residual = energy.gradient(x).norm() / b_norm;
-    IterationReport r = system.report(k, u, active_report);
+    IterationReport r = system.report(k, u, frame.state(), active_report);
     r.paper_criterion = paper;
     r.measure = Measure::gradient;
     r.fixed_point_residual = residual;  // for Newton: the relative norm of the energy gradient

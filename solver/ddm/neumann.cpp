@@ -10,7 +10,7 @@ namespace contact::ddm {
 void run_neumann(const ContactSystem& system, RunFrame& frame) {
   int initial_solves = 0;
   Displacements u0 = initial_iterate(system, frame, initial_solves);
-  NeumannMap map(system, frame.runner());
+  NeumannMap map(system, frame.state(), frame.runner());
   run_fixed_point(system, frame, map, std::move(u0));
   frame.outcome().subdomain_solves += initial_solves;
 }

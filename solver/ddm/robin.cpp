@@ -20,8 +20,10 @@ using Factor = Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::L
 
 class RobinMap final : public BodyMap {
  public:
-  RobinMap(const ContactSystem& system, const SolverSettings& settings, parallel::TaskRunner& runner)
+  RobinMap(const ContactSystem& system, const RunState& state, const SolverSettings& settings,
+           parallel::TaskRunner& runner)
       : system_(system),
+        state_(state),
         settings_(settings),
         runner_(runner),
         psi_(system.n_bodies()),
@@ -33,15 +35,15 @@ class RobinMap final : public BodyMap {
 
   Displacements apply(const Displacements& u) override {
     update_weights(u);
-    const Displacements contact = system_.contact_loads(u);
+    const Displacements contact = system_.contact_loads(u, state_);
     Displacements out(u.size());
     runner_.run_bodies(
         u.size(),
         [&](size_t a) {
           const auto& body = system_.body(a);
           const auto& c = body.constraints();
-          const Eigen::VectorXd load = psi_[a] * (u[a] - body.prescribed()) + contact[a];
-          out[a] = body.expand(solve(a, body.reduced_rhs() + c.T().transpose() * load));
+          const Eigen::VectorXd load = psi_[a] * (u[a] - body.prescribed(state_.load)) + contact[a];
+          out[a] = body.expand(solve(a, body.reduced_rhs(state_.load) + c.T().transpose() * load), state_.load);
         },
         share_vectors(out));
     return out;
@@ -79,7 +81,8 @@ class RobinMap final : public BodyMap {
       std::vector<char> now(static_cast<size_t>(pair.n_rows()), 1);
       if (settings_.robin.active_set && !all_active) {
         const Eigen::VectorXd p = pair.penalty_pressure(
-            pair.nodal_gap(u[static_cast<size_t>(pair.slave_body)], u[static_cast<size_t>(pair.master_body)]));
+            pair.nodal_gap(u[static_cast<size_t>(pair.slave_body)], u[static_cast<size_t>(pair.master_body)]),
+            state_.multipliers_of(k, pair.n_rows()));
         for (Eigen::Index q = 0; q < p.size(); ++q) now[static_cast<size_t>(q)] = p[q] > 0 ? 1 : 0;
       }
       const size_t sb = static_cast<size_t>(pair.slave_body);
@@ -138,6 +141,7 @@ class RobinMap final : public BodyMap {
   }
 
   const ContactSystem& system_;
+  const RunState& state_;
   const SolverSettings& settings_;
   parallel::TaskRunner& runner_;
   std::vector<Eigen::SparseMatrix<double>> psi_;
@@ -152,7 +156,7 @@ class RobinMap final : public BodyMap {
 void run_robin(const ContactSystem& system, RunFrame& frame) {
   int initial_solves = 0;
   Displacements u0 = initial_iterate(system, frame, initial_solves);
-  RobinMap map(system, frame.settings(), frame.runner());
+  RobinMap map(system, frame.state(), frame.settings(), frame.runner());
   run_fixed_point(system, frame, map, std::move(u0));
   MethodOutcome& out = frame.outcome();
   out.subdomain_solves += initial_solves;

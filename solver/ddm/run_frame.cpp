@@ -25,6 +25,7 @@ RunFrame::RunFrame(RunFrame& parent, InnerMarks marks, const Displacements* warm
       runner_(parent.runner_),
       start_(parent.start_),
       warm_(warm),
+      state_(parent.state_),
       parent_(&parent),
       offset_(parent.outcome_.iterations),
       marks_(std::move(marks)) {}

@@ -5,7 +5,9 @@
 //   - the one stop check, stop_requested(): true means stop, as every stop callback of the layers below returns
 //     (linalg's StepCallback, MPRGP's products, the BEM's and the factorisations' polls, which get stop_check());
 //   - report(): the one way an iteration is reported (elapsed time stamped, the observer told, the history kept);
-//   - the outcome being built at this level (outcome()), which nested() folds into the enclosing level's.
+//   - the outcome being built at this level (outcome()), which nested() folds into the enclosing level's;
+//   - the run state (state(): the load point, slip origins, augmented-Lagrangian multipliers; run_state.hpp), one per
+//     run, shared by the nested frames: the outer loops write it, the methods read it beside the const system.
 // A loop over inner solves (load steps, augmented-Lagrangian updates, adaptive steps) runs each in a nested frame:
 // its reports reach the observer numbered on from the iterations so far and marked (the update they belong to,
 // the refined counts), and its work adds up in the enclosing outcome (append).
@@ -53,6 +55,9 @@ class RunFrame {
   parallel::TaskRunner& runner() const { return runner_; }
   // Where an iterative method starts (the previous step's or update's displacements), or null.
   const Displacements* warm_start() const { return warm_; }
+  // The run's state (the top frame's; a nested frame shares it).
+  RunState& state() { return *state_; }
+  const RunState& state() const { return *state_; }
 
   // The one stop check: true when the run must stop (a cancel was asked). In a distributed run the token is the
   // one the processes agree on (set on every rank in the same collective operation), so every rank gets the same
@@ -100,6 +105,8 @@ class RunFrame {
   parallel::TaskRunner& runner_;
   Clock::time_point start_;
   const Displacements* warm_ = nullptr;
+  RunState own_state_;  // the top frame's
+  RunState* state_ = &own_state_;
   RunFrame* parent_ = nullptr;  // nested: the enclosing frame, its iterations when this one began, the marks
   int offset_ = 0;
   InnerMarks marks_;

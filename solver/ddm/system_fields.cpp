@@ -162,7 +162,7 @@ Eigen::MatrixX2d node_normals(const mortar::PairDiscretization& pair, const Eige
 
 }  // namespace
 
-void ContactSystem::stresses_and_reactions(const Displacements& u, const Displacements& loads,
+void ContactSystem::stresses_and_reactions(const Displacements& u, const Displacements& loads, const fem::LoadPoint& at,
                                            std::vector<fem::StressFields>& stress,
                                            std::vector<Eigen::VectorXd>& reaction) const {
   stress.assign(bodies_.size(), {});
@@ -184,7 +184,7 @@ void ContactSystem::stresses_and_reactions(const Displacements& u, const Displac
       bodies_.size(),
       [&](size_t a) {
         stress[a] = bodies_[a]->stresses(u[a]);
-        reaction[a] = bodies_[a]->reactions(u[a], loads[a]);
+        reaction[a] = bodies_[a]->reactions(u[a], loads[a], at);
       },
       share);
 }
@@ -256,13 +256,13 @@ PairField ContactSystem::pair_field(size_t k, const Displacements& u, const Eige
   return f;
 }
 
-Step ContactSystem::fields(const Displacements& u, const Pressures& z, int iteration,
+Step ContactSystem::fields(const Displacements& u, const Pressures& z, int iteration, const RunState& state,
                            const std::vector<Eigen::VectorXd>* rigid_amplitudes, const Pressures* q) const {
   Step step;
   step.iteration = iteration;
   std::vector<fem::StressFields> stress;
   std::vector<Eigen::VectorXd> reaction;
-  stresses_and_reactions(u, loads_from_pressures(z, q), stress, reaction);
+  stresses_and_reactions(u, loads_from_pressures(z, q), state.load, stress, reaction);
   for (size_t a = 0; a < bodies_.size(); ++a) {
     const Eigen::VectorXd* alpha = rigid_amplitudes && a < rigid_amplitudes->size() ? &(*rigid_amplitudes)[a] : nullptr;
     step.bodies.push_back(body_field(a, u[a], std::move(stress[a]), reaction[a], alpha));

@@ -174,30 +174,14 @@ void BodySolver::setup_history_groups() {
   }
 }
 
-void BodySolver::set_load_between(size_t step, double previous_factor, double factor, double t) {
-  load_factor_ = t == 1.0 ? factor : previous_factor + t * (factor - previous_factor);
-  for (auto& group : groups_) {
-    const auto& h = group.condition->history;
-    if (h.empty()) {
-      group.factor = load_factor_;
-      continue;
-    }
-    const double end = h[std::min(step, h.size() - 1)];
-    const double start = step == 0 ? 0.0 : h[std::min(step - 1, h.size() - 1)];
-    group.factor = t == 1.0 ? end : start + t * (end - start);
+Eigen::VectorXd BodySolver::scaled(const Eigen::VectorXd& base, Eigen::VectorXd LoadGroup::*part,
+                                   const LoadPoint& at) const {
+  const double factor = at.value();
+  Eigen::VectorXd out = factor * base;
+  for (const auto& group : groups_) {
+    const double own = at.of_history(group.condition->history);
+    if (own != factor) out += (own - factor) * (group.*part);
   }
-}
-
-double BodySolver::condition_factor(const BoundaryCondition& bc) const {
-  for (const auto& group : groups_)
-    if (group.condition == &bc) return group.factor;
-  return load_factor_;
-}
-
-Eigen::VectorXd BodySolver::scaled(const Eigen::VectorXd& base, Eigen::VectorXd LoadGroup::*part) const {
-  Eigen::VectorXd out = load_factor_ * base;
-  for (const auto& group : groups_)
-    if (group.factor != load_factor_) out += (group.factor - load_factor_) * (group.*part);
   return out;
 }
 
@@ -348,13 +332,17 @@ Eigen::MatrixXd BodySolver::solve_reduced(const Eigen::MatrixXd& reduced_rhs) co
   return factor_->solve(reduced_rhs);
 }
 
-Eigen::VectorXd BodySolver::reduced_rhs() const { return scaled(rhs_base_, &LoadGroup::rhs); }
+Eigen::VectorXd BodySolver::reduced_rhs(const LoadPoint& at) const { return scaled(rhs_base_, &LoadGroup::rhs, at); }
 
-Eigen::VectorXd BodySolver::external_load() const { return scaled(f_ext_, &LoadGroup::f_ext); }
+Eigen::VectorXd BodySolver::external_load(const LoadPoint& at) const { return scaled(f_ext_, &LoadGroup::f_ext, at); }
 
-Eigen::VectorXd BodySolver::prescribed() const { return scaled(constraints_.g(), &LoadGroup::g); }
+Eigen::VectorXd BodySolver::prescribed(const LoadPoint& at) const {
+  return scaled(constraints_.g(), &LoadGroup::g, at);
+}
 
-Eigen::VectorXd BodySolver::expand(const Eigen::VectorXd& x) const { return constraints_.T() * x + prescribed(); }
+Eigen::VectorXd BodySolver::expand(const Eigen::VectorXd& x, const LoadPoint& at) const {
+  return constraints_.T() * x + prescribed(at);
+}
 
 Eigen::VectorXd BodySolver::solve_homogeneous(const Eigen::VectorXd& load) const {
   if (n_free() == 0) return Eigen::VectorXd::Zero(n_dofs());
@@ -362,18 +350,19 @@ Eigen::VectorXd BodySolver::solve_homogeneous(const Eigen::VectorXd& load) const
   return constraints_.T() * solve_reduced(rhs);
 }
 
-Eigen::VectorXd BodySolver::solve(const Eigen::VectorXd& extra_load) const {
+Eigen::VectorXd BodySolver::solve(const Eigen::VectorXd& extra_load, const LoadPoint& at) const {
   if (extra_load.size() > 0) CONTACT_ASSERT_SIZE(extra_load.size(), n_dofs(), "a body's extra load");
-  if (n_free() == 0) return prescribed();
+  if (n_free() == 0) return prescribed(at);
   if (!factor_)
     throw std::logic_error(local_ ? "BodySolver::solve called on a solver built without factorisation"
                                   : "body '" + body_.name + "' is solved by another process");
-  Eigen::VectorXd rhs = reduced_rhs();
+  Eigen::VectorXd rhs = reduced_rhs(at);
   if (extra_load.size() > 0) rhs.noalias() += constraints_.T().transpose() * extra_load;
-  return expand(factor_->solve(rhs));
+  return expand(factor_->solve(rhs), at);
 }
 
-Eigen::VectorXd BodySolver::reactions(const Eigen::VectorXd& u, const Eigen::VectorXd& extra_load) const {
+Eigen::VectorXd BodySolver::reactions(const Eigen::VectorXd& u, const Eigen::VectorXd& extra_load,
+                                      const LoadPoint& at) const {
   // K u - f_ext - extra at the prescribed dofs, element by element. A hanging node's residual belongs to its
   // masters (its equation is theirs, through u_h = sum w_j u_j): where a master is prescribed, its share is part
   // of the support's reaction, so every element counts and the hanging nodes' residuals are moved to their
@@ -386,7 +375,7 @@ Eigen::VectorXd BodySolver::reactions(const Eigen::VectorXd& u, const Eigen::Vec
     const CellVector fe = cell_stiffness(m, c, elasticity_) * cell_values(m, c, u);
     for (Eigen::Index i = 0; i < dofs.size(); ++i) r[dofs[i]] += fe[i];
   }
-  r -= external_load();
+  r -= external_load(at);
   if (extra_load.size() > 0) r -= extra_load;
   r = constraints_.condense_to_masters(r);
   for (int d = 0; d < r.size(); ++d)

@@ -9,6 +9,7 @@
 #include "cholesky.hpp"
 #include "constraints.hpp"
 #include "elasticity.hpp"
+#include "load_point.hpp"
 
 #include <Eigen/SparseCore>
 
@@ -58,9 +59,9 @@ class BodySolver {
   int n_dofs() const { return constraints_.n_dofs(); }
   int n_free() const { return constraints_.n_free(); }
 
-  // Displacements (all dofs) under the body's own loads plus `extra_load` (full dof vector, e.g. contact
-  // forces). One back-substitution; safe to call concurrently for different BodySolver objects.
-  Eigen::VectorXd solve(const Eigen::VectorXd& extra_load) const;
+  // Displacements (all dofs) under the body's own loads at load point `at` plus `extra_load` (full dof vector, e.g.
+  // contact forces). One back-substitution; safe to call concurrently for different BodySolver objects.
+  Eigen::VectorXd solve(const Eigen::VectorXd& extra_load, const LoadPoint& at = {}) const;
   // The same for a load that is already reduced (T^T f) and without the body's own loads/prescribed values:
   // the linear response x = K_red^{-1} b. Used by the interface methods.
   Eigen::VectorXd solve_reduced(const Eigen::VectorXd& reduced_rhs) const;
@@ -69,9 +70,10 @@ class BodySolver {
   // Linear response to a load only (no body loads, prescribed values 0): T K_red^{-1} T^T f.
   Eigen::VectorXd solve_homogeneous(const Eigen::VectorXd& load) const;
 
-  // Support reactions: the force the supports exert on the body, K u - f_ext - extra_load, kept at the
-  // prescribed (Dirichlet) dofs and zero elsewhere.
-  Eigen::VectorXd reactions(const Eigen::VectorXd& u, const Eigen::VectorXd& extra_load) const;
+  // Support reactions: the force the supports exert on the body, K u - f_ext - extra_load (f_ext at `at`), kept at
+  // the prescribed (Dirichlet) dofs and zero elsewhere.
+  Eigen::VectorXd reactions(const Eigen::VectorXd& u, const Eigen::VectorXd& extra_load,
+                            const LoadPoint& at = {}) const;
 
   StressFields stresses(const Eigen::VectorXd& u) const;
 
@@ -79,23 +81,16 @@ class BodySolver {
   // The stiffness of all dofs, assembled on demand (not kept: the solver needs only the reduced one).
   Eigen::SparseMatrix<double> stiffness() const;
   const Eigen::SparseMatrix<double>& reduced_stiffness() const { return *K_red_; }
-  // The body's own loads and prescribed values are scaled by the load factor (load steps; 1 by default): the
-  // factorisation does not change, only these. set_load_step also gives every condition with its own history
-  // (BoundaryCondition::history) its factor of step `step`, the others the loading's `factor`.
-  void set_load_factor(double factor) { set_load_step(0, factor); }
-  void set_load_step(size_t step, double factor) { set_load_between(step, 0.0, factor, 1.0); }
-  // A point t in [0, 1] of the way from the end of step `step - 1` (loaded by previous_factor, 0 before step 0, and
-  // each history's value there, 0 before step 0) to the end of step `step`: every factor interpolated linearly (the
-  // sub-steps of a load step that is cut, ddm/load_steps.cpp).
-  void set_load_between(size_t step, double previous_factor, double factor, double t);
+  // The body's own loads and prescribed values at a load point (fem/load_point.hpp; the default: the end of the
+  // first step, the loading at 1): the factorisation does not change, only these. The body keeps no load state: the
+  // point is the run's (ddm/run_state.hpp).
   bool has_histories() const { return !groups_.empty(); }
-  double load_factor() const { return load_factor_; }
-  // The factor a condition of this body is at now: its own history's where it has one, else load_factor().
-  double condition_factor(const BoundaryCondition& bc) const;
-  Eigen::VectorXd external_load() const;                   // all dofs: tractions, forces, body force
-  Eigen::VectorXd reduced_rhs() const;                     // T^T (f_ext - K g)
-  Eigen::VectorXd prescribed() const;                      // g: the prescribed values (and 0 elsewhere), all dofs
-  Eigen::VectorXd expand(const Eigen::VectorXd& x) const;  // T x + g
+  // The factor a condition of this body is at: its own history's where it has one, else the loading's.
+  double condition_factor(const BoundaryCondition& bc, const LoadPoint& at) const { return at.of_history(bc.history); }
+  Eigen::VectorXd external_load(const LoadPoint& at = {}) const;  // all dofs: tractions, forces, body force
+  Eigen::VectorXd reduced_rhs(const LoadPoint& at = {}) const;    // T^T (f_ext - K g)
+  Eigen::VectorXd prescribed(const LoadPoint& at = {}) const;     // g: the prescribed values (0 elsewhere), all dofs
+  Eigen::VectorXd expand(const Eigen::VectorXd& x, const LoadPoint& at = {}) const;  // T x + g
   const Elasticity& elasticity() const { return elasticity_; }
   // The free unknowns behind the interface dofs, in the order of the rows of interface_factor(), and the
   // lower-triangular L_ZZ with L_ZZ L_ZZ^T = the Schur complement of the reduced stiffness on them (both empty
@@ -118,11 +113,10 @@ class BodySolver {
 
  private:
   // One per condition with a history: its share of the loads (f_ext), of the prescribed values (g) and of the
-  // reduced right-hand side (T^T (f - K g)), at factor 1, and its current factor.
+  // reduced right-hand side (T^T (f - K g)), at factor 1.
   struct LoadGroup {
     const BoundaryCondition* condition = nullptr;
     Eigen::VectorXd f_ext, g, rhs;
-    double factor = 1.0;
   };
   void setup_constraints();
   void assemble_system();
@@ -130,9 +124,9 @@ class BodySolver {
   void factorize();
   void add_condition_load(const BoundaryCondition& bc, Eigen::VectorXd& f) const;
   void setup_history_groups();
-  // The loading's factor times the base (every condition at factor 1) plus, per condition with a history, its
-  // own factor's difference times its part.
-  Eigen::VectorXd scaled(const Eigen::VectorXd& base, Eigen::VectorXd LoadGroup::*part) const;
+  // The loading's factor at `at` times the base (every condition at factor 1) plus, per condition with a history,
+  // its own factor's difference times its part.
+  Eigen::VectorXd scaled(const Eigen::VectorXd& base, Eigen::VectorXd LoadGroup::*part, const LoadPoint& at) const;
   std::vector<int> interface_unknowns_of(const std::vector<int>& dofs) const;
 
   const Body& body_;
@@ -144,7 +138,6 @@ class BodySolver {
   std::vector<int> interface_dofs_;
   bool allow_floating_ = false, factorize_ = true, local_ = true, was_cancelled_ = false;
   std::function<bool()> cancelled_;
-  double load_factor_ = 1.0;
   std::vector<LoadGroup> groups_;
   Eigen::MatrixXd rigid_modes_;
   std::vector<std::string> rigid_mode_names_;

@@ -38,10 +38,11 @@ constexpr std::array<double, 3> kGaussW = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
 
 }  // namespace
 
-Eigen::VectorXd PairDiscretization::penalty_pressure(const Eigen::VectorXd& g) const {
+Eigen::VectorXd PairDiscretization::penalty_pressure(const Eigen::VectorXd& g,
+                                                     const Eigen::VectorXd* multipliers) const {
   Eigen::VectorXd z(g.size());
-  const bool shifted = multiplier.size() == g.size();
-  for (Eigen::Index r = 0; r < g.size(); ++r) z[r] = std::max(0.0, (shifted ? multiplier[r] : 0.0) - g[r] / theta);
+  const bool shifted = multipliers && multipliers->size() == g.size();
+  for (Eigen::Index r = 0; r < g.size(); ++r) z[r] = std::max(0.0, (shifted ? (*multipliers)[r] : 0.0) - g[r] / theta);
   return z;
 }
 

@@ -23,7 +23,7 @@
 // has the structure of the weighted gap, and the forces are f_slave = -Ts^T q, f_master = Tm^T q (balanced
 // exactly, as the normal ones). So q is the tangential traction the slave exerts on the master, and the traction
 // on the slave along tau is t = -q. Friction acts on increments: the slip of a load step is w - w_origin, with
-// w_origin the jump at the end of the previous step.
+// w_origin the jump at the end of the previous step (run state: ddm/run_state.hpp).
 #pragma once
 
 #include "contact/problem.hpp"
@@ -80,25 +80,15 @@ struct PairDiscretization {
   SparseRows M;                         // rows x master_nodes (scalar mortar matrix, summed over segments)
   double covered_length = 0.0;          // length of the slave edge opposite the master edge (this pair's pieces)
 
-  // Augmented-Lagrangian multipliers per row (empty: none). The pressure is then max(0, lambda - g / theta).
-  Eigen::VectorXd multiplier;
-
   // Friction (empty operators when the pair is frictionless).
   FrictionSpec friction;
   std::vector<Eigen::Vector2d> tangent;  // per row: tau_r
   SparseRows Ts, Tm;                     // rows x slave dofs, rows x master dofs
-  Eigen::VectorXd jump_origin;           // w at the end of the previous load step (empty: zero)
   bool has_friction() const { return friction.active() && Ts.rows() == n_rows(); }
   // w = Tm u_master - Ts u_slave (weighted; / area gives the master's tangential displacement relative to the
   // slave's, a length).
   Eigen::VectorXd weighted_jump(const Eigen::VectorXd& us, const Eigen::VectorXd& um) const {
     return Tm * um - Ts * us;
-  }
-  // The slip of this step: w - w_origin.
-  Eigen::VectorXd weighted_slip(const Eigen::VectorXd& us, const Eigen::VectorXd& um) const {
-    Eigen::VectorXd w = weighted_jump(us, um);
-    if (jump_origin.size() == w.size()) w -= jump_origin;
-    return w;
   }
   // The resultant of the tangential forces on the slave, -Ts^T q summed by component.
   Eigen::Vector2d tangential_resultant(const Eigen::VectorXd& q) const;
@@ -116,8 +106,9 @@ struct PairDiscretization {
   Eigen::VectorXd nodal_gap(const Eigen::VectorXd& us, const Eigen::VectorXd& um) const {
     return weighted_gap(us, um).cwiseQuotient(area);
   }
-  // The penalty pressures of nodal gaps g: max(0, lambda - g / theta).
-  Eigen::VectorXd penalty_pressure(const Eigen::VectorXd& nodal_gaps) const;
+  // The penalty pressures of nodal gaps g: max(0, lambda - g / theta), with the augmented-Lagrangian multipliers
+  // lambda per row (null: none; ddm/run_state.hpp).
+  Eigen::VectorXd penalty_pressure(const Eigen::VectorXd& nodal_gaps, const Eigen::VectorXd* multipliers) const;
   // Adds the contact forces of row pressures z: fs -= Gs^T z, fm += Gm^T z.
   void add_forces(const Eigen::VectorXd& z, Eigen::VectorXd& fs, Eigen::VectorXd& fm) const;
   // Total normal force sum_r area_r z_r (the integral of the pressure field; per unit thickness in plane strain).

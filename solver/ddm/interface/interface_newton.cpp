@@ -34,23 +34,25 @@ std::string InterfaceNewton::unheld_bodies(const std::vector<Eigen::Index>& rows
 
 std::vector<Eigen::VectorXd> InterfaceNewton::rigid_amplitudes(const Eigen::VectorXd& alpha) const {
   std::vector<Eigen::VectorXd> out(system_.n_bodies());
-  if (alpha.size() != problem_.equilibrium().G.rows()) return out;  // (G does not depend on the load)
+  if (alpha.size() != problem_.rigid_unknowns()) return out;
   for (const auto& f : problem_.floating()) out[f.body] = alpha.segment(f.offset, f.count);
   return out;
 }
 
-InterfaceQp InterfaceNewton::make_qp(const SolverSettings& settings) const {
+InterfaceQp InterfaceNewton::make_qp(const SolverSettings& settings, const RunState& state) const {
   const auto& pairs = system_.pairs();
   const Eigen::Index m = problem_.size();
-  InterfaceQp qp{problem_, Eigen::VectorXd::Zero(m), problem_.free_gap(), problem_.equilibrium(), {}, {}};
+  InterfaceQp qp{problem_, Eigen::VectorXd::Zero(m), problem_.free_gap(state), problem_.equilibrium(state.load), {},
+                 {}};
   // H = F (+ theta D for the penalty), g = g_free (- theta D lambda under the augmented Lagrangian).
   if (settings.enforcement != Enforcement::exact)
     for (size_t k = 0; k < pairs.size(); ++k) {
       const auto& pair = pairs[k];
+      const Eigen::VectorXd* lambda = state.multipliers_of(k, pair.n_rows());
       for (Eigen::Index r = 0; r < pair.n_rows(); ++r) {
         const Eigen::Index i = problem_.offset(k) + r;
         qp.penalty[i] = pair.theta * pair.area[r];
-        if (pair.multiplier.size() == pair.n_rows()) qp.g[i] -= pair.theta * pair.area[r] * pair.multiplier[r];
+        if (lambda) qp.g[i] -= pair.theta * pair.area[r] * (*lambda)[r];
       }
     }
   // Each pair's rows are a line, ordered along the slave edge. A closed slave edge is the line cut at its start:
@@ -71,9 +73,11 @@ InterfaceQp InterfaceNewton::make_qp(const SolverSettings& settings) const {
 void InterfaceNewton::solve(RunFrame& frame) {
   const SolverSettings& settings = frame.settings();
   MethodOutcome& out = frame.outcome();
-  if (system_.has_histories()) problem_.refresh_loads(frame.runner());  // loads not proportional to the last ones
+  const RunState& state = frame.state();
+  // Loads not proportional to the last ones:
+  if (system_.has_histories()) problem_.refresh_loads(frame.runner(), state.load);
   if (system_.has_friction())
-    if (std::string overload = friction_cannot_hold(system_); !overload.empty()) {
+    if (std::string overload = friction_cannot_hold(system_, state.load); !overload.empty()) {
       out.stop_reason = StopReason::error;
       out.refused = true;
       out.message = overload;
@@ -81,11 +85,11 @@ void InterfaceNewton::solve(RunFrame& frame) {
     }
   const InterfaceProblem& ip = problem_;
   const Eigen::Index m = ip.size();
-  const InterfaceQp qp = make_qp(settings);
+  const InterfaceQp qp = make_qp(settings, state);
 
   std::vector<std::vector<char>> previous_active;
-  const Eigen::VectorXd& penalty_diagonal = qp.penalty;  // theta area (0: exact)
-  const Eigen::VectorXd shift = qp.g - ip.free_gap();    // -theta area lambda
+  const Eigen::VectorXd& penalty_diagonal = qp.penalty;     // theta area (0: exact)
+  const Eigen::VectorXd shift = qp.g - ip.free_gap(state);  // -theta area lambda
   const std::string* solver_note = nullptr;  // what the solver says of its start (coarse solves), on the first report
   std::string solver_name = solver_->name();
   // The iterative solver's preconditioner, as `auto` resolved it (names.hpp's word).
@@ -167,7 +171,7 @@ void InterfaceNewton::solve(RunFrame& frame) {
   }
   out.z = ip.split(result.z);
   if (system_.has_friction()) out.q = ip.split_tangential(result.z);
-  out.u = ip.displacements(result.z, result.alpha);
+  out.u = ip.displacements(result.z, result.alpha, state.load);
   out.rigid_amplitudes = rigid_amplitudes(result.alpha);
   out.subdomain_solves = 1;
 }

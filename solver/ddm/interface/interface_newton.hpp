@@ -18,14 +18,17 @@ namespace contact::ddm {
 
 class InterfaceNewton {
  public:
-  InterfaceNewton(const ContactSystem& system, const SolverSettings& settings, parallel::TaskRunner& runner)
+  // The bodies' free responses are computed at load point `at` (the run's when the method first runs): later load
+  // points scale them, or refresh them when a condition has its own history (interface_problem.hpp).
+  InterfaceNewton(const ContactSystem& system, const SolverSettings& settings, parallel::TaskRunner& runner,
+                  const fem::LoadPoint& at)
       : system_(system),
         settings_(resolved_settings(settings.interface, system)),
         kind_(choose_interface_solver(settings_, system, runner)),
-        problem_(system, runner, interface_options(kind_, settings_, system.has_friction())),
+        problem_(system, runner, interface_options(kind_, settings_, system.has_friction()), at),
         solver_(make_interface_solver(kind_, settings_, system.has_friction())) {}
-  // Solves with the frame's enforcement on the pairs' current multipliers, building the frame's outcome; reports
-  // every active-set step.
+  // Solves with the frame's enforcement at the run state's load point, slip origins and multipliers, building the
+  // frame's outcome; reports every active-set step.
   void solve(RunFrame& frame);
   const InterfaceProblem& problem() const { return problem_; }
   const InterfaceSolver& solver() const { return *solver_; }
@@ -37,7 +40,7 @@ class InterfaceNewton {
   std::vector<Eigen::VectorXd> rigid_amplitudes(const Eigen::VectorXd& alpha) const;
 
   // The problem as the solver takes it: H = F + theta D, g shifted by the multipliers, where each row lies.
-  InterfaceQp make_qp(const SolverSettings& settings) const;
+  InterfaceQp make_qp(const SolverSettings& settings, const RunState& state) const;
 
   const ContactSystem& system_;
   InterfaceSolverSettings settings_;  // the job's, `auto` preconditioner resolved

@@ -51,7 +51,7 @@ struct InterfaceProblem::BodyParts {
 
 // One body's share: its free response's gaps, its rigid modes' equilibrium rows, and its compliance (and
 // preconditioner) block on its rows.
-void InterfaceProblem::compute_body(size_t a, BodyParts& out) const {
+void InterfaceProblem::compute_body(size_t a, const fem::LoadPoint& at, BodyParts& out) const {
   const BodyRows& R = out.rows;
   const auto& body = system_.body(a);
   const Eigen::Index k = static_cast<Eigen::Index>(R.rows.size());
@@ -62,10 +62,10 @@ void InterfaceProblem::compute_body(size_t a, BodyParts& out) const {
     for (size_t i = 0; i < R.rows.size(); ++i)
       for (const auto& [dof, value] : R.entries[i])
         out.G.col(static_cast<Eigen::Index>(i)) += value * modes.row(dof).transpose();
-    out.e = -modes.transpose() * body.external_load();
+    out.e = -modes.transpose() * body.external_load(at);
   }
   // Free response: the body under its own loads only.
-  const Eigen::VectorXd u_free = body.solve(Eigen::VectorXd());
+  const Eigen::VectorXd u_free = body.solve(Eigen::VectorXd(), at);
   out.g = Eigen::VectorXd::Zero(k);
   for (size_t i = 0; i < R.rows.size(); ++i)
     for (const auto& [dof, value] : R.entries[i]) out.g[static_cast<Eigen::Index>(i)] += value * u_free[dof];
@@ -112,7 +112,8 @@ void InterfaceProblem::compute_body(size_t a, BodyParts& out) const {
   }
 }
 
-InterfaceProblem::InterfaceProblem(const ContactSystem& system, parallel::TaskRunner& runner, const Options& options)
+InterfaceProblem::InterfaceProblem(const ContactSystem& system, parallel::TaskRunner& runner, const Options& options,
+                                   const fem::LoadPoint& at)
     : system_(system), options_(options) {
   const auto& pairs = system.pairs();
   offset_.assign(pairs.size() + 1, 0);
@@ -127,7 +128,7 @@ InterfaceProblem::InterfaceProblem(const ContactSystem& system, parallel::TaskRu
   const Eigen::Index m = size_;
   D_.resize(m);
   gap0_ = Eigen::VectorXd::Zero(m);  // tangential rows: the slip origin is subtracted in free_gap()
-  factor_ = system.load_factor();
+  factor_ = at.value();
   for (size_t k = 0; k < pairs.size(); ++k) {
     D_.segment(offset_[k], pairs[k].n_rows()) = pairs[k].area;
     gap0_.segment(offset_[k], pairs[k].n_rows()) = pairs[k].gap0;
@@ -158,7 +159,7 @@ InterfaceProblem::InterfaceProblem(const ContactSystem& system, parallel::TaskRu
                                     parts[a].diagonal = in.get_vector();
                                   }};
   runner.run_bodies(
-      n_bodies, [&](size_t a) { compute_body(a, parts[a]); }, share);
+      n_bodies, [&](size_t a) { compute_body(a, at, parts[a]); }, share);
   g_loads_ = Eigen::VectorXd::Zero(m);
   diagonal_ = Eigen::VectorXd::Zero(m);
   blocks_.resize(n_bodies);
@@ -283,16 +284,17 @@ bool InterfaceProblem::apply_preconditioner(const Eigen::VectorXd& x, Eigen::Vec
   return stop;
 }
 
-Eigen::VectorXd InterfaceProblem::free_gap() const {
-  Eigen::VectorXd g = gap0_ + (system_.load_factor() / factor_) * g_loads_;
+Eigen::VectorXd InterfaceProblem::free_gap(const RunState& state) const {
+  Eigen::VectorXd g = gap0_ + (state.load.value() / factor_) * g_loads_;
   const auto& pairs = system_.pairs();
   for (size_t k = 0; k < pairs.size(); ++k)
-    if (tangential_offset_[k] >= 0 && pairs[k].jump_origin.size() == pairs[k].n_rows())
-      g.segment(tangential_offset_[k], pairs[k].n_rows()) -= pairs[k].jump_origin;
+    if (const Eigen::VectorXd* origin = state.slip_origin_of(k, pairs[k].n_rows());
+        origin && tangential_offset_[k] >= 0)
+      g.segment(tangential_offset_[k], pairs[k].n_rows()) -= *origin;
   return g;
 }
 
-void InterfaceProblem::refresh_loads(parallel::TaskRunner& runner) {
+void InterfaceProblem::refresh_loads(parallel::TaskRunner& runner, const fem::LoadPoint& at) {
   const size_t n_bodies = system_.n_bodies();
   std::vector<Eigen::VectorXd> g(n_bodies), e(n_bodies);
   const parallel::BodyShare share{[&](size_t a, parallel::Packer& out) {
@@ -309,22 +311,22 @@ void InterfaceProblem::refresh_loads(parallel::TaskRunner& runner) {
       n_bodies,
       [&](size_t a) {
         const auto& body = system_.body(a);
-        const Eigen::VectorXd u_free = body.solve(Eigen::VectorXd());
+        const Eigen::VectorXd u_free = body.solve(Eigen::VectorXd(), at);
         g[a] = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(rows[a].rows.size()));
         for (size_t i = 0; i < rows[a].rows.size(); ++i)
           for (const auto& [dof, value] : rows[a].entries[i]) g[a][static_cast<Eigen::Index>(i)] += value * u_free[dof];
-        if (body.floating()) e[a] = -body.rigid_modes().transpose() * body.external_load();
+        if (body.floating()) e[a] = -body.rigid_modes().transpose() * body.external_load(at);
       },
       share);
   g_loads_.setZero();
   for (size_t a = 0; a < n_bodies; ++a)
     for (size_t i = 0; i < rows[a].rows.size(); ++i) g_loads_[rows[a].rows[i]] += g[a][static_cast<Eigen::Index>(i)];
   for (const auto& f : floating_) equilibrium_.e.segment(f.offset, f.count) = e[f.body];
-  factor_ = system_.load_factor();
+  factor_ = at.value();
 }
 
-Equalities InterfaceProblem::equilibrium() const {
-  return Equalities{equilibrium_.G, (system_.load_factor() / factor_) * equilibrium_.e};
+Equalities InterfaceProblem::equilibrium(const fem::LoadPoint& at) const {
+  return Equalities{equilibrium_.G, (at.value() / factor_) * equilibrium_.e};
 }
 
 Pressures InterfaceProblem::split(const Eigen::VectorXd& stacked) const {
@@ -346,10 +348,11 @@ Eigen::VectorXd InterfaceProblem::stack(const Pressures& per_pair) const {
   return out;
 }
 
-Displacements InterfaceProblem::displacements(const Eigen::VectorXd& z, const Eigen::VectorXd& alpha) const {
+Displacements InterfaceProblem::displacements(const Eigen::VectorXd& z, const Eigen::VectorXd& alpha,
+                                              const fem::LoadPoint& at) const {
   CONTACT_ASSERT_SIZE(z.size(), size(), "the interface multipliers");
   const Pressures q = split_tangential(z);
-  Displacements u = system_.solve_bodies(system_.loads_from_pressures(split(z), &q));
+  Displacements u = system_.solve_bodies(system_.loads_from_pressures(split(z), &q), at);
   if (alpha.size() == equilibrium_.G.rows())
     for (const auto& f : floating_) u[f.body] += system_.body(f.body).rigid_modes() * alpha.segment(f.offset, f.count);
   return u;

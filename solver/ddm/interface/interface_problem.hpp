@@ -46,22 +46,23 @@ class InterfaceProblem {
     bool friction = false;
   };
 
-  // Needs a system built with Factorization::interface. Free responses and Schur complements, bodies in
-  // parallel through `runner`.
-  InterfaceProblem(const ContactSystem& system, parallel::TaskRunner& runner)
-      : InterfaceProblem(system, runner, Options{}) {}
-  InterfaceProblem(const ContactSystem& system, parallel::TaskRunner& runner, const Options& options);
+  // Needs a system built with Factorization::interface. Free responses (at load point `at`) and Schur complements,
+  // bodies in parallel through `runner`.
+  InterfaceProblem(const ContactSystem& system, parallel::TaskRunner& runner, const fem::LoadPoint& at = {})
+      : InterfaceProblem(system, runner, Options{}, at) {}
+  InterfaceProblem(const ContactSystem& system, parallel::TaskRunner& runner, const Options& options,
+                   const fem::LoadPoint& at = {});
 
   Eigen::Index size() const { return size_; }
   Eigen::Index normal_size() const { return static_cast<Eigen::Index>(offset_.back()); }
   // The first tangential row of pair k (-1: frictionless, or friction not asked for).
   Eigen::Index tangential_offset(size_t pair) const { return tangential_offset_[pair]; }
-  // Weighted gaps (and slips) with no contact force, at the system's current load factor (the bodies' part scales
-  // with it) and friction pairs' current slip origins.
-  Eigen::VectorXd free_gap() const;
-  // Recomputes the bodies' free responses for the current loads: needed when a step's loads are not a multiple of
+  // Weighted gaps (and slips) with no contact force, at the state's load point (the bodies' part scales with its
+  // factor) and friction pairs' slip origins.
+  Eigen::VectorXd free_gap(const RunState& state) const;
+  // Recomputes the bodies' free responses for the loads at `at`: needed when a step's loads are not a multiple of
   // the previous ones (conditions with their own history). One solve per body.
-  void refresh_loads(parallel::TaskRunner& runner);
+  void refresh_loads(parallel::TaskRunner& runner, const fem::LoadPoint& at);
   const Eigen::VectorXd& weights() const { return D_; }  // area of every row, stacked
   Eigen::Index offset(size_t pair) const { return offset_[pair]; }
   const ContactSystem& system() const { return system_; }
@@ -97,16 +98,18 @@ class InterfaceProblem {
     Eigen::Index offset = 0, count = 0;
   };
   const std::vector<Floating>& floating() const { return floating_; }
-  // The equilibrium of the floating bodies, G z = e, at the current load factor (empty without floating bodies).
-  Equalities equilibrium() const;
+  // The equilibrium of the floating bodies, G z = e, at load point `at` (empty without floating bodies).
+  Equalities equilibrium(const fem::LoadPoint& at) const;
+  // The number of rigid-mode amplitudes (rows of G).
+  Eigen::Index rigid_unknowns() const { return equilibrium_.G.rows(); }
 
-  // The bodies' displacements for pressures z and rigid-mode amplitudes alpha (empty without floating bodies):
-  // one solve per body, in parallel.
-  Displacements displacements(const Eigen::VectorXd& z, const Eigen::VectorXd& alpha) const;
+  // The bodies' displacements for pressures z and rigid-mode amplitudes alpha (empty without floating bodies) under
+  // their loads at `at`: one solve per body, in parallel.
+  Displacements displacements(const Eigen::VectorXd& z, const Eigen::VectorXd& alpha, const fem::LoadPoint& at) const;
 
  private:
   struct BodyParts;  // what one body's task computes
-  void compute_body(size_t a, BodyParts& out) const;
+  void compute_body(size_t a, const fem::LoadPoint& at, BodyParts& out) const;
   void assemble_equilibrium(const std::vector<BodyParts>& parts);
   bool apply_blocks(const Eigen::VectorXd& x, Eigen::VectorXd& y, parallel::TaskRunner& runner,
                     bool preconditioner) const;
@@ -127,7 +130,7 @@ class InterfaceProblem {
   std::vector<Eigen::Index> offset_, tangential_offset_;
   Eigen::Index size_ = 0;
   std::vector<Block> blocks_;
-  Eigen::VectorXd gap0_, g_loads_, D_, diagonal_, inverse_weight_;  // g_loads_: at load factor factor_
+  Eigen::VectorXd gap0_, g_loads_, D_, diagonal_, inverse_weight_;  // g_loads_: at the loading's factor factor_
   double factor_ = 1.0;
   std::vector<Floating> floating_;
   Equalities equilibrium_;
