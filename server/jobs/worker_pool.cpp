@@ -99,12 +99,16 @@ JobRecord WorkerPool::snapshot(const Job& job, int& queue_position) const {
   JobRecord record = registry_.snapshot(job);
   queue_position = 0;
   if (record.state == JobState::queued) {
+    // Stored QUEUED but not (yet) in the queue (a run moved out of the small lane, between its record's change and
+    // its release) has no position: 0, not one past every job waiting.
     int position = 1;
     for (const auto& waiting : queue_) {
-      if (waiting.get() == &job) break;
+      if (waiting.get() == &job) {
+        queue_position = position;
+        break;
+      }
       if (registry_.is_queued(*waiting)) ++position;
     }
-    queue_position = position;
   }
   return record;
 }
