@@ -277,6 +277,16 @@ bool counts_active_set_steps(const contact::Problem& problem) {
 
 // Everything after the job is parsed: solve on this process's share, report and write on rank 0. Returns the
 // exit code (rank 0's decides for all).
+void print_warning(const contact::Warning& w) {
+  std::cerr << "warning: " << (w.pointer.empty() ? "" : w.pointer + ": ") << w.message << "\n";
+}
+
+nlohmann::json warnings_json(const std::vector<contact::Warning>& list) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& w : list) out.push_back({{"pointer", w.pointer}, {"message", w.message}});
+  return out;
+}
+
 int solve_and_write(contact::Session& session, contact::Problem& problem, const std::string& output,
                     const std::string& job_id, bool quiet, bool ndjson, contact::io::ProgressSelection selection) {
   const bool root = session.root();
@@ -297,6 +307,8 @@ int solve_and_write(contact::Session& session, contact::Problem& problem, const 
   const std::string traffic = session.traffic();
   if (!root) return 0;
 
+  // The answer's warnings (after the job's, printed before the solve): on stderr, each with its pointer.
+  for (size_t k = problem.warnings.size(); k < result.warnings.size(); ++k) print_warning(result.warnings[k]);
   if (!ndjson) {
     std::printf("stop: %s after %d %s, %.3f s (setup %.3f s): %s\n", contact::to_string(result.stop_reason),
                 result.iterations, counts_active_set_steps(problem) ? "steps" : "iterations", result.wall_seconds,
@@ -312,6 +324,7 @@ int solve_and_write(contact::Session& session, contact::Problem& problem, const 
                             {"ranks", session.size()},
                             {"traffic", traffic},
                             {"result_written", false},
+                            {"warnings", warnings_json(result.warnings)},
                             {"steps", nlohmann::json::array()}};
   auto finish = [&](int code) {
     if (ndjson) std::printf("%s\n", summary.dump().c_str());
@@ -386,6 +399,11 @@ int main(int argc, char** argv) {
   app.add_option("job", job_path, "contact job (JSON, see docs/job-format.md)")->required();
   app.add_option("-o,--output", output, "result file (HDF5; default: the job file's name with .hdf)");
   app.add_flag("--validate", validate_only, "only validate the job and exit");
+  bool strict = false;
+  app.add_flag("--strict", strict,
+               "warnings are errors: a job whose model checks warn (an undeclared overlap, a pair open everywhere) "
+               "is invalid (exit 2), a solve whose answer warns (a body moved or turned far against its size) fails "
+               "(exit 1, its result kept); as the job's \"strict\": true");
   app.add_flag("-q,--quiet", quiet, "no per-iteration lines");
   app.add_option("--max-dofs", max_dofs, "reject jobs with more unknowns than this")->check(CLI::PositiveNumber);
   double max_interface_bytes = -1;
@@ -425,6 +443,7 @@ int main(int argc, char** argv) {
   if (!read_job(session, job_path, text)) return 2;
   contact::job::Limits limits;
   limits.max_dofs = max_dofs;
+  limits.strict = strict;
   // A job that cannot fit is refused with the estimate, not started to be killed for memory (a long contact's dense
   // blocks grow with the square of its nodes).
   limits.max_interface_bytes = max_interface_bytes >= 0 ? max_interface_bytes
@@ -443,6 +462,9 @@ int main(int argc, char** argv) {
     return 2;
   }
   contact::Problem& problem = *parsed.problem;
+  // The model checks' warnings (check/initial_gaps.hpp), before anything else is said of the job.
+  if (session.root())
+    for (const auto& w : problem.warnings) print_warning(w);
   if (threads >= 0) problem.solver.threads = threads;
   if (keep_iterate) problem.output.iterate = true;
   if (validate_only) {
@@ -450,7 +472,11 @@ int main(int argc, char** argv) {
     for (const auto& b : problem.bodies) dofs += 2L * b.mesh.num_nodes();
     if (session.root())
       std::cout << job_path << ": valid (" << problem.bodies.size() << " bodies, " << problem.contacts.size()
-                << " contact pairs, " << dofs << " dofs before constraints)\n";
+                << " contact pairs, " << dofs << " dofs before constraints"
+                << (problem.warnings.empty() ? std::string()
+                                             : ", " + std::to_string(problem.warnings.size()) + " warning" +
+                                                   (problem.warnings.size() == 1 ? "" : "s") + " above")
+                << ")\n";
     return 0;
   }
   if (output.empty()) output = std::filesystem::path(job_path).stem().string() + ".hdf";

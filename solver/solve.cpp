@@ -1,6 +1,7 @@
 #include "contact/solve.hpp"
 
 #include "adapt/adaptive.hpp"
+#include "check/large_motion.hpp"
 #include "ddm/load_steps.hpp"
 #include "held_bodies.hpp"
 
@@ -119,6 +120,20 @@ void refuse_below_resolution(const Problem& problem, Result& result) {
   result.kept.clear();
 }
 
+// The answer's warnings after the problem's (check/large_motion.hpp: on the last step). A strict job fails on one of
+// them: its steps are kept, the stop says why (a warning never changes the answer).
+void add_warnings(const Problem& problem, Result& result) {
+  if (result.steps.empty()) return;
+  const std::vector<Warning> after = check::motion_warnings(problem, result.steps.back());
+  result.warnings.insert(result.warnings.end(), after.begin(), after.end());
+  if (!problem.strict || after.empty() || !result.converged) return;
+  result.stop_reason = StopReason::error;
+  result.converged = false;
+  result.message = "strict: " + after.front().pointer + ": " + after.front().message +
+                   (after.size() > 1 ? " (and " + std::to_string(after.size() - 1) + " more warnings)" : "") +
+                   "; the solve itself converged (" + result.message + ")";
+}
+
 // What the result of a run that did not converge keeps: the steps that held and, if the job asked for it
 // (OutputSettings::iterate), the last iterate flagged as not converged. Empty when nothing was solved.
 std::string what_the_result_keeps(const Problem& problem, const ddm::StepLog& steps) {
@@ -172,6 +187,7 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
   Result result;
   result.method = to_string(problem.solver.method);
   result.enforcement = to_string(problem.solver.enforcement);
+  result.warnings = problem.warnings;  // what the job reader's checks found (check/initial_gaps.hpp)
   const ddm::MethodFacts& facts = ddm::facts_of(problem.solver.method);
   try {
     if (runner.distributed() && !facts.not_distributed.empty()) {
@@ -222,6 +238,7 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
       refuse_unheld_bodies(active, result, steps.dropped_iterate() ? &steps.dropped_step() : nullptr);
     if (result.stop_reason != StopReason::error && result.stop_reason != StopReason::cancelled) refuse_tension(result);
     refuse_below_resolution(active, result);
+    add_warnings(active, result);
     if (result.updates > 0 && !result.steps.empty()) {
       std::ostringstream os;
       os << "; remaining penetration " << max_penetration(result.steps.back());

@@ -18,14 +18,25 @@ def _cmd_submit(c, a):
         raise BadInput("-o, --xmf and --events-out need --wait")
     job = c.submit(a.file, idempotency_key=a.idempotency_key)
     print(one_line(job["id"]), flush=True)  # submit() checked that it is there
+    shown = print_warnings(job.get("warnings"))
     if not a.wait:
         return EXIT_OK
-    return _follow(c, job["id"], a)
+    return _follow(c, job["id"], a, shown)
 
 
-def _follow(c, job_id, a):
+def print_warnings(warnings, shown=0):
+    """The model checks' warnings (docs/job-format.md, "Warnings") past the first `shown`, on stderr, each as
+    "warning: <pointer>: <message>"; returns how many there are."""
+    listed = dicts(warnings)
+    for w in listed[shown:]:
+        pointer = word(w.get("pointer"), 200)
+        sys.stderr.write(f"warning: {pointer + ': ' if pointer else ''}{word(w.get('message'), 2000)}\n")
+    return max(shown, len(listed))
+
+
+def _follow(c, job_id, a, warnings_shown=0):
     """Follows the job to its end with the progress display; with -o downloads the result. With -q nothing is
-    printed but errors: a job that does not end SUCCEEDED is one ("error: job ... ended FAILED ...")."""
+    printed but errors and warnings: a job that does not end SUCCEEDED is one ("error: job ... ended FAILED ...")."""
     out = None
     progress = None
     try:
@@ -48,6 +59,8 @@ def _follow(c, job_id, a):
         if out:
             out.close()
     state = word(end.get("state")) if end else None
+    if end:  # the answer's warnings (the job's were shown at submission), with -q too: they are not progress
+        print_warnings(end.get("warnings"), warnings_shown)
     if getattr(a, "output", None):
         if end and end.get("result_available") is True:
             c.download(job_id, a.output, xmf=getattr(a, "xmf", False))
@@ -123,7 +136,8 @@ def _cmd_validate(c, a):
     bodies = ", ".join(f"{word(b.get('name'))} {num(b.get('elements'), 'd')} cells {num(b.get('nodes'), 'd')} nodes"
                        for b in dicts(r.get("bodies")))
     print(f"valid: {word(r.get('name'), 300)}: {num(r.get('dofs'), 'd')} dofs ({bodies}), "
-          f"{num(r.get('contacts'), 'd')} contact pair(s)")
+          f"{num(r.get('contacts'), 'd')} contact pair(s)", flush=True)
+    print_warnings(r.get("warnings"))
     if a.normalized:
         print(json.dumps(r.get("normalized"), indent=2))
     return EXIT_OK
@@ -231,7 +245,8 @@ def build_parser():
 
     def follow_opts(sp):
         sp.add_argument("-q", "--quiet", action="store_true",
-                        help="print nothing but errors (no progress, no state changes, no end line)")
+                        help="print nothing but errors and the model checks' warnings (no progress, no state "
+                             "changes, no end line)")
         sp.add_argument("--events-out", metavar="FILE", help="also save every event as NDJSON (for plot --events)")
         sp.add_argument("--retries", type=int, default=5, help="reconnections in a row before giving up (5)")
 

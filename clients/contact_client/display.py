@@ -268,6 +268,8 @@ def print_job(job, out):
         rows.append(("message", word(job["message"], 2000)))
     if job.get("error"):
         rows.append(("error", word(obj(job["error"]).get("message", job["error"]), 2000)))
+    for w in dicts(job.get("warnings")):
+        rows.append(("warning", f"{word(w.get('pointer'), 200)}: {word(w.get('message'), 2000)}"))
     t = obj(job.get("timings"))
     if t:
         rows.append(("timings", ", ".join(f"{word(k).replace('_seconds', '')} {num(v, '.3g')} s" for k, v in t.items()

@@ -173,6 +173,14 @@ class ResultFile:
         out.update({a: _attr(v) for a, v in h[name].attrs.items()})
         return out
 
+    def warnings(self):
+        """What the model checks found (/warnings; docs/job-format.md, "Warnings"): [{"pointer", "message"}], empty
+        for a file written before the checks."""
+        if "warnings" not in self._f:
+            return []
+        w = self._f["warnings"]
+        return [{"pointer": p, "message": m} for p, m in zip(_dataset(w["pointer"]), _dataset(w["message"]))]
+
     def job(self, key="job"):
         """The job as submitted (key "job") or with its defaults filled in ("normalized"), or None."""
         try:
@@ -196,7 +204,8 @@ def read_result(path):
                                                                        # last is final
      "history": {"iterations": {"iteration", "fixed_point_residual", "max_pressure" (I, P), ...,
                                 "body_names", "pair_names"},
-                 "steps": {...}}}
+                 "steps": {...}},
+     "warnings": [{"pointer", "message"}, ...]}                       # the model checks' (ResultFile.warnings)
     """
     result = {"path": os.fspath(path)}
     with ResultFile(path) as f:
@@ -214,6 +223,7 @@ def read_result(path):
         result["pair_names"] = steps[-1]["pair_names"] if steps else []
         history = {name: f.history(name) for name in ("iterations", "steps")}
         result["history"] = {name: h for name, h in history.items() if h}
+        result["warnings"] = f.warnings()
         job = f.job()
         if job is not None:
             result["job"] = job

@@ -34,7 +34,8 @@ nlohmann::json end_event(const JobRecord& r) {
           {"converged", r.converged.value_or(false)},
           {"iterations", r.iterations},
           {"solve_seconds", r.solve_seconds},
-          {"result_available", r.result_available}};
+          {"result_available", r.result_available},
+          {"warnings", r.warnings}};
 }
 
 }  // namespace contactd

@@ -3,6 +3,7 @@
 #include "common/log.hpp"
 #include "common/public_message.hpp"
 #include "common/time.hpp"
+#include "common/warnings_json.hpp"
 #include "jobs/events.hpp"
 #include "jobs/progress_observer.hpp"
 
@@ -142,6 +143,7 @@ contact::Result JobRun::solve_on_ranks(ProgressObserver& observer) {
   result.iterations = mpi_->iterations;
   result.converged = mpi_->converged;
   result.wall_seconds = mpi_->wall_seconds;
+  result.warnings = warnings_of(mpi_->warnings);
   return result;
 }
 
@@ -152,6 +154,7 @@ JobRecord JobRun::outcome_of(const contact::Result& result, CancelReason reason)
   outcome.solve_seconds = result.wall_seconds;
   outcome.message = result.message;
   outcome.stop_reason = contact::to_string(result.stop_reason);
+  outcome.warnings = warnings_json(result.warnings);
   switch (result.stop_reason) {
     case contact::StopReason::converged:
       outcome.state = JobState::succeeded;
@@ -248,6 +251,7 @@ void JobRun::finish(JobRecord outcome) {
     r.result_available = outcome.result_available;
     r.result_bytes = outcome.result_bytes;
     r.events_dropped = outcome.events_dropped;
+    r.warnings = outcome.warnings;
   };
   // The outcome is on disk before anyone is told: on a full disk the worker waits here (the job stays RUNNING
   // on disk and in the API) rather than report an outcome a restart would not find.

@@ -207,6 +207,7 @@ class MpiRun {
       outcome_.wall_seconds = result_.value("wall_seconds", outcome_.wall_seconds);
       outcome_.result_written = result_.value("result_written", false);
       if (result_.contains("steps") && result_["steps"].is_array()) outcome_.steps = result_["steps"];
+      if (result_.contains("warnings") && result_["warnings"].is_array()) outcome_.warnings = result_["warnings"];
       return outcome_;
     }
     std::ostringstream os;

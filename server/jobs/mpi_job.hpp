@@ -32,7 +32,8 @@ struct MpiOutcome {
   bool converged = false;
   double wall_seconds = 0.0;
   bool result_written = false;
-  nlohmann::json steps = nlohmann::json::array();  // step events, as the child reported them
+  nlohmann::json steps = nlohmann::json::array();     // step events, as the child reported them
+  nlohmann::json warnings = nlohmann::json::array();  // the model checks' warnings, as the child reported them
 };
 
 using ProgressLine = std::function<void(const std::string& type, const nlohmann::json& line)>;

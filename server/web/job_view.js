@@ -58,6 +58,7 @@ export class JobView {
     $("mesh").replaceChildren();
     $("log").replaceChildren();
     this.message("");
+    this.warnings([]);
     this.setState("");
     this.links(false);
     this.refresh();
@@ -126,10 +127,24 @@ export class JobView {
       if (job.queue_position) outcome.push(`queue position ${job.queue_position}`);
       $("job-outcome").textContent = outcome.join(", ");
       if (job.message) this.message(job.message, job.state === "FAILED");
+      this.warnings(job.warnings || []);
       this.links(job.result_available === true);
     } catch (e) {
       if (id === this.id) this.message(e.message, true);
     }
+  }
+
+  // The model checks' warnings (docs/job-format.md, "Warnings"): each with the JSON pointer it is about.
+  warnings(list) {
+    const ul = $("job-warnings");
+    ul.replaceChildren(...list.map((w) => {
+      const li = document.createElement("li");
+      const where = document.createElement("code");
+      where.textContent = w.pointer || "(the job)";
+      li.append("warning ", where, `: ${w.message}`);
+      return li;
+    }));
+    ul.hidden = list.length === 0;
   }
 
   log(text) {

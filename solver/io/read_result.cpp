@@ -53,6 +53,16 @@ void read_input_and_provenance(hid_t file, ResultFile& r) {
   r.job_json = h5::read_string_dataset(input, "job");
   r.normalized_json = h5::read_string_dataset(input, "normalized");
 
+  if (h5::has_link(file, "warnings")) {  // (absent in files written before the model checks)
+    Handle warnings = h5::open_group(file, "warnings");
+    const auto pointers = h5::read_strings_dataset(warnings, "pointer");
+    const auto messages = h5::read_strings_dataset(warnings, "message");
+    if (pointers.size() != messages.size())
+      throw std::runtime_error("/warnings: " + std::to_string(pointers.size()) + " pointers for " +
+                               std::to_string(messages.size()) + " messages");
+    for (size_t k = 0; k < pointers.size(); ++k) r.warnings.push_back({pointers[k], messages[k]});
+  }
+
   Handle prov = h5::open_group(file, "provenance");
   Provenance& p = r.provenance;
   p.solver_version = h5::read_string_attribute(prov, "solver_version");

@@ -91,6 +91,18 @@ void write_input(hid_t file, const Problem& problem) {
   h5::write_string_dataset(input, "normalized", dump_json(problem.normalized));
 }
 
+// What the model checks found, before and after the solve (Result::warnings): two string datasets of one row each.
+void write_warnings(hid_t file, const Result& result) {
+  Handle group = h5::create_group(file, "warnings");
+  std::vector<std::string> pointers, messages;
+  for (const auto& w : result.warnings) {
+    pointers.push_back(w.pointer);
+    messages.push_back(w.message);
+  }
+  h5::write_strings_dataset(group, "pointer", pointers);
+  h5::write_strings_dataset(group, "message", messages);
+}
+
 void write_provenance(hid_t file, const Result& result, const WriteInfo& info) {
   Handle prov = h5::create_group(file, "provenance");
   h5::write_attribute(prov, "solver_version", solver_version());
@@ -368,6 +380,7 @@ void write_all_but_steps(hid_t file, const Problem& problem, const Result& resul
                          const std::vector<StepSummary>& rows) {
   write_root_attributes(file, problem, result, info);
   write_input(file, problem);
+  write_warnings(file, result);
   write_provenance(file, result, info);
   {
     Handle history = h5::create_group(file, "history");

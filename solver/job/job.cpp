@@ -20,6 +20,7 @@
 #include <utility>
 #include <vector>
 
+#include "../check/initial_gaps.hpp"
 #include "job_reader.hpp"
 #include "names.hpp"
 #include "read.hpp"
@@ -35,10 +36,11 @@ void set_default(json& object, const std::string& key, json value) {
 ParseResult JobReader::run() {
   Fields top(job_, "", "the job",
              {"name", "version", "model", "meshes", "bodies", "contacts", "solver", "adaptivity", "loading", "parallel",
-              "output"},
+              "output", "strict", "warnings"},
              errors_);
   if (!top.ok()) return finish();
   read_header(top);
+  read_strict(top);
   read_model(top);
   if (const json* m = top.find("meshes"))
     gmsh_.read_table(*m, top.at("meshes"), errors_, sub_object(normalized_, "meshes"));
@@ -209,14 +211,42 @@ void JobReader::check_interface_memory() {
 
 ParseResult JobReader::finish() {
   ParseResult result;
+  if (errors_.size() == 0) {
+    for (auto& in : inputs_) problem_.bodies.push_back(std::move(in.body));
+    check_initial_gaps();
+  }
   result.errors = errors_.take();
   if (result.errors.empty()) {
-    for (auto& in : inputs_) problem_.bodies.push_back(std::move(in.body));
+    result.warnings = problem_.warnings;
     problem_.submitted = job_;
     problem_.normalized = std::move(normalized_);
     result.problem = std::move(problem_);
   }
   return result;
+}
+
+// Overlaps and pairs open everywhere, against each pair's fit (check/initial_gaps.hpp): warnings, in the problem and
+// the normalized copy; errors for a strict job. Once every mesh is built and nothing else is wrong (the pairs are
+// discretised as the solve will).
+void JobReader::check_initial_gaps() {
+  const auto gaps = check::measure_initial_gaps(problem_, [this] { return out_of_time("measuring the pairs' gaps"); });
+  if (timed_out_) return;
+  problem_.warnings = check::initial_gap_warnings(problem_, gaps);
+  json& listed = normalized_["warnings"];
+  listed = json::array();
+  for (const auto& w : problem_.warnings) {
+    listed.push_back({{"pointer", w.pointer}, {"message", w.message}});
+    if (problem_.strict) errors_.add(w.pointer, w.message + " (a strict job takes every warning as an error)");
+  }
+}
+
+// "strict" (the command line's --strict too, Limits::strict): warnings are errors. "warnings" is what the reader writes
+// into the normalized copy; given back (a normalized job submitted again) it is read as nothing and written anew.
+void JobReader::read_strict(const Fields& top) {
+  problem_.strict = limits_.strict;
+  if (const json* v = top.find("strict"))
+    if (auto b = read::boolean(*v, top.at("strict"), "strict", errors_)) problem_.strict = problem_.strict || *b;
+  set_default(normalized_, "strict", problem_.strict);
 }
 
 // The job format's default name (a Problem built in code has none).

@@ -109,6 +109,8 @@ class JobReader {
   void check_work_limits();
   ParseResult finish();
   void read_header(const Fields& top);
+  void read_strict(const Fields& top);
+  void check_initial_gaps();
   void read_model(const Fields& top);
   json& sub_object(json& parent, const std::string& key);
   json& element(json& array, size_t index);

@@ -71,6 +71,11 @@ struct NameTable<AdaptStrategy> {
       {{AdaptStrategy::paper, "paper"}, {AdaptStrategy::converge_then_refine, "converge_then_refine"}}};
 };
 template <>
+struct NameTable<Fit> {
+  static constexpr Entries<Fit, 3> entries{
+      {{Fit::touching, "touching"}, {Fit::interference, "interference"}, {Fit::clearance, "clearance"}}};
+};
+template <>
 struct NameTable<StepOutput> {  // "last" first, as the messages have always listed them
   static constexpr Entries<StepOutput, 2> entries{{{StepOutput::last, "last"}, {StepOutput::all, "all"}}};
 };

@@ -1,5 +1,6 @@
 // The job's contact pairs: their "body.edge" references resolved to the bodies read (phase 5), and their gaps.
 #include "job_reader.hpp"
+#include "names.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -75,7 +76,7 @@ void JobReader::read_contacts(const Fields& top) {
     if (k % 64 == 63 && out_of_time("reading the contact pairs")) return;
     const std::string cp = child("/contacts", k);
     json& out = element(out_list, k);
-    Fields f((*list)[k], cp, "a contact", {"name", "slave", "master", "gap", "friction"}, errors_);
+    Fields f((*list)[k], cp, "a contact", {"name", "slave", "master", "gap", "friction", "fit"}, errors_);
     if (!f.ok()) {
       contacts_complete_ = false;
       continue;
@@ -123,6 +124,8 @@ void JobReader::read_contacts(const Fields& top) {
     }
     read_gap(f, pair.gap, sub_object(out, "gap"));
     read_friction(f, pair.friction);
+    if (const json* v = f.find("fit")) read_name(*v, f.at("fit"), "fit", pair.fit, errors_);
+    set_default(out, "fit", name_of(ContactPair{}.fit));
     if (errors_.size() == before) {
       problem_.contacts.push_back(pair);
       friction_pointers_.push_back(pair.friction.active() ? f.at("friction") : std::string());

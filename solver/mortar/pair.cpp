@@ -204,6 +204,7 @@ class PairBuilder {
     assign_owners();
     number_rows();
     integrate();
+    node_gaps();
     assemble_operators();
     close_loop();
     keep_own_edge();
@@ -503,6 +504,26 @@ class PairBuilder {
     for (const auto& n : d_.normal) d_.tangent.emplace_back(-n.y(), n.x());
   }
 
+  // The initial gap at every slave polyline position: at the node's end of a mortar segment that covers it (the
+  // segment after it first, then the one before), as the quadrature points measure it (gap_point).
+  void node_gaps() {
+    d_.initial_gap.assign(n_, std::numeric_limits<double>::quiet_NaN());
+    constexpr double kAtEnd = 1e-12;  // a mortar segment's end within this of the node's parameter covers it
+    for (size_t i = 0; i < n_; ++i) {
+      for (const auto& [k, xi] : {std::pair<size_t, double>{i, 0.0}, std::pair<size_t, double>{i - 1, 1.0}}) {
+        if (k >= on_segment_.size()) continue;  // i - 1 wrapped past 0, or the last position has no segment after
+        const MortarSegment* on = nullptr;
+        for (const auto* s : on_segment_[k])
+          if (s->xi0 <= xi + kAtEnd && s->xi1 >= xi - kAtEnd) on = s;
+        if (!on || !(on->xi1 > on->xi0)) continue;
+        const double u = std::clamp((xi - on->xi0) / (on->xi1 - on->xi0), 0.0, 1.0);
+        const GapPoint p = gap_point(*on, k, u, xi);
+        d_.initial_gap[i] = (pair_.gap.geometric ? p.gap : 0.0) + analytic_gap(pair_.gap, p.x);
+        break;
+      }
+    }
+  }
+
   // Sparse operators. Exact zeros (an axis-aligned normal touches one component only) are left out, which keeps
   // each body's interface unknowns minimal; tiny off-diagonal remainders of biorthogonality are dropped too.
   SparseRows sparse_rows(const VectorEntries& entries, int n_dofs) const {
@@ -539,6 +560,9 @@ class PairBuilder {
     d_.status.resize(n);
     d_.row_of_node.resize(n);
     d_.node_from_rows.resize(n);
+    // The start again: covered from the loop's last segment where its first does not cover it.
+    if (std::isnan(d_.initial_gap.front()) && n_ > n) d_.initial_gap.front() = d_.initial_gap[n_ - 1];
+    d_.initial_gap.resize(n);
   }
 
   // A pair whose group chains several slave edges: its own edge's stretch of the per-node results (positions
@@ -555,10 +579,12 @@ class PairBuilder {
       d_.status.push_back(d_.status.front());
       d_.row_of_node.push_back(d_.row_of_node.front());
       d_.node_from_rows.push_back(d_.node_from_rows.front());
+      d_.initial_gap.push_back(d_.initial_gap.front());
     }
     slice(d_.status);
     slice(d_.row_of_node);
     slice(d_.node_from_rows);
+    slice(d_.initial_gap);
     d_.node_arc = arc_.segment(from, to - from).array() - arc(first);
     std::vector<size_t> multipliers;
     for (size_t i : d_.multiplier_nodes)

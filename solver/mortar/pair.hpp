@@ -62,6 +62,11 @@ struct PairDiscretization {
   double loop_length = 0.0;        // a closed slave edge's length, its closing segment included (0 if open)
   std::vector<NodeStatus> status;  // per slave node
   std::vector<int> row_of_node;    // per slave node: its row, or -1
+  // Per slave node: the initial gap at the node itself (geometric, on the edges' true curves, plus the analytic gap;
+  // negative: the edges overlap there), measured along the slave's normal to the master; NaN where no side of the
+  // master lies opposite. The pointwise value the drawing gives, for the model checks (check/initial_gaps.hpp); the
+  // solver uses the weighted gaps (gap0).
+  std::vector<double> initial_gap;
 
   // One row per contact node.
   std::vector<int> node_of_row;  // row -> index into slave_nodes

@@ -25,7 +25,7 @@ import urllib.request
 
 from client_paths import CLIENT, EXAMPLES, HERE, SRC  # noqa: E402,F401  (sets the import path)
 from contact_client.plot import AXIS_LABELS  # noqa: E402
-from harness import Server, example, long_job, read_all_events, roller_job  # noqa: E402
+from harness import Server, example, flat_patch, long_job, read_all_events, roller_job  # noqa: E402
 from checks import check, finish, section, skip  # noqa: E402
 
 CHROMIUM_FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
@@ -232,6 +232,7 @@ def test_without_token(server, b, downloads):
 
     test_friction(server, b)
     test_wall(server, b)
+    test_warnings(server, b)
 
     # 4. An invalid job: every error with its pointer, no job created.
     bad = example("flat_patch.json")
@@ -366,6 +367,28 @@ def test_wall(server, b):
     b.el("pairs-show").click()
     check("wall: a pattern matching nothing says so", b.wait(lambda: "no pair" in b.text("pairs-message"), 10),
           b.text("pairs-message"))
+
+
+def test_warnings(server, b):
+    """3d. A job whose model checks warn (the shrink fit without its "fit": its interference is an undeclared
+    overlap): the job's view lists each warning with its pointer; a job without any shows none."""
+    job = example("shrink_fit.json")
+    for c in job["contacts"]:
+        c.pop("fit", None)
+    job_id = server.submit_id(job)
+    check("warnings: solved", server.wait_done(job_id, 120).get("state") == "SUCCEEDED")
+    b.driver.execute_script(f"window.location.hash = 'job={job_id}';")
+    shown = b.wait(lambda: b.el("job-warnings").is_displayed()
+                   and len(b.driver.find_elements(By.CSS_SELECTOR, "#job-warnings li")) == 2, 30)
+    text = b.text("job-warnings")
+    check("warnings: the view lists both pairs' warnings with their pointers",
+          bool(shown) and "/contacts/0" in text and "/contacts/1" in text and "overlap by up to 0.667" in text, text)
+    clean = server.submit_id(flat_patch(name="no-warnings"))
+    server.wait_done(clean, 60)
+    b.driver.execute_script(f"window.location.hash = 'job={clean}';")
+    check("warnings: a job without any shows none",
+          b.wait(lambda: b.text("job-id") == clean and not b.el("job-warnings").is_displayed(), 30),
+          b.text("job-warnings"))
 
 
 def test_with_token(b, downloads):

@@ -361,4 +361,48 @@ with tempfile.TemporaryDirectory() as tmp:
               and int(f.attrs["converged"]) == 0 and str(f.attrs["stop_reason"]) == "error",
               (list(f["history/steps/converged"][()]), list(f["steps"].keys())))
 
+# Models that are wrong say so (issue 49): the shrink fit without its "fit" declaration (its interference, an
+# undeclared overlap) and E in the wrong units (displacements far past the bodies' sizes). Each warning on stderr
+# with its pointer, --validate counts them, the exit code unchanged; --strict makes them errors (exit 2 before the
+# solve, exit 1 after it with the result kept); the result file's /warnings has the job's and the answer's.
+with tempfile.TemporaryDirectory() as tmp:
+    with open(os.path.join(SRC, "api", "examples", "shrink_fit.json")) as f:
+        job = json.load(f)
+    for c in job["contacts"]:
+        c.pop("fit")
+    undeclared = os.path.join(tmp, "undeclared.json")
+    with open(undeclared, "w") as f:
+        json.dump(job, f)
+    r = run("--validate", undeclared)
+    lines = [l for l in r.stderr.splitlines() if l.startswith("warning: ")]
+    check("warnings: --validate exits 0 and prints each pair's warning with its pointer",
+          r.returncode == 0 and [l.split(":")[1].strip() for l in lines] == ["/contacts/0", "/contacts/1"]
+          and "2 warnings above" in r.stdout, (r.returncode, r.stdout, r.stderr))
+    r = run("--validate", "--strict", undeclared)
+    check("warnings: --validate --strict refuses it (exit 2) at both pointers",
+          r.returncode == 2 and "/contacts/0: the edges of pair" in r.stderr and "/contacts/1: " in r.stderr,
+          (r.returncode, r.stderr[-600:]))
+    r = run("--validate", os.path.join(SRC, "api", "examples", "shrink_fit.json"))
+    check("warnings: the example, declared, has none", r.returncode == 0 and "warning" not in r.stderr, r.stderr)
+
+    with open(os.path.join(SRC, "api", "examples", "punch_force.json")) as f:  # loaded by a force: u ~ 1 / E
+        soft = json.load(f)
+    for body in soft["bodies"]:
+        body["material"]["E"] = body["material"]["E"] * 1e-6
+    soft_path = os.path.join(tmp, "soft.json")
+    with open(soft_path, "w") as f:
+        json.dump(soft, f)
+    out = os.path.join(tmp, "soft.hdf")
+    r = run("-q", soft_path, "-o", out)
+    lines = [l for l in r.stderr.splitlines() if l.startswith("warning: /bodies/")]
+    check("warnings: E a million times too small converges (exit 0) and names every body that moves far",
+          r.returncode == 0 and len(lines) == len(soft["bodies"]) and all("small-displacement" in l for l in lines),
+          (r.returncode, r.stderr[-800:]))
+    with h5py.File(out, "r") as f:
+        stored = [p.decode() if isinstance(p, bytes) else str(p) for p in f["warnings/pointer"][()]]
+    check("warnings: the result file's /warnings has them", stored == [l.split(":")[1].strip() for l in lines], stored)
+    r = run("-q", "--strict", soft_path, "-o", out)
+    check("warnings: --strict fails the run (exit 1), its result kept",
+          r.returncode == 1 and os.path.exists(out) and "strict: /bodies/" in r.stdout, (r.returncode, r.stdout[-400:]))
+
 finish()

@@ -96,6 +96,19 @@ def input_documents(c):
 
 
 @check
+def warnings(c):
+    w = c.f["warnings"]
+    pointers, messages = names(w["pointer"][()]), names(w["message"][()])
+    expect(len(pointers) == len(messages), "/warnings: pointer and message lengths differ")
+    for p, m in zip(pointers, messages):
+        expect(p == "" or p.startswith("/"), f"/warnings pointer {p!r} is not a JSON pointer")
+        expect(len(m) > 0, "/warnings: an empty message")
+    normalized = json.loads(c.f["input/normalized"].asstr()[()])
+    expect(all(x in messages for x in (e["message"] for e in normalized.get("warnings", []))),
+           "/warnings lacks a warning of the normalized job's")
+
+
+@check
 def provenance(c):
     p = c.f["provenance"]
     for key in ("solver_version", "compiler", "build_type", "host", "method", "enforcement"):

@@ -33,7 +33,7 @@ PUBLIC_HEADERS = {
     "mesh.hpp": "mesh", "problem.hpp": "problem", "result.hpp": "result", "solve.hpp": "solve",
     "session.hpp": "session", "job.hpp": "job", "result_file.hpp": "io", "progress_json.hpp": "io",
     "files.hpp": "common", "utc_time.hpp": "common", "background_work.hpp": "common", "version.hpp": "common",
-    "work_label.hpp": "common",
+    "work_label.hpp": "common", "warning.hpp": "common",
 }
 # The library's own files at the top of solver/, by the module (row of the table) they belong to.
 ROOT_FILES = {
@@ -73,8 +73,8 @@ def module_of(path):
 
 
 # --- the rules: the Layout table ------------------------------------------------------------------------------
-SOLVER_MODULES = ["ddm/interface", "mesh", "fem", "mortar", "linalg", "bem", "ddm", "adapt", "job", "io", "parallel",
-                  "mpi", "session", "problem", "result", "solve", "common"]
+SOLVER_MODULES = ["ddm/interface", "mesh", "fem", "mortar", "linalg", "bem", "ddm", "adapt", "check", "job", "io",
+                  "parallel", "mpi", "session", "problem", "result", "solve", "common"]
 SERVER_MODULES = ["common", "store", "metrics", "jobs", "transport", "http", "routes"]  # (cli: the public headers)
 
 

@@ -55,11 +55,16 @@ struct Limits {
   // Unset, a job may not name a file (the server: a job sends the .msh text as "data").
   std::optional<std::string> mesh_directory;
   std::size_t max_mesh_file_bytes = 256u << 20;  // a .msh file read from disk
+  // Every job strict: its warnings are errors (contact-solve --strict; a job asks for it with "strict": true).
+  bool strict = false;
 };
 
 struct ParseResult {
   std::optional<Problem> problem;  // set if and only if errors is empty
   std::vector<ValidationError> errors;
+  // What the model checks found in a valid job (the same as problem->warnings; docs/job-format.md, "Warnings"): a
+  // strict job has none here, they are among its errors.
+  std::vector<Warning> warnings;
   bool ok() const { return errors.empty(); }
 };
 

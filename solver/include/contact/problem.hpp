@@ -7,6 +7,7 @@
 #pragma once
 
 #include "contact/mesh.hpp"
+#include "contact/warning.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -90,6 +91,11 @@ struct FrictionSpec {
   bool active() const { return law != Law::none; }
 };
 
+// What the drawing of a pair's edges means (docs/job-format.md, "fit"): touching (the edges drawn on each other:
+// an overlap or a pair open everywhere is a modelling mistake, warned of), interference (drawn overlapping: a shrink
+// or press fit) or clearance (drawn apart: a pin in a larger hole, a punch above its block).
+enum class Fit { touching, interference, clearance };
+
 struct ContactPair {
   std::string name;     // "slave_body.edge-master_body.edge" unless the job names it
   int slave_body = -1;  // index into Problem::bodies
@@ -98,6 +104,7 @@ struct ContactPair {
   std::string master_edge;
   GapSpec gap;
   FrictionSpec friction;
+  Fit fit = Fit::touching;
 };
 
 // theta = c * length / E_pair unless theta is given. E_pair is the harmonic mean 2 E1 E2 / (E1 + E2) of the
@@ -272,7 +279,11 @@ struct Problem {
   AdaptivitySettings adaptivity;
   LoadingSpec loading;
   OutputSettings output;
-  int ranks = 1;              // parallel.ranks: MPI ranks a server launches (contact-solve takes mpirun's)
+  int ranks = 1;        // parallel.ranks: MPI ranks a server launches (contact-solve takes mpirun's)
+  bool strict = false;  // warnings are errors (the job's "strict", contact-solve --strict)
+  // What the model checks found before the solve (check/initial_gaps.hpp: overlaps and open pairs), as the job
+  // reader reports them; the solve adds its own to Result::warnings.
+  std::vector<Warning> warnings;
   nlohmann::json submitted;   // the job JSON as submitted
   nlohmann::json normalized;  // the same with every default filled in
 

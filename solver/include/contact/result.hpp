@@ -3,6 +3,7 @@
 #pragma once
 
 #include "contact/mesh.hpp"
+#include "contact/warning.hpp"
 
 #include <Eigen/Core>
 
@@ -190,6 +191,9 @@ struct Result : RunOutcome {
   // When the run did not converge: what the result keeps, as the end of `message` says it ("the result keeps the 2
   // load steps that held, not the last iterate (...)"); empty when it converged or nothing was solved.
   std::string kept;
+  // The problem's warnings (before the solve) and the solve's (check/large_motion.hpp: displacements and rotations
+  // that void the small-displacement model, floating bodies moved far), in that order.
+  std::vector<Warning> warnings;
   double wall_seconds = 0.0;
   double setup_seconds = 0.0;  // assembly + factorisations
   double factorization_seconds = 0.0;

@@ -175,6 +175,7 @@ struct ResultFile {
   std::string method;
   // /input
   std::string job_json, normalized_json;
+  std::vector<Warning> warnings;  // /warnings: the model checks' (empty in a file written before them)
   Provenance provenance;
   IterationHistory history;
   StepHistory step_history;
