@@ -48,7 +48,8 @@ Motion motion_of(const BodyField& b) {
 constexpr const char* kVoid =
     ": the model is linear and small-displacement (strains from the displacements' first derivatives, contact on "
     "the drawn geometry), so this answer is not to be trusted there. Check the units of the loads and of E, the "
-    "supports, and that the body is drawn where it rests";
+    "supports, and that the body is drawn where it rests; a body that rolls or tips (a mechanism its contacts do not "
+    "stop) moves this far in a linear model";
 
 }  // namespace
 

@@ -140,12 +140,13 @@ BodyField read_body(hid_t bodies, const std::string& name) {
       b.mesh.cells.emplace_back(cells(e, 0), cells(e, 1), cells(e, 2), cells(e, 3));
   }
   b.mesh.level = h5::read_vector<int>(g, "level");
-  b.displacement = read_matrix<double>(g, "displacement", 2);
-  b.stress_cell = read_matrix<double>(g, "stress_cell", 4);
-  b.stress_node = read_matrix<double>(g, "stress_node", 4);
-  b.von_mises_cell = read_column<double>(g, "von_mises");
-  if (h5::has_link(g, "indicator")) b.indicator_cell = read_column<double>(g, "indicator");
-  b.reaction = read_matrix<double>(g, "reaction", 2);
+  body_fields(b, [&](const BodyFieldColumn& f, auto& v) {
+    if (f.optional && !h5::has_link(g, f.name)) return;
+    if constexpr (std::decay_t<decltype(v)>::ColsAtCompileTime == 1)
+      v = read_column<double>(g, f.name);
+    else
+      v = read_matrix<double>(g, f.name, f.components);
+  });
   if (h5::has_attribute(g, "reaction_total")) {  // since the resultants (older files: absent)
     const auto t = h5::read_attribute_array<double>(g, "reaction_total");
     if (t.size() == 2) b.reaction_total = Eigen::Vector2d(t[0], t[1]);

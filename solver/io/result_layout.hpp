@@ -65,6 +65,31 @@ void step_columns(History& h, Visit&& visit) {
   visit(HistoryColumn{"tangential_force", A::pairs, S::float64, true}, h.tangential_force);
 }
 
+// ---- /steps/<k>/bodies/<body> ------------------------------------------------------------------------------
+
+// A body's fields (docs/results-format.md, "/steps/<k>/bodies/<body>/"): a value or a row of components per node or
+// per cell, float64. The mesh (points, cells, cell_types, quads or xdmf_topology, level), the sidecar's stress
+// tensors and the supports' sums are written from the mesh and these fields (write_result.cpp, write_body).
+struct BodyFieldColumn {
+  enum class Per { node, cell };
+  const char* name;
+  Per per;
+  int components;  // 1: a (rows,) dataset
+  bool optional;   // absent where the body has none (empty member)
+};
+
+// visit(column, member) for every field of a body; Body is BodyField or its const.
+template <class Body, class Visit>
+void body_fields(Body& b, Visit&& visit) {
+  using P = BodyFieldColumn::Per;
+  visit(BodyFieldColumn{"displacement", P::node, 2, false}, b.displacement);
+  visit(BodyFieldColumn{"stress_cell", P::cell, 4, false}, b.stress_cell);
+  visit(BodyFieldColumn{"stress_node", P::node, 4, false}, b.stress_node);
+  visit(BodyFieldColumn{"von_mises", P::cell, 1, false}, b.von_mises_cell);
+  visit(BodyFieldColumn{"indicator", P::cell, 1, true}, b.indicator_cell);
+  visit(BodyFieldColumn{"reaction", P::node, 2, false}, b.reaction);
+}
+
 // ---- /steps/<k>/contacts ---------------------------------------------------------------------------------
 
 // A step's contact pairs as tables (format version 3): every pair's slave nodes one after the other, the pairs'

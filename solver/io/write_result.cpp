@@ -20,6 +20,7 @@
 #include <memory>
 #include <new>
 #include <system_error>
+#include <type_traits>
 
 namespace contact::io {
 
@@ -283,12 +284,10 @@ void write_body(hid_t bodies, const BodyField& b, const std::string& where) {
   const Eigen::Index n = m.num_nodes();
   const Eigen::Index c = m.num_cells();
   const std::string at = where + " body '" + b.name + "': ";
-  check_rows(at + "displacement", b.displacement.rows(), n);
-  check_rows(at + "stress_node", b.stress_node.rows(), n);
-  check_rows(at + "reaction", b.reaction.rows(), n);
-  check_rows(at + "stress_cell", b.stress_cell.rows(), c);
-  check_rows(at + "von_mises_cell", b.von_mises_cell.rows(), c);
-  check_rows(at + "indicator_cell", b.indicator_cell.rows(), c);
+  using Per = BodyFieldColumn::Per;
+  body_fields(b, [&](const BodyFieldColumn& f, const auto& v) {
+    if (!(f.optional && v.size() == 0)) check_rows(at + f.name, v.rows(), f.per == Per::node ? n : c);
+  });
   check_rows(at + "mesh level", static_cast<Eigen::Index>(m.level.size()), c);
 
   Handle g = h5::create_group(bodies, b.name);
@@ -317,14 +316,15 @@ void write_body(hid_t bodies, const BodyField& b, const std::string& where) {
   else
     h5::hard_link(g, "cells", "quads");
   h5::write_vector(g, "level", level);
-  write_matrix(g, "displacement", b.displacement);
-  write_matrix(g, "stress_cell", b.stress_cell);
-  write_matrix(g, "stress_node", b.stress_node);
+  body_fields(b, [&](const BodyFieldColumn& f, const auto& v) {
+    if (f.optional && v.size() == 0) return;
+    if constexpr (std::decay_t<decltype(v)>::ColsAtCompileTime == 1)
+      write_column(g, f.name, v);
+    else
+      write_matrix(g, f.name, v);
+  });
   write_matrix(g, "stress_cell_tensor", stress_tensor(b.stress_cell));  // the sidecar's (view_layout.hpp)
   write_matrix(g, "stress_node_tensor", stress_tensor(b.stress_node));
-  write_column(g, "von_mises", b.von_mises_cell);
-  if (b.indicator_cell.size() > 0) write_column(g, "indicator", b.indicator_cell);
-  write_matrix(g, "reaction", b.reaction);
   h5::write_attribute_array<double>(g, "reaction_total", {b.reaction_total.x(), b.reaction_total.y()});
   if (!b.support_reactions.empty()) {
     std::vector<std::string> names;

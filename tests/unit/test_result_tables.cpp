@@ -108,6 +108,32 @@ TEST(ResultLayout, TheContactTablesAreTheDocumentsTablesNameShapeAndType) {
   EXPECT_EQ(declared, documented);
 }
 
+// A body's fields are declared once (body_fields); the document's body table lists them with their shapes, and
+// besides them only what write_body makes from the mesh and the fields (named here: a dataset the writer adds
+// must be one or the other).
+TEST(ResultLayout, TheBodyFieldsAreTheDocumentsBodyTableNameShapeAndType) {
+  contact::BodyField b;
+  ColumnSet declared;
+  std::set<std::string> names;
+  contact::io::body_fields(b, [&](const contact::io::BodyFieldColumn& f, const auto&) {
+    const std::string rows = f.per == contact::io::BodyFieldColumn::Per::node ? "n" : "m";
+    declared.insert(std::string(f.name) + " (" + rows +
+                    (f.components == 1 ? ",)" : ", " + std::to_string(f.components) + ")") + " float64");
+    names.insert(f.name);
+  });
+  const ColumnSet documented = documented_columns("`/steps/<k>/bodies/<body>/`:", "`/steps/<k>/contacts/` holds");
+  const std::set<std::string> from_the_mesh = {"points",           "cells", "cell_types",         "quads",
+                                               "xdmf_topology",    "level", "stress_cell_tensor", "stress_node_tensor",
+                                               "support_reactions"};
+  EXPECT_EQ(declared.size(), 6u);
+  for (const auto& line : declared) EXPECT_EQ(documented.count(line), 1u) << line << " is not in the document";
+  for (const auto& line : documented) {
+    const std::string name = line.substr(0, line.find(' '));
+    EXPECT_TRUE(names.count(name) || from_the_mesh.count(name)) << name << " is documented but neither declared "
+                                                                << "(body_fields) nor made by write_body";
+  }
+}
+
 TEST(ResultLayout, TheHistoryTablesReadBackAsWritten) {
   // Written by the one table and read by it: every column comes back (two load steps, Coulomb on one pair).
   std::ifstream in(std::string(CONTACT_SOURCE_DIR) + "/tests/data/result_format_v2.json");
