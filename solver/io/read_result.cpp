@@ -25,6 +25,28 @@ Eigen::MatrixXd read_components(hid_t loc, const std::string& name) {
   return read_matrix<double>(loc, name);
 }
 
+// One attribute of result_layout.hpp's lists into its member. An optional one a file written before it existed lacks
+// leaves the member as it is; a required one missing throws (naming it).
+struct AttributeReader {
+  hid_t obj;
+  bool absent(const AttributeColumn& a) const { return a.optional && !h5::has_attribute(obj, a.name); }
+  void operator()(const AttributeColumn& a, std::string& v) const {
+    if (!absent(a)) v = h5::read_string_attribute(obj, a.name);
+  }
+  void operator()(const AttributeColumn& a, bool& v) const {
+    if (!absent(a)) v = h5::read_attribute<std::int32_t>(obj, a.name) != 0;
+  }
+  void operator()(const AttributeColumn& a, int& v) const {
+    if (!absent(a)) v = h5::read_attribute<std::int32_t>(obj, a.name);
+  }
+  void operator()(const AttributeColumn& a, std::int64_t& v) const {
+    if (!absent(a)) v = h5::read_attribute<std::int64_t>(obj, a.name);
+  }
+  void operator()(const AttributeColumn& a, double& v) const {
+    if (!absent(a)) v = h5::read_attribute<double>(obj, a.name);
+  }
+};
+
 void read_root(hid_t file, ResultFile& r) {
   if (!h5::has_attribute(file, "format"))
     throw std::runtime_error(std::string("not a result file: the root has no 'format' attribute (expected '") +
@@ -36,16 +58,7 @@ void read_root(hid_t file, ResultFile& r) {
   if (r.format_version > kFormatVersion)
     throw std::runtime_error("format_version " + std::to_string(r.format_version) + " is newer than this reader's " +
                              std::to_string(kFormatVersion));
-  r.solver_version = h5::read_string_attribute(file, "solver_version");
-  r.job_id = h5::read_string_attribute(file, "job_id");
-  r.job_name = h5::read_string_attribute(file, "name");
-  r.created = h5::read_string_attribute(file, "created");
-  r.wall_seconds = h5::read_attribute<double>(file, "wall_seconds");
-  r.converged = h5::read_attribute<std::int32_t>(file, "converged") != 0;
-  r.stop_reason = h5::read_string_attribute(file, "stop_reason");
-  r.message = h5::read_string_attribute(file, "message");
-  r.iterations = h5::read_attribute<std::int32_t>(file, "iterations");
-  r.method = h5::read_string_attribute(file, "method");
+  root_attributes(r, AttributeReader{file});
 }
 
 void read_input_and_provenance(hid_t file, ResultFile& r) {
@@ -65,16 +78,7 @@ void read_input_and_provenance(hid_t file, ResultFile& r) {
 
   Handle prov = h5::open_group(file, "provenance");
   Provenance& p = r.provenance;
-  p.solver_version = h5::read_string_attribute(prov, "solver_version");
-  p.compiler = h5::read_string_attribute(prov, "compiler");
-  p.build_type = h5::read_string_attribute(prov, "build_type");
-  p.host = h5::read_string_attribute(prov, "host");
-  p.method = h5::read_string_attribute(prov, "method");
-  p.enforcement = h5::read_string_attribute(prov, "enforcement");
-  p.gamma = h5::read_attribute<double>(prov, "gamma");
-  p.setup_seconds = h5::read_attribute<double>(prov, "setup_seconds");
-  p.factorization_seconds = h5::read_attribute<double>(prov, "factorization_seconds");
-  p.wall_seconds = h5::read_attribute<double>(prov, "wall_seconds");
+  provenance_attributes(p, AttributeReader{prov});
   p.pair_names = h5::read_strings_dataset(prov, "pair_names");
   p.theta = h5::read_vector<double>(prov, "theta");
 }

@@ -65,6 +65,54 @@ void step_columns(History& h, Visit&& visit) {
   visit(HistoryColumn{"tangential_force", A::pairs, S::float64, true}, h.tangential_force);
 }
 
+// ---- the root's and /provenance's attributes --------------------------------------------------------------
+
+// One scalar attribute (docs/results-format.md, "Root attributes" and "/provenance"); a bool member is stored as int32
+// 0 or 1.
+struct AttributeColumn {
+  enum class Stored { text, int32, int64, float64 };
+  const char* name;
+  Stored stored;
+  bool optional = false;  // absent in older files: the member keeps its default
+};
+
+// visit(attribute, member) for every root attribute; File is ResultFile or its const.
+template <class File, class Visit>
+void root_attributes(File& r, Visit&& visit) {
+  using S = AttributeColumn::Stored;
+  visit(AttributeColumn{"format", S::text}, r.format);
+  visit(AttributeColumn{"format_version", S::int32}, r.format_version);
+  visit(AttributeColumn{"solver_version", S::text}, r.solver_version);
+  visit(AttributeColumn{"job_id", S::text}, r.job_id);
+  visit(AttributeColumn{"name", S::text}, r.job_name);
+  visit(AttributeColumn{"created", S::text}, r.created);
+  visit(AttributeColumn{"wall_seconds", S::float64}, r.wall_seconds);
+  visit(AttributeColumn{"converged", S::int32}, r.converged);
+  visit(AttributeColumn{"stop_reason", S::text}, r.stop_reason);
+  visit(AttributeColumn{"message", S::text}, r.message);
+  visit(AttributeColumn{"iterations", S::int32}, r.iterations);
+  visit(AttributeColumn{"method", S::text}, r.method);
+}
+
+// visit(attribute, member) for every attribute of /provenance; Prov is Provenance or its const. (Its datasets,
+// pair_names and theta, are the final step's pairs'.)
+template <class Prov, class Visit>
+void provenance_attributes(Prov& p, Visit&& visit) {
+  using S = AttributeColumn::Stored;
+  visit(AttributeColumn{"solver_version", S::text}, p.solver_version);
+  visit(AttributeColumn{"compiler", S::text}, p.compiler);
+  visit(AttributeColumn{"build_type", S::text}, p.build_type);
+  visit(AttributeColumn{"host", S::text}, p.host);
+  visit(AttributeColumn{"method", S::text}, p.method);
+  visit(AttributeColumn{"enforcement", S::text}, p.enforcement);
+  visit(AttributeColumn{"interface_solver", S::text, true}, p.interface_solver);
+  visit(AttributeColumn{"interface_iterations", S::int64, true}, p.interface_iterations);
+  visit(AttributeColumn{"gamma", S::float64}, p.gamma);
+  visit(AttributeColumn{"setup_seconds", S::float64}, p.setup_seconds);
+  visit(AttributeColumn{"factorization_seconds", S::float64}, p.factorization_seconds);
+  visit(AttributeColumn{"wall_seconds", S::float64}, p.wall_seconds);
+}
+
 // ---- /steps/<k>/bodies/<body> ------------------------------------------------------------------------------
 
 // A body's fields (docs/results-format.md, "/steps/<k>/bodies/<body>/"): a value or a row of components per node or

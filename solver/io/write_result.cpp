@@ -66,19 +66,31 @@ void check_rows(const std::string& what, Eigen::Index rows, Eigen::Index expecte
 
 // ---- root, input, provenance --------------------------------------------------------------------------
 
+// One attribute of result_layout.hpp's lists, as the list says it is stored.
+struct AttributeWriter {
+  hid_t obj;
+  void operator()(const AttributeColumn& a, const std::string& v) const { h5::write_attribute(obj, a.name, v); }
+  void operator()(const AttributeColumn& a, bool v) const { h5::write_attribute<std::int32_t>(obj, a.name, v ? 1 : 0); }
+  void operator()(const AttributeColumn& a, int v) const { h5::write_attribute<std::int32_t>(obj, a.name, v); }
+  void operator()(const AttributeColumn& a, std::int64_t v) const { h5::write_attribute<std::int64_t>(obj, a.name, v); }
+  void operator()(const AttributeColumn& a, double v) const { h5::write_attribute<double>(obj, a.name, v); }
+};
+
 void write_root_attributes(hid_t file, const Problem& problem, const Result& result, const WriteInfo& info) {
-  h5::write_attribute(file, "format", kFormatName);
-  h5::write_attribute<std::int32_t>(file, "format_version", kFormatVersion);
-  h5::write_attribute(file, "solver_version", solver_version());
-  h5::write_attribute(file, "job_id", info.job_id);
-  h5::write_attribute(file, "name", problem.name);
-  h5::write_attribute(file, "created", info.created);
-  h5::write_attribute<double>(file, "wall_seconds", result.wall_seconds);
-  h5::write_attribute<std::int32_t>(file, "converged", result.converged ? 1 : 0);
-  h5::write_attribute(file, "stop_reason", to_string(result.stop_reason));
-  h5::write_attribute(file, "message", result.message);
-  h5::write_attribute<std::int32_t>(file, "iterations", result.iterations);
-  h5::write_attribute(file, "method", result.method);
+  ResultFile root;
+  root.format = kFormatName;
+  root.format_version = kFormatVersion;
+  root.solver_version = solver_version();
+  root.job_id = info.job_id;
+  root.job_name = problem.name;
+  root.created = info.created;
+  root.wall_seconds = result.wall_seconds;
+  root.converged = result.converged;
+  root.stop_reason = to_string(result.stop_reason);
+  root.message = result.message;
+  root.iterations = result.iterations;
+  root.method = result.method;
+  root_attributes(root, AttributeWriter{file});
 }
 
 std::string dump_json(const nlohmann::json& j) {
@@ -106,18 +118,20 @@ void write_warnings(hid_t file, const Result& result) {
 
 void write_provenance(hid_t file, const Result& result, const WriteInfo& info) {
   Handle prov = h5::create_group(file, "provenance");
-  h5::write_attribute(prov, "solver_version", solver_version());
-  h5::write_attribute(prov, "compiler", compiler_name());
-  h5::write_attribute(prov, "build_type", build_type());
-  h5::write_attribute(prov, "host", info.host);
-  h5::write_attribute(prov, "method", result.method);
-  h5::write_attribute(prov, "enforcement", result.enforcement);
-  h5::write_attribute(prov, "interface_solver", result.interface_solver);
-  h5::write_attribute<std::int64_t>(prov, "interface_iterations", result.interface_iterations);
-  h5::write_attribute<double>(prov, "gamma", result.gamma);
-  h5::write_attribute<double>(prov, "setup_seconds", result.setup_seconds);
-  h5::write_attribute<double>(prov, "factorization_seconds", result.factorization_seconds);
-  h5::write_attribute<double>(prov, "wall_seconds", result.wall_seconds);
+  Provenance p;
+  p.solver_version = solver_version();
+  p.compiler = compiler_name();
+  p.build_type = build_type();
+  p.host = info.host;
+  p.method = result.method;
+  p.enforcement = result.enforcement;
+  p.interface_solver = result.interface_solver;
+  p.interface_iterations = result.interface_iterations;
+  p.gamma = result.gamma;
+  p.setup_seconds = result.setup_seconds;
+  p.factorization_seconds = result.factorization_seconds;
+  p.wall_seconds = result.wall_seconds;
+  provenance_attributes(p, AttributeWriter{prov});
   std::vector<std::string> names;
   std::vector<double> theta;
   if (!result.steps.empty()) {

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <regex>
 #include <set>
 #include <string>
@@ -132,6 +133,34 @@ TEST(ResultLayout, TheBodyFieldsAreTheDocumentsBodyTableNameShapeAndType) {
     EXPECT_TRUE(names.count(name) || from_the_mesh.count(name)) << name << " is documented but neither declared "
                                                                 << "(body_fields) nor made by write_body";
   }
+}
+
+// The root's attributes and /provenance's are declared once (root_attributes, provenance_attributes): the root's are
+// the document's table, name and type; every attribute of /provenance is named in its section.
+TEST(ResultLayout, TheRootAndProvenanceAttributesAreTheDocuments) {
+  auto type_of = [](const contact::io::AttributeColumn& a) {
+    using S = contact::io::AttributeColumn::Stored;
+    return a.stored == S::text ? "str" : a.stored == S::int32 ? "int32" : a.stored == S::int64 ? "int64" : "float64";
+  };
+  contact::io::ResultFile r;
+  ColumnSet declared;
+  contact::io::root_attributes(r, [&](const contact::io::AttributeColumn& a, const auto&) {
+    declared.insert(std::string(a.name) + " " + type_of(a));
+  });
+  EXPECT_EQ(declared.size(), 12u);
+  EXPECT_EQ(declared, documented_columns("### Root attributes"));
+
+  std::ifstream in(std::string(CONTACT_SOURCE_DIR) + "/docs/results-format.md");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const size_t from = text.find("### `/provenance`"), to = text.find("\n### ", from + 1);
+  ASSERT_NE(from, std::string::npos);
+  const std::string section = text.substr(from, to - from);
+  int count = 0;
+  contact::io::provenance_attributes(r.provenance, [&](const contact::io::AttributeColumn& a, const auto&) {
+    EXPECT_NE(section.find(std::string("`") + a.name + "`"), std::string::npos) << a.name << " is not documented";
+    ++count;
+  });
+  EXPECT_EQ(count, 12);
 }
 
 TEST(ResultLayout, TheHistoryTablesReadBackAsWritten) {

@@ -114,6 +114,8 @@ double kept_nodes_within(double bytes, double bodies, double pairs, double kept_
 
 struct Provenance {
   std::string solver_version, compiler, build_type, host, method, enforcement;
+  std::string interface_solver;           // "direct" or "iterative" (interface_newton), else ""
+  std::int64_t interface_iterations = 0;  // the iterative interface solver's MPRGP iterations
   double gamma = 0.0;
   double setup_seconds = 0.0, factorization_seconds = 0.0, wall_seconds = 0.0;
   std::vector<std::string> pair_names;  // of the final step
