@@ -207,9 +207,11 @@ Displacements ContactSystem::loads_from_pressures(const Pressures& z, const Pres
 bool ContactSystem::has_histories() const {
   for (const auto& b : bodies_)
     if (b->has_histories()) return true;
-  for (const auto& body : problem_.bodies)  // bodies of other processes are not assembled here
+  for (const auto& body : problem_.bodies) {  // bodies of other processes are not assembled here
+    if (!body.body_force_history.empty()) return true;
     for (const auto& bc : body.boundary)
       if (!bc.history.empty()) return true;
+  }
   return false;
 }
 

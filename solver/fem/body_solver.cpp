@@ -21,6 +21,7 @@ BodySolver::BodySolver(const Body& body, const Model& model, bool factorize_now,
                        bool allow_floating, bool local, std::function<bool()> cancelled)
     : body_(body),
       elasticity_(make_elasticity(body.material, model)),
+      weight_(body.weight(model.gravity)),
       constraints_(2 * body.mesh.num_nodes()),
       interface_dofs_(interface_dofs),
       allow_floating_(allow_floating),
@@ -148,10 +149,24 @@ void BodySolver::add_condition_load(const BoundaryCondition& bc, Eigen::VectorXd
 void BodySolver::setup_history_groups() {
   const auto& m = body_.mesh;
   const Eigen::SparseMatrix<double, Eigen::RowMajor> T = constraints_.T();
+  if (!body_.body_force_history.empty() && body_.body_force.squaredNorm() > 0) {
+    // The job's body force (not the weight, which follows the loading) at factor 1, cell by cell.
+    LoadGroup group;
+    group.history = &body_.body_force_history;
+    group.f_ext = Eigen::VectorXd::Zero(n_dofs());
+    for (int c = 0; c < m.num_cells(); ++c) {
+      const CellVector fe = cell_body_force(m, c, body_.body_force, elasticity_);
+      const CellDofs dofs = cell_dofs(m.cells[static_cast<size_t>(c)]);
+      for (Eigen::Index i = 0; i < dofs.size(); ++i) group.f_ext[dofs[i]] += fe[i];
+    }
+    group.g = Eigen::VectorXd::Zero(n_dofs());
+    group.rhs = T.transpose() * group.f_ext;
+    groups_.push_back(std::move(group));
+  }
   for (const auto& bc : body_.boundary) {
     if (bc.history.empty()) continue;
     LoadGroup group;
-    group.condition = &bc;
+    group.history = &bc.history;
     group.f_ext = Eigen::VectorXd::Zero(n_dofs());
     add_condition_load(bc, group.f_ext);
     group.g = Eigen::VectorXd::Zero(n_dofs());
@@ -179,7 +194,7 @@ Eigen::VectorXd BodySolver::scaled(const Eigen::VectorXd& base, Eigen::VectorXd 
   const double factor = at.value();
   Eigen::VectorXd out = factor * base;
   for (const auto& group : groups_) {
-    const double own = at.of_history(group.condition->history);
+    const double own = at.of_history(*group.history);
     if (own != factor) out += (own - factor) * (group.*part);
   }
   return out;
@@ -196,7 +211,9 @@ void BodySolver::assemble_system() {
   const Eigen::SparseMatrix<double, Eigen::RowMajor> T = constraints_.T();
   const Eigen::VectorXd& g = constraints_.g();
   f_ext_ = Eigen::VectorXd::Zero(n);
-  const bool has_body_force = body_.body_force.squaredNorm() > 0;
+  // The body forces at factor 1: the job's body_force and the body's weight under gravity.
+  const Eigen::Vector2d body_force = body_.body_force + weight_;
+  const bool has_body_force = body_force.squaredNorm() > 0;
 
   // Edge tractions: constant over each straight side, so the consistent load is half the side's force at
   // each end node (exact). A normal pressure p acts as t = -p n with n the outward normal. A total force on an
@@ -243,7 +260,7 @@ void BodySolver::assemble_system() {
     const Eigen::Index nd = dofs.size();
     CellVector fe = CellVector::Zero(nd);
     if (has_body_force) {
-      fe = cell_body_force(m, c, body_.body_force, elasticity_);
+      fe = cell_body_force(m, c, body_force, elasticity_);
       for (Eigen::Index i = 0; i < nd; ++i) f_ext_[dofs[i]] += fe[i];
     }
     const CellVector load = fe - Ke * cell_values(m, c, g);  // this element's share of f - K g

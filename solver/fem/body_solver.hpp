@@ -112,10 +112,10 @@ class BodySolver {
   double assembly_seconds() const { return assembly_seconds_; }
 
  private:
-  // One per condition with a history: its share of the loads (f_ext), of the prescribed values (g) and of the
-  // reduced right-hand side (T^T (f - K g)), at factor 1.
+  // One per load with a history of its own (a condition's, or the body force's): its share of the loads (f_ext), of
+  // the prescribed values (g) and of the reduced right-hand side (T^T (f - K g)), at factor 1.
   struct LoadGroup {
-    const BoundaryCondition* condition = nullptr;
+    const std::vector<double>* history = nullptr;
     Eigen::VectorXd f_ext, g, rhs;
   };
   void setup_constraints();
@@ -131,6 +131,7 @@ class BodySolver {
 
   const Body& body_;
   Elasticity elasticity_;
+  Eigen::Vector2d weight_;  // density x gravity, per volume (follows the loading)
   Constraints constraints_;
   // Shared with a factorisation that a cancel may leave running after this object is gone.
   std::shared_ptr<const Eigen::SparseMatrix<double>> K_red_ = std::make_shared<const Eigen::SparseMatrix<double>>();

@@ -279,15 +279,18 @@ void JobReader::read_header(const Fields& top) {
 void JobReader::read_model(const Fields& top) {
   json& out = sub_object(normalized_, "model");
   if (const json* v = top.find("model")) {
-    Fields f(*v, top.at("model"), "model", {"plane", "thickness"}, errors_);
+    Fields f(*v, top.at("model"), "model", {"plane", "thickness", "gravity"}, errors_);
     if (const json* p = f.find("plane")) read_name(*p, f.at("plane"), "plane", problem_.model.plane, errors_);
     if (const json* t = f.find("thickness")) {
       if (auto x = positive(*t, f.at("thickness"), "thickness", errors_)) problem_.model.thickness = *x;
     }
+    if (const json* g = f.find("gravity"))
+      if (auto x = read::pair(*g, f.at("gravity"), "gravity", errors_)) problem_.model.gravity = *x;
   }
   const Model d;  // contact/problem.hpp's defaults
   set_default(out, "plane", name_of(d.plane));
   set_default(out, "thickness", d.thickness);
+  set_default(out, "gravity", json::array({d.gravity.x(), d.gravity.y()}));
 }
 
 // The normalized counterpart of a sub-object, created as {} if absent. Where the submitted value has the

@@ -80,6 +80,7 @@ struct BodyInput {
   MeshInput mesh;
   std::vector<std::string> free_motions;  // rigid motions its displacement conditions leave free (a floating body)
   std::vector<std::string> condition_pointers;  // per entry of body.boundary: its pointer (/bodies/i/boundary/j)
+  std::string body_force_pointer;               // /bodies/i/body_force when it has a history, else ""
 };
 
 // Questions on what was read of a mesh (read_meshes.cpp).
@@ -195,7 +196,8 @@ class JobReader {
 
   // read_friction.cpp: a pair's friction, a condition's load history, and what they require of the rest
   void read_friction(const Fields& contact, FrictionSpec& friction);
-  void read_history(const Fields& condition, BoundaryCondition& bc);
+  void read_history(const Fields& condition, std::vector<double>& history);
+  void read_body_force(const json& value, const std::string& pointer, BodyInput& in);
   void check_friction_and_histories();
 
   const json& job_;

@@ -93,22 +93,45 @@ void JobReader::read_body(const json& value, BodyInput& in, json& out) {
       in.body.name = *s;
       in.has_name = true;
     }
-  if (const json* m = f.require("material", "an object {\"E\": Young's modulus, \"nu\": Poisson's ratio}"))
+  if (const json* m = f.require("material", "an object {\"E\": Young's modulus, \"nu\": Poisson's ratio}")) {
     read_material(*m, f.at("material"), in.body.material);
+    set_default(sub_object(out, "material"), "density", Material{}.density);
+  }
   if (const json* m = f.require("mesh",
                                 "one of {\"block\": {...}}, {\"nodes\": ..., \"quads\": ..., \"edges\": ...} "
                                 "or {\"gmsh\": {...}}"))
     read_mesh(*m, f.at("mesh"), in.mesh, sub_object(out, "mesh"));
   if (const json* b = f.find("boundary")) read_boundary(*b, f.at("boundary"), in);
   set_default(out, "boundary", json::array());
-  if (const json* b = f.find("body_force"))
-    if (auto v = read::pair(*b, f.at("body_force"), "body_force", errors_)) in.body.body_force = *v;
+  if (const json* b = f.find("body_force")) read_body_force(*b, f.at("body_force"), in);
   const Eigen::Vector2d none = Body{}.body_force;  // contact/problem.hpp's default
   set_default(out, "body_force", json::array({none.x(), none.y()}));
 }
 
+// [x, y] (force per volume, following the loading), or {"value": [x, y], "history": [...]}: its own factor per
+// load step, as a condition's history.
+void JobReader::read_body_force(const json& value, const std::string& pointer, BodyInput& in) {
+  if (!value.is_object()) {
+    if (auto v = read::pair(value, pointer, "body_force", errors_)) in.body.body_force = *v;
+    return;
+  }
+  Fields f(value, pointer, "body_force", {"value", "history"}, errors_);
+  if (!f.ok()) return;
+  if (const json* v = f.require("value", "the force per volume [x, y]"))
+    if (auto x = read::pair(*v, f.at("value"), "value", errors_)) in.body.body_force = *x;
+  read_history(f, in.body.body_force_history);
+  if (f.has("history")) in.body_force_pointer = pointer;
+}
+
 void JobReader::read_material(const json& value, const std::string& pointer, Material& material) {
-  Fields f(value, pointer, "material", {"E", "nu"}, errors_);
+  Fields f(value, pointer, "material", {"E", "nu", "density"}, errors_);
+  if (const json* d = f.find("density"))
+    if (auto x = read::number(*d, f.at("density"), "density", errors_)) {
+      if (*x >= 0)
+        material.density = *x;
+      else
+        errors_.add(f.at("density"), "density = " + format_number(*x) + " must not be negative (mass per volume)");
+    }
   if (const json* e = f.require("E", "Young's modulus, a positive number"))
     if (auto x = read::number(*e, f.at("E"), "E", errors_)) {
       if (*x > 0)
@@ -153,7 +176,7 @@ void JobReader::read_condition(const json& value, const std::string& bp, BodyInp
   if (!condition_kinds_allowed(f, bp, at_vertex)) return;
   read_condition_values(f, bp, bc);
   check_loads_off_supports(f, bp, bc);
-  read_history(f, bc);
+  read_history(f, bc.history);
   if (errors_.size() == before) {
     in.body.boundary.push_back(bc);
     in.condition_pointers.push_back(bp);

@@ -30,7 +30,7 @@ void JobReader::read_friction(const Fields& contact, FrictionSpec& friction) {
   (key == "coefficient" ? friction.coefficient : friction.bound) = *x;
 }
 
-void JobReader::read_history(const Fields& condition, BoundaryCondition& bc) {
+void JobReader::read_history(const Fields& condition, std::vector<double>& history) {
   const json* v = condition.find("history");
   if (!v) return;
   const std::string pointer = condition.at("history");
@@ -45,26 +45,29 @@ void JobReader::read_history(const Fields& condition, BoundaryCondition& bc) {
     return;
   }
   for (size_t k = 0; k < v->size(); ++k)
-    if (auto x = read::number((*v)[k], child(pointer, k), "load factor", errors_)) bc.history.push_back(*x);
+    if (auto x = read::number((*v)[k], child(pointer, k), "load factor", errors_)) history.push_back(*x);
 }
 
 // After the bodies, contacts, solver and loading are read: a history has one factor per load step; friction
 // needs the exact interface problem (interface_newton with its direct solver, or the monolithic reference).
 void JobReader::check_friction_and_histories() {
   const size_t steps = problem_.loading.factors.size();
-  for (const auto& in : inputs_)
-    for (size_t j = 0; j < in.body.boundary.size() && j < in.condition_pointers.size(); ++j) {
-      const auto& h = in.body.boundary[j].history;
-      if (!h.empty() && problem_.adaptivity.enabled && problem_.adaptivity.strategy == AdaptStrategy::paper)
-        errors_.add(child(in.condition_pointers[j], "history"),
-                    "a load history needs load steps, which the adaptive strategy \"paper\" does not take (use "
-                    "\"converge_then_refine\")");
-      else if (!h.empty() && h.size() != steps && loading_read_)  // else the number of steps is not known
-        errors_.add(child(in.condition_pointers[j], "history"),
-                    "history has " + std::to_string(h.size()) + " load factors but the job has " +
-                        std::to_string(steps) + " load step" + (steps == 1 ? "" : "s") +
-                        " (loading): give one factor per step");
-    }
+  // A history at `at` (a condition, or a body force given with one).
+  auto check_history = [&](const std::vector<double>& h, const std::string& at) {
+    if (!h.empty() && problem_.adaptivity.enabled && problem_.adaptivity.strategy == AdaptStrategy::paper)
+      errors_.add(child(at, "history"),
+                  "a load history needs load steps, which the adaptive strategy \"paper\" does not take (use "
+                  "\"converge_then_refine\")");
+    else if (!h.empty() && h.size() != steps && loading_read_)  // else the number of steps is not known
+      errors_.add(child(at, "history"), "history has " + std::to_string(h.size()) + " load factors but the job has " +
+                                            std::to_string(steps) + " load step" + (steps == 1 ? "" : "s") +
+                                            " (loading): give one factor per step");
+  };
+  for (const auto& in : inputs_) {
+    for (size_t j = 0; j < in.body.boundary.size() && j < in.condition_pointers.size(); ++j)
+      check_history(in.body.boundary[j].history, in.condition_pointers[j]);
+    if (!in.body_force_pointer.empty()) check_history(in.body.body_force_history, in.body_force_pointer);
+  }
   const SolverSettings& s = problem_.solver;
   for (size_t k = 0; k < problem_.contacts.size() && k < friction_pointers_.size(); ++k) {
     if (!problem_.contacts[k].friction.active()) continue;

@@ -22,11 +22,15 @@ enum class Plane { strain, stress };
 struct Model {
   Plane plane = Plane::strain;
   double thickness = 1.0;  // out-of-plane thickness; forces are per this thickness (plane stress only)
+  // The acceleration of gravity (a vector: [0, -9.81] in m/s^2); every body weighs density x gravity per volume, a
+  // body force that follows the loading's factor (docs/job-format.md, "Loads").
+  Eigen::Vector2d gravity = Eigen::Vector2d::Zero();
 };
 
 struct Material {
-  double E = 0.0;   // Young's modulus, > 0
-  double nu = 0.0;  // Poisson's ratio, in (-1, 0.5)
+  double E = 0.0;        // Young's modulus, > 0
+  double nu = 0.0;       // Poisson's ratio, in (-1, 0.5)
+  double density = 0.0;  // mass per volume, >= 0: the body's weight under Model::gravity
 };
 
 // One boundary condition on a named edge, or at a named vertex, of a body. Edges without a condition are
@@ -70,6 +74,12 @@ struct Body {
   mesh::Mesh mesh;
   std::vector<BoundaryCondition> boundary;
   Eigen::Vector2d body_force = Eigen::Vector2d::Zero();  // force per volume (optional; zero in the paper)
+  // body_force's own load factor per load step, as a condition's history (empty: it follows the loading): a
+  // horizontal seismic coefficient ramped while the weight (density x gravity) is held.
+  std::vector<double> body_force_history;
+
+  // The body's weight per volume under `gravity`, a body force besides body_force.
+  Eigen::Vector2d weight(const Eigen::Vector2d& gravity) const { return material.density * gravity; }
 };
 
 // The initial gap d(x) at a slave point x: the geometric normal distance to the master edge (unless switched

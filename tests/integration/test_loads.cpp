@@ -1,0 +1,97 @@
+// Loads as engineers give them (issue 48, item 5, in part): gravity with a material density, and a body force with
+// a history of its own, so that the weight is held while a horizontal coefficient grows. The figures come from
+// statics: whatever the block's deformation, its support carries its weight and the sideways force, and the joint's
+// friction carries the sideways force until it passes mu times the weight.
+#include "support.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace contact;
+using contact::testing::parse_or_fail;
+using nlohmann::json;
+
+namespace {
+
+// A block 1 x 0.5 (m) on a clamped base, Coulomb mu = 0.5 on the joint, gravity [0, -10] and the density 2500
+// (25 kN/m^3); `horizontal`: the block's sideways body force as factors of its weight per load step (none: no
+// sideways force).
+json block_on_base(const std::vector<double>& horizontal = {}) {
+  auto block = [](const std::string& name, double y0, double y1) {
+    return json{{"name", name},
+                {"material", {{"E", 3e10}, {"nu", 0.2}, {"density", 2500}}},
+                {"mesh", {{"block", {{"corners", {{0, y0}, {1, y0}, {1, y1}, {0, y1}}}, {"nx", 8}, {"ny", 4}}}}}};
+  };
+  json base = block("base", 0, 0.5);
+  base["boundary"] = json::array({{{"edge", "bottom"}, {"displacement", {{"x", 0}, {"y", 0}}}}});
+  json top = block("block", 0.5, 1.0);
+  json job = {
+      {"name", "block"},
+      {"model", {{"gravity", {0, -10}}}},
+      {"bodies", {base, top}},
+      {"contacts", {{{"slave", "block.bottom"}, {"master", "base.top"}, {"friction", {{"coefficient", 0.5}}}}}}};
+  if (!horizontal.empty()) {
+    job["bodies"][1]["body_force"] = {{"value", {25000, 0}}, {"history", horizontal}};
+    job["loading"] = {{"factors", std::vector<double>(horizontal.size(), 1.0)}};
+  }
+  return job;
+}
+
+}  // namespace
+
+// The weight from gravity and density is the body force rho g: the same answer bit for bit.
+TEST(Loads, GravityTimesDensityIsTheBodyForceOfTheWeight) {
+  const Result by_gravity = contact::testing::run(block_on_base());
+  json explicit_force = block_on_base();
+  explicit_force["model"].erase("gravity");
+  for (auto& b : explicit_force["bodies"]) {
+    b["material"].erase("density");
+    b["body_force"] = {0, -25000};
+  }
+  const Result by_force = contact::testing::run(explicit_force);
+  ASSERT_TRUE(by_gravity.converged && by_force.converged) << by_gravity.message << by_force.message;
+  for (size_t a = 0; a < 2; ++a)
+    EXPECT_EQ(by_gravity.steps.back().bodies[a].displacement, by_force.steps.back().bodies[a].displacement);
+  // The base's support carries both weights: 25 kN/m^3 x 0.5 m^2 each.
+  EXPECT_NEAR(by_gravity.steps.back().bodies[0].reaction_total.y(), 25000.0, 1e-6);
+}
+
+// The weight held at factor 1 in every step while the sideways force grows 0, 0.2, 0.4 of it: the support carries
+// the weight and the sideways force of each step, and the joint's friction the sideways force.
+TEST(Loads, ABodyForceWithAHistoryGrowsWhileTheWeightIsHeld) {
+  const std::vector<double> h = {0.0, 0.2, 0.4};
+  const Problem problem = parse_or_fail(block_on_base(h));
+  ASSERT_EQ(problem.bodies[1].body_force_history, h);
+  const Result r = contact::testing::solve_quietly(problem);
+  ASSERT_TRUE(r.converged) << r.message;
+  ASSERT_EQ(r.steps.size(), 3u);
+  const double weight = 25000 * 0.5;  // of one body
+  for (size_t k = 0; k < 3; ++k) {
+    const Step& s = r.steps[k];
+    EXPECT_NEAR(s.bodies[0].reaction_total.y(), 2 * weight, 1e-6 * weight) << "step " << k;
+    EXPECT_NEAR(s.bodies[0].reaction_total.x(), -h[k] * weight, 1e-6 * weight) << "step " << k;
+    EXPECT_NEAR(std::abs(r.step_history[k].tangential_force[0]), h[k] * weight, 1e-6 * weight) << "step " << k;
+  }
+}
+
+// Past mu times the weight no friction holds the block: statics refuses the step, with the ratio 0.6 / 0.5.
+TEST(Loads, ASidewaysForcePastFrictionIsRefusedAtItsStepWithTheRatio) {
+  const Result r = contact::testing::run(block_on_base({0.0, 0.3, 0.6}));
+  EXPECT_FALSE(r.converged);
+  EXPECT_NE(r.message.find("load step 3 of 3"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("1.200"), std::string::npos) << r.message;
+  EXPECT_EQ(r.steps.size(), 2u);  // the steps that held
+}
+
+TEST(Loads, ABodyForceHistoryIsOnePerStepAndADensityIsNotNegative) {
+  json job = block_on_base({0.0, 0.2});
+  job["loading"] = {{"factors", {1, 1, 1}}};
+  auto parsed = job::parse(job);
+  ASSERT_FALSE(parsed.ok());
+  EXPECT_EQ(parsed.errors[0].pointer, "/bodies/1/body_force/history");
+  EXPECT_NE(parsed.errors[0].message.find("history has 2 load factors but the job has 3"), std::string::npos);
+  json negative = block_on_base();
+  negative["bodies"][0]["material"]["density"] = -1;
+  parsed = job::parse(negative);
+  ASSERT_FALSE(parsed.ok());
+  EXPECT_EQ(parsed.errors[0].pointer, "/bodies/0/material/density");
+}
