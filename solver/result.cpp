@@ -2,6 +2,10 @@
 
 #include "contact_extent.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
 namespace contact {
 
 const char* to_string(StopReason r) {
@@ -72,6 +76,41 @@ StepSummary summarize(const Step& step) {
     s.contact_end.push_back(extent.end);
   }
   return s;
+}
+
+JointResults joint_results(const PairField& f) {
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+  JointResults j;
+  const Eigen::Index n = f.weight.size();
+  const bool friction = f.friction != "none" && f.stick.size() == n && f.tangential_traction.size() == n;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (Eigen::Index i = 0; i < n && i < f.status.size(); ++i)
+    if (f.status[i] != 1 && f.status[i] != 5) {  // not opposite the master, or carried by another pair
+      lo = std::min(lo, f.arc_length[i]);
+      hi = std::max(hi, f.arc_length[i]);
+    }
+  double W = 0.0, N = 0.0, moment = 0.0, open = 0.0, slipping = 0.0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double w = f.weight[i], p = f.pressure[i];
+    if (!(w > 0)) continue;
+    W += w;
+    if (p > 0) {
+      N += w * p;
+      moment += w * p * f.arc_length[i];
+      if (friction && f.stick[i] == 0) slipping += w;
+    } else {
+      open += w;
+    }
+  }
+  j.open_fraction = W > 0 ? open / W : nan;
+  j.slip_fraction = friction && W > 0 ? slipping / W : nan;
+  j.centre_of_pressure = N > 0 ? moment / N : nan;
+  j.eccentricity = N > 0 && hi > lo ? (j.centre_of_pressure - 0.5 * (lo + hi)) / (0.5 * (hi - lo)) : nan;
+  const double capacity = f.friction == "coulomb"  ? f.friction_coefficient * N
+                          : f.friction == "tresca" ? f.friction_bound * W
+                                                   : 0.0;
+  j.friction_utilisation = capacity > 0 ? std::abs(f.tangential_force) / capacity : nan;
+  return j;
 }
 
 }  // namespace contact

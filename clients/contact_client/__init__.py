@@ -42,8 +42,8 @@ from .display import Progress, compact_iterations, format_iteration
 from .errors import (EXIT_ERROR, EXIT_JOB, EXIT_OK, EXIT_USAGE, ApiError, BadAnswer, BadInput, ClientError,
                      ConnectionFailed, RequestTimeout)
 from .plot import load_curve, load_path, plot_result
-from .results import ResultFile, read_events, read_result
+from .results import ResultFile, joint_results, read_events, read_result
 
 __all__ = ["Client", "ClientError", "ConnectionFailed", "RequestTimeout", "ApiError", "BadInput", "BadAnswer",
-           "read_result", "read_events", "ResultFile", "plot_result", "load_curve", "load_path", "DEFAULT_URL",
-           "DEFAULT_TIMEOUT", "main"]
+           "read_result", "read_events", "ResultFile", "joint_results", "plot_result", "load_curve", "load_path",
+           "DEFAULT_URL", "DEFAULT_TIMEOUT", "main"]

@@ -11,8 +11,9 @@ RESULT_FORMAT_VERSION = 3  # docs/results-format.md; 2: mortar contact (per-node
 # Format version 3's contact tables (/steps/<k>/contacts): per pair (P rows) and per slave node (N rows, the pairs'
 # nodes one after the other from offsets[p]); `segments` holds rows of the node tables. The friction columns of a
 # frictionless pair are not returned, as version 2 had none.
+_JOINT_COLUMNS = ("centre_of_pressure", "eccentricity", "open_fraction", "slip_fraction", "friction_utilisation")
 _PAIR_COLUMNS = ("slave_body", "slave_edge", "master_body", "master_edge", "enforcement", "friction", "theta", "force",
-                 "resultant", "friction_coefficient", "friction_bound", "tangential_force")
+                 "resultant", "friction_coefficient", "friction_bound", "tangential_force") + _JOINT_COLUMNS
 _FRICTION_ONLY = {"friction_coefficient", "friction_bound", "tangential_force", "tangent", "tangential_traction",
                   "slip", "stick"}
 
@@ -39,6 +40,35 @@ def _dataset(item):
         v = item.asstr()[()]
         return v if isinstance(v, str) else [str(s) for s in np.asarray(v).tolist()]
     return item[()]
+
+
+def joint_results(pair):
+    """A pair as a joint (docs/results-format.md, the contact tables' joint columns), from its nodes: the centre of
+    pressure, its eccentricity over the half-length, the open and slipping shares by weight, the friction's
+    utilisation; NaN where a value does not apply. The solver's contact::joint_results, for files without them."""
+    import numpy as np
+    attrs = pair.get("attrs", {})
+    w, p, s = (np.asarray(pair[k], dtype=float) for k in ("weight", "pressure", "arc_length"))
+    status = np.asarray(pair["status"])
+    carried = (status != 1) & (status != 5)
+    lo, hi = (s[carried].min(), s[carried].max()) if carried.any() else (np.nan, np.nan)
+    rows = w > 0
+    W = w[rows].sum()
+    pressed = rows & (p > 0)
+    N = (w * p)[pressed].sum()
+    friction = attrs.get("friction", "none")
+    stick = np.asarray(pair["stick"]) if "stick" in pair else None
+    nan = float("nan")
+    centre = float((w * p * s)[pressed].sum() / N) if N > 0 else nan
+    out = {"centre_of_pressure": centre,
+           "eccentricity": (centre - 0.5 * (lo + hi)) / (0.5 * (hi - lo)) if N > 0 and hi > lo else nan,
+           "open_fraction": float(w[rows & ~(p > 0)].sum() / W) if W > 0 else nan,
+           "slip_fraction": float(w[pressed & (stick == 0)].sum() / W) if friction != "none" and stick is not None
+           and W > 0 else nan}
+    capacity = (attrs.get("friction_coefficient", 0.0) * N if friction == "coulomb"
+                else attrs.get("friction_bound", 0.0) * W if friction == "tresca" else 0.0)
+    out["friction_utilisation"] = abs(attrs.get("tangential_force", 0.0)) / capacity if capacity > 0 else nan
+    return out
 
 
 class ResultFile:
@@ -123,6 +153,9 @@ class ResultFile:
             out["attrs"] = {a: _attr(v) for a, v in g.attrs.items()}
         if "position" in out and len(out["position"]):
             out["x"] = out["position"][:, 0]
+        if "centre_of_pressure" not in out["attrs"] and all(key in out for key in ("weight", "pressure", "arc_length",
+                                                                                 "status")):
+            out["attrs"].update(joint_results(out))  # a file written before the joint columns: derived
         return out
 
     def _table(self, k, contacts, key):

@@ -270,6 +270,7 @@ Step ContactSystem::fields(const Displacements& u, const Pressures& z, int itera
   for (size_t k = 0; k < pairs_.size(); ++k)
     step.pairs.push_back(pair_field(k, u, z[k], q && k < q->size() ? &(*q)[k] : nullptr));
   share_carried_values(step.pairs);
+  for (auto& pair : step.pairs) pair.joint = joint_results(pair);
   return step;
 }
 

@@ -92,6 +92,11 @@ void add_pair(ContactTables& t, const PairField& p, bool closed) {
   t.friction_coefficient.push_back(frictional ? p.friction_coefficient : 0.0);
   t.friction_bound.push_back(frictional ? p.friction_bound : 0.0);
   t.tangential_force.push_back(frictional ? p.tangential_force : 0.0);
+  t.centre_of_pressure.push_back(p.joint.centre_of_pressure);
+  t.eccentricity.push_back(p.joint.eccentricity);
+  t.open_fraction.push_back(p.joint.open_fraction);
+  t.slip_fraction.push_back(p.joint.slip_fraction);
+  t.friction_utilisation.push_back(p.joint.friction_utilisation);
 }
 
 // One dataset of the contact tables (result_layout.hpp): a text per pair, or values in one or two columns.
@@ -157,6 +162,7 @@ struct TableReader {
   }
   template <class T>
   void operator()(const ContactColumn& c, std::vector<T>& v) const {
+    if (c.optional && !h5::has_link(group, c.name)) return;
     v = table<T>(group, c.name, rows(c), c.width == 2 ? 2 : 0);
   }
 };
@@ -210,6 +216,12 @@ std::vector<PairField> read_tables(hid_t g, const std::vector<std::string>& name
       f.slip = slice(t.slip, b, e);
       f.stick = slice(t.stick, b, e).cast<int>();
     }
+    // The joint results as written; from the fields where a file written before them lacks them.
+    if (t.centre_of_pressure.size() == count)
+      f.joint = {t.centre_of_pressure[p], t.eccentricity[p], t.open_fraction[p], t.slip_fraction[p],
+                 t.friction_utilisation[p]};
+    else
+      f.joint = joint_results(f);
   }
   return out;
 }
@@ -251,6 +263,7 @@ PairField read_pair_group(hid_t contacts, const std::string& name) {
     p.slip = read_column<double>(g, "slip");
     p.stick = read_column<int>(g, "stick");
   }
+  p.joint = joint_results(p);  // (version 2 had none: from the fields)
   return p;
 }
 

@@ -147,6 +147,7 @@ struct ContactTables {
   std::vector<std::int64_t> offsets{0}, segment_offsets{0};
   std::vector<std::string> slave_body, slave_edge, master_body, master_edge, enforcement, friction;
   std::vector<double> theta, force, resultant, friction_coefficient, friction_bound, tangential_force;
+  std::vector<double> centre_of_pressure, eccentricity, open_fraction, slip_fraction, friction_utilisation;  // joints
   // per slave node: N rows
   std::vector<std::int32_t> pair;
   std::vector<std::int64_t> node;
@@ -161,7 +162,8 @@ struct ContactColumn {
   enum class Rows { pair_offsets, pairs, nodes, segments };  // P + 1, P, N or L rows
   const char* name;
   Rows rows;
-  int width;  // 1: one value a row; 2: two columns
+  int width;              // 1: one value a row; 2: two columns
+  bool optional = false;  // absent in older files of this version: read as empty (and then derived)
 };
 
 // visit(column, member) for every dataset of a contacts group; Tables is ContactTables or its const.
@@ -182,6 +184,11 @@ void contact_columns(Tables& t, Visit&& visit) {
   visit(ContactColumn{"friction_coefficient", R::pairs, 1}, t.friction_coefficient);
   visit(ContactColumn{"friction_bound", R::pairs, 1}, t.friction_bound);
   visit(ContactColumn{"tangential_force", R::pairs, 1}, t.tangential_force);
+  visit(ContactColumn{"centre_of_pressure", R::pairs, 1, true}, t.centre_of_pressure);
+  visit(ContactColumn{"eccentricity", R::pairs, 1, true}, t.eccentricity);
+  visit(ContactColumn{"open_fraction", R::pairs, 1, true}, t.open_fraction);
+  visit(ContactColumn{"slip_fraction", R::pairs, 1, true}, t.slip_fraction);
+  visit(ContactColumn{"friction_utilisation", R::pairs, 1, true}, t.friction_utilisation);
   visit(ContactColumn{"pair", R::nodes, 1}, t.pair);
   visit(ContactColumn{"node", R::nodes, 1}, t.node);
   visit(ContactColumn{"position", R::nodes, 2}, t.position);

@@ -2,7 +2,10 @@
 // a history of its own, so that the weight is held while a horizontal coefficient grows. The figures come from
 // statics: whatever the block's deformation, its support carries its weight and the sideways force, and the joint's
 // friction carries the sideways force until it passes mu times the weight.
+#include "contact/result_file.hpp"
 #include "support.hpp"
+
+#include <cstdio>
 
 #include <gtest/gtest.h>
 
@@ -94,4 +97,37 @@ TEST(Loads, ABodyForceHistoryIsOnePerStepAndADensityIsNotNegative) {
   parsed = job::parse(negative);
   ASSERT_FALSE(parsed.ok());
   EXPECT_EQ(parsed.errors[0].pointer, "/bodies/0/material/density");
+}
+
+// The joint the block rests on, read as an engineer reads it (JointResults), from statics: the sideways force H at
+// the block's centroid (0.25 above the joint) moves the normal force's line of action by H 0.25 / W from the middle
+// (0.5 along the joint), and friction carries H: |T| / (mu N) = (H / W) / mu. The result file keeps them.
+TEST(Loads, TheJointUnderTheBlockHasTheCentreOfPressureAndTheFrictionUtilisationOfStatics) {
+  const std::vector<double> h = {0.0, 0.2, 0.4};
+  const Result r = contact::testing::run(block_on_base(h));
+  ASSERT_TRUE(r.converged) << r.message;
+  for (size_t k = 0; k < h.size(); ++k) {
+    const JointResults& j = r.steps[k].pairs[0].joint;
+    EXPECT_NEAR(j.centre_of_pressure, 0.5 + 0.25 * h[k], 1e-8) << "step " << k;
+    EXPECT_NEAR(j.eccentricity, 0.5 * h[k], 2e-8) << "step " << k;
+    EXPECT_NEAR(j.friction_utilisation, h[k] / 0.5, 1e-8) << "step " << k;
+    EXPECT_GE(j.open_fraction, 0.0);
+    EXPECT_LE(j.open_fraction, 1.0);
+  }
+  const std::string path = ::testing::TempDir() + "/joint_results.hdf";
+  io::write_result(path, parse_or_fail(block_on_base(h)), r);
+  const io::ResultFile back = io::read_result(path);
+  ASSERT_EQ(back.steps.size(), 3u);
+  for (size_t k = 0; k < 3; ++k) {
+    const JointResults &a = r.steps[k].pairs[0].joint, &b = back.steps[k].pairs[0].joint;
+    EXPECT_EQ(a.centre_of_pressure, b.centre_of_pressure);
+    EXPECT_EQ(a.eccentricity, b.eccentricity);
+    EXPECT_EQ(a.friction_utilisation, b.friction_utilisation);
+    EXPECT_EQ(a.open_fraction, b.open_fraction);
+    // The derivation from the nodes (as for a file written before the columns) gives the same.
+    const JointResults d = joint_results(back.steps[k].pairs[0]);
+    EXPECT_NEAR(d.centre_of_pressure, a.centre_of_pressure, 1e-12);
+    EXPECT_NEAR(d.friction_utilisation, a.friction_utilisation, 1e-12);
+  }
+  std::remove(path.c_str());
 }

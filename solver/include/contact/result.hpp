@@ -96,6 +96,19 @@ struct BodyField {
   Eigen::Vector3d rigid_motion = Eigen::Vector3d::Zero();
 };
 
+// A pair as a joint of a structure (a masonry bed joint, a voussoir's face): what an engineer reads of it, from its
+// nodal pressures and tractions (joint_results). Over the nodes that carry a multiplier, each by its weight; the
+// joint's extent is the arc length the pair carries (its nodes opposite the master, not another pair's). NaN where
+// a value does not apply: a joint with no pressure has no centre of pressure, a frictionless one no slip fraction
+// and no friction utilisation.
+struct JointResults {
+  double centre_of_pressure = 0.0;  // arc length along the slave edge of the pressure's resultant
+  double eccentricity = 0.0;        // its offset from the joint's middle over the half-length, in [-1, 1]: |e| / (L/2)
+  double open_fraction = 0.0;       // the share of the joint (by weight) with no pressure
+  double slip_fraction = 0.0;       // the share in contact and slipping (friction)
+  double friction_utilisation = 0.0;  // |T| / (mu N) (Coulomb), |T| / (g x the joint's weight) (Tresca)
+};
+
 // Contact quantities along one pair, at the slave edge's nodes, ordered along the slave edge. The gaps are the
 // mortar (dual-weighted) nodal gaps, weighted gap / D; NaN where a slave node carries no multiplier (status).
 struct PairField {
@@ -133,7 +146,11 @@ struct PairField {
   Eigen::VectorXd slip;
   Eigen::VectorXi stick;
   double tangential_force = 0.0;  // sum of weight x tangential traction
+  JointResults joint;             // the pair as a joint (joint_results)
 };
+
+// The joint results of a pair's fields (JointResults).
+JointResults joint_results(const PairField& pair);
 
 // One mesh state of the adaptive loop, or one load step; without either there is a single step.
 struct Step {
