@@ -224,6 +224,13 @@ void print_final_step(const contact::Step& step) {
                   p.name.c_str(), p.friction.c_str(), p.friction == "coulomb" ? "mu" : "bound",
                   p.friction == "coulomb" ? p.friction_coefficient : p.friction_bound, p.tangential_force, stick,
                   in_contact);
+      // The joint as an engineer reads it (contact::JointResults; NaN where it does not apply).
+      std::printf(
+          "pair %s: as a joint: centre of pressure at %.6g along the slave edge (eccentricity %.3g of the "
+          "half-length), "
+          "%.3g open, %.3g slipping, friction utilisation %.3g\n",
+          p.name.c_str(), p.joint.centre_of_pressure, p.joint.eccentricity, p.joint.open_fraction,
+          p.joint.slip_fraction, p.joint.friction_utilisation);
     }
   }
   if (step.pairs.size() > kPairLines)
