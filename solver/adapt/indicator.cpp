@@ -198,10 +198,10 @@ IndicatorResult zz_indicator(const Body& body, const fem::BodySolver& solver, co
 
 namespace {
 
-// The body's edge conditions per boundary side (vertex conditions hold no side) and each condition's edge length
-// (for a total force spread over its edge).
+// The body's edge conditions per boundary side (vertex conditions hold no side; several loads may share an edge:
+// they add) and each condition's edge length (for a total force spread over its edge).
 struct SideConditions {
-  std::map<std::pair<int, int>, const BoundaryCondition*> condition;
+  std::map<std::pair<int, int>, std::vector<const BoundaryCondition*>> condition;
   std::map<const BoundaryCondition*, double> edge_length;
 };
 
@@ -214,7 +214,7 @@ SideConditions side_conditions(const Body& body) {
     if (it == m.edge_sets.end()) continue;
     for (const auto& e : it->second) {
       const auto n = m.edge_nodes(e);
-      out.condition[key(n[0], n[1])] = &bc;
+      out.condition[key(n[0], n[1])].push_back(&bc);
       out.edge_length[&bc] += (m.nodes[static_cast<size_t>(n[1])] - m.nodes[static_cast<size_t>(n[0])]).norm();
     }
   }
@@ -266,17 +266,24 @@ bem::BoundaryProblem boundary_problem(const Body& body, const Model& model, cons
   for (size_t i = 0; i < nb; ++i) {
     const int a = loop[i], b = loop[(i + 1) % nb];
     auto& el = bp.elements[i];
-    auto c = sides.condition.find(key(a, b));
-    const BoundaryCondition* bc = c == sides.condition.end() ? nullptr : c->second;
+    const auto c = sides.condition.find(key(a, b));
+    static const std::vector<const BoundaryCondition*> none;
+    const auto& conditions = c == sides.condition.end() ? none : c->second;
     const Eigen::Vector2d pa = m.nodes[static_cast<size_t>(a)], pb = m.nodes[static_cast<size_t>(b)];
     const Eigen::Vector2d outward((pb - pa).y(), -(pb - pa).x());
     Eigen::Vector2d traction = Eigen::Vector2d::Zero();
-    if (bc && bc->kind == BoundaryCondition::Kind::traction)
-      traction = bc->normal_pressure ? Eigen::Vector2d(-bc->pressure * outward.normalized()) : bc->traction;
-    if (bc && bc->kind == BoundaryCondition::Kind::force) traction = bc->force / (sides.edge_length[bc] * thickness);
-    if (bc) traction *= solver.condition_factor(*bc, at);
+    std::array<bool, 2> held = {false, false};
+    for (const BoundaryCondition* bc : conditions) {
+      Eigen::Vector2d t = Eigen::Vector2d::Zero();
+      if (bc->kind == BoundaryCondition::Kind::traction)
+        t = bc->normal_pressure ? Eigen::Vector2d(-bc->pressure * outward.normalized()) : bc->traction;
+      if (bc->kind == BoundaryCondition::Kind::force) t = bc->force / (sides.edge_length[bc] * thickness);
+      traction += solver.condition_factor(*bc, at) * t;
+      held[0] = held[0] || bc->ux.has_value();
+      held[1] = held[1] || bc->uy.has_value();
+    }
     for (int comp = 0; comp < 2; ++comp) {
-      const bool prescribed = bc && (comp == 0 ? bc->ux : bc->uy);
+      const bool prescribed = held[static_cast<size_t>(comp)];
       el.displacement_prescribed[static_cast<size_t>(comp)] = prescribed;
       if (prescribed) {
         el.value(comp, 0) = u[2 * a + comp];

@@ -73,6 +73,13 @@ struct MeshInput {
   std::shared_ptr<const GmshBody> gmsh;
 };
 
+// The first condition given at an edge or vertex of a body, and whether every condition there so far is a load
+// alone (several loads on one place add; a displacement or "free" stands alone).
+struct PlaceUse {
+  std::string pointer;
+  bool loads_only = false;
+};
+
 struct BodyInput {
   std::string pointer;
   bool has_name = false;
@@ -148,9 +155,9 @@ class JobReader {
   void read_material(const json& value, const std::string& pointer, Material& material);
   void read_boundary(const json& value, const std::string& pointer, BodyInput& in);
   void read_condition(const json& value, const std::string& pointer, BodyInput& in,
-                      std::map<std::string, std::string>& first_pointer_of_place);
+                      std::map<std::string, PlaceUse>& first_pointer_of_place);
   void read_condition_place(const Fields& f, bool at_vertex, const MeshInput& mesh, BoundaryCondition& bc,
-                            std::map<std::string, std::string>& first_pointer_of_place);
+                            std::map<std::string, PlaceUse>& first_pointer_of_place);
   bool condition_kinds_allowed(const Fields& f, const std::string& pointer, bool at_vertex);
   void read_condition_values(const Fields& f, const std::string& pointer, BoundaryCondition& bc);
   void check_loads_off_supports(const Fields& f, const std::string& pointer, const BoundaryCondition& bc);

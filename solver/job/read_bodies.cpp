@@ -154,14 +154,14 @@ void JobReader::read_boundary(const json& value, const std::string& pointer, Bod
     errors_.add(pointer, "boundary must be an array of conditions, got " + read::type_name(value));
     return;
   }
-  std::map<std::string, std::string> first_pointer_of_place;
+  std::map<std::string, PlaceUse> first_pointer_of_place;
   for (size_t j = 0; j < value.size(); ++j) read_condition(value[j], child(pointer, j), in, first_pointer_of_place);
 }
 
 // One boundary condition: where (an edge or a vertex), what (displacement, load, both on different components,
 // free), its load history; kept in the body only if all of it reads without error.
 void JobReader::read_condition(const json& value, const std::string& bp, BodyInput& in,
-                               std::map<std::string, std::string>& first_pointer_of_place) {
+                               std::map<std::string, PlaceUse>& first_pointer_of_place) {
   Fields f(value, bp, "a boundary condition",
            {"edge", "vertex", "displacement", "traction", "force", "free", "history"}, errors_);
   if (!f.ok()) return;
@@ -185,7 +185,7 @@ void JobReader::read_condition(const json& value, const std::string& bp, BodyInp
 
 // The condition's edge or vertex: a named one of the body's mesh, and the first condition there.
 void JobReader::read_condition_place(const Fields& f, bool at_vertex, const MeshInput& mesh, BoundaryCondition& bc,
-                                     std::map<std::string, std::string>& first_pointer_of_place) {
+                                     std::map<std::string, PlaceUse>& first_pointer_of_place) {
   const std::string bp = f.pointer();
   const std::string place_key = at_vertex ? "vertex" : "edge";
   const std::vector<std::string>& names = at_vertex ? mesh.vertex_names : mesh.edge_names;
@@ -201,11 +201,15 @@ void JobReader::read_condition_place(const Fields& f, bool at_vertex, const Mesh
                                                       : "its " + std::string(at_vertex ? "vertices" : "edges") +
                                                             " are " + join_names(names))));
       } else {
-        auto [it, inserted] = first_pointer_of_place.emplace(place_key + ":" + *s, bp);
-        if (!inserted)
-          errors_.add(f.at(place_key), place_key + " '" + *s + "' already has a condition at " + it->second +
-                                           "; give each " + place_key +
-                                           " one condition (displacement fixes only its given components)");
+        // Loads alone may share a place (a precompression and a shear with histories of their own): they add.
+        const bool load_only = (f.has("traction") || f.has("force")) && !f.has("displacement") && !f.has("free");
+        auto [it, inserted] = first_pointer_of_place.emplace(place_key + ":" + *s, PlaceUse{bp, load_only});
+        if (!inserted && !(load_only && it->second.loads_only))
+          errors_.add(f.at(place_key), place_key + " '" + *s + "' already has a condition at " + it->second.pointer +
+                                           "; a displacement (or \"free\") is the only condition of its " + place_key +
+                                           " (it fixes only its given components: a load on the other "
+                                           "goes in the same condition); several loads on one " +
+                                           place_key + " add");
       }
     }
 }

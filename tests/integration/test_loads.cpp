@@ -131,3 +131,74 @@ TEST(Loads, TheJointUnderTheBlockHasTheCentreOfPressureAndTheFrictionUtilisation
   }
   std::remove(path.c_str());
 }
+
+namespace {
+
+// The block on its base, its top edge loaded by a normal pressure p and a shear s (kN/m); as one traction, or as two
+// conditions on the same edge (each with its own history when given).
+json block_loaded_on_top(bool two_conditions, std::vector<double> p_history = {}, std::vector<double> s_history = {}) {
+  json job = block_on_base();
+  const double p = 20000, s = 4000;
+  json& boundary = job["bodies"][1]["boundary"];
+  if (!two_conditions) {
+    boundary = json::array({{{"edge", "top"}, {"traction", {s, -p}}}});
+    return job;
+  }
+  json precompression = {{"edge", "top"}, {"traction", {{"normal", p}}}};
+  json shear = {{"edge", "top"}, {"traction", {s, 0}}};
+  if (!p_history.empty()) {
+    precompression["history"] = p_history;
+    shear["history"] = s_history;
+    job["loading"] = {{"factors", std::vector<double>(p_history.size(), 1.0)}};
+  }
+  boundary = json::array({precompression, shear});
+  return job;
+}
+
+}  // namespace
+
+// Loads on one edge add: a normal pressure and a shear as two conditions give the answer of the one traction that is
+// their sum (to rounding), and with histories of their own the precompression is held while the shear grows: the
+// support carries both weights plus p at every step and the shear of that step.
+TEST(Loads, TwoLoadsOnOneEdgeAddAndKeepTheirOwnHistories) {
+  const Result one = contact::testing::run(block_loaded_on_top(false));
+  const Result two = contact::testing::run(block_loaded_on_top(true));
+  ASSERT_TRUE(one.converged && two.converged) << one.message << two.message;
+  for (size_t a = 0; a < 2; ++a) {
+    const auto& u1 = one.steps.back().bodies[a].displacement;
+    EXPECT_LE((u1 - two.steps.back().bodies[a].displacement).cwiseAbs().maxCoeff(), 1e-10 * u1.cwiseAbs().maxCoeff());
+  }
+  const std::vector<double> held = {1, 1, 1}, ramp = {0, 0.5, 1};
+  const Result r = contact::testing::run(block_loaded_on_top(true, held, ramp));
+  ASSERT_TRUE(r.converged) << r.message;
+  for (size_t k = 0; k < 3; ++k) {
+    const Eigen::Vector2d support = r.steps[k].bodies[0].reaction_total;
+    EXPECT_NEAR(support.y(), 25000.0 + 20000.0, 1e-6 * 45000.0) << "step " << k;
+    EXPECT_NEAR(support.x(), -4000.0 * ramp[k], 1e-6 * 45000.0) << "step " << k;
+  }
+  // A displacement is alone on its edge; a load there belongs in the same condition.
+  json fixed = block_loaded_on_top(true);
+  fixed["bodies"][1]["boundary"][0] = {{"edge", "top"}, {"displacement", {{"y", 0}}}};
+  const auto parsed = job::parse(fixed);
+  ASSERT_FALSE(parsed.ok());
+  EXPECT_EQ(parsed.errors[0].pointer, "/bodies/1/boundary/1/edge");
+  EXPECT_NE(parsed.errors[0].message.find("is the only condition of its edge"), std::string::npos)
+      << parsed.errors[0].message;
+}
+
+// The FEM-BEM indicator reads a side's loads summed: the two-condition job's indicator is the one traction's.
+TEST(Loads, TheBoundaryElementIndicatorSumsTheLoadsOfASide) {
+  auto adaptive = [](json job) {
+    job["adaptivity"] = {{"indicator", "fem_bem"}, {"max_steps", 1}, {"bodies", {"block"}}};
+    return job;
+  };
+  const Result one = contact::testing::run(adaptive(block_loaded_on_top(false)));
+  const Result two = contact::testing::run(adaptive(block_loaded_on_top(true)));
+  ASSERT_FALSE(one.steps.empty());
+  ASSERT_FALSE(two.steps.empty());
+  const Eigen::VectorXd& a = one.steps.back().bodies[1].indicator_cell;
+  const Eigen::VectorXd& b = two.steps.back().bodies[1].indicator_cell;
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_GT(a.size(), 0);
+  EXPECT_LE((a - b).cwiseAbs().maxCoeff(), 1e-8 * a.cwiseAbs().maxCoeff());
+}

@@ -675,12 +675,12 @@ TEST(JobBoundary, VertexConditionsForcesAndLoadingAreReadAndBadOnesNamed) {
   EXPECT_EQ(bc[2].force, Eigen::Vector2d(0, -5));
   EXPECT_EQ(bc[3].edge, "right");
   EXPECT_EQ(r.problem->loading.factors, (std::vector<double>{0.25, 0.5, 0.75, 1.0}));
-  // Unknown vertex, a traction at a vertex, both edge and vertex, two conditions at one vertex.
+  // Unknown vertex, a traction at a vertex, both edge and vertex, a load at a vertex a displacement holds.
   json bad = small_job();
   bad["bodies"][0]["boundary"] = {{{"vertex", "middle"}, {"displacement", {{"x", 0}}}},
                                   {{"vertex", "top_left"}, {"traction", {0, 1}}},
                                   {{"vertex", "top_right"}, {"edge", "top"}, {"force", {0, 1}}},
-                                  {{"vertex", "bottom_left"}, {"force", {0, 1}}},
+                                  {{"vertex", "bottom_left"}, {"displacement", {{"x", 0}}}},
                                   {{"vertex", "bottom_left"}, {"force", {0, 2}}}};
   r = parse(bad);
   const std::string text = listing(r);
