@@ -288,12 +288,6 @@ void print_warning(const contact::Warning& w) {
   std::cerr << "warning: " << (w.pointer.empty() ? "" : w.pointer + ": ") << w.message << "\n";
 }
 
-nlohmann::json warnings_json(const std::vector<contact::Warning>& list) {
-  nlohmann::json out = nlohmann::json::array();
-  for (const auto& w : list) out.push_back({{"pointer", w.pointer}, {"message", w.message}});
-  return out;
-}
-
 int solve_and_write(contact::Session& session, contact::Problem& problem, const std::string& output,
                     const std::string& job_id, bool quiet, bool ndjson, contact::io::ProgressSelection selection) {
   const bool root = session.root();
@@ -331,7 +325,7 @@ int solve_and_write(contact::Session& session, contact::Problem& problem, const 
                             {"ranks", session.size()},
                             {"traffic", traffic},
                             {"result_written", false},
-                            {"warnings", warnings_json(result.warnings)},
+                            {"warnings", contact::warnings_json(result.warnings)},
                             {"steps", nlohmann::json::array()}};
   auto finish = [&](int code) {
     if (ndjson) std::printf("%s\n", summary.dump().c_str());

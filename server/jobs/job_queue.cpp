@@ -4,7 +4,7 @@
 #include "common/log.hpp"
 #include "common/public_message.hpp"
 #include "common/time.hpp"
-#include "common/warnings_json.hpp"
+#include "contact/warning.hpp"
 #include "jobs/events.hpp"
 #include "jobs/job_recovery.hpp"
 
@@ -84,7 +84,7 @@ JobQueue::Submission JobQueue::submit(const std::string& body, contact::job::Par
   const std::shared_ptr<Job> job = admission.job;
   job->record.small = small_job(settings_, *parsed.problem);  // not yet visible: nobody reads it concurrently
   job->record.result_estimate = estimated_result(*parsed.problem);
-  job->record.warnings = warnings_json(parsed.warnings);
+  job->record.warnings = contact::warnings_json(parsed.warnings);
   const JobRecord record = job->record;  // nobody changes it before it is stored (persist lock held)
   try {
     store_.create(record, body);

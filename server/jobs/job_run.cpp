@@ -3,7 +3,7 @@
 #include "common/log.hpp"
 #include "common/public_message.hpp"
 #include "common/time.hpp"
-#include "common/warnings_json.hpp"
+#include "contact/warning.hpp"
 #include "jobs/events.hpp"
 #include "jobs/progress_observer.hpp"
 
@@ -143,7 +143,7 @@ contact::Result JobRun::solve_on_ranks(ProgressObserver& observer) {
   result.iterations = mpi_->iterations;
   result.converged = mpi_->converged;
   result.wall_seconds = mpi_->wall_seconds;
-  result.warnings = warnings_of(mpi_->warnings);
+  result.warnings = contact::warnings_of(mpi_->warnings);
   return result;
 }
 
@@ -154,7 +154,7 @@ JobRecord JobRun::outcome_of(const contact::Result& result, CancelReason reason)
   outcome.solve_seconds = result.wall_seconds;
   outcome.message = result.message;
   outcome.stop_reason = contact::to_string(result.stop_reason);
-  outcome.warnings = warnings_json(result.warnings);
+  outcome.warnings = contact::warnings_json(result.warnings);
   switch (result.stop_reason) {
     case contact::StopReason::converged:
       outcome.state = JobState::succeeded;

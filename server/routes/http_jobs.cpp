@@ -6,7 +6,7 @@
 
 #include "common/encoding.hpp"
 #include "common/job_id.hpp"
-#include "common/warnings_json.hpp"
+#include "contact/warning.hpp"
 #include "http/problem_document.hpp"
 
 #include <algorithm>
@@ -207,7 +207,7 @@ void handle_validate(RouteContext& ctx, const Request& req, Response& res, const
              {"bodies", bodies},
              {"contacts", p.contacts.size()},
              {"dofs", dofs},
-             {"warnings", warnings_json(parsed.warnings)},
+             {"warnings", contact::warnings_json(parsed.warnings)},
              {"normalized", p.normalized}});
 }
 

@@ -45,7 +45,7 @@ struct JobRecord {
   bool result_available = false;    // result.hdf and result.xmf exist
   std::int64_t result_bytes = 0;    // the size of result.hdf as written (checked before it is served)
   std::int64_t events_dropped = 0;  // iteration events not recorded: the job's event log reached its cap
-  // The model checks' warnings, [{"pointer", "message"}] (common/warnings_json.hpp): the job's at submission, the
+  // The model checks' warnings, [{"pointer", "message"}] (contact/warning.hpp): the job's at submission, the
   // run's (the job's and the answer's) once it is done.
   nlohmann::json warnings = nlohmann::json::array();
   // The latest iteration in short (null before the first); shared, so copying a record (a listing, a snapshot)
