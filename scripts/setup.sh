@@ -11,6 +11,7 @@ BUILD_PACKAGES=(
   build-essential cmake pkg-config git
   libeigen3-dev libsuitesparse-dev libopenblas0-pthread nlohmann-json3-dev libhdf5-dev libcli11-dev
   libcpp-httplib-dev
+  libglpk-dev                 # the collapse analysis's rigid-block statics, a linear program (solver/limit/)
   libopenmpi-dev openmpi-bin  # bodies on MPI ranks (docs/parallel.md); the build works without them
 )
 # The Python client (clients/): HTTP with the standard library; results, plots and the progress bar.
@@ -26,7 +27,7 @@ TEST_PACKAGES=(
   clang-format                              # tests/unit/test_format.py: the code as .clang-format says (Debian's 14)
 )
 RUNTIME_PACKAGES=(
-  libcholmod3 libumfpack5 libopenblas0-pthread libhdf5-103-1 libcpp-httplib0.11 ca-certificates curl
+  libcholmod3 libumfpack5 libopenblas0-pthread libhdf5-103-1 libcpp-httplib0.11 libglpk40 ca-certificates curl
   libopenmpi3 openmpi-bin     # mpirun, for contactd --mpi-launcher
 )
 

@@ -56,6 +56,7 @@ StepSummary summarize(const Step& step) {
   s.index = step.index;
   s.iteration = step.iteration;
   s.load_factor = step.load_factor;
+  s.multiplier = step.multiplier;
   s.converged = step.converged;
   for (const auto& b : step.bodies) {
     s.body_names.push_back(b.name);

@@ -4,6 +4,8 @@
 #include "check/large_motion.hpp"
 #include "ddm/load_steps.hpp"
 #include "held_bodies.hpp"
+#include "limit/collapse.hpp"
+#include "limit/verdict.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -226,6 +228,17 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
       adapt::run_adaptive(working, system, frame, *method, steps);
     } else {
       ddm::run_load_steps(system, problem.loading.factors, frame, *method, steps);
+      ddm::MethodOutcome& loading = frame.outcome();
+      if (problem.collapse.enabled && loading.converged) {
+        limit::run_collapse(system, problem.collapse, frame, *method, steps, result.collapse);
+      } else if (!loading.converged && !loading.refused && loading.stop_reason != StopReason::cancelled &&
+                 !frame.stop_requested()) {
+        // Why the step failed, by statics: a collapse (no equilibrium, its mechanism) or the solver.
+        result.collapse = limit::judge_failed_step(system, frame.state().load,
+                                                   problem.collapse.enabled ? "the dead loads" : "the loads");
+        if (problem.collapse.enabled) result.collapse.verdict = "dead_loads_fail";
+        loading.message += "; " + result.collapse.words;
+      }
     }
     static_cast<RunOutcome&>(result) = static_cast<RunOutcome&&>(frame.take_outcome());
     result.factorization_seconds = system.total_factorization_seconds();

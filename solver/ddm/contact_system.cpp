@@ -208,9 +208,9 @@ bool ContactSystem::has_histories() const {
   for (const auto& b : bodies_)
     if (b->has_histories()) return true;
   for (const auto& body : problem_.bodies) {  // bodies of other processes are not assembled here
-    if (!body.body_force_history.empty()) return true;
+    if (!body.body_force_history.empty() || body.body_force_live) return true;
     for (const auto& bc : body.boundary)
-      if (!bc.history.empty()) return true;
+      if (!bc.history.empty() || bc.live) return true;
   }
   return false;
 }

@@ -35,6 +35,12 @@ bool homogeneous_from_rest(const ContactSystem& system, size_t k, double done) {
 
 }  // namespace
 
+Step step_of(const ContactSystem& system, const MethodOutcome& outcome, const RunState& state) {
+  return outcome.z.empty() ? system.fields(outcome.u, outcome.iterations, state)
+                           : system.fields(outcome.u, outcome.z, outcome.iterations, state, &outcome.rigid_amplitudes,
+                                           outcome.q.empty() ? nullptr : &outcome.q);
+}
+
 void run_load_steps(const ContactSystem& system, const std::vector<double>& factors, RunFrame& frame,
                     ContactMethod& method, StepLog& steps) {
   MethodOutcome& total = frame.outcome();
@@ -77,9 +83,7 @@ void run_load_steps(const ContactSystem& system, const std::vector<double>& fact
                 "(not cut: from rest with every joint closed, a smaller increment is the same problem scaled)";
     if (!prefix.empty()) total.message = prefix + ": " + total.message;
     if (total.u.empty()) return;
-    Step step = total.z.empty() ? system.fields(total.u, total.iterations, state)
-                                : system.fields(total.u, total.z, total.iterations, state, &total.rigid_amplitudes,
-                                                total.q.empty() ? nullptr : &total.q);
+    Step step = step_of(system, total, state);
     step.index = static_cast<int>(k);
     step.load_factor = state.load.value();  // factors[k], or where a cut step failed the fraction tried
     step.converged = total.converged;

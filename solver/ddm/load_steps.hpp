@@ -12,6 +12,9 @@
 
 namespace contact::ddm {
 
+// The fields of a solved state (a load step, a collapse analysis's trial) as a result Step.
+Step step_of(const ContactSystem& system, const MethodOutcome& outcome, const RunState& state);
+
 void run_load_steps(const ContactSystem& system, const std::vector<double>& factors, RunFrame& frame,
                     ContactMethod& method, StepLog& steps);
 

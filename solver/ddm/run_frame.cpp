@@ -1,5 +1,7 @@
 #include "run_frame.hpp"
 
+#include <cmath>
+
 namespace contact::ddm {
 
 namespace {
@@ -7,6 +9,7 @@ namespace {
 // The marks on one report: the update on every one, the refined counts on the first of an inner solve only.
 void mark(IterationReport& r, const InnerMarks& marks, bool first) {
   if (marks.update > 0) r.update = marks.update;
+  if (!std::isnan(marks.multiplier)) r.multiplier = marks.multiplier;
   if (first)
     for (size_t a = 0; a < r.bodies.size() && a < marks.refined.size(); ++a)
       r.bodies[a].elements_refined = marks.refined[a];

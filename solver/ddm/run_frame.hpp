@@ -17,6 +17,7 @@
 
 #include <chrono>
 #include <functional>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -39,6 +40,7 @@ struct MethodOutcome : RunOutcome {
 struct InnerMarks {
   int update = 0;
   std::vector<int> refined;
+  double multiplier = std::numeric_limits<double>::quiet_NaN();  // a collapse analysis's trial (NaN: none)
 };
 
 class RunFrame {

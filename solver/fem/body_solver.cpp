@@ -143,16 +143,17 @@ void BodySolver::add_condition_load(const BoundaryCondition& bc, Eigen::VectorXd
   }
 }
 
-// Each condition with a history gets its own share of the loads: its traction or force, its prescribed values
-// (the dofs it prescribes, at the value the constraints hold), and T^T (f - K g) of those, element by element over
-// the cells its prescribed values touch.
+// Each condition with a history (or a live load) gets its own share of the loads: its traction or force, its prescribed
+// values (the dofs it prescribes, at the value the constraints hold), and T^T (f - K g) of those, element by element
+// over the cells its prescribed values touch.
 void BodySolver::setup_history_groups() {
   const auto& m = body_.mesh;
   const Eigen::SparseMatrix<double, Eigen::RowMajor> T = constraints_.T();
-  if (!body_.body_force_history.empty() && body_.body_force.squaredNorm() > 0) {
+  if ((!body_.body_force_history.empty() || body_.body_force_live) && body_.body_force.squaredNorm() > 0) {
     // The job's body force (not the weight, which follows the loading) at factor 1, cell by cell.
     LoadGroup group;
     group.history = &body_.body_force_history;
+    group.live = body_.body_force_live;
     group.f_ext = Eigen::VectorXd::Zero(n_dofs());
     for (int c = 0; c < m.num_cells(); ++c) {
       const CellVector fe = cell_body_force(m, c, body_.body_force, elasticity_);
@@ -164,9 +165,10 @@ void BodySolver::setup_history_groups() {
     groups_.push_back(std::move(group));
   }
   for (const auto& bc : body_.boundary) {
-    if (bc.history.empty()) continue;
+    if (bc.history.empty() && !bc.live) continue;
     LoadGroup group;
     group.history = &bc.history;
+    group.live = bc.live;
     group.f_ext = Eigen::VectorXd::Zero(n_dofs());
     add_condition_load(bc, group.f_ext);
     group.g = Eigen::VectorXd::Zero(n_dofs());
@@ -194,7 +196,7 @@ Eigen::VectorXd BodySolver::scaled(const Eigen::VectorXd& base, Eigen::VectorXd 
   const double factor = at.value();
   Eigen::VectorXd out = factor * base;
   for (const auto& group : groups_) {
-    const double own = at.of_history(*group.history);
+    const double own = at.of_condition(*group.history, group.live);
     if (own != factor) out += (own - factor) * (group.*part);
   }
   return out;

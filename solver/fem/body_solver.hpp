@@ -86,7 +86,9 @@ class BodySolver {
   // point is the run's (ddm/run_state.hpp).
   bool has_histories() const { return !groups_.empty(); }
   // The factor a condition of this body is at: its own history's where it has one, else the loading's.
-  double condition_factor(const BoundaryCondition& bc, const LoadPoint& at) const { return at.of_history(bc.history); }
+  double condition_factor(const BoundaryCondition& bc, const LoadPoint& at) const {
+    return at.of_condition(bc.history, bc.live);
+  }
   Eigen::VectorXd external_load(const LoadPoint& at = {}) const;  // all dofs: tractions, forces, body force
   Eigen::VectorXd reduced_rhs(const LoadPoint& at = {}) const;    // T^T (f_ext - K g)
   Eigen::VectorXd prescribed(const LoadPoint& at = {}) const;     // g: the prescribed values (0 elsewhere), all dofs
@@ -112,10 +114,12 @@ class BodySolver {
   double assembly_seconds() const { return assembly_seconds_; }
 
  private:
-  // One per load with a history of its own (a condition's, or the body force's): its share of the loads (f_ext), of
-  // the prescribed values (g) and of the reduced right-hand side (T^T (f - K g)), at factor 1.
+  // One per load with a factor of its own (a history, a condition's or the body force's, or a live load of a
+  // collapse analysis): its share of the loads (f_ext), of the prescribed values (g) and of the reduced right-hand
+  // side (T^T (f - K g)), at factor 1.
   struct LoadGroup {
     const std::vector<double>* history = nullptr;
+    bool live = false;
     Eigen::VectorXd f_ext, g, rhs;
   };
   void setup_constraints();

@@ -16,6 +16,9 @@ struct LoadPoint {
   double previous_factor = 0.0;  // the loading's factor at the end of step - 1 (0 before the first step)
   double factor = 1.0;           // the loading's factor at the end of `step`
   double t = 1.0;                // the fraction of the way from the end of step - 1 to the end of `step`
+  // A collapse analysis's load multiplier lambda: the factor of the live loads (0 while the loading brings the dead
+  // loads on; limit/collapse.hpp raises it once the loading's last step holds).
+  double multiplier = 0.0;
 
   // The end of step `step`, at the loading's factor `factor` there (the default point: the first step, whole).
   static LoadPoint end_of(size_t step, double factor) { return LoadPoint{step, 0.0, factor, 1.0}; }
@@ -30,6 +33,10 @@ struct LoadPoint {
     const double end = history[std::min(step, history.size() - 1)];
     const double start = step == 0 ? 0.0 : history[std::min(step - 1, history.size() - 1)];
     return t == 1.0 ? end : start + t * (end - start);
+  }
+  // The factor here of a condition: a live load's is the multiplier, else of_history(history).
+  double of_condition(const std::vector<double>& history, bool live) const {
+    return live ? multiplier : of_history(history);
   }
 };
 

@@ -76,19 +76,22 @@ nlohmann::json iteration_json(const IterationReport& report, bool profiles) {
         {{"name", b.name}, {"elements", b.elements}, {"dofs", b.dofs}, {"elements_refined", b.elements_refined}});
   nlohmann::json pairs = nlohmann::json::array();
   for (const auto& p : report.pairs) pairs.push_back(pair_json(p, profiles));
-  return {{"iteration", report.iteration},
-          {"measure", to_string(report.measure)},
-          {"paper_criterion", report.paper_criterion},
-          {"fixed_point_residual", report.fixed_point_residual},
-          {"complementarity", report.complementarity},
-          {"active_nodes", report.active_nodes},
-          {"active_set_changes", report.active_set_changes},
-          {"elapsed_seconds", report.elapsed_seconds},
-          {"gamma", report.gamma},
-          {"update", report.update},
-          {"note", report.note},
-          {"bodies", std::move(bodies)},
-          {"pairs", std::move(pairs)}};
+  nlohmann::json out = {{"iteration", report.iteration},
+                        {"measure", to_string(report.measure)},
+                        {"paper_criterion", report.paper_criterion},
+                        {"fixed_point_residual", report.fixed_point_residual},
+                        {"complementarity", report.complementarity},
+                        {"active_nodes", report.active_nodes},
+                        {"active_set_changes", report.active_set_changes},
+                        {"elapsed_seconds", report.elapsed_seconds},
+                        {"gamma", report.gamma},
+                        {"update", report.update},
+                        {"note", report.note},
+                        {"bodies", std::move(bodies)},
+                        {"pairs", std::move(pairs)}};
+  // A collapse analysis's trials: the multiplier being tried (docs/progress.md).
+  if (!std::isnan(report.multiplier)) out["multiplier"] = report.multiplier;
+  return out;
 }
 
 bool matches_any(const std::string& name, const std::vector<std::string>& patterns) {

@@ -2,6 +2,7 @@
 #include "contact/result_file.hpp"
 
 #include "contact_tables.hpp"
+#include "collapse_group.hpp"
 #include "h5.hpp"
 #include "h5_eigen.hpp"
 #include "result_layout.hpp"
@@ -75,6 +76,8 @@ void read_input_and_provenance(hid_t file, ResultFile& r) {
                                std::to_string(messages.size()) + " messages");
     for (size_t k = 0; k < pointers.size(); ++k) r.warnings.push_back({pointers[k], messages[k]});
   }
+
+  read_collapse(file, r.collapse);
 
   Handle prov = h5::open_group(file, "provenance");
   Provenance& p = r.provenance;
@@ -180,6 +183,7 @@ void read_steps(hid_t file, ResultFile& r) {
     s.index = h5::has_attribute(g, "step") ? h5::read_attribute<std::int32_t>(g, "step") : k;  // its history row
     s.iteration = h5::read_attribute<std::int32_t>(g, "iteration");
     s.load_factor = h5::read_attribute<double>(g, "load_factor");
+    if (h5::has_attribute(g, "multiplier")) s.multiplier = h5::read_attribute<double>(g, "multiplier");
     s.converged = !h5::has_attribute(g, "converged") || h5::read_attribute<std::int8_t>(g, "converged") != 0;
     Handle bodies = h5::open_group(g, "bodies");
     for (const auto& name : h5::read_strings_attribute(g, "body_names")) s.bodies.push_back(read_body(bodies, name));

@@ -57,6 +57,7 @@ void step_columns(History& h, Visit&& visit) {
   visit(HistoryColumn{"iteration", A::none, S::int32, false}, h.iteration);
   visit(HistoryColumn{"load_factor", A::none, S::float64, false}, h.load_factor);
   visit(HistoryColumn{"converged", A::none, S::int8, true}, h.converged);
+  visit(HistoryColumn{"multiplier", A::none, S::float64, true}, h.multiplier);
   visit(HistoryColumn{"elements", A::bodies, S::int32, false}, h.elements);
   visit(HistoryColumn{"dofs", A::bodies, S::int32, false}, h.dofs);
   visit(HistoryColumn{"force", A::pairs, S::float64, false}, h.force);

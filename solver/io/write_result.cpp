@@ -11,6 +11,7 @@
 #include "h5.hpp"
 #include "h5_eigen.hpp"
 #include "result_layout.hpp"
+#include "collapse_group.hpp"
 #include "contact_tables.hpp"
 #include "vtkhdf.hpp"
 
@@ -135,9 +136,9 @@ void write_provenance(hid_t file, const Result& result, const WriteInfo& info) {
   std::vector<std::string> names;
   std::vector<double> theta;
   if (!result.steps.empty()) {
-    for (const auto& p : result.steps.back().pairs) {
-      names.push_back(p.name);
-      theta.push_back(p.theta);
+    for (const auto& pair : result.steps.back().pairs) {
+      names.push_back(pair.name);
+      theta.push_back(pair.theta);
     }
   }
   h5::write_strings_dataset(prov, "pair_names", names);
@@ -267,6 +268,7 @@ StepHistory step_table(const std::vector<StepSummary>& rows) {
     h.step.push_back(static_cast<int>(k));
     h.iteration.push_back(s.iteration);
     h.load_factor.push_back(s.load_factor);
+    h.multiplier.push_back(s.multiplier);
     h.converged.push_back(s.converged ? 1 : 0);
     for (Eigen::Index b = 0; b < nb; ++b) {
       h.elements(k, b) = s.elements[static_cast<size_t>(b)];
@@ -364,6 +366,7 @@ void write_step(hid_t steps, const Step& s, size_t k, size_t row) {
   h5::write_attribute<std::int32_t>(g, "step", static_cast<std::int32_t>(row));
   h5::write_attribute<std::int32_t>(g, "iteration", s.iteration);
   h5::write_attribute<double>(g, "load_factor", s.load_factor);
+  h5::write_attribute<double>(g, "multiplier", s.multiplier);
   h5::write_attribute<std::int8_t>(g, "converged", s.converged ? 1 : 0);
   h5::write_attribute(g, "body_names", body_names_of(s));
   h5::write_attribute(g, "pair_names", pair_names_of(s));
@@ -395,6 +398,7 @@ void write_all_but_steps(hid_t file, const Problem& problem, const Result& resul
   write_root_attributes(file, problem, result, info);
   write_input(file, problem);
   write_warnings(file, result);
+  write_collapse(file, result.collapse);
   write_provenance(file, result, info);
   {
     Handle history = h5::create_group(file, "history");

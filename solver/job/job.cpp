@@ -35,8 +35,8 @@ void set_default(json& object, const std::string& key, json value) {
 
 ParseResult JobReader::run() {
   Fields top(job_, "", "the job",
-             {"name", "version", "model", "meshes", "bodies", "contacts", "solver", "adaptivity", "loading", "parallel",
-              "output", "strict", "warnings"},
+             {"name", "version", "model", "meshes", "bodies", "contacts", "solver", "adaptivity", "loading", "collapse",
+              "parallel", "output", "strict", "warnings"},
              errors_);
   if (!top.ok()) return finish();
   read_header(top);
@@ -54,10 +54,12 @@ ParseResult JobReader::run() {
   read_solver(top);
   if (const json* a = top.find("adaptivity")) read_adaptivity(*a, top.at("adaptivity"));
   read_loading(top);
+  read_collapse(top);
   read_output(top);
   read_parallel(top);
   resolve_method_defaults();
   check_friction_and_histories();
+  check_collapse();
   check_floating_bodies();
   if (out_of_time("checking the floating bodies")) return finish();
   check_work_limits();

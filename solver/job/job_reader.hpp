@@ -88,6 +88,7 @@ struct BodyInput {
   std::vector<std::string> free_motions;  // rigid motions its displacement conditions leave free (a floating body)
   std::vector<std::string> condition_pointers;  // per entry of body.boundary: its pointer (/bodies/i/boundary/j)
   std::string body_force_pointer;               // /bodies/i/body_force when it has a history, else ""
+  std::vector<std::string> live_pointers;       // the "live" flags that are true (a collapse analysis's loads)
 };
 
 // Questions on what was read of a mesh (read_meshes.cpp).
@@ -204,12 +205,18 @@ class JobReader {
   // read_friction.cpp: a pair's friction, a condition's load history, and what they require of the rest
   void read_friction(const Fields& contact, FrictionSpec& friction);
   void read_history(const Fields& condition, std::vector<double>& history);
+  // A load's "live" flag (read_collapse.cpp): true marks a live load of the collapse analysis; a load only (not a
+  // displacement, not "free"), without a history of its own.
+  bool read_live(const Fields& condition);
+  void read_collapse(const Fields& top);  // "collapse"
+  void check_collapse();                  // after everything: live loads and the collapse section agree
   void read_body_force(const json& value, const std::string& pointer, BodyInput& in);
   void check_friction_and_histories();
 
   const json& job_;
   const Limits& limits_;
   json normalized_;
+  std::string collapse_pointer_;  // "/collapse" when the job has one
   json discarded_;
   Errors errors_;
   Problem problem_;

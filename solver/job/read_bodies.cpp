@@ -115,12 +115,14 @@ void JobReader::read_body_force(const json& value, const std::string& pointer, B
     if (auto v = read::pair(value, pointer, "body_force", errors_)) in.body.body_force = *v;
     return;
   }
-  Fields f(value, pointer, "body_force", {"value", "history"}, errors_);
+  Fields f(value, pointer, "body_force", {"value", "history", "live"}, errors_);
   if (!f.ok()) return;
   if (const json* v = f.require("value", "the force per volume [x, y]"))
     if (auto x = read::pair(*v, f.at("value"), "value", errors_)) in.body.body_force = *x;
   read_history(f, in.body.body_force_history);
   if (f.has("history")) in.body_force_pointer = pointer;
+  in.body.body_force_live = read_live(f);
+  if (in.body.body_force_live) in.live_pointers.push_back(f.at("live"));
 }
 
 void JobReader::read_material(const json& value, const std::string& pointer, Material& material) {
@@ -163,7 +165,7 @@ void JobReader::read_boundary(const json& value, const std::string& pointer, Bod
 void JobReader::read_condition(const json& value, const std::string& bp, BodyInput& in,
                                std::map<std::string, PlaceUse>& first_pointer_of_place) {
   Fields f(value, bp, "a boundary condition",
-           {"edge", "vertex", "displacement", "traction", "force", "free", "history"}, errors_);
+           {"edge", "vertex", "displacement", "traction", "force", "free", "history", "live"}, errors_);
   if (!f.ok()) return;
   const size_t before = errors_.size();
   BoundaryCondition bc;
@@ -177,9 +179,11 @@ void JobReader::read_condition(const json& value, const std::string& bp, BodyInp
   read_condition_values(f, bp, bc);
   check_loads_off_supports(f, bp, bc);
   read_history(f, bc.history);
+  bc.live = read_live(f);
   if (errors_.size() == before) {
     in.body.boundary.push_back(bc);
     in.condition_pointers.push_back(bp);
+    if (bc.live) in.live_pointers.push_back(f.at("live"));
   }
 }
 

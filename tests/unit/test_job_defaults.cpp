@@ -66,8 +66,8 @@ class DefaultsWalk {
  private:
   // Where in a job (an array index as "*") the default follows from the rest of the job.
   const std::vector<std::vector<std::string>> kJobDependent = {
-      {"output", "steps"},       // "last" for an adaptive job, else "all"
-      {"adaptivity", "bodies"},  // every named body
+      {"output", "steps"},        // "last" for an adaptive job, else "all"
+      {"adaptivity", "bodies"},   // every named body
       {"contacts", "*", "name"},  // "slave-master"
   };
 
@@ -181,8 +181,8 @@ class DefaultsWalk {
         failures.push_back(job_ + " " + child(at, key) + ": the schema's default " + d->node->dump() + " (" + d->at +
                            ") is not in the normalized copy");
       else if (!agrees(value[key], *d->node))
-        failures.push_back(job_ + " " + child(at, key) + ": the schema's default is " + d->node->dump() + " (" +
-                           d->at + ") but the reader writes " + value[key].dump());
+        failures.push_back(job_ + " " + child(at, key) + ": the schema's default is " + d->node->dump() + " (" + d->at +
+                           ") but the reader writes " + value[key].dump());
     }
   }
 
@@ -193,8 +193,7 @@ class DefaultsWalk {
     bool go_in = false;
     const json* around = nullptr;
   };
-  Written written(const std::string& where, const std::optional<SchemaNode>& m, const json& value,
-                  const json* around) {
+  Written written(const std::string& where, const std::optional<SchemaNode>& m, const json& value, const json* around) {
     const std::string key = where.substr(where.rfind('/') + 1);
     if (job_dependent(tokens(where))) return {};
     const json* cover = nullptr;
@@ -258,10 +257,11 @@ json lone_body_job() {
   })");
 }
 
-// A box held by its contacts alone (no "boundary") in the corner of a wall and a floor: the pairs' defaults, one
-// with a gap parabola; the sections given empty, where the reader fills in the members (the solver's penalty,
-// augmented-Lagrangian and interface settings too). Not "robin": {}: the reader writes psi only where the whole
-// "robin" is left out, so a given empty "robin" stays {} in the copy (psi "active_set" is meant all the same).
+// A box held by its contacts alone (no "boundary") in the corner of a wall and a floor, pushed into the corner by a
+// live load of an empty "collapse" (its defaults): the pairs' defaults, one with a gap parabola; the sections given
+// empty, where the reader fills in the members (the solver's penalty, augmented-Lagrangian and interface settings too).
+// Not "robin": {}: the reader writes psi only where the whole "robin" is left out, so a given empty "robin" stays {} in
+// the copy (psi "active_set" is meant all the same).
 json corner_job() {
   return json::parse(R"({
     "name": "corner",
@@ -269,7 +269,8 @@ json corner_job() {
     "bodies": [
       {"name": "box", "material": {"E": 2.1e5, "nu": 0.3},
        "mesh": {"nodes": [[0, 0], [1, 0], [2, 0], [0, 1], [1, 1], [2, 1]], "quads": [[0, 1, 4, 3], [1, 2, 5, 4]],
-                "edges": {"base": [[0, 1], [1, 2]], "wall": [[3, 0]]}}},
+                "edges": {"base": [[0, 1], [1, 2]], "wall": [[3, 0]]}},
+       "body_force": {"value": [-1, 0], "live": true}},
       {"name": "floor", "material": {"E": 2.1e5, "nu": 0.3},
        "mesh": {"block": {"corners": [[0, -1], [2, -1], [2, 0], [0, 0]], "nx": 2, "ny": 1}},
        "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]},
@@ -281,7 +282,8 @@ json corner_job() {
                  {"slave": "box.wall", "master": "wall.right"}],
     "solver": {"penalty": {}, "augmented_lagrangian": {}, "interface": {}},
     "parallel": {},
-    "output": {}
+    "output": {},
+    "collapse": {}
   })");
 }
 
@@ -355,8 +357,8 @@ TEST(SettingsConflict, ExactEnforcementOfAPenaltyIterationIsRefusedInOneWordingB
   // Every other combination can run.
   for (const auto method : {contact::Method::neumann, contact::Method::robin, contact::Method::monolithic,
                             contact::Method::interface_newton})
-    for (const auto enforcement : {contact::Enforcement::exact, contact::Enforcement::penalty,
-                                   contact::Enforcement::augmented_lagrangian}) {
+    for (const auto enforcement :
+         {contact::Enforcement::exact, contact::Enforcement::penalty, contact::Enforcement::augmented_lagrangian}) {
       contact::SolverSettings settings;
       settings.method = method;
       settings.enforcement = enforcement;

@@ -73,8 +73,8 @@ def module_of(path):
 
 
 # --- the rules: the Layout table ------------------------------------------------------------------------------
-SOLVER_MODULES = ["ddm/interface", "mesh", "fem", "mortar", "linalg", "bem", "ddm", "adapt", "check", "job", "io",
-                  "parallel", "mpi", "session", "problem", "result", "solve", "common"]
+SOLVER_MODULES = ["ddm/interface", "mesh", "fem", "mortar", "linalg", "bem", "ddm", "adapt", "check", "limit", "job",
+                  "io", "parallel", "mpi", "session", "problem", "result", "solve", "common"]
 SERVER_MODULES = ["common", "store", "metrics", "jobs", "transport", "http", "routes"]  # (cli: the public headers)
 
 

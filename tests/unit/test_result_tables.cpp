@@ -83,7 +83,7 @@ TEST(ResultLayout, TheStepHistoryIsTheDocumentsTableNameShapeAndType) {
   contact::io::StepHistory h;
   const ColumnSet declared = declared_columns([&](auto visit) { contact::io::step_columns(h, visit); }, "S");
   const ColumnSet documented = documented_columns("### `/history/steps`");
-  EXPECT_EQ(declared.size(), 10u);
+  EXPECT_EQ(declared.size(), 11u);
   EXPECT_EQ(declared, documented);
 }
 

@@ -148,18 +148,15 @@ void describe_stop(const linalg::FrictionNewtonResult& r, const InterfaceQp& qp,
       return;
     case SolveStop::singular: {
       // Statics has refused the loads that friction cannot carry along flat joints before the solve
-      // (friction_statics.hpp); what is left is the solver failing or a motion that check cannot judge.
+      // (friction_statics.hpp); whether the rest is a collapse or the solver, solve() judges by the rigid-block
+      // statics of the whole (limit/verdict.hpp) once the run has stopped.
       std::ostringstream os;
       os.precision(3);
       os << "the friction Newton did not converge: at step " << r.report.iterations
          << " the stick and slip sets it predicted, and every set between them and the last solved one, leave a "
             "floating body (or a group of them) held by nothing (a singular system"
          << (unheld.empty() ? std::string() : "; the predicted sets hold no contact node that fixes " + unheld)
-         << "); the complementarity residual of the last iterate is " << complementarity
-         << ". The statics check before the solve found no set of bodies that friction cannot hold along a flat "
-            "joint, so either the solver failed (try smaller load steps) or the loads move a body that check cannot "
-            "judge (a curved contact, bodies held only by frictionless contacts): check that every floating body is "
-            "held";
+         << "); the complementarity residual of the last iterate is " << complementarity;
       result.report.message = os.str();
       return;
     }

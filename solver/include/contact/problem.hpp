@@ -55,6 +55,9 @@ struct BoundaryCondition {
   // This condition's own load factor for each load step (its value is scaled by history[k] in step k instead of
   // the loading's factor): a normal load held while a tangential one grows. Empty: it follows the loading.
   std::vector<double> history;
+  // A live load of a collapse analysis (Problem::collapse): scaled by the load multiplier lambda instead of the
+  // loading's factor (0 during the loading's steps, which bring the dead loads on). Loads only, never a history.
+  bool live = false;
 };
 
 inline bool prescribes_displacement(const BoundaryCondition& bc) { return bc.ux.has_value() || bc.uy.has_value(); }
@@ -77,6 +80,7 @@ struct Body {
   // body_force's own load factor per load step, as a condition's history (empty: it follows the loading): a
   // horizontal seismic coefficient ramped while the weight (density x gravity) is held.
   std::vector<double> body_force_history;
+  bool body_force_live = false;  // body_force is a live load of the collapse analysis (as BoundaryCondition::live)
 
   // The body's weight per volume under `gravity`, a body force besides body_force.
   Eigen::Vector2d weight(const Eigen::Vector2d& gravity) const { return material.density * gravity; }
@@ -265,6 +269,18 @@ struct LoadingSpec {
   std::vector<double> factors = {1.0};
 };
 
+// A collapse analysis (the job's "collapse", docs/limit-analysis.md): once the loading's steps have brought the dead
+// loads on, the live loads (BoundaryCondition::live, Body::body_force_live) are raised by a load multiplier lambda
+// from 0, by increments the analysis adapts, until a trial does not hold; the limit is then bracketed by bisection,
+// each trial from the last state that held, to `tolerance` relative (limit/collapse.hpp).
+struct CollapseSpec {
+  bool enabled = false;
+  double tolerance = 1e-3;      // the bracket's width relative to the multiplier that held
+  double first = 0.0;           // the first trial multiplier (0: half the rigid-block statics bound, else 1)
+  double max_multiplier = 1e6;  // no collapse up to this: the answer is "holds up to max_multiplier"
+  int max_solves = 60;          // trial solves at most (each one load increment)
+};
+
 // Which steps the result keeps whole (the job's "output"): every step's fields, or the last step's only. The
 // scalars of every step (Result::step_history, /history/steps) are kept either way. The job reader's default is
 // `last` for adaptive jobs and `all` otherwise (docs/job-format.md, "Output"); a Problem built in code keeps all.
@@ -288,6 +304,7 @@ struct Problem {
   SolverSettings solver;
   AdaptivitySettings adaptivity;
   LoadingSpec loading;
+  CollapseSpec collapse;
   OutputSettings output;
   int ranks = 1;        // parallel.ranks: MPI ranks a server launches (contact-solve takes mpirun's)
   bool strict = false;  // warnings are errors (the job's "strict", contact-solve --strict)

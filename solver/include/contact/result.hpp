@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 
 #include <atomic>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -65,6 +66,8 @@ struct IterationReport {
   double gamma = 0.0;                 // relaxation in use (0 for methods without one)
   int update = 0;                     // augmented-Lagrangian update (0 for the pure penalty method)
   std::string note;                   // what changed in this iteration, if anything (e.g. "gamma reduced")
+  // A collapse analysis: the multiplier of the trial this iteration belongs to (NaN outside the trials).
+  double multiplier = std::numeric_limits<double>::quiet_NaN();
   std::vector<BodyReport> bodies;
   std::vector<PairReport> pairs;
   double elapsed_seconds = 0.0;
@@ -157,6 +160,7 @@ struct Step {
   int index = 0;
   int iteration = 0;         // the DDM iteration at which this step's mesh was final
   double load_factor = 1.0;  // the load factor of this step (Problem::loading)
+  double multiplier = 0.0;   // a collapse analysis's load multiplier of the live loads (0 without one)
   // Whether this step's solve converged. A step that did not is kept only as the last one of a run that stopped on
   // it (its iterate, flagged), never as an answer: the steps before it all converged.
   bool converged = true;
@@ -170,6 +174,7 @@ struct StepSummary {
   int index = 0;
   int iteration = 0;
   double load_factor = 1.0;
+  double multiplier = 0.0;
   bool converged = true;
   std::vector<std::string> body_names;
   std::vector<int> elements, nodes;  // per body
@@ -197,6 +202,57 @@ struct RunOutcome {
   std::vector<IterationReport> history;
 };
 
+// A collapse mechanism (limit/mechanism.hpp): the rigid motion of each body that moves and what each joint (contact
+// pair) does, at the scale where the largest body velocity is 1.
+struct BodyMotion {
+  std::string body;
+  Eigen::Vector2d velocity = Eigen::Vector2d::Zero();  // of the body's reference point (the mean of its nodes)
+  double omega = 0.0;                                  // angular velocity, anticlockwise positive
+  Eigen::Vector2d reference = Eigen::Vector2d::Zero();
+  // Where the body turns about (its instantaneous centre), when it turns; NaN when it translates.
+  Eigen::Vector2d centre = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+  std::string words;  // "translates along (0.83, 0.55)", "turns clockwise about (2, 0)"
+};
+struct JointMotion {
+  std::string pair;
+  // "hinge" (the joint opens turning about a point of it), "slides" (along the joint), "opens" (separates without
+  // turning on it), "opens and slides" (turns about a point off the joint)
+  std::string kind;
+  Eigen::Vector2d point = Eigen::Vector2d::Zero();  // a hinge's point; else the middle of the joint's rows
+  double slip = 0.0;     // the slave's velocity along the pair's tangent relative to the master, at the point
+  double opening = 0.0;  // the largest opening rate over the joint
+  std::string words;
+};
+struct Mechanism {
+  // "overturning", "sliding", "hinging" (several hinges), "mixed" (hinges and sliding), "lift-off" (joints that only
+  // open), "unsupported" (bodies that move with no joint taking part), "" (none found)
+  std::string kind;
+  std::vector<BodyMotion> bodies;   // the bodies that move
+  std::vector<JointMotion> joints;  // the joints that open or slide
+  std::string words;                // one sentence: what moves and how
+};
+
+// A collapse analysis's answer (Problem::collapse; limit/collapse.hpp). The result's steps are the states that held
+// along the way, each with its multiplier (the capacity curve); the last is the last that held.
+struct CollapseResult {
+  bool analysed = false;
+  // "collapse" (bracketed: a multiplier held and a larger one did not), "holds" (no collapse up to
+  // max_multiplier), "dead_loads_fail" (the loading's steps did not hold: the collapse multiplier was never
+  // raised), "solver_failed" (the trials stopped before a bracket: max_solves, a cancel, an error)
+  std::string verdict;
+  double held = 0.0;                                         // the largest multiplier that held (lambda_c from below)
+  double failed = std::numeric_limits<double>::quiet_NaN();  // the smallest that did not (lambda_c from above)
+  bool failed_by_statics = false;  // `failed` exceeds the statics bound: refused without a solve
+  double tolerance = 0.0;
+  int solves = 0;          // trial solves, each one load increment from the last state that held
+  int bracket_solves = 0;  // of those, after the first failure (the bisection)
+  // The rigid-block statics (limit/statics.hpp): the largest multiplier the bodies as rigid blocks carry with
+  // associated friction, an upper bound of lambda_c; +inf when any multiple is carried, NaN when not computed.
+  double statics_bound = std::numeric_limits<double>::quiet_NaN();
+  Mechanism mechanism;  // the statics' mechanism at its bound
+  std::string words;    // the verdict as one paragraph (also the end of Result::message)
+};
+
 struct Result : RunOutcome {
   std::string method;       // "interface_newton", "neumann", "robin" or "monolithic"
   std::string enforcement;  // "exact", "penalty" or "augmented_lagrangian"
@@ -211,6 +267,7 @@ struct Result : RunOutcome {
   // The problem's warnings (before the solve) and the solve's (check/large_motion.hpp: displacements and rotations
   // that void the small-displacement model, floating bodies moved far), in that order.
   std::vector<Warning> warnings;
+  CollapseResult collapse;  // a collapse analysis's answer (analysed false without one)
   double wall_seconds = 0.0;
   double setup_seconds = 0.0;  // assembly + factorisations
   double factorization_seconds = 0.0;

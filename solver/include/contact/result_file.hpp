@@ -138,7 +138,8 @@ struct StepHistory {
   std::vector<std::string> body_names, pair_names;
   std::vector<int> step, iteration;
   std::vector<double> load_factor;
-  std::vector<int> converged;  // 1 or 0 per step (older files: absent, every step converged)
+  std::vector<int> converged;      // 1 or 0 per step (older files: absent, every step converged)
+  std::vector<double> multiplier;  // a collapse analysis's multiplier per step (0 before it; older files: empty)
   Eigen::MatrixXi elements, dofs;
   Eigen::MatrixXd force, contact_begin, contact_end;  // S x P
   Eigen::MatrixXd tangential_force;                   // S x P (0 for frictionless pairs; empty in older files)
@@ -178,6 +179,7 @@ struct ResultFile {
   // /input
   std::string job_json, normalized_json;
   std::vector<Warning> warnings;  // /warnings: the model checks' (empty in a file written before them)
+  CollapseResult collapse;        // /collapse: a collapse analysis's answer (analysed false without one)
   Provenance provenance;
   IterationHistory history;
   StepHistory step_history;
