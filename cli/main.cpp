@@ -326,6 +326,7 @@ int solve_and_write(contact::Session& session, contact::Problem& problem, const 
                             {"traffic", traffic},
                             {"result_written", false},
                             {"warnings", contact::warnings_json(result.warnings)},
+                            {"collapse", contact::io::collapse_json(result.collapse)},
                             {"steps", nlohmann::json::array()}};
   auto finish = [&](int code) {
     if (ndjson) std::printf("%s\n", summary.dump().c_str());

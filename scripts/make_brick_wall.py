@@ -23,14 +23,16 @@ dowels: friction alone holds the bricks sideways (--head-friction gives the head
 for frictionless ones). The load is then a path of two steps: the precompression (the
 top pressure) in step 1, held in step 2 while a horizontal point load at the top-left corner of every top-row
 brick grows from 0 to --shear S times that brick's vertical load (its `history`). Statics: every bed joint carries
-the shear S V over the normal load V, so the wall holds for S < MU and its courses slide for S > MU."""
+the shear S V over the normal load V, so no wall holds for S > MU (and some fail below it, by rocking end stones over
+a stepped crack). --collapse asks instead for the collapse analysis (docs/limit-analysis.md): the precompression
+held, the shear a live load whose multiplier is S, raised to the largest S the wall holds."""
 import argparse
 import json
 import sys
 
 
 def wall(rows, bricks, cells, length=0.24, height=0.07, pressure=2.0, abutments=False, head_joints=False,
-         friction=None, shear=0.0, head_friction=None):
+         friction=None, shear=0.0, head_friction=None, collapse=False):
     E, nu = 1.0e4, 0.2            # MPa: brick
     E_base, nu_base = 3.0e4, 0.2  # concrete base
     width = bricks * length
@@ -95,21 +97,29 @@ def wall(rows, bricks, cells, length=0.24, height=0.07, pressure=2.0, abutments=
                 pair(f"{name}.right", f"{right}.left", head_mu)
             if abutments:
                 pair(f"{row[-1][0]}.right", "abutment_right.left", head_mu)
-    stepped = friction is not None
+    stepped = friction is not None and not collapse
     for name, x0, x1 in layout[-1]:
         boundary = next(b for b in bodies if b["name"] == name)["boundary"]
         boundary.append({"edge": "top", "traction": {"normal": pressure}})
-        if stepped:
+        if collapse:
+            # The shear as a live load of the collapse analysis: lambda times the brick's vertical load, so that
+            # lambda_c is the shear ratio S the wall holds at most.
+            boundary.append({"vertex": "top_left", "force": [pressure * (x1 - x0), 0], "live": True})
+        elif stepped:
             boundary[-1]["history"] = [1, 1]
             # The shear: S times the brick's vertical load (pressure x its length), growing in step 2.
             boundary.append({"vertex": "top_left", "force": [shear * pressure * (x1 - x0), 0], "history": [0, 1]})
 
     kind = "_abutments" if abutments else "_head_joints" if head_joints else ""
     name = f"brick_wall_{rows}x{bricks}{kind}" + (f"_mu{friction:g}_shear{shear:g}" if stepped else "")
+    if collapse:
+        name = f"brick_wall_{rows}x{bricks}{kind}_mu{friction:g}_collapse"
     job = {"name": name, "version": 1, "model": {"plane": "strain"}, "bodies": bodies, "contacts": contacts,
            "solver": {"method": "interface_newton", "enforcement": "exact"}}
     if stepped:
         job["loading"] = {"factors": [1, 1]}
+    if collapse:
+        job["collapse"] = {}
     return job
 
 
@@ -118,6 +128,8 @@ def main():
     p.add_argument("--rows", type=int, default=8)
     p.add_argument("--bricks", type=int, default=8, help="full bricks per row")
     p.add_argument("--cells", type=int, default=4, help="elements along a full brick (half as many across)")
+    p.add_argument("--brick-height", type=float, default=0.07,
+                   help="a brick's height (its length is 0.24): 0.12 for stones of 2:1")
     joints = p.add_mutually_exclusive_group()
     joints.add_argument("--abutments", action="store_true",
                         help="no dowels: abutments and head-joint contacts hold the bricks sideways")
@@ -129,6 +141,9 @@ def main():
                    help="with --friction: the horizontal load on each top brick in step 2, as a share of its vertical load")
     p.add_argument("--head-friction", type=float, metavar="MU",
                    help="with --friction: the head joints' coefficient (default MU; 0: frictionless head joints)")
+    p.add_argument("--collapse", action="store_true",
+                   help="with --friction: a collapse analysis instead of the shear S: the precompression dead, the "
+                        "shear live (lambda times each top brick's vertical load), lambda raised to its limit")
     p.add_argument("-o", "--output", default="-")
     a = p.parse_args()
     if a.rows < 1 or a.bricks < 1 or a.cells < 2:
@@ -137,6 +152,8 @@ def main():
         p.error("--friction must be >= 0")
     if a.friction is None and a.shear:
         p.error("--shear needs --friction (a frictionless wall without dowels cannot carry a shear)")
+    if a.collapse and (a.friction is None or a.shear):
+        p.error("--collapse needs --friction and no --shear (the analysis finds the largest shear)")
     if a.friction is None and a.head_friction is not None:
         p.error("--head-friction needs --friction")
     if a.head_friction is not None and not a.head_friction >= 0:
@@ -150,8 +167,10 @@ def main():
         # nothing holds it: every solver fails, the monolithic reference included (docs/friction.md, "Limits").
         p.error(f"--head-joints needs --cells 4 or more (got {a.cells}): a half brick of one element rests on a "
                 "single contact multiplier, which cannot hold the moment of a shear")
-    job = wall(a.rows, a.bricks, a.cells, abutments=a.abutments, head_joints=a.head_joints, friction=a.friction,
-               shear=a.shear, head_friction=a.head_friction)
+    if not a.brick_height > 0:
+        p.error("--brick-height must be > 0")
+    job = wall(a.rows, a.bricks, a.cells, height=a.brick_height, abutments=a.abutments, head_joints=a.head_joints, friction=a.friction,
+               shear=a.shear, head_friction=a.head_friction, collapse=a.collapse)
     text = json.dumps(job, indent=1) + "\n"
     if a.output == "-":
         sys.stdout.write(text)

@@ -17,6 +17,9 @@ As a command (clients/contact_client.py, or python3 -m contact_client with clien
                                               # friction pairs: also the tangential traction, the slip and
                                               # the stick zone per step; many bodies: an overview of all
                                               # bodies and joints; stepped jobs: the load path
+    contact_client.py collapse wall.hdf -o wall.png [--body NAME [--point X Y]]
+                                              # a collapse analysis: the verdict, the capacity curve and
+                                              # the mechanism
 
     --url (CONTACT_URL, default http://127.0.0.1:8080), --token (CONTACT_TOKEN), --timeout (seconds).
     Exit codes: 0 ok; 1 server, connection or job error (an answer that is not the API's included);
@@ -34,7 +37,7 @@ As a module:
 
 Modules: errors (the exceptions), client (HTTP and the API), sse (event streams), results (reading files, all
 or in part), plot (the figure; its parts in plot_profiles, plot_pairs, plot_paths, plot_mesh, plot_wall and
-plot_select), display (what the commands print), cli (the commands).
+plot_select), plot_collapse (a collapse analysis's view), display (what the commands print), cli (the commands).
 """
 from .cli import build_parser, main
 from .client import DEFAULT_TIMEOUT, DEFAULT_URL, STREAM_READ_TIMEOUT, Client
@@ -42,8 +45,10 @@ from .display import Progress, compact_iterations, format_iteration
 from .errors import (EXIT_ERROR, EXIT_JOB, EXIT_OK, EXIT_USAGE, ApiError, BadAnswer, BadInput, ClientError,
                      ConnectionFailed, RequestTimeout)
 from .plot import load_curve, load_path, plot_result
+from .plot_collapse import capacity_curve, plot_collapse
 from .results import ResultFile, joint_results, read_events, read_result
 
 __all__ = ["Client", "ClientError", "ConnectionFailed", "RequestTimeout", "ApiError", "BadInput", "BadAnswer",
            "read_result", "read_events", "ResultFile", "joint_results", "plot_result", "load_curve", "load_path",
+           "plot_collapse", "capacity_curve",
            "DEFAULT_URL", "DEFAULT_TIMEOUT", "main"]

@@ -10,6 +10,7 @@ from .client import DEFAULT_TIMEOUT, DEFAULT_URL, Client
 from .display import Progress, dicts, num, print_job, word
 from .errors import EXIT_ERROR, EXIT_JOB, EXIT_OK, EXIT_USAGE, BadInput, ClientError, one_line
 from .plot import MAX_PAIRS, plot_result
+from .plot_collapse import plot_collapse
 from .results import read_events
 
 
@@ -32,6 +33,25 @@ def print_warnings(warnings, shown=0):
         pointer = word(w.get("pointer"), 200)
         sys.stderr.write(f"warning: {pointer + ': ' if pointer else ''}{word(w.get('message'), 2000)}\n")
     return max(shown, len(listed))
+
+
+def print_collapse(collapse, out=None):
+    """A collapse analysis's answer, or a failed step's statics verdict (the end event's `collapse`), in lines."""
+    if not isinstance(collapse, dict):
+        return
+    out = out or sys.stderr
+    verdict, held, failed = word(collapse.get("verdict")), collapse.get("held"), collapse.get("failed")
+    if verdict == "collapse" and isinstance(held, (int, float)) and isinstance(failed, (int, float)):
+        out.write(f"collapse: lambda_c between {held:.6g} (held) and {failed:.6g} (did not hold), "
+                  f"{collapse.get('solves', 0)} trial solves\n")
+    elif verdict:
+        out.write(f"collapse analysis: {verdict}\n")
+    bound = collapse.get("statics_bound")
+    if isinstance(bound, (int, float)):
+        out.write(f"  statics (rigid blocks, associated friction): lambda <= {bound:.6g}\n")
+    mechanism = collapse.get("mechanism") or {}
+    if mechanism.get("words"):
+        out.write(f"  mechanism: {word(mechanism['words'], 600)}\n")
 
 
 def _follow(c, job_id, a, warnings_shown=0):
@@ -61,6 +81,8 @@ def _follow(c, job_id, a, warnings_shown=0):
     state = word(end.get("state")) if end else None
     if end:  # the answer's warnings (the job's were shown at submission), with -q too: they are not progress
         print_warnings(end.get("warnings"), warnings_shown)
+        if not a.quiet:
+            print_collapse(end.get("collapse"))
     if getattr(a, "output", None):
         if end and end.get("result_available") is True:
             c.download(job_id, a.output, xmf=getattr(a, "xmf", False))
@@ -184,6 +206,22 @@ def _cmd_plot(c, a):
     except (OSError, KeyError) as exc:
         raise BadInput(f"cannot read {a.file}: {one_line(exc)}") from None
     _print_plot(a.output, drawn)
+    return EXIT_OK
+
+
+def _cmd_collapse(c, a):
+    if not os.path.exists(a.file):
+        raise BadInput(f"cannot read {a.file}: no such file")
+    if a.point is not None and not a.body:
+        raise BadInput("--point needs --body (the body whose node nearest the point is followed)")
+    try:
+        drawn = plot_collapse(a.file, a.output, body=a.body, point=a.point, title=a.title)
+    except (OSError, KeyError) as exc:
+        raise BadInput(f"cannot read {a.file}: {one_line(exc)}") from None
+    curve = drawn["curve"]
+    print(f"wrote {a.output}: the capacity curve ({len(curve['multiplier'])} states that held, the displacement of "
+          f"'{curve['body']}' node {curve['node']}) and the mechanism ({drawn['kind'] or 'none found'})")
+    print(f"verdict: {word(drawn['words'], 2000)}")
     return EXIT_OK
 
 
@@ -331,13 +369,25 @@ def build_parser():
                        help="draw the mesh row whatever the number of bodies")
     s.add_argument("--title")
     s.set_defaults(func=_cmd_plot)
+
+    s = sub.add_parser("collapse", parents=[common],
+                       help="a collapse analysis's result: the verdict, the capacity curve (the multiplier of every "
+                            "state that held against a displacement) and the mechanism over the structure")
+    s.add_argument("file", metavar="FILE.hdf")
+    s.add_argument("-o", "--output", required=True, metavar="PNG")
+    s.add_argument("--body", help="the capacity curve follows a node of this body (default: the node that moved "
+                                  "most at the last state that held)")
+    s.add_argument("--point", nargs=2, type=float, metavar=("X", "Y"),
+                   help="with --body: the node of that body nearest (X, Y)")
+    s.add_argument("--title")
+    s.set_defaults(func=_cmd_collapse)
     return p
 
 
 def main(argv=None):
     a = build_parser().parse_args(argv)
     try:
-        if a.command == "plot":
+        if a.command in ("plot", "collapse"):
             return a.func(None, a)
         c = Client(getattr(a, "url", None), getattr(a, "token", None),
                    getattr(a, "timeout", DEFAULT_TIMEOUT))

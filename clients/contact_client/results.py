@@ -214,6 +214,20 @@ class ResultFile:
         w = self._f["warnings"]
         return [{"pointer": p, "message": m} for p, m in zip(_dataset(w["pointer"]), _dataset(w["message"]))]
 
+    def collapse(self):
+        """A collapse analysis's answer, or the statics' verdict on a failed step (/collapse; docs/results-format.md):
+        {"verdict", "held", "failed", "statics_bound", "solves", "words", ..., "mechanism": {"kind", "words",
+        "body_names", "body_velocity", "body_omega", "body_reference", "body_centre", "pair_names", "joint_kind",
+        "joint_point", ...}}, or None for a file without one."""
+        if "collapse" not in self._f:
+            return None
+        g = self._f["collapse"]
+        out = {k: _attr(v) for k, v in g.attrs.items()}
+        m = g["mechanism"]
+        out["mechanism"] = {k: _attr(v) for k, v in m.attrs.items()}
+        out["mechanism"].update({k: _dataset(item) for k, item in m.items()})
+        return out
+
     def job(self, key="job"):
         """The job as submitted (key "job") or with its defaults filled in ("normalized"), or None."""
         try:

@@ -35,7 +35,8 @@ nlohmann::json end_event(const JobRecord& r) {
           {"iterations", r.iterations},
           {"solve_seconds", r.solve_seconds},
           {"result_available", r.result_available},
-          {"warnings", r.warnings}};
+          {"warnings", r.warnings},
+          {"collapse", r.collapse}};
 }
 
 }  // namespace contactd

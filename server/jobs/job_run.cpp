@@ -7,6 +7,7 @@
 #include "jobs/events.hpp"
 #include "jobs/progress_observer.hpp"
 
+#include "contact/progress_json.hpp"
 #include "contact/result_file.hpp"
 #include "contact/solve.hpp"
 #include "contact/work_label.hpp"
@@ -155,6 +156,8 @@ JobRecord JobRun::outcome_of(const contact::Result& result, CancelReason reason)
   outcome.message = result.message;
   outcome.stop_reason = contact::to_string(result.stop_reason);
   outcome.warnings = contact::warnings_json(result.warnings);
+  // A collapse analysis's answer or a failed step's statics verdict: a run on MPI ranks reports it as JSON already.
+  outcome.collapse = mpi_ ? mpi_->collapse : contact::io::collapse_json(result.collapse);
   switch (result.stop_reason) {
     case contact::StopReason::converged:
       outcome.state = JobState::succeeded;
@@ -252,6 +255,7 @@ void JobRun::finish(JobRecord outcome) {
     r.result_bytes = outcome.result_bytes;
     r.events_dropped = outcome.events_dropped;
     r.warnings = outcome.warnings;
+    r.collapse = outcome.collapse;
   };
   // The outcome is on disk before anyone is told: on a full disk the worker waits here (the job stays RUNNING
   // on disk and in the API) rather than report an outcome a restart would not find.

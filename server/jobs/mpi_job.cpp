@@ -208,6 +208,7 @@ class MpiRun {
       outcome_.result_written = result_.value("result_written", false);
       if (result_.contains("steps") && result_["steps"].is_array()) outcome_.steps = result_["steps"];
       if (result_.contains("warnings") && result_["warnings"].is_array()) outcome_.warnings = result_["warnings"];
+      if (result_.contains("collapse") && result_["collapse"].is_object()) outcome_.collapse = result_["collapse"];
       return outcome_;
     }
     std::ostringstream os;

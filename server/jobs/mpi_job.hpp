@@ -34,6 +34,7 @@ struct MpiOutcome {
   bool result_written = false;
   nlohmann::json steps = nlohmann::json::array();     // step events, as the child reported them
   nlohmann::json warnings = nlohmann::json::array();  // the model checks' warnings, as the child reported them
+  nlohmann::json collapse;  // the collapse analysis's answer or a failed step's verdict (contact::io::collapse_json)
 };
 
 using ProgressLine = std::function<void(const std::string& type, const nlohmann::json& line)>;

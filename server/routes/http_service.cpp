@@ -47,6 +47,7 @@ nlohmann::json RouteContext::job_resource(const JobRecord& r, int queue_position
                       {"result_bytes", r.result_available ? nlohmann::json(r.result_bytes) : nlohmann::json(nullptr)},
                       {"events_dropped", r.events_dropped},
                       {"warnings", r.warnings},
+                      {"collapse", r.collapse},
                       {"links", links}};
   j["queue_position"] =
       r.state == JobState::queued && queue_position > 0 ? nlohmann::json(queue_position) : nlohmann::json(nullptr);

@@ -53,6 +53,7 @@ nlohmann::json to_state_json(const JobRecord& r) {
                       {"result_bytes", r.result_bytes},
                       {"events_dropped", r.events_dropped},
                       {"warnings", r.warnings},
+                      {"collapse", r.collapse},
                       {"progress", r.progress ? *r.progress : nlohmann::json(nullptr)}};
   j["converged"] = r.converged ? nlohmann::json(*r.converged) : nlohmann::json(nullptr);
   return j;
@@ -85,6 +86,7 @@ JobRecord from_state_json(const nlohmann::json& j) {
   r.result_bytes = j.value("result_bytes", std::int64_t{0});
   r.events_dropped = j.value("events_dropped", std::int64_t{0});
   if (j.contains("warnings") && j["warnings"].is_array()) r.warnings = j["warnings"];
+  if (j.contains("collapse") && j["collapse"].is_object()) r.collapse = j["collapse"];
   if (j.contains("converged") && j["converged"].is_boolean()) r.converged = j["converged"].get<bool>();
   if (j.contains("progress") && !j["progress"].is_null())
     r.progress = std::make_shared<const nlohmann::json>(j["progress"]);

@@ -48,6 +48,9 @@ struct JobRecord {
   // The model checks' warnings, [{"pointer", "message"}] (contact/warning.hpp): the job's at submission, the
   // run's (the job's and the answer's) once it is done.
   nlohmann::json warnings = nlohmann::json::array();
+  // Once done: a collapse analysis's answer, or the statics' verdict on a step that failed (contact::io::
+  // collapse_json: verdict, bracket, statics bound, mechanism); null for the others.
+  nlohmann::json collapse;
   // The latest iteration in short (null before the first); shared, so copying a record (a listing, a snapshot)
   // does not copy it: a 500-body wall's is 0.6 MB.
   std::shared_ptr<const nlohmann::json> progress;

@@ -49,6 +49,7 @@ class ContactSystem {
   double total_factorization_seconds() const { return factorization_seconds_; }
 
   const Problem& problem() const { return problem_; }
+  parallel::TaskRunner& runner() const { return runner_; }  // the processes and threads it was built on
   size_t n_bodies() const { return bodies_.size(); }
   const fem::BodySolver& body(size_t a) const { return *bodies_[a]; }
   const std::vector<mortar::PairDiscretization>& pairs() const { return pairs_; }

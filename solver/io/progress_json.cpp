@@ -204,7 +204,44 @@ nlohmann::json step_json(const StepSummary& step) {
       {"iteration", step.iteration},
       {"bodies_summary", {{"count", step.body_names.size()}, {"elements", elements}, {"nodes", nodes}}}};
   if (step.body_names.size() <= kBodiesListedAll) j["bodies"] = std::move(bodies);
+  if (step.multiplier != 0.0) j["multiplier"] = step.multiplier;
   return j;
+}
+
+nlohmann::json collapse_json(const CollapseResult& c) {
+  if (!c.analysed) return nullptr;
+  // JSON has no NaN or infinity: a bound or a failure not known is null, an unbounded statics "inf".
+  auto number = [](double x) -> nlohmann::json {
+    if (std::isnan(x)) return nullptr;
+    if (std::isinf(x)) return "inf";
+    return x;
+  };
+  nlohmann::json bodies = nlohmann::json::array(), joints = nlohmann::json::array();
+  for (const auto& b : c.mechanism.bodies)
+    bodies.push_back(
+        {{"body", b.body},
+         {"velocity", {b.velocity.x(), b.velocity.y()}},
+         {"omega", b.omega},
+         {"centre", std::isnan(b.centre.x()) ? nlohmann::json(nullptr) : nlohmann::json{b.centre.x(), b.centre.y()}},
+         {"words", b.words}});
+  for (const auto& j : c.mechanism.joints)
+    joints.push_back({{"pair", j.pair},
+                      {"kind", j.kind},
+                      {"point", {j.point.x(), j.point.y()}},
+                      {"slip", j.slip},
+                      {"opening", j.opening},
+                      {"words", j.words}});
+  return {{"verdict", c.verdict},
+          {"held", c.held},
+          {"failed", number(c.failed)},
+          {"failed_by_statics", c.failed_by_statics},
+          {"tolerance", c.tolerance},
+          {"solves", c.solves},
+          {"bracket_solves", c.bracket_solves},
+          {"statics_bound", number(c.statics_bound)},
+          {"words", c.words},
+          {"mechanism",
+           {{"kind", c.mechanism.kind}, {"words", c.mechanism.words}, {"bodies", bodies}, {"joints", joints}}}};
 }
 
 }  // namespace contact::io

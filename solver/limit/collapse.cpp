@@ -23,12 +23,11 @@ struct Loads {
 // The bodies' load resultants at `at`: the dead ones (multiplier 0) and the live ones at multiplier 1.
 Loads loads_at(const ddm::ContactSystem& system, const RigidBlocks& blocks, fem::LoadPoint at) {
   Loads out;
-  for (size_t a = 0; a < blocks.bodies.size(); ++a) {
-    at.multiplier = 0.0;
-    out.dead.push_back(load_resultant(system, blocks, a, at));
-    at.multiplier = 1.0;
-    out.live.push_back(load_resultant(system, blocks, a, at) - out.dead.back());
-  }
+  at.multiplier = 0.0;
+  out.dead = load_resultants(system, blocks, at);
+  at.multiplier = 1.0;
+  out.live = load_resultants(system, blocks, at);
+  for (size_t a = 0; a < out.live.size(); ++a) out.live[a] -= out.dead[a];
   return out;
 }
 

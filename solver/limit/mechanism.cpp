@@ -167,6 +167,8 @@ Mechanism describe_mechanism(const ddm::ContactSystem& system, const RigidBlocks
     m.kind = "sliding";
   } else if (hinges == joints) {
     m.kind = hinges == 1 ? "overturning" : "hinging";
+  } else if (groups.size() == 1 && !std::isnan(m.bodies.front().centre.x())) {
+    m.kind = "overturning";  // one group turning as one about a point: over a stepped crack, about a toe
   } else {
     m.kind = "mixed";
   }

@@ -112,17 +112,26 @@ RigidBlocks rigid_blocks(const ddm::ContactSystem& system) {
   return blocks;
 }
 
-Resultant load_resultant(const ddm::ContactSystem& system, const RigidBlocks& blocks, size_t a,
-                         const fem::LoadPoint& at) {
-  const Eigen::VectorXd f = system.body(a).external_load(at);
-  const auto& nodes = system.problem().bodies[a].mesh.nodes;
-  const Eigen::Vector2d& c = blocks.bodies[a].reference;
-  Resultant out = Resultant::Zero();
-  for (size_t i = 0; i < nodes.size() && 2 * i + 1 < static_cast<size_t>(f.size()); ++i) {
-    const Eigen::Vector2d fi(f[static_cast<Eigen::Index>(2 * i)], f[static_cast<Eigen::Index>(2 * i + 1)]);
-    const Eigen::Vector2d d = nodes[i] - c;
-    out += Resultant(fi.x(), fi.y(), d.x() * fi.y() - d.y() * fi.x());
+std::vector<Resultant> load_resultants(const ddm::ContactSystem& system, const RigidBlocks& blocks,
+                                       const fem::LoadPoint& at) {
+  const size_t nb = blocks.bodies.size();
+  std::vector<double> sums(3 * nb, 0.0);
+  for (size_t a = 0; a < nb; ++a) {
+    if (!system.runner().owns(a)) continue;  // (its owner assembles its loads)
+    const Eigen::VectorXd f = system.body(a).external_load(at);
+    const auto& nodes = system.problem().bodies[a].mesh.nodes;
+    const Eigen::Vector2d& c = blocks.bodies[a].reference;
+    for (size_t i = 0; i < nodes.size() && 2 * i + 1 < static_cast<size_t>(f.size()); ++i) {
+      const Eigen::Vector2d fi(f[static_cast<Eigen::Index>(2 * i)], f[static_cast<Eigen::Index>(2 * i + 1)]);
+      const Eigen::Vector2d d = nodes[i] - c;
+      sums[3 * a] += fi.x();
+      sums[3 * a + 1] += fi.y();
+      sums[3 * a + 2] += d.x() * fi.y() - d.y() * fi.x();
+    }
   }
+  system.runner().sum(sums.data(), sums.size());  // (a cancel it carries is the caller's frame's to see)
+  std::vector<Resultant> out(nb);
+  for (size_t a = 0; a < nb; ++a) out[a] = Resultant(sums[3 * a], sums[3 * a + 1], sums[3 * a + 2]);
   return out;
 }
 

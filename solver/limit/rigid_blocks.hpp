@@ -53,9 +53,10 @@ struct RigidBlocks {
 // The blocks of the system's bodies and pairs.
 RigidBlocks rigid_blocks(const ddm::ContactSystem& system);
 
-// Body a's external loads at load point `at` (tractions, forces, body forces, weight) as its resultant.
-Resultant load_resultant(const ddm::ContactSystem& system, const RigidBlocks& blocks, size_t a,
-                         const fem::LoadPoint& at);
+// Every body's external loads at load point `at` (tractions, forces, body forces, weight) as its resultant: each
+// computed by the process that owns the body, then summed over the processes (a collective call on MPI ranks).
+std::vector<Resultant> load_resultants(const ddm::ContactSystem& system, const RigidBlocks& blocks,
+                                       const fem::LoadPoint& at);
 
 // The velocity at point x of a body moving with generalised velocity v = (vx, vy, omega) at `reference`.
 inline Eigen::Vector2d velocity_at(const Eigen::Vector3d& v, const Eigen::Vector2d& reference,

@@ -12,8 +12,8 @@ CollapseResult judge_failed_step(const ddm::ContactSystem& system, const fem::Lo
   out.analysed = true;
   out.verdict = "solver_failed";
   const RigidBlocks blocks = rigid_blocks(system);
-  std::vector<Resultant> none(blocks.bodies.size(), Resultant::Zero()), loads;
-  for (size_t a = 0; a < blocks.bodies.size(); ++a) loads.push_back(load_resultant(system, blocks, a, at));
+  const std::vector<Resultant> none(blocks.bodies.size(), Resultant::Zero());
+  const std::vector<Resultant> loads = load_resultants(system, blocks, at);
   const StaticsAnswer statics = largest_multiplier(blocks, none, loads);
   switch (statics.status) {
     case StaticsAnswer::Status::bounded:

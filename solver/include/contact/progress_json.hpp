@@ -59,4 +59,9 @@ nlohmann::json bounded_progress(nlohmann::json full, const ProgressSelection& se
 // {"step", "iteration", "bodies": [{"name", "elements", "nodes"}]}.
 nlohmann::json step_json(const StepSummary& step);
 
+// A collapse analysis's answer, or a failed step's statics verdict (Result::collapse), as the server's job and end
+// event and contact-solve's summary give it: {"verdict", "held", "failed", "statics_bound", "solves", "words",
+// "mechanism": {"kind", "words", "bodies", "joints"}, ...}; null when there is none.
+nlohmann::json collapse_json(const CollapseResult& c);
+
 }  // namespace contact::io
