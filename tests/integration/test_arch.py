@@ -1,0 +1,79 @@
+#!/usr/bin/env python3
+"""A semicircular arch of 12 voussoirs under its own weight (issue 48, "Must show"): the solver finds its limit
+thickness where the classical thrust-line argument puts it (tests/integration/arch.py, computed independently:
+Milankovitch's problem for these voussoirs), and below it names the classical five-hinge mechanism.
+
+- The independent method first: for many voussoirs it gives Milankovitch's t/R = 0.1075 of the continuous arch
+  (to 0.5 %).
+- 0.3 % thicker than the limit the arch stands (contact-solve exits 0, converged); 0.3 % thinner it fails, and the
+  verdict is statics' (no equilibrium), not the solver's: the mechanism is hinging, with four or five hinges, each
+  at a springing's or the crown's extrados or at a haunch joint's intrados, where the limit thrust line touches.
+
+Exits 1 on any failure."""
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SRC = os.environ.get("CONTACT_SOURCE_DIR", os.path.join(HERE, "..", ".."))
+BIN = os.environ.get("CONTACT_BINARY_DIR", os.path.join(SRC, "build"))
+CLI = os.path.join(BIN, "contact-solve")
+sys.path.insert(0, HERE)
+sys.path.insert(0, os.path.join(HERE, ".."))  # tests/: checks.py
+import arch  # noqa: E402
+from checks import check, finish  # noqa: E402
+
+N = 12
+
+
+def solve(t, tmp):
+    """contact-solve on the arch of thickness t: (exit code, the final "result" summary of --progress ndjson)."""
+    path = os.path.join(tmp, f"arch_{t:.6f}.json")
+    with open(path, "w") as f:
+        json.dump(arch.arch_job(N, t), f)
+    r = subprocess.run([CLI, path, "-o", os.path.join(tmp, "arch.hdf"), "--progress", "ndjson"], capture_output=True,
+                       text=True, timeout=300)
+    lines = [json.loads(line) for line in r.stdout.splitlines() if line.startswith("{")]
+    results = [line for line in lines if line.get("type") == "result"]
+    return r.returncode, (results[-1] if results else {})
+
+
+continuous = arch.limit_thickness(200)
+check("the thrust-line method: 200 voussoirs give Milankovitch's t/R = 0.1075 to 0.5 %",
+      abs(continuous - 0.1075) <= 0.005 * 0.1075, continuous)
+t_min = arch.limit_thickness(N)
+ok, ratio = arch.admits_thrust_line(N, t_min * 1.0001)
+check("12 voussoirs: the limit line needs friction below the joints' 0.9 (no sliding: Heyman's assumption)",
+      ok and ratio < 0.9, ratio)
+
+with tempfile.TemporaryDirectory() as tmp:
+    code, above = solve(1.003 * t_min, tmp)
+    check("0.3 % above the limit thickness the arch stands", code == 0 and above.get("converged") is True,
+          (code, above.get("message", "")[:300]))
+    code, below = solve(0.997 * t_min, tmp)
+    verdict = below.get("collapse") or {}
+    mechanism = verdict.get("mechanism") or {}
+    check("0.3 % below it the arch falls, and statics says so (no equilibrium, not the solver)",
+          code != 0 and verdict.get("verdict") == "no_equilibrium" and "no equilibrium by statics" in
+          below.get("message", ""), (code, verdict.get("verdict"), below.get("message", "")[-300:]))
+    hinges = [j for j in mechanism.get("joints", []) if j.get("kind") == "hinge"]
+    # (Below the limit no multiple of the weight is carried: every mechanism the weight moves is one, the
+    # symmetric five-hinge one and the four-hinge ones alike; the statics names one of them.)
+    check("the mechanism is hinging, with four or five hinges", mechanism.get("kind") == "hinging" and
+          len(hinges) in (4, 5), mechanism.get("words"))
+    # Where the classical line touches: the crown and springings (extrados), the haunches (intrados), mirrored.
+    t = 0.997 * t_min
+    radius = {"intrados": 1 - t / 2, "extrados": 1 + t / 2}
+    expected = []
+    for phi, side in arch.hinges_at_limit(N):
+        for angle in {phi, math.pi - phi}:
+            expected.append((radius[side] * math.cos(angle), radius[side] * math.sin(angle)))
+    found = [tuple(j["point"]) for j in hinges]
+    matched = all(min(math.dist(e, f) for e in expected) < 1e-9 for f in found)
+    check("each hinge is where the limit thrust line touches: springings and crown outside, haunches inside",
+          matched and len(found) >= 4, (sorted(expected), sorted(found)))
+
+finish()
