@@ -80,6 +80,20 @@ void write_collapse(hid_t file, const CollapseResult& c) {
   h5::write_vector(m, "joint_slip", slip);
   h5::write_vector(m, "joint_opening", opening);
   h5::write_strings_dataset(m, "joint_words", joint_words);
+  Handle t = h5::create_group(g, "trials");
+  std::vector<double> lambda, seconds;
+  std::vector<std::int8_t> held;
+  std::vector<std::int32_t> iterations;
+  for (const auto& trial : c.trials) {
+    lambda.push_back(trial.multiplier);
+    held.push_back(trial.held ? 1 : 0);
+    iterations.push_back(trial.iterations);
+    seconds.push_back(trial.seconds);
+  }
+  h5::write_vector(t, "multiplier", lambda);
+  h5::write_vector(t, "held", held);
+  h5::write_vector(t, "iterations", iterations);
+  h5::write_vector(t, "seconds", seconds);
 }
 
 void read_collapse(hid_t file, CollapseResult& c) {
@@ -126,6 +140,15 @@ void read_collapse(hid_t file, CollapseResult& c) {
     expect_rows(v, pairs.size(), what);
   for (size_t i = 0; i < pairs.size(); ++i)
     c.mechanism.joints.push_back(JointMotion{pairs[i], kinds[i], point[i], slip[i], opening[i], joint_words[i]});
+  if (!h5::has_link(g, "trials")) return;
+  Handle t = h5::open_group(g, "trials");
+  const auto lambda = h5::read_vector<double>(t, "multiplier");
+  const auto held = h5::read_vector<std::int8_t>(t, "held");
+  const auto iterations = h5::read_vector<std::int32_t>(t, "iterations");
+  const auto seconds = h5::read_vector<double>(t, "seconds");
+  if (held.size() != lambda.size() || iterations.size() != lambda.size() || seconds.size() != lambda.size())
+    throw std::runtime_error("/collapse/trials: its datasets differ in length");
+  for (size_t i = 0; i < lambda.size(); ++i) c.trials.push_back({lambda[i], held[i] != 0, iterations[i], seconds[i]});
 }
 
 }  // namespace contact::io

@@ -224,6 +224,10 @@ nlohmann::json collapse_json(const CollapseResult& c) {
          {"omega", b.omega},
          {"centre", std::isnan(b.centre.x()) ? nlohmann::json(nullptr) : nlohmann::json{b.centre.x(), b.centre.y()}},
          {"words", b.words}});
+  nlohmann::json trials = nlohmann::json::array();
+  for (const auto& t : c.trials)
+    trials.push_back({{"multiplier", t.multiplier}, {"held", t.held}, {"iterations", t.iterations},
+                      {"seconds", t.seconds}});
   for (const auto& j : c.mechanism.joints)
     joints.push_back({{"pair", j.pair},
                       {"kind", j.kind},
@@ -240,6 +244,7 @@ nlohmann::json collapse_json(const CollapseResult& c) {
           {"bracket_solves", c.bracket_solves},
           {"statics_bound", number(c.statics_bound)},
           {"words", c.words},
+          {"trials", trials},
           {"mechanism",
            {{"kind", c.mechanism.kind}, {"words", c.mechanism.words}, {"bodies", bodies}, {"joints", joints}}}};
 }

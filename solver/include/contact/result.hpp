@@ -251,6 +251,14 @@ struct CollapseResult {
   double statics_bound = std::numeric_limits<double>::quiet_NaN();
   Mechanism mechanism;  // the statics' mechanism at its bound
   std::string words;    // the verdict as one paragraph (also the end of Result::message)
+  // Every trial in order: its multiplier, whether it held, its solver iterations and its wall time (s).
+  struct Trial {
+    double multiplier = 0.0;
+    bool held = false;
+    int iterations = 0;
+    double seconds = 0.0;
+  };
+  std::vector<Trial> trials;
 };
 
 struct Result : RunOutcome {
