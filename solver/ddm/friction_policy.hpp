@@ -1,8 +1,8 @@
 // The friction and FETI policy: the tuning of the chain a frictional load step goes through, named once. The solvers
 // read these values as PERMON's read their options; each field says its rule in a line, and the section of
-// docs/algorithm.md (or docs/friction.md) that justifies it. The runs that pin them are the golden record
-// (tests/data/golden_record.json, scripts/golden_record.py): a retuning moves its counts, and its test fails until
-// the record is written again, so that the move shows in review.
+// docs/algorithm.md (or docs/friction.md, docs/friction-solvers.md) that justifies it. The runs that pin them are the
+// golden record (tests/data/golden_record.json, scripts/golden_record.py): a retuning moves its counts, and its test
+// fails until the record is written again, so that the move shows in review.
 //
 // The recovery chain of a frictional load step, in order:
 //   1. The direct interface solver's friction Newton (ddm/interface/friction_direct.cpp on linalg/friction_newton:
@@ -26,8 +26,7 @@ namespace contact::ddm::policy {
 // 1-2. The direct solver's friction Newton before the iterative solver takes the step over.
 struct DirectNewton {
   // Steps of the direct friction Newton before the take-over: where it settles it does so within tens of steps (51
-  // at the most measured); past that it crawls by damped steps of one sparse LU each (docs/friction.md, "Solvers and
-  // their cost").
+  // at the most measured); past that it crawls by damped steps of one sparse LU each (docs/friction-solvers.md).
   int budget = 100;
 };
 

@@ -81,7 +81,7 @@ InterfaceSolverKind choose_interface_solver(const InterfaceSolverSettings& setti
 // coarse space carries the global coupling, Dirichlet cuts the MPRGP iterations by 5-35 % only (on dowelled
 // frictionless walls it adds to them), and each iteration costs a second dense product per body: none is as fast
 // or faster from 19 bodies up (1.15-1.8x on 16 x 16 frictional walls of 4 to 16 cells per brick; 106 s against
-// 150 s at 64 x 64). On two or three finely meshed bodies it cuts them 1.6-2.6x (docs/friction.md).
+// 150 s at 64 x 64). On two or three finely meshed bodies it cuts them 1.6-2.6x (docs/friction-solvers.md).
 InterfaceSolverSettings resolved_settings(const InterfaceSolverSettings& settings, const ContactSystem& system);
 // How the interface problem must be built for that solver (blocks replicated or not, preconditioner, tangential
 // rows for friction).
