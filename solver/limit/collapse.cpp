@@ -159,8 +159,7 @@ void run_collapse(const ddm::ContactSystem& system, const CollapseSpec& spec, dd
     const double started = frame.elapsed();
     const int iterations_before = total.iterations;
     frame.nested(&held.u, marks, [&](ddm::RunFrame& inner) { ddm::run_enforced(system, inner, method); });
-    out.trials.push_back(
-        {trial, total.converged, total.iterations - iterations_before, frame.elapsed() - started});
+    out.trials.push_back({trial, total.converged, total.iterations - iterations_before, frame.elapsed() - started});
     ++out.solves;
     if (solve_failed) ++out.bracket_solves;
     if (total.stop_reason == StopReason::cancelled || frame.stop_requested()) {
