@@ -128,6 +128,7 @@ export class JobView {
       $("job-outcome").textContent = outcome.join(", ");
       if (job.message) this.message(job.message, job.state === "FAILED");
       this.warnings(job.warnings || []);
+      this.collapse(job.collapse || null);
       this.links(job.result_available === true);
     } catch (e) {
       if (id === this.id) this.message(e.message, true);
@@ -145,6 +146,37 @@ export class JobView {
       return li;
     }));
     ul.hidden = list.length === 0;
+  }
+
+  // A collapse analysis's answer, or the statics' verdict on a failed step (docs/limit-analysis.md): the bracket of
+  // the collapse multiplier, the statics' bound, the mechanism, and every trial with its cost.
+  collapse(c) {
+    const box = $("job-collapse");
+    box.hidden = !c;
+    if (!c) return;
+    const num = (x) => (typeof x === "number" ? x.toPrecision(5) : String(x));
+    let verdict = `collapse analysis: ${c.verdict}`;
+    if (c.verdict === "collapse")
+      verdict = `collapse: the multiplier of the live loads held at ${num(c.held)} and did not at ${num(c.failed)}` +
+        ` (${c.solves} trial solves)`;
+    else if (c.verdict === "holds") verdict = `no collapse: held at ${num(c.held)} (max_multiplier)`;
+    else if (c.verdict === "no_equilibrium") verdict = "no equilibrium by statics: the loads cannot be carried";
+    if (c.statics_bound !== null && c.statics_bound !== undefined)
+      verdict += `; rigid-block statics: at most ${num(c.statics_bound)}`;
+    $("collapse-verdict").textContent = verdict;
+    const m = c.mechanism || {};
+    $("collapse-mechanism").textContent = m.words ? `mechanism: ${m.words}` : "";
+    const rows = (c.trials || []).map((t, i) => {
+      const tr = document.createElement("tr");
+      for (const v of [i + 1, num(t.multiplier), t.held ? "yes" : "no", t.iterations, num(t.seconds)]) {
+        const td = document.createElement("td");
+        td.textContent = String(v);
+        tr.append(td);
+      }
+      return tr;
+    });
+    $("collapse-trials").querySelector("tbody").replaceChildren(...rows);
+    $("collapse-trials").hidden = rows.length === 0;
   }
 
   log(text) {

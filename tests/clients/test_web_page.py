@@ -233,6 +233,7 @@ def test_without_token(server, b, downloads):
     test_friction(server, b)
     test_wall(server, b)
     test_warnings(server, b)
+    test_collapse(server, b)
 
     # 4. An invalid job: every error with its pointer, no job created.
     bad = example("flat_patch.json")
@@ -389,6 +390,43 @@ def test_warnings(server, b):
     check("warnings: a job without any shows none",
           b.wait(lambda: b.text("job-id") == clean and not b.el("job-warnings").is_displayed(), 30),
           b.text("job-warnings"))
+
+
+def column_collapse():
+    """Three 1 x 1 blocks on a clamped ground, gravity dead, a horizontal body force live: they overturn about the
+    base's toe at lambda_c = 1/3 (docs/limit-analysis.md)."""
+    def block(name, y0):
+        return {"name": name, "material": {"E": 1e5, "nu": 0.2, "density": 1.0},
+                "mesh": {"block": {"corners": [[0, y0], [1, y0], [1, y0 + 1], [0, y0 + 1]], "nx": 4, "ny": 4}},
+                "body_force": {"value": [10, 0], "live": True}}
+    ground = {"name": "ground", "material": {"E": 1e5, "nu": 0.2},
+              "mesh": {"block": {"corners": [[-1, -1], [2, -1], [2, 0], [-1, 0]], "nx": 12, "ny": 3}},
+              "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]}
+    return {"name": "column-collapse", "model": {"gravity": [0, -10]},
+            "bodies": [ground, block("b1", 0), block("b2", 1), block("b3", 2)],
+            "contacts": [{"slave": f"b{i + 1}.bottom", "master": "ground.top" if i == 0 else f"b{i}.top",
+                          "friction": {"coefficient": 0.8}} for i in range(3)],
+            "collapse": {}}
+
+
+def test_collapse(server, b):
+    """3e. A collapse analysis: the job's view says the bracket, the statics' bound and the mechanism, and lists the
+    trials; a job without one shows none of it."""
+    job_id = server.submit_id(column_collapse())
+    check("collapse: solved", server.wait_done(job_id, 120).get("state") == "SUCCEEDED")
+    b.driver.execute_script(f"window.location.hash = 'job={job_id}';")
+    shown = b.wait(lambda: b.el("job-collapse").is_displayed()
+                   and len(b.driver.find_elements(By.CSS_SELECTOR, "#collapse-trials tbody tr")) == 2, 30)
+    text = b.text("job-collapse")
+    check("collapse: the view gives the bracket around 1/3, the bound and the overturning mechanism",
+          bool(shown) and "held at 0.33325" in text and "did not at 0.33342" in text and "at most 0.33333" in text
+          and "overturning" in text, text)
+    clean = server.submit_id(flat_patch(name="no-collapse"))
+    server.wait_done(clean, 60)
+    b.driver.execute_script(f"window.location.hash = 'job={clean}';")
+    check("collapse: a job without one shows none",
+          b.wait(lambda: b.text("job-id") == clean and not b.el("job-collapse").is_displayed(), 30),
+          b.text("job-collapse"))
 
 
 def test_with_token(b, downloads):
