@@ -2,7 +2,9 @@
 multiplier of every state that held against a displacement of the user's choice (by default the node that moved
 most at the last state that held, along its own final displacement), and the mechanism drawn over the structure:
 every body's mesh, the bodies that move tinted with an arrow of their velocity, the joints that hinge marked at
-their point, the joints that slide or open drawn over their slave edges. The verdict is the figure's title."""
+their point, the joints that slide or open drawn over their slave edges, and each joint's centre of pressure at the
+last state that held (joined into the thrust line where the joints form a chain: an arch, a column). The verdict
+is the figure's title."""
 from .errors import BadInput
 from .plot_mesh import _bounds, _fit
 from .results import ResultFile
@@ -49,6 +51,27 @@ def capacity_curve(f, body=None, point=None):
         u = np.asarray(f.body(k, name, ("displacement",))["displacement"])[node]
         disp.append(float(np.dot(u, direction)))
     return {"multiplier": lam, "displacement": disp, "body": name, "node": node, "direction": direction.tolist()}
+
+
+def thrust_line(f, k, step):
+    """Each pair's centre of pressure at step group k (the point along its slave edge where its normal force acts),
+    in the order of the pairs: {"points": [(x, y), ...], "pairs": [...], "chain": whether each pair shares a body
+    with the next (an arch, a column: the points then join into the thrust line)}."""
+    import numpy as np
+    points, pairs, bodies = [], [], []
+    for name in step["pair_names"]:
+        c = f.pair(k, name, ("position", "arc_length"))
+        s = c.get("attrs", {}).get("centre_of_pressure")
+        force = c.get("attrs", {}).get("force", 0.0)
+        if s is None or not force or not np.isfinite(s) or "arc_length" not in c or not len(c["arc_length"]):
+            continue
+        arc, xy = np.asarray(c["arc_length"], dtype=float), np.asarray(c["position"], dtype=float)
+        points.append((float(np.interp(s, arc, xy[:, 0])), float(np.interp(s, arc, xy[:, 1]))))
+        pairs.append(name)
+        attrs = c["attrs"]
+        bodies.append({attrs.get("slave_body"), attrs.get("master_body")})
+    chain = len(points) > 2 and all(a & b for a, b in zip(bodies, bodies[1:]))
+    return {"points": points, "pairs": pairs, "chain": chain}
 
 
 def draw_mechanism(fig, ax, f, collapse):
@@ -107,6 +130,15 @@ def draw_mechanism(fig, ax, f, collapse):
             marker = "o" if kind == "hinge" else None
             handles.append(Line2D([], [], color=KIND_COLOURS[kind], lw=0 if marker else 3, marker=marker,
                                   label=f"{kind} ({n} joint{'s' if n > 1 else ''})"))
+    line = thrust_line(f, last, step)
+    if line["points"]:
+        pts = np.asarray(line["points"])
+        if line["chain"]:
+            ax.plot(pts[:, 0], pts[:, 1], "-", color="black", lw=1.2, zorder=5)
+        ax.plot(pts[:, 0], pts[:, 1], "o", color="black", ms=3, zorder=6)
+        handles.append(Line2D([], [], color="black", marker="o", ms=3, lw=1.2 if line["chain"] else 0,
+                              label="centres of pressure at the last state that held"
+                                    + (" (the thrust line)" if line["chain"] else "")))
     ax.legend(handles=handles, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.05), ncol=len(handles))
     ax.set_title(f"mechanism ({m.get('kind') or 'none found'}): the statics' motion at its bound", fontsize=10)
 
