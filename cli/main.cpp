@@ -145,6 +145,21 @@ class ProgressPrinter final : public contact::Observer {
   // One line per adaptive step: cells and unknowns per body (and the cells refined after the step), the global
   // estimate, force and peak pressure with their relative changes over the step (what the stop test compares),
   // the estimate's own time and the elapsed time.
+  // One line per load step that held, cut and collapse trial (their own words: an iteration line is the solver's).
+  void on_load_step(const contact::LoadStepReport& r) override {
+    const nlohmann::json line = contact::io::load_step_json(r);
+    if (ndjson_) {
+      nlohmann::json out = line;
+      out["type"] = "load_step";
+      std::printf("%s\n", out.dump().c_str());
+      std::fflush(stdout);
+      return;
+    }
+    if (quiet_) return;
+    std::printf("%s  %.2fs\n", contact::io::load_step_words(line).c_str(), r.elapsed_seconds);
+    std::fflush(stdout);
+  }
+
   void on_adaptive_step(const contact::AdaptiveStepReport& r) override {
     if (ndjson_) {
       nlohmann::json line = contact::io::adaptive_step_json(r);

@@ -39,7 +39,8 @@ class Progress:
 
     On a terminal, with Debian's python3-tqdm: a tqdm counter redrawn in place, with the iteration, what decides
     convergence (the measure: residuals, or the complementarity and the active set), the force and maximum
-    pressure of each pair, the DOFs of each body and the solver's elapsed time; state changes and adaptive steps
+    pressure of each pair, the DOFs of each body and the solver's elapsed time; load steps, cuts and collapse
+    trials in their own words (load_step_words); state changes and adaptive steps
     are printed above it. Otherwise (a pipe, a log, or no tqdm): one plain line per iteration.
     quiet: nothing at all (the commands print errors only); events_out still receives every event."""
 
@@ -117,6 +118,8 @@ class Progress:
             else:
                 bodies = ", ".join(f"{word(b.get('name'))} {num(b.get('elements'), 'd')} cells" for b in listed)
             self._line(f"step {num(e.get('step'), 'd')} at iteration {num(e.get('iteration'), 'd')}: {bodies}")
+        elif t == "load_step":
+            self._line(load_step_words(e))
         elif t == "end":
             if self.bar is not None:
                 self.bar.refresh()
@@ -127,6 +130,24 @@ class Progress:
             msg = f": {word(e['message'], 500)}" if e.get("message") else ""
             self._line(f"end {word(e.get('state'))} ({conv}) after {num(e.get('iterations'), 'd')} "
                        f"iterations, {num(e.get('solve_seconds', 0), '.3g')} s{msg}")
+
+
+def load_step_words(e):
+    """A load_step event in words (contact/progress_json.hpp's load_step_words, the same): a load step held, a cut
+    (with the load reached and the next try), a collapse trial (its multiplier, held or not)."""
+    iterations = num(e.get("iterations", 0), "d")
+    if e.get("kind") == "trial":
+        return (f"collapse trial {num(e.get('step'), 'd')}: multiplier {num(e.get('multiplier'), '.6g')} "
+                f"{'held' if e.get('held') else 'did not hold'} ({iterations} iterations)")
+    step = f"load step {num(e.get('step'), 'd')} of {num(e.get('steps'), 'd')}"
+    fraction = e.get("fraction", 1.0)
+    if e.get("kind") == "cut":
+        return (f"{step} cut: held up to {num(100 * fraction, '.4g')} % of the step (load factor "
+                f"{num(e.get('load_factor'), '.6g')}), now trying {num(100 * e.get('next', 0.0), '.4g')} %")
+    if isinstance(fraction, (int, float)) and fraction < 1.0:
+        return (f"{step}: sub-step to {num(100 * fraction, '.4g')} % held (load factor "
+                f"{num(e.get('load_factor'), '.6g')}, {iterations} iterations)")
+    return f"{step} held at load factor {num(e.get('load_factor'), '.6g')} ({iterations} iterations)"
 
 
 def _measure_parts(e, wide=True):

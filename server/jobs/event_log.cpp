@@ -16,7 +16,7 @@ namespace contactd {
 
 namespace {
 
-const char* const kTypes[] = {"state", "iteration", "step", "end", "adaptive_step"};
+const char* const kTypes[] = {"state", "iteration", "step", "end", "adaptive_step", "load_step"};
 constexpr std::uint64_t kUnwritten = ~std::uint64_t{0};
 
 std::uint8_t type_index(const std::string& type) {

@@ -136,6 +136,7 @@ contact::Result JobRun::solve_on_ranks(ProgressObserver& observer) {
       [&](const std::string& type, const nlohmann::json& j) {
         if (type == "iteration") observer.on_iteration_json(j);
         if (type == "adaptive_step") observer.on_adaptive_step_json(j);
+        if (type == "load_step") observer.on_load_step_json(j);
       },
       job_->cancel);
   contact::Result result;

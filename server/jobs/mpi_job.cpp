@@ -188,7 +188,7 @@ class MpiRun {
         outcome_.iterations = j["iteration"].get<int>();
       on_progress_("iteration", j);
     }
-    if (type == "adaptive_step") on_progress_(type, j);
+    if (type == "adaptive_step" || type == "load_step") on_progress_(type, j);
     if (type == "result") result_ = std::move(j);
   }
 

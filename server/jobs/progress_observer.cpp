@@ -39,4 +39,13 @@ void ProgressObserver::on_adaptive_step_json(nlohmann::json step) {
   job_.events.append("adaptive_step", step);
 }
 
+void ProgressObserver::on_load_step(const contact::LoadStepReport& report) {
+  on_load_step_json(contact::io::load_step_json(report));
+}
+
+void ProgressObserver::on_load_step_json(nlohmann::json step) {
+  step.erase("type");
+  job_.events.append("load_step", step);
+}
+
 }  // namespace contactd

@@ -28,6 +28,8 @@ class ProgressObserver final : public contact::Observer {
   // run's progress line.
   void on_adaptive_step(const contact::AdaptiveStepReport& report) override;
   void on_adaptive_step_json(nlohmann::json step);
+  void on_load_step(const contact::LoadStepReport& report) override;
+  void on_load_step_json(nlohmann::json step);
   // Where the job's steps go as they are reached: its result file (contact::io::ResultStream).
   void set_step_sink(contact::StepSink* sink) { sink_ = sink; }
   contact::StepSink* step_sink() override { return sink_; }

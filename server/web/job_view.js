@@ -228,6 +228,19 @@ export class JobView {
                  `${pressure}`);
         break;
       }
+      case "load_step": {
+        const n = (x, d = 6) => (typeof x === "number" ? Number(x.toPrecision(d)) : x);
+        if (e.kind === "trial")
+          this.log(`collapse trial ${e.step}: multiplier ${n(e.multiplier)} ${e.held ? "held" : "did not hold"}` +
+                   ` (${e.iterations} iterations)`);
+        else if (e.kind === "cut")
+          this.log(`load step ${e.step} of ${e.steps} cut: held up to ${n(100 * e.fraction, 4)} % of the step, ` +
+                   `now trying ${n(100 * e.next, 4)} %`);
+        else
+          this.log(`load step ${e.step} of ${e.steps}: ${e.fraction < 1 ? `${n(100 * e.fraction, 4)} % ` : ""}held` +
+                   ` at load factor ${n(e.load_factor)} (${e.iterations} iterations)`);
+        break;
+      }
       case "end":
         this.setState(e.state);
         this.log(`end ${e.state} (${e.stop_reason}) after ${e.iterations} iterations` +

@@ -51,11 +51,25 @@ void run_load_steps(const ContactSystem& system, const std::vector<double>& fact
     double done = 0.0, increment = 1.0;
     int cuts = 0, sub_steps = 0;
     bool not_cut = false;
+    auto announce = [&](LoadStepReport::Kind kind, double reached, double next, int iterations) {
+      if (factors.size() == 1 && kind == LoadStepReport::Kind::held && reached == 1.0) return;  // one plain solve
+      LoadStepReport r;
+      r.kind = kind;
+      r.step = static_cast<int>(k) + 1;
+      r.steps = static_cast<int>(factors.size());
+      r.fraction = reached;
+      r.next = next;
+      r.load_factor = previous + reached * (factors[k] - previous);
+      r.iterations = iterations;
+      frame.report(r);
+    };
     while (true) {
       const double t = std::min(1.0, done + increment);
       state.load = fem::LoadPoint{k, previous, factors[k], t};
+      const int before = total.iterations;
       frame.nested(warm.empty() ? nullptr : &warm, InnerMarks{},
                    [&](RunFrame& inner) { run_enforced(system, inner, method); });
+      if (total.converged) announce(LoadStepReport::Kind::held, t, 0.0, total.iterations - before);
       if (total.converged && t < 1.0) {  // a sub-step held: its state is the next one's start
         state.slip_origin = system.tangential_jumps(total.u);
         warm = total.u;
@@ -70,6 +84,7 @@ void run_load_steps(const ContactSystem& system, const std::vector<double>& fact
       }
       increment *= 0.5;
       ++cuts;
+      announce(LoadStepReport::Kind::cut, done, std::min(1.0, done + increment), total.iterations - before);
     }
     std::string prefix = factors.size() == 1
                              ? std::string()

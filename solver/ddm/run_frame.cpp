@@ -41,6 +41,11 @@ void RunFrame::report(IterationReport r) {
 
 void RunFrame::report(const AdaptiveStepReport& r) const { observer_.on_adaptive_step(r); }
 
+void RunFrame::report(LoadStepReport r) const {
+  r.elapsed_seconds = elapsed();
+  observer_.on_load_step(r);
+}
+
 void RunFrame::notify(IterationReport r) {
   if (!parent_) {
     observer_.on_iteration(r);

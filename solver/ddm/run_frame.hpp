@@ -76,6 +76,8 @@ class RunFrame {
   void report(IterationReport r);
   // Reports an adaptive step to the observer.
   void report(const AdaptiveStepReport& r) const;
+  // Reports a load step's end, a cut or a collapse trial to the observer (its elapsed time stamped).
+  void report(LoadStepReport r) const;
 
   MethodOutcome& outcome() { return outcome_; }
   const MethodOutcome& outcome() const { return outcome_; }

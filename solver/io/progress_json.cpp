@@ -3,6 +3,7 @@
 #include <fnmatch.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 
 namespace contact::io {
@@ -206,6 +207,48 @@ nlohmann::json step_json(const StepSummary& step) {
   if (step.body_names.size() <= kBodiesListedAll) j["bodies"] = std::move(bodies);
   if (step.multiplier != 0.0) j["multiplier"] = step.multiplier;
   return j;
+}
+
+nlohmann::json load_step_json(const LoadStepReport& r) {
+  const char* kinds[] = {"held", "cut", "trial"};
+  nlohmann::json j = {{"kind", kinds[static_cast<int>(r.kind)]},
+                      {"step", r.step},
+                      {"load_factor", r.load_factor},
+                      {"iterations", r.iterations},
+                      {"elapsed_seconds", r.elapsed_seconds}};
+  if (r.kind == LoadStepReport::Kind::trial) {
+    j["multiplier"] = r.multiplier;
+    j["held"] = r.held;
+  } else {
+    j["steps"] = r.steps;
+    j["fraction"] = r.fraction;
+    if (r.kind == LoadStepReport::Kind::cut) j["next"] = r.next;
+  }
+  return j;
+}
+
+std::string load_step_words(const nlohmann::json& e) {
+  char text[256];
+  const std::string kind = e.value("kind", "");
+  const int iterations = e.value("iterations", 0);
+  if (kind == "trial") {
+    std::snprintf(text, sizeof text, "collapse trial %d: multiplier %.6g %s (%d iterations)", e.value("step", 0),
+                  e.value("multiplier", 0.0), e.value("held", false) ? "held" : "did not hold", iterations);
+  } else if (kind == "cut") {
+    std::snprintf(text, sizeof text,
+                  "load step %d of %d cut: held up to %.4g %% of the step (load factor %.6g), now trying %.4g %%",
+                  e.value("step", 0), e.value("steps", 0), 100 * e.value("fraction", 0.0), e.value("load_factor", 0.0),
+                  100 * e.value("next", 0.0));
+  } else {
+    const double fraction = e.value("fraction", 1.0);
+    if (fraction < 1.0)
+      std::snprintf(text, sizeof text, "load step %d of %d: sub-step to %.4g %% held (load factor %.6g, %d iterations)",
+                    e.value("step", 0), e.value("steps", 0), 100 * fraction, e.value("load_factor", 0.0), iterations);
+    else
+      std::snprintf(text, sizeof text, "load step %d of %d held at load factor %.6g (%d iterations)",
+                    e.value("step", 0), e.value("steps", 0), e.value("load_factor", 0.0), iterations);
+  }
+  return text;
 }
 
 nlohmann::json collapse_json(const CollapseResult& c) {

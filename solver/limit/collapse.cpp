@@ -160,6 +160,14 @@ void run_collapse(const ddm::ContactSystem& system, const CollapseSpec& spec, dd
     const int iterations_before = total.iterations;
     frame.nested(&held.u, marks, [&](ddm::RunFrame& inner) { ddm::run_enforced(system, inner, method); });
     out.trials.push_back({trial, total.converged, total.iterations - iterations_before, frame.elapsed() - started});
+    LoadStepReport report;
+    report.kind = LoadStepReport::Kind::trial;
+    report.step = static_cast<int>(out.trials.size());
+    report.multiplier = trial;
+    report.held = total.converged;
+    report.iterations = out.trials.back().iterations;
+    report.load_factor = state.load.value();
+    frame.report(report);
     ++out.solves;
     if (solve_failed) ++out.bracket_solves;
     if (total.stop_reason == StopReason::cancelled || frame.stop_requested()) {

@@ -71,6 +71,14 @@ with tempfile.TemporaryDirectory() as tmp:
             ends = [e for e in events if e.get("type") == "end"]
             check("the end event carries it", len(ends) == 1 and ends[0].get("collapse", {}).get("held") ==
                   served.get("held"), ends and ends[0].get("collapse", {}).get("held"))
+            reported = [e for e in events if e.get("type") == "load_step"]
+            check("one load_step event per trial, in order, saying whether it held",
+                  len(reported) == served.get("solves") and all(e.get("kind") == "trial" for e in reported) and
+                  [e.get("held") for e in reported] == [t.get("held") for t in served.get("trials", [])],
+                  (len(reported), served.get("solves")))
+            check("submit --wait printed the trials in their own words",
+                  s.stdout.count("collapse trial ") + s.stderr.count("collapse trial ") == served.get("solves"),
+                  s.stderr[-500:])
             trials = sorted({e["multiplier"] for e in events if e.get("type") == "iteration" and "multiplier" in e})
             check("the iteration events carry the trials' multipliers, the largest that held among them",
                   len(trials) >= 2 and served.get("held") in trials, trials)

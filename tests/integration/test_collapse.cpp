@@ -324,3 +324,42 @@ TEST(Collapse, LiveLoadsAndTheCollapseSectionAreValidated) {
   EXPECT_TRUE(p.collapse.enabled);
   EXPECT_TRUE(p.bodies[1].body_force_live);
 }
+
+// The progress names each solve of the load path in its own words (not an iteration): the loading's steps that held,
+// then every trial with its multiplier and whether it held, as many as the trial solves.
+TEST(Collapse, TheProgressReportsEveryLoadStepAndTrialAsTheyEnd) {
+  struct Recorder : Observer {
+    std::vector<LoadStepReport> reports;
+    int iterations = 0;
+    void on_load_step(const LoadStepReport& r) override { reports.push_back(r); }
+    void on_iteration(const IterationReport&) override { ++iterations; }
+  } recorder;
+  json job = column(3, 1.0, 1.0, 0.8, "body");
+  job["collapse"] = {{"first", 0.3}};
+  job["loading"] = {{"steps", 2}};
+  const Problem problem = parse_or_fail(job);
+  CancelToken cancel;
+  const Result r = solve(problem, recorder, cancel);
+  ASSERT_TRUE(r.converged) << r.message;
+  ASSERT_EQ(recorder.reports.size(), 2u + static_cast<size_t>(r.collapse.solves));
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_EQ(recorder.reports[k].kind, LoadStepReport::Kind::held);
+    EXPECT_EQ(recorder.reports[k].step, k + 1);
+    EXPECT_EQ(recorder.reports[k].steps, 2);
+    EXPECT_DOUBLE_EQ(recorder.reports[k].load_factor, 0.5 * (k + 1));
+  }
+  int iterations = 0;
+  for (size_t i = 0; i < recorder.reports.size(); ++i) {
+    const LoadStepReport& t = recorder.reports[i];
+    iterations += t.iterations;
+    if (i < 2) continue;
+    const CollapseResult::Trial& trial = r.collapse.trials[i - 2];
+    EXPECT_EQ(t.kind, LoadStepReport::Kind::trial);
+    EXPECT_EQ(t.multiplier, trial.multiplier);
+    EXPECT_EQ(t.held, trial.held);
+    EXPECT_EQ(t.iterations, trial.iterations);
+  }
+  // Every iteration belongs to one of them.
+  EXPECT_EQ(iterations, recorder.iterations);
+  EXPECT_EQ(iterations, r.iterations);
+}

@@ -29,6 +29,15 @@ nlohmann::json iteration_json(const IterationReport& report, bool profiles = tru
 // --ndjson "adaptive_step" lines and contactd's "adaptive_step" events.
 nlohmann::json adaptive_step_json(const AdaptiveStepReport& report);
 
+// A load step's end, a cut or a collapse trial (LoadStepReport): {"kind": "held" | "cut" | "trial", "step",
+// "steps", "fraction", "next" (a cut), "load_factor", "multiplier" and "held" (a trial), "iterations",
+// "elapsed_seconds"}, as contactd's `load_step` events and contact-solve --progress ndjson carry it.
+nlohmann::json load_step_json(const LoadStepReport& report);
+
+// The same in words, one line: "load step 2 of 4 held at load factor 0.5 (12 iterations)", "load step 2 of 4 cut:
+// held to 25 % of the step, now trying 37.5 %", "collapse trial 3: multiplier 0.45 held (13 iterations)".
+std::string load_step_words(const nlohmann::json& event);
+
 // Which pairs a bounded progress object lists in full.
 struct ProgressSelection {
   std::vector<std::string> patterns;  // shell globs on pair names (fnmatch: * ? [..]); empty: the default

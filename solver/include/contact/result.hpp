@@ -281,6 +281,23 @@ struct Result : RunOutcome {
   double factorization_seconds = 0.0;
 };
 
+// A solve of the load path ended (not an iteration: each holds many): a load step or sub-step that held, a load
+// step cut (its increment halved, from the load it reached), or a collapse analysis's trial (held or not). The
+// progress says load steps, cuts and trials in these words, and solver iterations only in theirs.
+struct LoadStepReport {
+  enum class Kind { held, cut, trial };
+  Kind kind = Kind::held;
+  int step = 0;              // the load step, 1-based (a trial: the trial's number)
+  int steps = 0;             // of how many load steps (0 for a trial)
+  double fraction = 1.0;     // held/cut: the fraction of the step reached (1: the whole step)
+  double next = 0.0;         // cut: the fraction the next sub-step tries
+  double load_factor = 0.0;  // the loading's factor reached (held), or where the cut step stays (cut)
+  double multiplier = std::numeric_limits<double>::quiet_NaN();  // a trial's multiplier
+  bool held = true;                                              // a trial: whether it held
+  int iterations = 0;                                            // the solver's iterations of this solve
+  double elapsed_seconds = 0.0;
+};
+
 // One step of the adaptive loop (converge_then_refine), reported once its mesh is solved and estimated.
 // Relative changes are against the previous step: |now - before| / max(|now|, |before|) (0 at step 0).
 struct AdaptiveStepReport {
@@ -314,6 +331,7 @@ class Observer {
   virtual ~Observer() = default;
   virtual void on_iteration(const IterationReport&) {}
   virtual void on_adaptive_step(const AdaptiveStepReport&) {}
+  virtual void on_load_step(const LoadStepReport&) {}
   // Where the steps go as they are reached when the job keeps every step's fields (StepOutput::all): solve() then
   // holds only the last one (Result::steps, Result::streamed_steps). nullptr: every kept step stays in memory.
   virtual StepSink* step_sink() { return nullptr; }
