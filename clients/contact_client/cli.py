@@ -358,9 +358,9 @@ def build_parser():
     s.add_argument("--pairs", metavar="PATTERN[,PATTERN]", action="append",
                    help="draw the panels of these pairs: names or shell patterns (* ?) of pairs, or of their "
                         "slave or master bodies ('b0_*', base); repeatable (default: every pair, or beyond "
-                        "--max-pairs the ones with the largest contact force)")
+                        "--max-pairs the joints that govern: the highest friction utilisation or eccentricity, the largest force among equals)")
     s.add_argument("--max-pairs", type=int, default=MAX_PAIRS, metavar="N",
-                   help=f"at most N pair panels ({MAX_PAIRS}); beyond, those with the largest contact force")
+                   help=f"at most N pair panels ({MAX_PAIRS}); beyond, the joints that govern (slipping or hinging first)")
     group = s.add_mutually_exclusive_group()
     group.add_argument("--overview", dest="overview", action="store_true", default=None,
                        help="draw all bodies by stress and every joint by state (open, stick, slip) instead of "

@@ -14,7 +14,7 @@ from .plot_pairs import draw_pair
 from .plot_paths import draw_load_curve, draw_load_history, load_curve, load_path
 from .plot_profiles import (AXIS_LABELS, COORDINATES, contact_pressure, fit_circle, friction_text,
                             iteration_profiles, resolve_along, slip, stick_zones, tangential_traction)
-from .plot_select import MAX_PAIRS, OVERVIEW_BODIES, choose_pairs, final_forces, read_for_plot
+from .plot_select import MAX_PAIRS, OVERVIEW_BODIES, choose_pairs, final_forces, governing, read_for_plot
 from .plot_wall import draw_overview
 from .results import pair_friction, read_events
 
@@ -39,7 +39,8 @@ def _select(result, pairs, max_pairs, overview):
     bodies_of = {n: (final["contacts"].get(n, {}).get("attrs", {}).get("slave_body"),
                      final["contacts"].get(n, {}).get("attrs", {}).get("master_body")) for n in names}
     forces = final_forces(result.get("history", {}).get("steps", {}), names)
-    drawn, matched, note = choose_pairs(names, pairs, max_pairs, forces, bodies_of)
+    governs = {n: governing(final["contacts"].get(n, {}).get("attrs", {})) for n in names}
+    drawn, matched, note = choose_pairs(names, pairs, max_pairs, forces, bodies_of, governs)
     many = len(final["body_names"]) > OVERVIEW_BODIES if overview is None else bool(overview)
     return {"drawn": drawn, "matched": matched, "note": note, "overview": many}
 
@@ -88,7 +89,8 @@ def plot_result(result, png, events=None, warp=None, title=None, max_curves=12, 
     top: the contact pressure along each pair drawn (one panel per pair): the pairs that `pairs` selects
          (fnmatch patterns, a list or one string with commas, on the pair's name or its slave or master body's
          name: "b0_*", "*base*"; BadInput naming the pairs when none matches), or every pair; beyond max_pairs (4)
-         of them the max_pairs with the largest final contact force, and a line on the figure says so (with
+         of them the max_pairs that govern (plot_select.governing: slipping or hinging joints first), and a line on the
+         figure says so (with
          hundreds of pairs, one panel each would be illegible and take minutes). Against `along`: "arc" (the arc
          length along the slave edge from its first node, as the web page and the events), "x", "angle" (degrees
          about the centre of the circle fitted through the slave nodes: plot_profiles.resolve_along; the arc length

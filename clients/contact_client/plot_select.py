@@ -8,7 +8,8 @@ from .plot_mesh import analytic_gaps
 from .plot_profiles import _spread
 from .results import ResultFile
 
-# Without a choice of pairs, at most MAX_PAIRS panels: those of the pairs with the largest final contact force.
+# Without a choice of pairs, at most MAX_PAIRS panels: those of the joints that govern (governing()), the largest
+# final contact force among equals.
 MAX_PAIRS = 4
 # A result with more bodies than this is drawn as an overview of all bodies and joints (plot_wall) instead of the
 # mesh row.
@@ -48,22 +49,38 @@ def no_match(patterns, names):
                     f"the pairs: {shown or 'none'}")
 
 
-def choose_pairs(names, patterns=None, max_pairs=MAX_PAIRS, force=None, bodies_of=None):
+def governing(attrs):
+    """How near a joint is to giving way, from its joint results at the final step (a pair's attributes:
+    results-format.md, the contact tables): the larger of its friction utilisation |T| / (mu N) (1: it slips) and
+    its eccentricity |e| / (L/2) (1: it hinges at an end); 0 for a joint without force (open) or without them."""
+    import math
+    if not attrs or not float(attrs.get("force", 0.0) or 0.0):
+        return 0.0
+    values = [abs(float(attrs.get(k, 0.0) or 0.0)) for k in ("friction_utilisation", "eccentricity")]
+    return max((v for v in values if math.isfinite(v)), default=0.0)
+
+
+def choose_pairs(names, patterns=None, max_pairs=MAX_PAIRS, force=None, bodies_of=None, governs=None):
     """The pairs to draw a panel for: (drawn, matched, note). `matched` are the pairs the patterns select (all
-    without patterns; BadInput when they select none); beyond max_pairs of them, the max_pairs with the largest
-    final contact force (force: {pair: force}) are drawn, in the result's order, and the note says so."""
+    without patterns; BadInput when they select none); beyond max_pairs of them, the max_pairs that govern most
+    (governs: {pair: governing()}: slipping or hinging joints first), the largest final contact force (force: {pair:
+    force}) among equals, are drawn, in the result's order, and the note says so."""
     patterns = split_patterns(patterns)
     matched = match_pairs(names, patterns, bodies_of) if patterns else list(names)
     if patterns and not matched:
         raise no_match(patterns, list(names))
     if len(matched) <= max_pairs:
         return matched, matched, ""
-    force = force or {}
-    largest = sorted(matched, key=lambda n: -abs(float(force.get(n, 0.0))))[:max_pairs]
-    drawn = [n for n in matched if n in largest]
+    force, governs = force or {}, governs or {}
+    # Utilisations equal to 3 digits count as equal (1.000 for every slipping joint): the force decides among them.
+    chosen = sorted(matched, key=lambda n: (-round(float(governs.get(n, 0.0)), 3),
+                                            -abs(float(force.get(n, 0.0)))))[:max_pairs]
+    drawn = [n for n in matched if n in chosen]
     what = f"{len(matched)} pairs match" if patterns else f"{len(matched)} pairs"
-    return drawn, matched, (f"{what}: the {max_pairs} with the largest contact force drawn; choose with "
-                            "--pairs PATTERN[,PATTERN] (pair or body names, * and ?) and --max-pairs N")
+    rule = ("that govern (the highest friction utilisation |T|/(mu N) or eccentricity |e|/(L/2); the largest force "
+            "among equals)" if governs else "with the largest contact force")
+    return drawn, matched, (f"{what}: the {max_pairs} {rule} drawn; choose with --pairs PATTERN[,PATTERN] (pair or "
+                            "body names, * and ?) and --max-pairs N")
 
 
 def final_forces(history, names):
@@ -132,11 +149,11 @@ def read_for_plot(path, pairs=None, max_pairs=MAX_PAIRS, max_curves=12, overview
             return result, {"drawn": [], "matched": [], "note": "", "overview": False}
         final = steps[-1]
         names = final["pair_names"]
-        bodies_of = None
-        if split_patterns(pairs):
-            attrs = {n: f.pair(final["step"], n, ())["attrs"] for n in names}
-            bodies_of = {n: (a.get("slave_body"), a.get("master_body")) for n, a in attrs.items()}
-        drawn, matched, note = choose_pairs(names, pairs, max_pairs, final_forces(history, names), bodies_of)
+        attrs = {n: f.pair(final["step"], n, ())["attrs"] for n in names}
+        bodies_of = {n: (a.get("slave_body"), a.get("master_body")) for n, a in attrs.items()}
+        governs = {n: governing(a) for n, a in attrs.items()}
+        drawn, matched, note = choose_pairs(names, pairs, max_pairs, final_forces(history, names), bodies_of,
+                                            governs)
         for k in sorted(set(_spread(len(steps), max_curves)) | {len(steps) - 1}):
             for name in drawn:
                 if name in steps[k]["pair_names"]:

@@ -53,4 +53,22 @@ with tempfile.TemporaryDirectory() as tmp:
                   all((math.isnan(derived[key]) and math.isnan(a[key])) or abs(derived[key] - a[key]) < 1e-12
                       for key in derived), (derived, {key: a[key] for key in derived}))
 
+# The plot's default choice of panels: the joints that govern. A slipping joint (utilisation 1) and one about to
+# hinge (|e| / (L/2) = 0.95) before a joint carrying more force at 0.3; an open joint (no force) last; among equals
+# the larger force.
+from contact_client.plot_select import choose_pairs, governing  # noqa: E402
+
+attrs = {"slips": {"force": 1.0, "friction_utilisation": 1.0, "eccentricity": 0.1},
+         "hinges": {"force": 2.0, "friction_utilisation": 0.2, "eccentricity": -0.95},
+         "heavy": {"force": 50.0, "friction_utilisation": 0.3, "eccentricity": 0.0},
+         "slips_more_force": {"force": 3.0, "friction_utilisation": 0.99999, "eccentricity": 0.0},
+         "open": {"force": 0.0, "friction_utilisation": float("nan"), "eccentricity": float("nan")}}
+scores = {n: governing(a) for n, a in attrs.items()}
+check("governing: the larger of utilisation and |eccentricity|, 0 for an open joint",
+      scores == {"slips": 1.0, "hinges": 0.95, "heavy": 0.3, "slips_more_force": 0.99999, "open": 0.0}, scores)
+names = list(attrs)
+drawn, matched, note = choose_pairs(names, None, 3, {n: a["force"] for n, a in attrs.items()}, None, scores)
+check("the panels: the slipping joints (the larger force first among equals) and the hinging one, in the result's "
+      "order", drawn == ["slips", "hinges", "slips_more_force"] and "govern" in note, (drawn, note))
+
 finish()
