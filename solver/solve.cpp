@@ -2,6 +2,7 @@
 
 #include "adapt/adaptive.hpp"
 #include "check/large_motion.hpp"
+#include "check/support_ends.hpp"
 #include "ddm/load_steps.hpp"
 #include "held_bodies.hpp"
 #include "limit/collapse.hpp"
@@ -126,7 +127,9 @@ void refuse_below_resolution(const Problem& problem, Result& result) {
 // them: its steps are kept, the stop says why (a warning never changes the answer).
 void add_warnings(const Problem& problem, Result& result) {
   if (result.steps.empty()) return;
-  const std::vector<Warning> after = check::motion_warnings(problem, result.steps.back());
+  std::vector<Warning> after = check::motion_warnings(problem, result.steps.back());
+  const std::vector<Warning> ends = check::support_end_warnings(problem, result.steps.back());
+  after.insert(after.end(), ends.begin(), ends.end());
   result.warnings.insert(result.warnings.end(), after.begin(), after.end());
   if (!problem.strict || after.empty() || !result.converged) return;
   result.stop_reason = StopReason::error;
