@@ -363,3 +363,29 @@ TEST(Collapse, TheProgressReportsEveryLoadStepAndTrialAsTheyEnd) {
   EXPECT_EQ(iterations, recorder.iterations);
   EXPECT_EQ(iterations, r.iterations);
 }
+
+// Every solver brackets the same limit, and the last held states agree: the direct and the iterative interface
+// solvers and the monolithic reference (an independent method) on the overturning column, the last held state's
+// displacements to 1e-8 of their largest.
+TEST(Collapse, EverySolverBracketsTheSameLimitAndAgreesOnTheLastHeldState) {
+  std::vector<Result> runs;
+  for (const json& solver : {json{{"interface", {{"solver", "direct"}}}},
+                             json{{"interface", {{"solver", "iterative"}}}}, json{{"method", "monolithic"}}}) {
+    json job = column(3, 1.0, 1.0, 0.8, "body");
+    job["solver"] = solver;
+    runs.push_back(contact::testing::run(job));
+    ASSERT_TRUE(runs.back().converged) << solver.dump() << ": " << runs.back().message;
+    expect_bracket(runs.back().collapse, 1.0 / 3.0);
+  }
+  const Step& reference = runs.back().steps.back();  // the monolithic reference's
+  for (size_t k = 0; k + 1 < runs.size(); ++k) {
+    EXPECT_EQ(runs[k].collapse.held, runs.back().collapse.held);
+    const Step& s = runs[k].steps.back();
+    for (size_t a = 0; a < s.bodies.size(); ++a) {
+      const double scale = contact::testing::max_abs(reference.bodies[a].displacement);
+      EXPECT_LE(contact::testing::max_abs(s.bodies[a].displacement - reference.bodies[a].displacement),
+                1e-8 * std::max(scale, 1e-300))
+          << "solver " << k << ", body " << s.bodies[a].name;
+    }
+  }
+}
