@@ -100,128 +100,163 @@ void word_verdict(CollapseResult& c, const std::string& last_failure, const std:
   c.words = std::move(w);
 }
 
+// One collapse analysis in its phases: the statics' bound, the trials (each one increment from the last held state),
+// the answer restored to the last held state.
+class CollapseRun {
+ public:
+  CollapseRun(const ddm::ContactSystem& system, const CollapseSpec& spec, ddm::RunFrame& frame,
+              ddm::ContactMethod& method, ddm::StepLog& steps, CollapseResult& out)
+      : system_(system), spec_(spec), frame_(frame), method_(method), steps_(steps), out_(out) {}
+
+  void run() {
+    out_.analysed = true;
+    out_.tolerance = spec_.tolerance;
+    bound_by_statics();
+    held_ = Held::of(frame_.outcome(), frame_.state(), 0.0);
+    first_index_ = steps_.held();
+    double next = spec_.first > 0 ? spec_.first : bounded() ? 0.5 * out_.statics_bound : 1.0;
+    while (!decided()) next = trial(next);
+    finish();
+  }
+
+ private:
+  bool bounded() const { return std::isfinite(out_.statics_bound); }
+
+  // 1. The statics: the bound (its top, lambda_s (1 + tol/4), the bracket's top before any solve) and its mechanism.
+  void bound_by_statics() {
+    const RigidBlocks blocks = rigid_blocks(system_);
+    const Loads loads = loads_at(system_, blocks, frame_.state().load);
+    statics_ = largest_multiplier(blocks, loads.dead, loads.live);
+    if (statics_.status == StaticsAnswer::Status::bounded) {
+      out_.statics_bound = statics_.multiplier;
+      out_.mechanism = describe_mechanism(system_, blocks, statics_.velocity);
+      hi_ = statics_.multiplier * (1 + spec_.tolerance / 4);
+    } else if (statics_.status == StaticsAnswer::Status::unbounded) {
+      out_.statics_bound = std::numeric_limits<double>::infinity();
+    }
+  }
+
+  // Whether the analysis has its verdict (bracketed, holds, out of solves).
+  bool decided() {
+    if (!std::isnan(hi_) && hi_ - held_.multiplier <= spec_.tolerance * held_.multiplier) {
+      out_.verdict = "collapse";
+    } else if (bounded() && out_.statics_bound <= 0) {  // the live loads cannot be carried at all
+      out_.verdict = "collapse";
+      hi_ = 0.0;
+    } else if (held_.multiplier >= spec_.max_multiplier) {
+      out_.verdict = "holds";
+    } else if (out_.solves == spec_.max_solves) {
+      out_.verdict = "solver_failed";
+      stopped_ = "max_solves = " + std::to_string(spec_.max_solves) + " reached";
+    }
+    return !out_.verdict.empty();
+  }
+
+  // 2-3. One trial at `next` (moved into the bracket), from the last held state; returns the next trial's multiplier.
+  double trial(double next) {
+    ddm::RunState& state = frame_.state();
+    MethodOutcome& total = frame_.outcome();
+    double lambda = std::min(next, spec_.max_multiplier);
+    if (!std::isnan(hi_) && (lambda >= hi_ || lambda <= held_.multiplier)) lambda = 0.5 * (held_.multiplier + hi_);
+    state.slip_origin = held_.slip_origin;
+    state.load.multiplier = lambda;
+    ddm::InnerMarks marks;
+    marks.multiplier = lambda;
+    const double started = frame_.elapsed();
+    const int iterations_before = total.iterations;
+    frame_.nested(&held_.u, marks, [&](ddm::RunFrame& inner) { ddm::run_enforced(system_, inner, method_); });
+    out_.trials.push_back({lambda, total.converged, total.iterations - iterations_before, frame_.elapsed() - started});
+    report(lambda);
+    ++out_.solves;
+    if (solve_failed_) ++out_.bracket_solves;
+    if (total.stop_reason == StopReason::cancelled || frame_.stop_requested()) {
+      out_.verdict = "solver_failed";
+      stopped_ = "cancelled";
+      return lambda;
+    }
+    if (!total.converged) {
+      hi_ = lambda;
+      solve_failed_ = true;
+      last_failure_ = total.message;
+      return 0.5 * (held_.multiplier + hi_);
+    }
+    const double previous = held_.multiplier;
+    keep_held(lambda);
+    if (!std::isnan(hi_))  // just under the statics' top while no solve failed, else the bracket's middle
+      return !solve_failed_ && bounded() ? out_.statics_bound * (1 - spec_.tolerance / 4)
+                                         : 0.5 * (held_.multiplier + hi_);
+    // No bound: any multiple is carried by statics (try the largest asked), or growing increments.
+    return statics_.status == StaticsAnswer::Status::unbounded ? spec_.max_multiplier
+                                                               : lambda + 2 * (lambda - previous);
+  }
+
+  void report(double lambda) const {
+    LoadStepReport r;
+    r.kind = LoadStepReport::Kind::trial;
+    r.step = static_cast<int>(out_.trials.size());
+    r.multiplier = lambda;
+    r.held = out_.trials.back().held;
+    r.iterations = out_.trials.back().iterations;
+    r.load_factor = frame_.state().load.value();
+    frame_.report(r);
+  }
+
+  // A trial that held: the next trials start from it, and it is a result step with its multiplier.
+  void keep_held(double lambda) {
+    ddm::RunState& state = frame_.state();
+    const MethodOutcome& total = frame_.outcome();
+    state.slip_origin = system_.tangential_jumps(total.u);
+    held_ = Held::of(total, state, lambda);
+    Step step = ddm::step_of(system_, total, state);
+    step.index = first_index_ + out_.solves - 1;
+    step.load_factor = state.load.value();
+    step.multiplier = lambda;
+    steps_.push_back(std::move(step));
+  }
+
+  // The answer: the last state that held, and the verdict in words.
+  void finish() {
+    ddm::RunState& state = frame_.state();
+    MethodOutcome& total = frame_.outcome();
+    out_.held = held_.multiplier;
+    out_.failed = hi_;
+    out_.failed_by_statics = !std::isnan(hi_) && !solve_failed_;
+    if (!stopped_.empty()) last_failure_ = stopped_;
+    total.u = std::move(held_.u);
+    total.z = std::move(held_.z);
+    total.q = std::move(held_.q);
+    total.rigid_amplitudes = std::move(held_.rigid_amplitudes);
+    state.slip_origin = std::move(held_.slip_origin);
+    state.load.multiplier = out_.held;
+    word_verdict(out_, last_failure_, !steps_.empty() ? joints_that_give(steps_.back()) : std::string());
+    total.refused = false;
+    const bool answered = out_.verdict != "solver_failed";
+    total.converged = answered;
+    total.stop_reason = answered                  ? StopReason::converged
+                        : stopped_ == "cancelled" ? StopReason::cancelled
+                                                  : StopReason::max_iterations;
+    total.message = out_.words;
+  }
+
+  const ddm::ContactSystem& system_;
+  const CollapseSpec& spec_;
+  ddm::RunFrame& frame_;
+  ddm::ContactMethod& method_;
+  ddm::StepLog& steps_;
+  CollapseResult& out_;
+  StaticsAnswer statics_;
+  Held held_;
+  int first_index_ = 0;
+  double hi_ = std::numeric_limits<double>::quiet_NaN();  // the smallest multiplier known not to hold
+  bool solve_failed_ = false;
+  std::string last_failure_, stopped_;
+};
+
 }  // namespace
 
 void run_collapse(const ddm::ContactSystem& system, const CollapseSpec& spec, ddm::RunFrame& frame,
                   ddm::ContactMethod& method, ddm::StepLog& steps, CollapseResult& out) {
-  out.analysed = true;
-  out.tolerance = spec.tolerance;
-  ddm::RunState& state = frame.state();
-  MethodOutcome& total = frame.outcome();
-  const double tol = spec.tolerance;
-
-  // 1. The statics: the bound and its mechanism.
-  const RigidBlocks blocks = rigid_blocks(system);
-  const Loads loads = loads_at(system, blocks, state.load);
-  const StaticsAnswer statics = largest_multiplier(blocks, loads.dead, loads.live);
-  double hi = std::numeric_limits<double>::quiet_NaN();  // the smallest multiplier known not to hold
-  if (statics.status == StaticsAnswer::Status::bounded) {
-    out.statics_bound = statics.multiplier;
-    out.mechanism = describe_mechanism(system, blocks, statics.velocity);
-    hi = statics.multiplier * (1 + tol / 4);
-    out.failed_by_statics = true;
-  } else if (statics.status == StaticsAnswer::Status::unbounded) {
-    out.statics_bound = std::numeric_limits<double>::infinity();
-  }
-  const bool bounded = std::isfinite(out.statics_bound);
-
-  // 2-3. The trials, each from the last state that held.
-  Held held = Held::of(total, state, 0.0);
-  const int first_index = steps.held();
-  bool solve_failed = false;
-  std::string last_failure, stopped;
-  double next = spec.first > 0 ? spec.first : bounded ? 0.5 * out.statics_bound : 1.0;
-  while (true) {
-    if (!std::isnan(hi) && hi - held.multiplier <= tol * held.multiplier) {
-      out.verdict = "collapse";
-      break;
-    }
-    if (bounded && out.statics_bound <= 0) {  // the live loads cannot be carried at all
-      out.verdict = "collapse";
-      hi = 0.0;
-      break;
-    }
-    if (held.multiplier >= spec.max_multiplier) {
-      out.verdict = "holds";
-      break;
-    }
-    if (out.solves == spec.max_solves) {
-      out.verdict = "solver_failed";
-      stopped = "max_solves = " + std::to_string(spec.max_solves) + " reached";
-      break;
-    }
-    double trial = std::min(next, spec.max_multiplier);
-    if (!std::isnan(hi) && (trial >= hi || trial <= held.multiplier)) trial = 0.5 * (held.multiplier + hi);
-    state.slip_origin = held.slip_origin;
-    state.load.multiplier = trial;
-    ddm::InnerMarks marks;
-    marks.multiplier = trial;
-    const double started = frame.elapsed();
-    const int iterations_before = total.iterations;
-    frame.nested(&held.u, marks, [&](ddm::RunFrame& inner) { ddm::run_enforced(system, inner, method); });
-    out.trials.push_back({trial, total.converged, total.iterations - iterations_before, frame.elapsed() - started});
-    LoadStepReport report;
-    report.kind = LoadStepReport::Kind::trial;
-    report.step = static_cast<int>(out.trials.size());
-    report.multiplier = trial;
-    report.held = total.converged;
-    report.iterations = out.trials.back().iterations;
-    report.load_factor = state.load.value();
-    frame.report(report);
-    ++out.solves;
-    if (solve_failed) ++out.bracket_solves;
-    if (total.stop_reason == StopReason::cancelled || frame.stop_requested()) {
-      out.verdict = "solver_failed";
-      stopped = "cancelled";
-      break;
-    }
-    if (total.converged) {
-      const double previous = held.multiplier;
-      state.slip_origin = system.tangential_jumps(total.u);
-      held = Held::of(total, state, trial);
-      Step step = ddm::step_of(system, total, state);
-      step.index = first_index + out.solves - 1;
-      step.load_factor = state.load.value();
-      step.multiplier = trial;
-      steps.push_back(std::move(step));
-      if (!std::isnan(hi))
-        next = !solve_failed && bounded ? out.statics_bound * (1 - tol / 4) : 0.5 * (held.multiplier + hi);
-      else
-        next =
-            statics.status == StaticsAnswer::Status::unbounded ? spec.max_multiplier : trial + 2 * (trial - previous);
-    } else {
-      hi = trial;
-      solve_failed = true;
-      out.failed_by_statics = false;
-      last_failure = total.message;
-      next = 0.5 * (held.multiplier + hi);
-    }
-  }
-  out.held = held.multiplier;
-  out.failed = hi;
-  if (!std::isnan(hi) && !solve_failed) out.failed_by_statics = true;
-  if (stopped == "cancelled")
-    last_failure = "cancelled";
-  else if (!stopped.empty())
-    last_failure = stopped;
-
-  // The answer: the last state that held.
-  total.u = std::move(held.u);
-  total.z = std::move(held.z);
-  total.q = std::move(held.q);
-  total.rigid_amplitudes = std::move(held.rigid_amplitudes);
-  state.slip_origin = std::move(held.slip_origin);
-  state.load.multiplier = out.held;
-  word_verdict(out, last_failure, !steps.empty() ? joints_that_give(steps.back()) : std::string());
-  total.refused = false;
-  if (out.verdict == "solver_failed") {
-    total.converged = false;
-    total.stop_reason = stopped == "cancelled" ? StopReason::cancelled : StopReason::max_iterations;
-  } else {
-    total.converged = true;
-    total.stop_reason = StopReason::converged;
-  }
-  total.message = out.words;
+  CollapseRun(system, spec, frame, method, steps, out).run();
 }
 
 }  // namespace contact::limit
