@@ -237,8 +237,8 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
       } else if (!loading.converged && !loading.refused && loading.stop_reason != StopReason::cancelled &&
                  !frame.stop_requested()) {
         // Why the step failed, by statics: a collapse (no equilibrium, its mechanism) or the solver.
-        result.collapse = limit::judge_failed_step(system, frame.state().load,
-                                                   problem.collapse.enabled ? "the dead loads" : "the loads");
+        result.collapse = limit::judge_failed_step(
+            system, frame.state().load, problem.collapse.enabled ? "the dead loads" : "the loads", frame.stop_check());
         if (problem.collapse.enabled) result.collapse.verdict = "dead_loads_fail";
         loading.message += "; " + result.collapse.words;
       }

@@ -126,7 +126,7 @@ class CollapseRun {
   void bound_by_statics() {
     const RigidBlocks blocks = rigid_blocks(system_);
     const Loads loads = loads_at(system_, blocks, frame_.state().load);
-    statics_ = largest_multiplier(blocks, loads.dead, loads.live);
+    statics_ = largest_multiplier(blocks, loads.dead, loads.live, frame_.stop_check());
     if (statics_.status == StaticsAnswer::Status::bounded) {
       out_.statics_bound = statics_.multiplier;
       out_.mechanism = describe_mechanism(system_, blocks, statics_.velocity);

@@ -1,5 +1,7 @@
 #include "statics.hpp"
 
+#include "../common/background.hpp"
+
 #include <glpk.h>
 
 #include <algorithm>
@@ -30,10 +32,9 @@ struct Triplets {
   }
 };
 
-}  // namespace
-
-StaticsAnswer largest_multiplier(const RigidBlocks& blocks, const std::vector<Resultant>& fixed,
-                                 const std::vector<Resultant>& scaled) {
+// The linear program itself (on the caller's thread, or on its own when a cancel may leave it: largest_multiplier).
+StaticsAnswer solve_statics(const RigidBlocks& blocks, const std::vector<Resultant>& fixed,
+                            const std::vector<Resultant>& scaled) {
   StaticsAnswer out;
   const size_t nb = blocks.bodies.size();
   // GLPK keeps its environment (the terminal output switch, its memory accounting) per thread at best: one program
@@ -174,6 +175,21 @@ StaticsAnswer largest_multiplier(const RigidBlocks& blocks, const std::vector<Re
     for (Eigen::Index i = 0; i < 3; ++i)
       if (std::abs(v[i]) < 1e-12) v[i] = 0.0;
   }
+  return out;
+}
+
+}  // namespace
+
+StaticsAnswer largest_multiplier(const RigidBlocks& blocks, const std::vector<Resultant>& fixed,
+                                 const std::vector<Resultant>& scaled, const std::function<bool()>& cancelled) {
+  // GLPK's simplex has no interrupt: on its own thread (common/background.hpp) a cancel returns at once and leaves
+  // it to finish alone, so the work owns copies of its inputs.
+  std::unique_ptr<StaticsAnswer> answer = run_unless_cancelled<StaticsAnswer>(
+      [blocks, fixed, scaled] { return std::make_unique<StaticsAnswer>(solve_statics(blocks, fixed, scaled)); },
+      cancelled);
+  if (answer) return std::move(*answer);
+  StaticsAnswer out;
+  out.message = "cancelled";
   return out;
 }
 

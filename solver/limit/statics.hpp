@@ -16,6 +16,7 @@
 
 #include "rigid_blocks.hpp"
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -36,8 +37,9 @@ struct StaticsAnswer {
   std::string message;
 };
 
-// The statics with the loads `fixed` (per body, held) and `scaled` (per body, times lambda).
+// The statics with the loads `fixed` (per body, held) and `scaled` (per body, times lambda). With `cancelled`, the
+// LP runs on a thread of its own and a cancel returns at once (Status::failed, message "cancelled").
 StaticsAnswer largest_multiplier(const RigidBlocks& blocks, const std::vector<Resultant>& fixed,
-                                 const std::vector<Resultant>& scaled);
+                                 const std::vector<Resultant>& scaled, const std::function<bool()>& cancelled = {});
 
 }  // namespace contact::limit

@@ -7,14 +7,15 @@
 
 namespace contact::limit {
 
-CollapseResult judge_failed_step(const ddm::ContactSystem& system, const fem::LoadPoint& at, const std::string& what) {
+CollapseResult judge_failed_step(const ddm::ContactSystem& system, const fem::LoadPoint& at, const std::string& what,
+                                 const std::function<bool()>& cancelled) {
   CollapseResult out;
   out.analysed = true;
   out.verdict = "solver_failed";
   const RigidBlocks blocks = rigid_blocks(system);
   const std::vector<Resultant> none(blocks.bodies.size(), Resultant::Zero());
   const std::vector<Resultant> loads = load_resultants(system, blocks, at);
-  const StaticsAnswer statics = largest_multiplier(blocks, none, loads);
+  const StaticsAnswer statics = largest_multiplier(blocks, none, loads, cancelled);
   switch (statics.status) {
     case StaticsAnswer::Status::bounded:
       out.statics_bound = statics.multiplier;
@@ -44,8 +45,8 @@ CollapseResult judge_failed_step(const ddm::ContactSystem& system, const fem::Lo
       out.verdict = "no_equilibrium";
       out.words = "no equilibrium by statics: the bodies as rigid blocks carry none of " + what;
       break;
-    case StaticsAnswer::Status::failed:
-      out.words = statics.message;
+    case StaticsAnswer::Status::failed:  // the LP library, or a cancel
+      out.words = statics.message == "cancelled" ? "the statics' verdict was cancelled" : statics.message;
       break;
   }
   return out;

@@ -12,7 +12,9 @@
 namespace contact::limit {
 
 // The verdict on a step that stopped at `at`, in a CollapseResult (verdict, statics_bound: the fraction of the
-// loads carried, mechanism, words). `what` names the loads in the words ("the loads", "the dead loads").
-CollapseResult judge_failed_step(const ddm::ContactSystem& system, const fem::LoadPoint& at, const std::string& what);
+// loads carried, mechanism, words). `what` names the loads in the words ("the loads", "the dead loads"); a cancel
+// (`cancelled`) returns at once, the verdict then without statics.
+CollapseResult judge_failed_step(const ddm::ContactSystem& system, const fem::LoadPoint& at, const std::string& what,
+                                 const std::function<bool()>& cancelled = {});
 
 }  // namespace contact::limit
