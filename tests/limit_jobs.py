@@ -1,4 +1,5 @@
-"""A semicircular arch of N voussoirs (straight intrados and extrados chords, radial joints) under its own weight:
+"""Jobs of the limit state with their classical answers, shared by the tests and bench/bench_collapse.py: a column of
+blocks (column()), and a semicircular arch of N voussoirs (straight intrados and extrados chords, radial joints) under its own weight:
 the job, and its limit thickness by the classical thrust-line argument (Heyman; Milankovitch's problem), computed
 here independently of the solver.
 
@@ -152,3 +153,22 @@ def hinges_at_limit(n, radius=1.0):
         elif abs(r - r_out) < 1e-4 * radius:
             out.append((phi, "extrados"))
     return out
+
+
+def column(n=3, push=10.0, mu=0.8, nx=4):
+    """n blocks 1 x 1 stacked on a clamped ground (density 1, gravity [0, -10] dead), Coulomb mu on every joint, a
+    horizontal body force `push` per volume live: the column overturns about the base's toe at lambda_c = 1 / n
+    (b / (n h)) while that is below mu."""
+    def block(name, y0):
+        return {"name": name, "material": {"E": 1e5, "nu": 0.2, "density": 1.0},
+                "mesh": {"block": {"corners": [[0, y0], [1, y0], [1, y0 + 1], [0, y0 + 1]], "nx": nx, "ny": nx}},
+                "body_force": {"value": [push, 0], "live": True}}
+    ground = {"name": "ground", "material": {"E": 1e5, "nu": 0.2},
+              "mesh": {"block": {"corners": [[-1, -1], [2, -1], [2, 0], [-1, 0]], "nx": 3 * nx, "ny": 3}},
+              "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]}
+    return {"name": "column", "model": {"gravity": [0, -10]},
+            "bodies": [ground] + [block(f"b{i + 1}", i) for i in range(n)],
+            "contacts": [{"slave": f"b{i + 1}.bottom", "master": "ground.top" if i == 0 else f"b{i}.top",
+                          "friction": {"coefficient": mu}} for i in range(n)],
+            "collapse": {}}
+

@@ -27,6 +27,7 @@ from client_paths import CLIENT, EXAMPLES, HERE, SRC  # noqa: E402,F401  (sets t
 from contact_client.plot import AXIS_LABELS  # noqa: E402
 from harness import Server, example, flat_patch, long_job, read_all_events, roller_job  # noqa: E402
 from checks import check, finish, section, skip  # noqa: E402
+from limit_jobs import column  # noqa: E402
 
 CHROMIUM_FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
                   "--disable-background-networking", "--disable-component-update", "--disable-sync",
@@ -392,27 +393,10 @@ def test_warnings(server, b):
           b.text("job-warnings"))
 
 
-def column_collapse():
-    """Three 1 x 1 blocks on a clamped ground, gravity dead, a horizontal body force live: they overturn about the
-    base's toe at lambda_c = 1/3 (docs/limit-analysis.md)."""
-    def block(name, y0):
-        return {"name": name, "material": {"E": 1e5, "nu": 0.2, "density": 1.0},
-                "mesh": {"block": {"corners": [[0, y0], [1, y0], [1, y0 + 1], [0, y0 + 1]], "nx": 4, "ny": 4}},
-                "body_force": {"value": [10, 0], "live": True}}
-    ground = {"name": "ground", "material": {"E": 1e5, "nu": 0.2},
-              "mesh": {"block": {"corners": [[-1, -1], [2, -1], [2, 0], [-1, 0]], "nx": 12, "ny": 3}},
-              "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]}
-    return {"name": "column-collapse", "model": {"gravity": [0, -10]},
-            "bodies": [ground, block("b1", 0), block("b2", 1), block("b3", 2)],
-            "contacts": [{"slave": f"b{i + 1}.bottom", "master": "ground.top" if i == 0 else f"b{i}.top",
-                          "friction": {"coefficient": 0.8}} for i in range(3)],
-            "collapse": {}}
-
-
 def test_collapse(server, b):
     """3e. A collapse analysis: the job's view says the bracket, the statics' bound and the mechanism, and lists the
     trials; a job without one shows none of it."""
-    job_id = server.submit_id(column_collapse())
+    job_id = server.submit_id(dict(column(), name="column-collapse"))
     check("collapse: solved", server.wait_done(job_id, 120).get("state") == "SUCCEEDED")
     b.driver.execute_script(f"window.location.hash = 'job={job_id}';")
     shown = b.wait(lambda: b.el("job-collapse").is_displayed()

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """A semicircular arch of 12 voussoirs under its own weight (issue 48, "Must show"): the solver finds its limit
-thickness where the classical thrust-line argument puts it (tests/integration/arch.py, computed independently:
+thickness where the classical thrust-line argument puts it (tests/limit_jobs.py, computed independently:
 Milankovitch's problem for these voussoirs), and below it names the classical five-hinge mechanism.
 
 - The independent method first: for many voussoirs it gives Milankovitch's t/R = 0.1075 of the continuous arch
@@ -23,7 +23,7 @@ BIN = os.environ.get("CONTACT_BINARY_DIR", os.path.join(SRC, "build"))
 CLI = os.path.join(BIN, "contact-solve")
 sys.path.insert(0, HERE)
 sys.path.insert(0, os.path.join(HERE, ".."))  # tests/: checks.py
-import arch  # noqa: E402
+import limit_jobs as arch  # noqa: E402
 from checks import check, finish  # noqa: E402
 
 N = 12

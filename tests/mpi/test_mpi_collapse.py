@@ -19,6 +19,7 @@ CLI = os.path.join(BIN, "contact-solve")
 EXAMPLES = os.path.join(SRC, "api", "examples")
 sys.path.insert(0, os.path.join(HERE, ".."))  # tests/: checks.py
 from checks import check, finish, skip  # noqa: E402
+from limit_jobs import column  # noqa: E402
 
 import h5py  # noqa: E402
 
@@ -35,23 +36,6 @@ def collapse(path):
         g = f["collapse"]
         return {"verdict": g.attrs["verdict"], "held": float(g.attrs["held"]), "failed": float(g.attrs["failed"]),
                 "bound": float(g.attrs["statics_bound"]), "kind": g["mechanism"].attrs["kind"]}
-
-
-def column():
-    """Three 1 x 1 blocks on a clamped ground, gravity dead, a horizontal body force of the weight's size live."""
-    def block(name, y0):
-        return {"name": name, "material": {"E": 1e5, "nu": 0.2, "density": 1.0},
-                "mesh": {"block": {"corners": [[0, y0], [1, y0], [1, y0 + 1], [0, y0 + 1]], "nx": 4, "ny": 4}},
-                "body_force": {"value": [10, 0], "live": True}}
-    ground = {"name": "ground", "material": {"E": 1e5, "nu": 0.2},
-              "mesh": {"block": {"corners": [[-1, -1], [2, -1], [2, 0], [-1, 0]], "nx": 12, "ny": 3}},
-              "boundary": [{"edge": "bottom", "displacement": {"x": 0, "y": 0}}]}
-    return {"name": "column", "model": {"gravity": [0, -10]},
-            "bodies": [ground, block("b1", 0), block("b2", 1), block("b3", 2)],
-            "contacts": [{"slave": "b1.bottom", "master": "ground.top", "friction": {"coefficient": 0.8}},
-                         {"slave": "b2.bottom", "master": "b1.top", "friction": {"coefficient": 0.8}},
-                         {"slave": "b3.bottom", "master": "b2.top", "friction": {"coefficient": 0.8}}],
-            "collapse": {}}
 
 
 if not shutil.which("mpirun"):
