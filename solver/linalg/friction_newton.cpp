@@ -113,6 +113,8 @@ class Newton {
   // The Newton point n from x: taken whole, or damped by the line search.
   FrictionIterate globalise(const FrictionIterate& n, bool visited, bool& damped);
   void record_merit(double theta);
+  // The stall rule (FrictionNewtonSettings::stall_steps) on the lowest merits after each accepted step.
+  bool stalled() const;
 
   const FrictionNewtonProblem& p_;
   const FrictionNewtonSettings& s_;
@@ -121,6 +123,7 @@ class Newton {
   FrictionIterate x_;
   bool have_x_ = false;
   double best_merit_ = std::numeric_limits<double>::infinity();
+  std::vector<double> best_history_;  // best_merit_ after each accepted step
   int steps_since_best_ = 0;
   bool tied_retreat_ = false;
   bool cancelled_ = false;
@@ -189,6 +192,12 @@ void Newton::record_merit(double theta) {
   } else {
     ++steps_since_best_;
   }
+  best_history_.push_back(best_merit_);
+}
+
+bool Newton::stalled() const {
+  const size_t k = best_history_.size(), window = static_cast<size_t>(std::max(0, s_.stall_steps));
+  return window > 0 && k > window && best_history_[k - 1] > s_.stall_fall * best_history_[k - 1 - window];
 }
 
 FrictionNewtonResult Newton::run(FrictionSets sets) {
@@ -208,6 +217,7 @@ FrictionNewtonResult Newton::run(FrictionSets sets) {
     FrictionIterate x = globalise(n, seen, damped);
     result_.damped_steps += damped;
     result_.sets = sets;
+    ++result_.accepted_steps;
     x_ = std::move(x);
     have_x_ = true;
     record_merit(merit(x_));
@@ -224,6 +234,11 @@ FrictionNewtonResult Newton::run(FrictionSets sets) {
     }
     if ((!damped && next == sets) || info.complementarity <= s_.tolerance) {
       result_.report.stop = SolveStop::converged;
+      return result_;
+    }
+    if (stalled()) {
+      result_.stalled = true;
+      result_.report.stop = SolveStop::max_iterations;
       return result_;
     }
     sets = next;

@@ -17,6 +17,9 @@
 //   * the full step is taken without a line search while the sets are new and Theta has reached a new low within
 //     the last four steps (a watchdog: the usual run, whose Theta may rise for a step before it falls to zero, is
 //     unchanged); a repeated set (a cycle) or four steps without progress switch to the line search;
+//   * where another solver can take the step over (the direct interface solver's, ddm/friction_policy.hpp), it
+//     stops once it stalls: the lowest merit of its last few accepted steps not even halved against the lowest
+//     before them (cycling or crawling by damped steps, which settle, if ever, only after tens of linear solves);
 //   * a singular system is met by moving towards the predicted sets in halves: the rows whose state would change
 //     are ordered by how far their prediction lies past the switching point, and only the first half (a quarter,
 //     ...) switches, until the system is solvable; if not even one switch is, the solver says so (`singular`).
@@ -53,6 +56,11 @@ struct FrictionNewtonProblem {
 struct FrictionNewtonSettings {
   int max_steps = 100;
   double tolerance = 1e-13;  // friction_complementarity at which an iterate is taken as the solution
+  // Stalled: the lowest merit of the last `stall_steps` accepted steps fell by less than `stall_fall` of the lowest
+  // before them (the iteration cycles or crawls by damped steps); it stops then as `max_iterations` with `stalled`
+  // set. 0: never (the monolithic reference and the coarse levels, which have no solver to hand over to).
+  int stall_steps = 0;
+  double stall_fall = 0.5;
 };
 
 struct FrictionNewtonResult {
@@ -60,10 +68,12 @@ struct FrictionNewtonResult {
   FrictionSets sets;        // the sets of the last solve
   FrictionSets unsolvable;  // singular: the predicted sets whose system (and every one towards them) was singular
   int damped_steps = 0;     // steps the line search shortened
+  int accepted_steps = 0;   // iterates accepted (each after one or more linear solves)
+  bool stalled = false;     // stopped by the stall rule (FrictionNewtonSettings::stall_steps)
   // iterations: linear systems solved (each step's, the halvings included). converged: the sets repeated (the
   // iterate is the exact solution of its sets) or the complementarity vanished; singular: no set on the way to the
-  // predicted one had a solvable system; max_iterations: not settled within max_steps; cancelled: the step
-  // callback asked to stop.
+  // predicted one had a solvable system; max_iterations: not settled within max_steps, or stalled; cancelled: the
+  // step callback asked to stop.
   SolveReport report;
 };
 

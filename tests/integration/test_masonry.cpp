@@ -102,7 +102,8 @@ int expect_wall_holds(const json& job, const Result& r, double mu, const std::st
     for (Eigen::Index i = 0; i < pair.pressure.size(); ++i) {
       EXPECT_LE(std::abs(pair.tangential_traction[i]), mu * pair.pressure[i] + 1e-8 * p_max)
           << what << ": " << pair.name << " node " << i;
-      slipping += pair.pressure[i] > 1e-6 * p_max && std::abs(pair.tangential_traction[i]) > (mu - 1e-6) * pair.pressure[i];
+      slipping +=
+          pair.pressure[i] > 1e-6 * p_max && std::abs(pair.tangential_traction[i]) > (mu - 1e-6) * pair.pressure[i];
     }
   return slipping;
 }
@@ -149,11 +150,33 @@ TEST(Masonry, FreeEndedWallsHoldAShearOfHalfTheirLoad) {
     if (options.find("--head-joints") != std::string::npos) {
       bool took_over = false;
       for (const auto& report : r.history)
-        took_over = took_over || report.note.find("iterative (the direct solver's friction Newton did not settle)") != std::string::npos;
+        took_over = took_over || report.note.find("iterative (the direct solver's friction Newton did not settle)") !=
+                                     std::string::npos;
       EXPECT_TRUE(took_over) << "the direct solver settled by itself: the case no longer tests the take-over";
       EXPECT_EQ(r.message.find("settled with the complementarity"), std::string::npos) << r.message;
+      // Handed over because it stalled (its merit not halved over 8 steps), not after its budget of 100 linear
+      // solves (issue 47: the Newton crawled 51 solves here, 95 on 16 cells a brick, before the take-over).
+      EXPECT_NE(r.message.find("the friction Newton stalled"), std::string::npos) << r.message;
+      EXPECT_EQ(r.message.find("within 100 steps"), std::string::npos) << r.message;
     }
   }
+}
+
+TEST(Masonry, NearItsLimitAWallsCollapseTrialsAreDecidedWithoutRunningOutTheirBudget) {
+  // The 8 x 8 wall's collapse analysis (shear live, H/V = lambda): its trials near the limit hand the step from the
+  // direct Newton to the iterative solver, whose Coulomb iteration may extrapolate slip bounds that hold no
+  // equilibrium. SMALBE's equality violation then freezes (the box holds the multipliers) and must be told within a
+  // few updates (Smalbe::update_multipliers, policy rho_frozen): one such Tresca solve ran its 2,000 updates and
+  // 288,367 MPRGP iterations before, nearly the job's whole budget (interface.max_iterations 300,000), and the
+  // whole analysis cost more than 300,000. Statics bounds the answer from above (associated friction).
+  json job = wall(8, 8, "--head-joints --friction 0.6 --collapse");
+  const Result r = run(job);
+  const CollapseResult& c = r.collapse;
+  ASSERT_EQ(c.verdict, "collapse") << r.message;
+  EXPECT_LE(c.held, c.statics_bound) << c.words;
+  EXPECT_LE(c.failed - c.held, c.tolerance * c.held * (1 + 1e-9)) << c.words;
+  EXPECT_GT(c.held, 0.9 * c.statics_bound) << c.words;  // sliding governs these free-ended courses: near the bound
+  EXPECT_LT(r.interface_iterations, 100000) << r.message;
 }
 
 TEST(Masonry, TheIterativeSolverHoldsAFreeEndedWallAtHalfItsLoadInOneIncrement) {
@@ -166,7 +189,8 @@ TEST(Masonry, TheIterativeSolverHoldsAFreeEndedWallAtHalfItsLoadInOneIncrement) 
   job["solver"]["interface"] = {{"solver", "iterative"}};
   const Result r = run(job);
   EXPECT_EQ(r.message.find("cut"), std::string::npos) << r.message;
-  EXPECT_GT(expect_wall_holds(job, r, 0.6, "8 x 8"), 0) << "no node slips: the case no longer has the indeterminate bricks it is about";
+  EXPECT_GT(expect_wall_holds(job, r, 0.6, "8 x 8"), 0)
+      << "no node slips: the case no longer has the indeterminate bricks it is about";
 }
 
 TEST(Masonry, TheIterativeSolversProductsGrowLittleFromAn8x8ToA32x32FrictionalWall) {
@@ -405,7 +429,8 @@ TEST(Masonry, AStepThatDidNotConvergeIsCutAndIfThatFailsKeptOnlyAsTheLastAndFlag
   EXPECT_FALSE(r.converged);
   EXPECT_NE(r.message.find("cut 5 times"), std::string::npos) << r.message;
   EXPECT_NE(r.message.find("the result keeps the 1 load step that held and the last iterate (converged 0)"),
-            std::string::npos) << r.message;
+            std::string::npos)
+      << r.message;
   ASSERT_EQ(r.steps.size(), 2u) << r.message;
   EXPECT_TRUE(r.steps[0].converged) << r.message;
   EXPECT_FALSE(r.steps[1].converged);

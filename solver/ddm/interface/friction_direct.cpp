@@ -2,6 +2,7 @@
 
 #include "../../linalg/friction_nested.hpp"
 #include "../../linalg/friction_newton.hpp"
+#include "../friction_policy.hpp"
 #include "../friction_rows.hpp"
 
 #include <Eigen/SVD>
@@ -163,8 +164,15 @@ void describe_stop(const linalg::FrictionNewtonResult& r, const InterfaceQp& qp,
     case SolveStop::max_iterations: {
       std::ostringstream os;
       os.precision(3);
-      os << "the stick and slip sets did not settle within " << max_steps << " steps (complementarity residual "
-         << complementarity << " at the last iterate)";
+      if (r.stalled)
+        os << "the stick and slip sets did not settle: the friction Newton stalled (its merit fell by less than "
+           << 1 / policy::kFrictionPolicy.direct.stall_fall << "x over its last "
+           << policy::kFrictionPolicy.direct.stall_steps << " steps; " << r.accepted_steps << " steps, "
+           << r.report.iterations << " linear solves; complementarity residual " << complementarity
+           << " at the last iterate)";
+      else
+        os << "the stick and slip sets did not settle within " << max_steps << " steps (complementarity residual "
+           << complementarity << " at the last iterate)";
       result.report.message = os.str();
       return;
     }
@@ -188,8 +196,8 @@ linalg::QpSolution FrictionDirectSolver::solve(const InterfaceQp& qp, const Eige
   const std::vector<char> mask =
       ddm::tangential_unknowns(qp.problem.system(), n, [&](size_t k) { return qp.problem.tangential_offset(k); });
   const Eigen::VectorXd c = linalg::friction_scaling(F);
-  if (last_alpha_.size() != qp.equilibrium.G.rows()) last_alpha_.resize(0);
-  const FrictionSets sticking = first_sets(F, qp, z0, last_alpha_, c, rows, mask, context.note);
+  const Eigen::VectorXd alpha0 = context.alpha0.size() == qp.equilibrium.G.rows() ? context.alpha0 : Eigen::VectorXd();
+  const FrictionSets sticking = first_sets(F, qp, z0, alpha0, c, rows, mask, context.note);
   FrictionSets sets = sticking;
   const bool from_coarse = first_sets_from_coarse(F, qp, rows, mask, sets, context.note);
 
@@ -201,6 +209,8 @@ linalg::QpSolution FrictionDirectSolver::solve(const InterfaceQp& qp, const Eige
       [&] { return context.frame.stop_requested(); }};
   linalg::FrictionNewtonSettings settings;
   settings.max_steps = context.max_steps;
+  settings.stall_steps = context.stall_steps;
+  settings.stall_fall = policy::kFrictionPolicy.direct.stall_fall;
   const linalg::FrictionStepCallback on_step = [&](const linalg::FrictionIterate& x,
                                                    const linalg::ActiveSetStep& info) {
     return context.on_step(x.lambda, x.h, info);
@@ -213,7 +223,6 @@ linalg::QpSolution FrictionDirectSolver::solve(const InterfaceQp& qp, const Eige
   result.z = r.iterate.lambda.size() == n ? r.iterate.lambda : Eigen::VectorXd(Eigen::VectorXd::Zero(n));
   result.h = r.iterate.h;
   result.alpha = r.iterate.other;
-  if (r.iterate.lambda.size() == n) last_alpha_ = r.iterate.other;
   const double residual = r.iterate.lambda.size() == n
                               ? linalg::friction_complementarity(r.iterate.lambda, r.iterate.h, c, rows, mask)
                               : 1.0;

@@ -25,7 +25,6 @@ class FrictionDirectSolver final : public InterfaceSolver {
 
  private:
   AssembledCompliance compliance_;
-  Eigen::VectorXd last_alpha_;  // the floating bodies' rigid amplitudes of the last solve (with its warm start)
 };
 
 }  // namespace contact::ddm

@@ -116,15 +116,20 @@ void InterfaceNewton::solve(RunFrame& frame) {
     frame.report(std::move(r));
     return frame.stop_requested();
   };
-  InterfaceSolveContext ctx{frame, on_step, std::max(1, settings.max_iterations), {}};
+  InterfaceSolveContext ctx{frame, on_step, std::max(1, settings.max_iterations), 0, {}, {}};
+  if (last_z_.size() == m) ctx.alpha0 = last_alpha_;
   solver_note = &ctx.note;
   const Eigen::VectorXd* z0 = last_z_.size() == m && m > 0 && last_z_.cwiseAbs().maxCoeff() > 0 ? &last_z_ : nullptr;
   // With friction the direct solver's Newton gets a budget of its own before the iterative solver takes the step
   // over (below; the chain and the budget's rule: ddm/friction_policy.hpp).
   const bool may_take_over = system_.has_friction() && kind_ == InterfaceSolverKind::direct;
-  if (may_take_over) ctx.max_steps = std::min(ctx.max_steps, policy::kFrictionPolicy.direct.budget);
+  if (may_take_over) {
+    ctx.max_steps = std::min(ctx.max_steps, policy::kFrictionPolicy.direct.budget);
+    ctx.stall_steps = policy::kFrictionPolicy.direct.stall_steps;
+  }
   linalg::QpSolution result = solver_->solve(qp, z0, ctx);
   ctx.max_steps = std::max(1, settings.max_iterations);
+  ctx.stall_steps = 0;
   bool took_over = false;
   if (may_take_over && !result.report.converged() && !result.report.cancelled()) {
     // The direct solver's semismooth Newton can cycle where friction holds (its stick and slip sets oscillating:
@@ -134,7 +139,7 @@ void InterfaceNewton::solve(RunFrame& frame) {
     // solver's problem has none).
     InterfaceSolverSettings iterative = settings_;
     iterative.preconditioner = InterfacePreconditioner::none;
-    const long direct_steps = result.report.iterations;
+    const std::string direct_said = result.report.message;  // why it stopped: stalled, singular sets, its budget
     solver_name = "iterative (the direct solver's friction Newton did not settle)";
     ctx.note.clear();
     linalg::QpSolution second = FetiSolver(iterative).solve(qp, z0, ctx);
@@ -142,15 +147,20 @@ void InterfaceNewton::solve(RunFrame& frame) {
       result = std::move(second);
       took_over = true;
       if (result.report.converged())
-        result.report.message = "the direct solver's friction Newton did not settle (" + std::to_string(direct_steps) +
-                                " steps); the iterative solver took the step over: " + result.report.message;
+        result.report.message =
+            "the direct solver: " + direct_said + "; the iterative solver took the step over: " + result.report.message;
     } else {
       solver_name = solver_->name();
       result.report.message += "; the iterative solver did not settle it either: " + second.report.message;
     }
   }
   const int max_steps = ctx.max_steps;
-  last_z_ = result.z;
+  // The next solve starts from the last answer, not from a failed iterate (a cut load step's sub-step, a collapse
+  // trial after one that did not hold: both restart from the last held state).
+  if (result.report.converged()) {
+    last_z_ = result.z;
+    last_alpha_ = result.alpha;
+  }
   out.iterations = static_cast<int>(result.report.iterations);
   out.interface_solver = took_over ? "iterative" : solver_->name();
   out.interface_iterations = result.inner_iterations;

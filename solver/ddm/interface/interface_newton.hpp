@@ -47,7 +47,8 @@ class InterfaceNewton {
   InterfaceSolverKind kind_;
   InterfaceProblem problem_;
   std::unique_ptr<InterfaceSolver> solver_;
-  Eigen::VectorXd last_z_;  // warm start of the next solve (augmented-Lagrangian updates)
+  Eigen::VectorXd last_z_;      // warm start of the next solve: the last converged answer (load steps, updates, trials)
+  Eigen::VectorXd last_alpha_;  // its floating bodies' rigid amplitudes
 };
 
 }  // namespace contact::ddm

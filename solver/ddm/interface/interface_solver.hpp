@@ -42,7 +42,12 @@ struct InterfaceSolveContext {
   RunFrame& frame;
   const linalg::StepCallback& on_step;  // after every active-set step / outer iteration (reports); true stops
   int max_steps = 100;                  // active-set steps / outer iterations
-  std::string note;                     // out: what the first report says (coarse solves, solver chosen)
+  // The direct friction Newton stops once it stalls over this many steps (0: never; set where another solver
+  // takes the step over, ddm/friction_policy.hpp's chain).
+  int stall_steps = 0;
+  // The floating bodies' rigid amplitudes of the answer the warm start z0 is (empty: none), whichever solver gave it.
+  Eigen::VectorXd alpha0;
+  std::string note;  // out: what the first report says (coarse solves, solver chosen)
 };
 
 // F assembled as a sparse matrix once per interface problem, for the direct solvers (augmented-Lagrangian updates

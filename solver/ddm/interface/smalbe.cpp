@@ -301,7 +301,8 @@ bool Smalbe::update_multipliers(const Eigen::VectorXd& x, const linalg::MprgpRes
   };
   const policy::Smalbe& tuning = policy::kFrictionPolicy.smalbe;
   const bool crawling = fell_little_thrice(tuning.rho_crawl);
-  const bool stalled = fell_little_thrice(tuning.rho_stall) && r.report.iterations <= tuning.rho_stall_inner;
+  const bool stalled = fell_little_thrice(tuning.rho_frozen) ||
+                       (fell_little_thrice(tuning.rho_stall) && r.report.iterations <= tuning.rho_stall_inner);
   if (crawling && rho_ < (stalled ? tuning.rho_stall_cap : tuning.rho_cap) * norm_PHP_) {
     rho_ *= tuning.rho_raise;
     norm_A_ = std::max(norm_PHP_, rho_);
