@@ -108,6 +108,8 @@ bool RouteContext::read_json_body(const Request& req, Response& res, const Conte
           res, 408, "",
           "the body did not arrive within " + std::to_string(static_cast<int>(settings.body_timeout_seconds)) + " s",
           req.path);
+    else if (exchange && !exchange->bad_framing.empty())
+      send_problem(res, 400, "invalid-request", "the chunked body is malformed: " + exchange->bad_framing, req.path);
     else
       send_problem(res, 400, "", "the request body could not be read", req.path);
     return false;

@@ -6,7 +6,11 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cctype>
 #include <cstring>
+#include <string_view>
+
+#include "transport/chunk_framing.hpp"
 
 namespace contactd {
 
@@ -31,7 +35,12 @@ int poll_for(int fd, short events, std::chrono::milliseconds timeout) {
 class ConnStream final : public httplib::Stream {
  public:
   ConnStream(Connection& c, const TransportSettings& s, Exchange& exchange)
-      : c_(c), s_(s), exchange_(exchange), body_deadline_(Clock::now() + s.body_timeout) {}
+      : c_(c),
+        s_(s),
+        exchange_(exchange),
+        body_deadline_(Clock::now() + s.body_timeout),
+        head_left_(c.head_bytes),
+        chunked_(is_chunked(std::string_view(c.buffer).substr(0, std::min(c.head_bytes, c.buffer.size())))) {}
 
   // Removes what this request consumed from the connection's buffer.
   void finish() { c_.buffer.erase(0, std::min(consumed_, c_.buffer.size())); }
@@ -52,6 +61,13 @@ class ConnStream final : public httplib::Stream {
     if (consumed_ >= c_.buffer.size() && !fill()) return -1;
     if (consumed_ >= c_.buffer.size()) return 0;  // end of stream
     const std::size_t n = std::min(size, c_.buffer.size() - consumed_);
+    // The body's bytes (past the head) of a chunked request go through its framing check first.
+    const std::size_t head = std::min(n, head_left_);
+    head_left_ -= head;
+    if (chunked_ && n > head && !framing_.feed(c_.buffer.data() + consumed_ + head, n - head)) {
+      exchange_.bad_framing = framing_.error();
+      return -1;
+    }
     std::memcpy(ptr, c_.buffer.data() + consumed_, n);
     consumed_ += n;
     return static_cast<ssize_t>(n);
@@ -112,11 +128,27 @@ class ConnStream final : public httplib::Stream {
     }
   }
 
+  // Whether the head (its field lines, case-insensitive) says Transfer-Encoding: chunked. request_guard's
+  // check_framing refuses any other coding before a body is read.
+  static bool is_chunked(std::string_view head) {
+    std::string lowered(head);
+    for (char& ch : lowered) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    for (std::size_t at = lowered.find("\r\ntransfer-encoding:"); at != std::string::npos;
+         at = lowered.find("\r\ntransfer-encoding:", at + 2)) {
+      const std::size_t end = lowered.find("\r\n", at + 2);
+      if (lowered.substr(at, end - at).find("chunked") != std::string::npos) return true;
+    }
+    return false;
+  }
+
   Connection& c_;
   const TransportSettings& s_;
   Exchange& exchange_;
   const Clock::time_point body_deadline_;
   std::size_t consumed_ = 0;
+  std::size_t head_left_;  // bytes of the head not yet read (fill() may empty the buffer once they are)
+  const bool chunked_;
+  ChunkFraming framing_;
 };
 
 }  // namespace

@@ -35,6 +35,7 @@ struct TransportSettings {
 // What the HTTP thread serving a request knows about its exchange (thread-local; null outside a request).
 struct Exchange {
   bool body_timed_out = false;  // a body read ran past body_timeout: the handler should answer 408
+  std::string bad_framing;      // a chunked body's framing is broken (chunk_framing.hpp): the handler answers 400
   bool close_after = false;     // close the connection after this response
 };
 Exchange* current_exchange();
