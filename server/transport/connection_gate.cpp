@@ -396,7 +396,7 @@ void ConnectionGate::examine(int fd) {
       break;
   }
   c.buffer.erase(0, check.skip);
-  c.head_bytes = check.head_end - check.skip;
+  c.head_bytes = shorten_range_positions(c.buffer, check.head_end - check.skip);
   c.probe = check.probe;
   ::epoll_ctl(epoll_fd_, EPOLL_CTL_DEL, fd, nullptr);
   std::unique_ptr<Connection> ready = std::move(entry.connection);

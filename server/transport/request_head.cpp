@@ -1,5 +1,7 @@
 #include "transport/request_head.hpp"
 
+#include <cctype>
+
 namespace contactd {
 
 namespace {
@@ -83,6 +85,38 @@ HeadCheck check_head(std::string_view received, const HeadLimits& limits) {
     }
     pos = next;
   }
+}
+
+std::size_t shorten_range_positions(std::string& buffer, std::size_t head_end) {
+  static const std::string kLargest = "999999999999999999";
+  std::size_t pos = buffer.find("\r\n");  // past the request line
+  while (pos != std::string::npos && pos + 2 < head_end) {
+    const std::size_t start = pos + 2, end = buffer.find("\r\n", start);
+    if (end == std::string::npos || end > head_end) break;
+    std::string line = buffer.substr(start, end - start);
+    bool range = line.size() > 6;
+    for (std::size_t k = 0; range && k < 6; ++k)
+      range = std::tolower(static_cast<unsigned char>(line[k])) == "range:"[k];
+    if (range) {
+      std::string shortened;
+      for (std::size_t k = 0; k < line.size();) {
+        std::size_t digits = k;
+        while (digits < line.size() && line[digits] >= '0' && line[digits] <= '9') ++digits;
+        if (digits == k) {
+          shortened += line[k++];
+          continue;
+        }
+        shortened += digits - k >= 19 ? kLargest : line.substr(k, digits - k);
+        k = digits;
+      }
+      buffer.replace(start, line.size(), shortened);
+      head_end = head_end + shortened.size() - line.size();
+      pos = start + shortened.size();
+      continue;
+    }
+    pos = end;
+  }
+  return head_end;
 }
 
 }  // namespace contactd

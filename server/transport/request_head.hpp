@@ -34,4 +34,11 @@ struct HeadCheck {
 // space before the colon, and anything over the limits. Says `incomplete` until the empty line arrives.
 HeadCheck check_head(std::string_view received, const HeadLimits& limits);
 
+// A complete head's Range field lines with a byte position of 19 digits or more get 999999999999999999 (10^18 - 1)
+// there instead; returns the head's new length. httplib parses Range before any handler runs, with stoll, and
+// answers 416 to a position past 2^63 - 1 where RFC 9110 (14.1.2) clamps a last position to the file's end (206);
+// 10^18 - 1 is past the end of any file this server keeps, as a first position (416) and as a last one (clamped),
+// so the answer is the same as for the number given (http/range.cpp parses it).
+std::size_t shorten_range_positions(std::string& buffer, std::size_t head_end);
+
 }  // namespace contactd

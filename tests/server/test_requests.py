@@ -127,14 +127,19 @@ with Server(token=TOKEN, args=["--workers", "1"]) as server:
     check("bytes=-0: 416 with bytes */size", r.status == 416 and r.headers.get("content-range") == f"bytes */{size}",
           (r.status, r.headers))
     # A last position far past the end: RFC 9110 clamps it to the file's end (206 with the whole file), as any
-    # last position past the end (2^63 - 1 was 200). (Past 2^63 - 1 httplib answers 416 before any handler runs:
-    # its own parse of the header fails.)
-    for last in (10 ** 18, 2 ** 63 - 1):
+    # last position past the end (2^63 - 1 was 200; past it httplib's own parse of the header answered 416 before
+    # any handler ran: the gate now writes such positions as 10^18 - 1, transport/request_head.hpp).
+    for last in (10 ** 18, 2 ** 63 - 1, 2 ** 63, 2 ** 64 - 1, 10 ** 30):
         r = ranged(f"bytes=0-{last}")
         check(f"bytes=0-{last}: 206 with the whole file, clamped", r.status == 206 and r.body == whole.body and
               r.headers.get("content-range") == f"bytes 0-{size - 1}/{size}", (r.status, r.headers))
-    r = ranged(f"bytes={2 ** 63 - 1}-")
-    check("a first position of 2^63 - 1: 416", r.status == 416, (r.status, r.headers))
+    r = ranged(f"bytes=5-{2 ** 64 - 1}", **{"If-Range": whole.headers.get("etag", "")})
+    check("bytes=5-(2^64 - 1) with If-Range: from byte 5 to the end", r.status == 206 and r.body == whole.body[5:] and
+          r.headers.get("content-range") == f"bytes 5-{size - 1}/{size}", (r.status, r.headers))
+    for first in (2 ** 63 - 1, 2 ** 64 - 1, 10 ** 30):
+        r = ranged(f"bytes={first}-")
+        check(f"a first position of {first}: 416 with bytes */size", r.status == 416 and
+              r.headers.get("content-range") == f"bytes */{size}", (r.status, r.headers))
     r = ranged("bytes=0-0,5-6")
     check("several ranges: the whole file (200)", r.status == 200 and r.body == whole.body, r.status)
     r = ranged("bytes=0-0", **{"If-Range": '"another-etag"'})
@@ -160,6 +165,25 @@ with Server(token=TOKEN, args=["--workers", "1"]) as server:
                      b"Content-Type: application/json\r\nContent-Length: %d\r\nTransfer-Encoding: chunked\r\n\r\n"
                      % len(good) + good)
     check("Content-Length with Transfer-Encoding: 400", raw.startswith(b"HTTP/1.1 400"), raw[:300])
+    # A chunked body whose framing is broken is refused as it arrives (httplib's strtoul took "-5" for 2^64 - 5 and
+    # waited for that many bytes until its 10 s read timeout): a negative size, a size that is not hexadecimal,
+    # data longer than its size. A well-framed chunked body (with chunk extensions) is read whole. (Trailer fields
+    # after the last chunk are not: httplib 0.11 wants the empty line right after it, and answers 400.)
+    head = (b"POST /v1/validate HTTP/1.1\r\nHost: 127.0.0.1\r\n" + auth +
+            b"Content-Type: application/json\r\nTransfer-Encoding: chunked\r\n\r\n")
+    for name, body in (("a negative chunk size", b"-5\r\nhello\r\n0\r\n\r\n"),
+                       ("a chunk size that is not hexadecimal", b"zz\r\nhello\r\n0\r\n\r\n"),
+                       ("data longer than its chunk size", b"2\r\nhello\r\n0\r\n\r\n"),
+                       ("a chunk size of 17 hex digits", b"1" * 17 + b"\r\nx\r\n0\r\n\r\n")):
+        started = time.monotonic()
+        raw = server.raw(head + body)
+        seconds = time.monotonic() - started
+        check(f"{name}: 400 at once, naming the chunked framing", raw.startswith(b"HTTP/1.1 400") and
+              b"chunked body is malformed" in raw and seconds < 5, (seconds, raw[:300]))
+    chunks = b"".join(b"%x;ext=1\r\n%s\r\n" % (len(good[k:k + 100]), good[k:k + 100]) for k in range(0, len(good), 100))
+    raw = server.raw(head + chunks + b"0\r\n\r\n")
+    check("a well-framed chunked body with chunk extensions: validated (200)", raw.startswith(b"HTTP/1.1 200"),
+          raw[:300])
     form = (b"--XyZ\r\nContent-Disposition: form-data; name=\"job\"\r\n\r\n" + good + b"\r\n--XyZ--\r\n")
     r = server.request("POST", "/v1/jobs", body=form, headers={"Content-Type": "multipart/form-data; boundary=XyZ"})
     check("multipart/form-data: 415", r.status == 415 and r.is_problem(), r)
