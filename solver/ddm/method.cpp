@@ -39,9 +39,13 @@ class RobinMethod final : public ContactMethod {
 class MonolithicMethod final : public ContactMethod {
  public:
   using ContactMethod::ContactMethod;
+  void reset() override { memory_ = {}; }
 
  protected:
-  void solve(RunFrame& frame) override { run_monolithic(system_, frame); }
+  void solve(RunFrame& frame) override { run_monolithic(system_, frame, memory_); }
+
+ private:
+  MonolithicMemory memory_;
 };
 
 // Keeps the interface problem between runs on the same meshes (augmented-Lagrangian updates and load steps only

@@ -4,6 +4,7 @@
 // is the one place that does.
 #pragma once
 
+#include "../linalg/friction_sets.hpp"
 #include "run_frame.hpp"
 
 #include <memory>
@@ -53,8 +54,14 @@ void run_neumann(const ContactSystem& system, RunFrame& frame);
 // The Robin-type variant (docs/algorithm.md): each body's matrix carries the Robin weight on its contact zone.
 void run_robin(const ContactSystem& system, RunFrame& frame);
 
+// What the monolithic reference keeps between runs on the same meshes: the contact and stick/slip sets of its last
+// converged answer, the next load step's (sub-step's, collapse trial's) first sets.
+struct MonolithicMemory {
+  linalg::FrictionSets sets;
+};
+
 // The same discrete problem (exact or penalty, per the settings' enforcement) solved in one system: the
 // reference solver (monolithic.cpp).
-void run_monolithic(const ContactSystem& system, RunFrame& frame);
+void run_monolithic(const ContactSystem& system, RunFrame& frame, MonolithicMemory& memory);
 
 }  // namespace contact::ddm

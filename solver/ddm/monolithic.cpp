@@ -210,7 +210,7 @@ double zone_change(const ContactSystem& system, const Displacements& u, std::vec
   return paper;
 }
 
-void run_exact(const ContactSystem& system, RunFrame& frame) {
+void run_exact(const ContactSystem& system, RunFrame& frame, MonolithicMemory& memory) {
   MethodOutcome& out = frame.outcome();
   if (std::string sliding = friction_cannot_hold(system, frame.state().load);
       !sliding.empty()) {  // statics: no solver can hold it
@@ -255,7 +255,14 @@ void run_exact(const ContactSystem& system, RunFrame& frame) {
     frame.report(std::move(r));
     return frame.stop_requested();
   };
-  const linalg::FrictionNewtonResult result = linalg::friction_newton(problem, std::move(sets), newton, on_step);
+  // From the last converged answer's sets where there is one (a load step, a cut's sub-step, a collapse trial: each
+  // a small increment from it), else from the start above; where those leave a body held by nothing at once, from
+  // the start above after all.
+  const bool warm = memory.sets.active.size() == sets.active.size() && memory.sets.state.size() == sets.state.size();
+  linalg::FrictionNewtonResult result = linalg::friction_newton(problem, warm ? memory.sets : sets, newton, on_step);
+  if (warm && result.report.stop == SolveStop::singular && result.iterate.lambda.size() == 0)
+    result = linalg::friction_newton(problem, std::move(sets), newton, on_step);
+  if (result.report.stop == SolveStop::converged) memory.sets = result.sets;
   out.iterations = static_cast<int>(result.report.iterations);
   switch (result.report.stop) {
     case SolveStop::converged: {
@@ -413,8 +420,8 @@ void run_penalty(const ContactSystem& system, RunFrame& frame) {
 
 }  // namespace
 
-void run_monolithic(const ContactSystem& system, RunFrame& frame) {
-  if (frame.settings().enforcement == Enforcement::exact) return run_exact(system, frame);
+void run_monolithic(const ContactSystem& system, RunFrame& frame, MonolithicMemory& memory) {
+  if (frame.settings().enforcement == Enforcement::exact) return run_exact(system, frame, memory);
   run_penalty(system, frame);
 }
 
