@@ -216,7 +216,8 @@ class ResultFile:
 
     def collapse(self):
         """A collapse analysis's answer, or the statics' verdict on a failed step (/collapse; docs/results-format.md):
-        {"verdict", "held", "failed", "statics_bound", "solves", "words", ..., "mechanism": {"kind", "words",
+        {"verdict", "held", "failed", "statics_bound", "solves", "words", ..., "trials": {"multiplier", "held",
+        "iterations", "seconds", "displacement"}, "mechanism": {"kind", "words",
         "body_names", "body_velocity", "body_omega", "body_reference", "body_centre", "pair_names", "joint_kind",
         "joint_point", ...}}, or None for a file without one."""
         if "collapse" not in self._f:
@@ -226,6 +227,10 @@ class ResultFile:
         m = g["mechanism"]
         out["mechanism"] = {k: _attr(v) for k, v in m.attrs.items()}
         out["mechanism"].update({k: _dataset(item) for k, item in m.items()})
+        # Every trial: "multiplier", "held", "iterations", "seconds" and, at those that held, the live loads'
+        # "displacement" (NaN elsewhere): the capacity curve's points.
+        if "trials" in g:
+            out["trials"] = {k: _dataset(item) for k, item in g["trials"].items()}
         return out
 
     def job(self, key="job"):

@@ -2,7 +2,7 @@
 // event log, the download links and the cancel / delete buttons.
 
 import {ApiError, api, download, getToken} from "./api.js";
-import {ConvergencePlot, PressurePlot} from "./plots.js";
+import {CapacityPlot, ConvergencePlot, PressurePlot} from "./plots.js";
 import {followEvents} from "./stream.js";
 
 const $ = (id) => document.getElementById(id);
@@ -18,6 +18,7 @@ export class JobView {
     this.id = null;
     this.controller = null;
     this.convergence = new ConvergencePlot($("convergence"), $("convergence-title"));
+    this.capacity = new CapacityPlot($("collapse-curve"));
     this.pairs = new Map();
     this.picked = "";        // the names or patterns shown on request (GET v1/jobs/{id}/pairs)
     this.pickPending = false;
@@ -40,6 +41,7 @@ export class JobView {
     window.addEventListener("resize", () => {
       this.convergence.resize();
       for (const p of this.pairs.values()) p.resize();
+      this.capacity.resize();
     });
   }
 
@@ -153,6 +155,7 @@ export class JobView {
   collapse(c) {
     const box = $("job-collapse");
     box.hidden = !c;
+    this.capacity.show(c);
     if (!c) return;
     const num = (x) => (typeof x === "number" ? x.toPrecision(5) : String(x));
     let verdict = `collapse analysis: ${c.verdict}`;
@@ -168,7 +171,8 @@ export class JobView {
     $("collapse-mechanism").textContent = m.words ? `mechanism: ${m.words}` : "";
     const rows = (c.trials || []).map((t, i) => {
       const tr = document.createElement("tr");
-      for (const v of [i + 1, num(t.multiplier), t.held ? "yes" : "no", t.iterations, num(t.seconds)]) {
+      const shift = typeof t.displacement === "number" ? t.displacement.toPrecision(4) : "";
+      for (const v of [i + 1, num(t.multiplier), t.held ? "yes" : "no", t.iterations, num(t.seconds), shift]) {
         const td = document.createElement("td");
         td.textContent = String(v);
         tr.append(td);

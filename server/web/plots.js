@@ -6,6 +6,8 @@
 //   PressurePlot: one pair's contact pressure along its slave edge (arc length), the latest iteration's profile;
 //     for a friction pair (its events carry `tangential_tractions` and `stick`) the tangential traction below it,
 //     on the same arc length, with the stick zone shaded green.
+//   CapacityPlot: a collapse analysis's capacity curve: the multiplier of every trial that held against the live
+//     loads' displacement (the job's collapse.trials), drawn once the job has its answer.
 // Each keeps its data and redraws at most a few times a second; the container's data-points / data-iteration
 // (and data-tangential-points / data-stick-zones) attributes say what has been drawn (what the browser test
 // reads).
@@ -305,5 +307,46 @@ export class PressurePlot {
     this.throttle.cancel();
     if (this.plot) this.plot.destroy();
     if (this.tangential) this.tangential.destroy();
+  }
+}
+
+// The capacity curve of a collapse analysis (docs/limit-analysis.md): the held trials' multiplier against the live
+// loads' displacement, sorted by multiplier, with the bracket's top (the smallest multiplier that did not hold) as a
+// dashed level. The container's data-points says how many held trials are drawn (what the browser test reads).
+export class CapacityPlot {
+  constructor(el) {
+    this.el = el;
+    this.plot = null;
+    this.el.dataset.points = "0";
+  }
+
+  show(collapse) {
+    if (this.plot) this.plot.destroy();
+    this.plot = null;
+    const held = (collapse && collapse.trials ? collapse.trials : [])
+      .filter((t) => t.held && finite(t.displacement) !== null)
+      .sort((a, b) => a.multiplier - b.multiplier);
+    this.el.dataset.points = String(held.length);
+    this.el.hidden = held.length < 2;
+    if (held.length < 2) return;
+    const x = [0, ...held.map((t) => t.displacement)];
+    const y = [0, ...held.map((t) => t.multiplier)];
+    const top = finite(collapse.failed);
+    const data = [x, y, x.map(() => top)];
+    this.plot = new uPlot({
+      width: width(this.el),
+      height: 240,
+      scales: {x: {time: false}},
+      axes: [{label: "live loads' displacement"}, {label: "multiplier", size: 60}],
+      series: [
+        {label: "displacement"},
+        {label: "held", stroke: COLOURS[0], width: 1.5, points: {show: true}},
+        {label: "did not hold", stroke: COLOURS[1], width: 1, dash: [4, 3], points: {show: false}},
+      ],
+    }, data, this.el);
+  }
+
+  resize() {
+    if (this.plot) this.plot.setSize({width: width(this.el), height: 240});
   }
 }

@@ -2,6 +2,7 @@
 
 #include "h5.hpp"
 
+#include <cmath>
 #include <cstdint>
 #include <stdexcept>
 
@@ -81,7 +82,7 @@ void write_collapse(hid_t file, const CollapseResult& c) {
   h5::write_vector(m, "joint_opening", opening);
   h5::write_strings_dataset(m, "joint_words", joint_words);
   Handle t = h5::create_group(g, "trials");
-  std::vector<double> lambda, seconds;
+  std::vector<double> lambda, seconds, displacement;
   std::vector<std::int8_t> held;
   std::vector<std::int32_t> iterations;
   for (const auto& trial : c.trials) {
@@ -89,11 +90,13 @@ void write_collapse(hid_t file, const CollapseResult& c) {
     held.push_back(trial.held ? 1 : 0);
     iterations.push_back(trial.iterations);
     seconds.push_back(trial.seconds);
+    displacement.push_back(trial.displacement);
   }
   h5::write_vector(t, "multiplier", lambda);
   h5::write_vector(t, "held", held);
   h5::write_vector(t, "iterations", iterations);
   h5::write_vector(t, "seconds", seconds);
+  h5::write_vector(t, "displacement", displacement);
 }
 
 void read_collapse(hid_t file, CollapseResult& c) {
@@ -146,9 +149,14 @@ void read_collapse(hid_t file, CollapseResult& c) {
   const auto held = h5::read_vector<std::int8_t>(t, "held");
   const auto iterations = h5::read_vector<std::int32_t>(t, "iterations");
   const auto seconds = h5::read_vector<double>(t, "seconds");
-  if (held.size() != lambda.size() || iterations.size() != lambda.size() || seconds.size() != lambda.size())
+  // (files written before the capacity curve's displacement have none: NaN)
+  const auto displacement = h5::has_link(t, "displacement") ? h5::read_vector<double>(t, "displacement")
+                                                            : std::vector<double>(lambda.size(), std::nan(""));
+  if (held.size() != lambda.size() || iterations.size() != lambda.size() || seconds.size() != lambda.size() ||
+      displacement.size() != lambda.size())
     throw std::runtime_error("/collapse/trials: its datasets differ in length");
-  for (size_t i = 0; i < lambda.size(); ++i) c.trials.push_back({lambda[i], held[i] != 0, iterations[i], seconds[i]});
+  for (size_t i = 0; i < lambda.size(); ++i)
+    c.trials.push_back({lambda[i], held[i] != 0, iterations[i], seconds[i], displacement[i]});
 }
 
 }  // namespace contact::io

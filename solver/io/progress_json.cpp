@@ -269,8 +269,11 @@ nlohmann::json collapse_json(const CollapseResult& c) {
          {"words", b.words}});
   nlohmann::json trials = nlohmann::json::array();
   for (const auto& t : c.trials)
-    trials.push_back(
-        {{"multiplier", t.multiplier}, {"held", t.held}, {"iterations", t.iterations}, {"seconds", t.seconds}});
+    trials.push_back({{"multiplier", t.multiplier},
+                      {"held", t.held},
+                      {"iterations", t.iterations},
+                      {"seconds", t.seconds},
+                      {"displacement", number(t.displacement)}});
   for (const auto& j : c.mechanism.joints)
     joints.push_back({{"pair", j.pair},
                       {"kind", j.kind},

@@ -112,6 +112,7 @@ class CollapseRun {
     out_.analysed = true;
     out_.tolerance = spec_.tolerance;
     bound_by_statics();
+    live_loads();
     held_ = Held::of(frame_.outcome(), frame_.state(), 0.0);
     first_index_ = steps_.held();
     double next = spec_.first > 0 ? spec_.first : bounded() ? 0.5 * out_.statics_bound : 1.0;
@@ -134,6 +135,33 @@ class CollapseRun {
     } else if (statics_.status == StaticsAnswer::Status::unbounded) {
       out_.statics_bound = std::numeric_limits<double>::infinity();
     }
+  }
+
+  // The live loads at multiplier 1, per body (its owner's), and the sum of their nodal magnitudes over all bodies:
+  // what the capacity curve's displacement is measured with (CollapseResult::Trial::displacement).
+  void live_loads() {
+    fem::LoadPoint at = frame_.state().load;
+    live_.assign(system_.n_bodies(), Eigen::VectorXd());
+    double magnitude = 0.0;
+    for (size_t a = 0; a < system_.n_bodies(); ++a) {
+      if (!system_.runner().owns(a)) continue;
+      at.multiplier = 1.0;
+      live_[a] = system_.body(a).external_load(at);
+      at.multiplier = 0.0;
+      live_[a] -= system_.body(a).external_load(at);
+      for (Eigen::Index i = 0; i + 1 < live_[a].size(); i += 2) magnitude += live_[a].segment<2>(i).norm();
+    }
+    system_.runner().sum(&magnitude, 1);
+    live_magnitude_ = magnitude;
+  }
+
+  // The live loads' displacement at the answer u (collective: every process calls it).
+  double live_displacement(const Displacements& u) const {
+    double work = 0.0;
+    for (size_t a = 0; a < live_.size(); ++a)
+      if (live_[a].size() > 0 && a < u.size() && u[a].size() == live_[a].size()) work += live_[a].dot(u[a]);
+    system_.runner().sum(&work, 1);
+    return live_magnitude_ > 0 ? work / live_magnitude_ : std::numeric_limits<double>::quiet_NaN();
   }
 
   // Whether the analysis has its verdict (bracketed, holds, out of solves).
@@ -165,7 +193,8 @@ class CollapseRun {
     const double started = frame_.elapsed();
     const int iterations_before = total.iterations;
     frame_.nested(&held_.u, marks, [&](ddm::RunFrame& inner) { ddm::run_enforced(system_, inner, method_); });
-    out_.trials.push_back({lambda, total.converged, total.iterations - iterations_before, frame_.elapsed() - started});
+    out_.trials.push_back({lambda, total.converged, total.iterations - iterations_before, frame_.elapsed() - started,
+                           total.converged ? live_displacement(total.u) : std::numeric_limits<double>::quiet_NaN()});
     report(lambda);
     ++out_.solves;
     if (solve_failed_) ++out_.bracket_solves;
@@ -245,6 +274,8 @@ class CollapseRun {
   ddm::StepLog& steps_;
   CollapseResult& out_;
   StaticsAnswer statics_;
+  std::vector<Eigen::VectorXd> live_;  // the live loads at multiplier 1 of the bodies this process owns
+  double live_magnitude_ = 0.0;        // sum of their nodal magnitudes over every body
   Held held_;
   int first_index_ = 0;
   double hi_ = std::numeric_limits<double>::quiet_NaN();  // the smallest multiplier known not to hold

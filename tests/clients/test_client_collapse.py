@@ -53,6 +53,11 @@ with tempfile.TemporaryDirectory() as tmp:
     check("contact-solve: lambda_c below the rigid-block statics' bound, and a mechanism named",
           ref["failed"] <= ref["statics_bound"] * (1 + ref["tolerance"]) and ref["mechanism"]["kind"] != "",
           (ref["held"], ref["statics_bound"], ref["mechanism"].get("kind")))
+    t = ref.get("trials", {})
+    held = sorted((m, d) for m, h, d in zip(t.get("multiplier", []), t.get("held", []), t.get("displacement", [])) if h)
+    check("ResultFile.collapse(): the trials with the capacity curve's displacement, growing with the multiplier",
+          len(held) >= 2 and all(d > 0 for _, d in held) and all(b[1] > a[1] for a, b in zip(held, held[1:])) and
+          all(d != d for h, d in zip(t.get("held", []), t.get("displacement", [])) if not h), held)
 
     with Server() as server:
         url = f"http://127.0.0.1:{server.port}"

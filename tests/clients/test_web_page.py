@@ -405,11 +405,27 @@ def test_collapse(server, b):
     check("collapse: the view gives the bracket around 1/3, the bound and the overturning mechanism",
           bool(shown) and "held at 0.33325" in text and "did not at 0.33342" in text and "at most 0.33333" in text
           and "overturning" in text, text)
+    # The capacity curve: the held trials' multiplier against the live loads' displacement (the job resource's
+    # collapse.trials), drawn as a chart with one point per held trial; the table gives each displacement.
+    trials = server.get(f"/v1/jobs/{job_id}").json()["collapse"]["trials"]
+    held = sorted((t["multiplier"], t["displacement"]) for t in trials if t["held"])
+    check("collapse: every held trial has a positive displacement, growing with the multiplier",
+          len(held) == 2 and all(d > 0 for _, d in held) and held[1][1] > held[0][1], trials)
+    curve = b.wait(lambda: b.el("collapse-curve").is_displayed()
+                   and b.el("collapse-curve").get_attribute("data-points") == "2"
+                   and b.driver.find_elements(By.CSS_SELECTOR, "#collapse-curve canvas"), 30)
+    check("collapse: the capacity curve is drawn with its 2 held trials", bool(curve),
+          b.el("collapse-curve").get_attribute("data-points"))
+    cells = [r.find_elements(By.TAG_NAME, "td")[-1].text
+             for r in b.driver.find_elements(By.CSS_SELECTOR, "#collapse-trials tbody tr")]
+    check("collapse: the trials table gives each held trial's displacement",
+          len(cells) == 2 and all(c and float(c) > 0 for c in cells), cells)
     clean = server.submit_id(flat_patch(name="no-collapse"))
     server.wait_done(clean, 60)
     b.driver.execute_script(f"window.location.hash = 'job={clean}';")
     check("collapse: a job without one shows none",
-          b.wait(lambda: b.text("job-id") == clean and not b.el("job-collapse").is_displayed(), 30),
+          b.wait(lambda: b.text("job-id") == clean and not b.el("job-collapse").is_displayed()
+                 and b.el("collapse-curve").get_attribute("data-points") == "0", 30),
           b.text("job-collapse"))
 
 

@@ -12,6 +12,7 @@
 #include "contact/result_file.hpp"
 #include "support.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -197,6 +198,21 @@ TEST(Collapse, EveryTrialIsOneIncrementAndTheBisectionHalvesTheBracket) {
   EXPECT_GE(held, 1);
   EXPECT_LE(held, c.solves);
   EXPECT_EQ(r.step_history[1].multiplier, 0.3);
+  // The capacity curve's points: at every held trial the live loads' displacement, positive (the push does
+  // positive work on the column it moves) and growing with the multiplier; none where a trial did not hold. (Its
+  // softening: Masonry.NearItsLimitAWallsCollapseTrials..., whose bisection holds more trials.)
+  std::vector<std::pair<double, double>> curve;
+  for (const auto& t : c.trials) {
+    if (!t.held) {
+      EXPECT_TRUE(std::isnan(t.displacement)) << t.multiplier;
+      continue;
+    }
+    EXPECT_GT(t.displacement, 0.0) << t.multiplier;
+    curve.emplace_back(t.multiplier, t.displacement);
+  }
+  std::sort(curve.begin(), curve.end());
+  ASSERT_GE(curve.size(), 2u) << c.words;
+  for (size_t k = 1; k < curve.size(); ++k) EXPECT_GT(curve[k].second, curve[k - 1].second) << curve[k].first;
 }
 
 // A job whose live loads only press the joints shut has no collapse: statics carries any multiple, and the trial
@@ -242,6 +258,14 @@ TEST(Collapse, TheResultFileKeepsTheVerdictTheMechanismAndTheCapacityCurve) {
   ASSERT_EQ(f.step_history.multiplier.size(), r.step_history.size());
   EXPECT_EQ(f.step_history.multiplier.back(), r.collapse.held);
   EXPECT_EQ(f.steps.back().multiplier, r.collapse.held);
+  ASSERT_EQ(c.trials.size(), r.collapse.trials.size());
+  for (size_t k = 0; k < c.trials.size(); ++k) {
+    EXPECT_EQ(c.trials[k].held, r.collapse.trials[k].held);
+    if (c.trials[k].held)
+      EXPECT_EQ(c.trials[k].displacement, r.collapse.trials[k].displacement);
+    else
+      EXPECT_TRUE(std::isnan(c.trials[k].displacement));
+  }
 }
 
 // A plain job (no collapse analysis) whose loads no equilibrium carries gets the statics' verdict, not the generic

@@ -251,12 +251,17 @@ struct CollapseResult {
   double statics_bound = std::numeric_limits<double>::quiet_NaN();
   Mechanism mechanism;  // the statics' mechanism at its bound
   std::string words;    // the verdict as one paragraph (also the end of Result::message)
-  // Every trial in order: its multiplier, whether it held, its solver iterations and its wall time (s).
+  // Every trial in order: its multiplier, whether it held, its solver iterations and its wall time (s), and at a
+  // trial that held the live loads' displacement: the work of the live loads at multiplier 1 on the answer's
+  // displacements over the sum of their nodal magnitudes, (f_live . u) / sum |f_live,i| (for one point load its
+  // point's displacement along it; NaN where the trial did not hold). Against the multiplier: the capacity curve,
+  // whose slope falls to zero at the collapse.
   struct Trial {
     double multiplier = 0.0;
     bool held = false;
     int iterations = 0;
     double seconds = 0.0;
+    double displacement = std::numeric_limits<double>::quiet_NaN();
   };
   std::vector<Trial> trials;
 };
