@@ -34,8 +34,11 @@ def mpirun(ranks, *args):
 def collapse(path):
     with h5py.File(path, "r") as f:
         g = f["collapse"]
+        t = g["trials"]
         return {"verdict": g.attrs["verdict"], "held": float(g.attrs["held"]), "failed": float(g.attrs["failed"]),
-                "bound": float(g.attrs["statics_bound"]), "kind": g["mechanism"].attrs["kind"]}
+                "bound": float(g.attrs["statics_bound"]), "kind": g["mechanism"].attrs["kind"],
+                "curve": sorted((float(m), float(d)) for m, h, d in
+                                zip(t["multiplier"][()], t["held"][()], t["displacement"][()]) if h)}
 
 
 if not shutil.which("mpirun"):
@@ -63,6 +66,12 @@ with tempfile.TemporaryDirectory() as tmp:
     check("1 and 2 ranks: the same statics bound (1e-9) and mechanism",
           abs(one["bound"] - two["bound"]) <= 1e-9 * one["bound"] and one["kind"] == two["kind"] != "", (one, two))
     check("the bracket lies below the statics bound", one["failed"] <= one["bound"] * 1.001, one)
+    # The capacity curve's displacement sums the live loads' work over the ranks that own the bodies: at the first
+    # held trial (the same multiplier on both) the same to 1e-8.
+    check("1 and 2 ranks: the same live-load displacement at the first held trial (1e-8)",
+          one["curve"] and two["curve"] and one["curve"][0][0] == two["curve"][0][0] and
+          abs(one["curve"][0][1] - two["curve"][0][1]) <= 1e-8 * abs(one["curve"][0][1]) and one["curve"][0][1] > 0,
+          (one["curve"][:2], two["curve"][:2]))
 
     path = os.path.join(tmp, "column.json")
     with open(path, "w") as f:
