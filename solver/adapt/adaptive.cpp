@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <sstream>
 #include <string>
@@ -123,6 +124,34 @@ Marking chosen_marking(const std::vector<int>& chosen, const std::vector<char>& 
   return m;
 }
 
+// A refinement whose meshes would take the interface problem past the job's limit on its memory (method
+// interface_newton: dense blocks over each body's contact unknowns, growing with the square of the contact edges'
+// nodes) is undone, the meshes restored from `before`, and the run stops refining there with the reason.
+void keep_interface_within(Problem& problem, std::vector<mesh::Mesh>& before, RefineOutcome& out) {
+  const auto edge_nodes = [&](int body, const std::string& edge) {
+    return static_cast<double>(problem.bodies[static_cast<size_t>(body)].mesh.edge_set_nodes(edge).size());
+  };
+  const InterfaceMemoryEstimate next = estimate_interface_memory(problem.contacts, problem.bodies.size(), edge_nodes);
+  const double limit = problem.adaptivity.max_interface_bytes;
+  if (next.bytes <= limit) return;
+  for (size_t a = 0; a < problem.bodies.size() && a < before.size(); ++a)
+    if (out.changed[a]) problem.bodies[a].mesh = std::move(before[a]);
+  out.any = false;
+  out.blocked = true;
+  std::fill(out.changed.begin(), out.changed.end(), 0);
+  std::fill(out.refined.begin(), out.refined.end(), 0);
+  for (auto& r : out.refinements) r = {};
+  const auto mb = [](double bytes) {  // as the job reader says it
+    char text[32];
+    std::snprintf(text, sizeof text, bytes >= 1e9 ? "%.3g GB" : "%.3g MB", bytes >= 1e9 ? bytes / 1e9 : bytes / 1e6);
+    return std::string(text);
+  };
+  add_note(out.note, "the refined meshes' contact interface would take about " + mb(next.bytes) + " (body '" +
+                         problem.bodies[next.body].name + "': " +
+                         std::to_string(static_cast<long>(next.contact_nodes)) + " contact nodes), more than the " +
+                         mb(limit) + " the job was admitted under (--max-interface-bytes): refinement stopped");
+}
+
 // Marks and refines the adaptive bodies; `step` is the current mesh state (its contact zones for the grading);
 // `kept_nodes`: the nodes of the steps the result keeps besides the next mesh (StepLog::committed_nodes);
 // `goal`: the cells to refine, chosen by the goal-oriented marking (with a target), instead of the indicator's
@@ -142,6 +171,10 @@ RefineOutcome mark_and_refine(Problem& problem, const std::vector<IndicatorResul
       s.marking == MarkingRule::contact ? contact_zones(step) : std::vector<ContactZone>{};
   RefineOutcome out;
   const size_t n = problem.bodies.size();
+  // With a limit on the interface's memory, the meshes as they were: restored if the refined ones would pass it.
+  std::vector<mesh::Mesh> before;
+  if (s.max_interface_bytes > 0)
+    for (size_t a = 0; a < n; ++a) before.push_back(adapts(s, a) ? problem.bodies[a].mesh : mesh::Mesh());
   // The job's total: each body may grow by what the others leave (counted as 2 x nodes, as mark() does).
   long total = 0;
   for (const auto& body : problem.bodies) total += 2L * body.mesh.num_nodes();
@@ -182,6 +215,7 @@ RefineOutcome mark_and_refine(Problem& problem, const std::vector<IndicatorResul
     add_note(out.note, "cells at max_level not refined (they carry part of the pressure's error)");
     out.blocked = true;
   }
+  if (out.any && s.max_interface_bytes > 0) keep_interface_within(problem, before, out);
   if (total_hit && result_bound) {
     add_note(out.note,
              "the result's limit on its size (the steps kept, --max-result-bytes) reached, refinement "

@@ -156,54 +156,28 @@ void JobReader::check_result_size() {
                                             : ": take coarser meshes"));
 }
 
-// The interface problem's memory (ddm/interface/interface_problem.hpp), from the contact edges' nodes, before
-// anything is factorised. Body a holds dense blocks over its contact unknowns (z_a: two per node of its contact
-// edges) and its pairs' rows (r_a: a pair's slave nodes, twice with friction): the trailing block of its factor
-// (z_a x z_a), W_a = L^-1 B^T (z_a x r_a), F_a (r_a x r_a), and a few r_a x r_a more for the preconditioner, the
-// direct solver's assembled copy and factor (3 in all frictionless, 6 with friction: its Newton matrices). Measured
-// on two strips of N cells in contact (N = 1,000 and 2,000): 125 N^2 bytes, 500 N^2 with friction; this estimate
-// gives 144 N^2 and 512 N^2. Only interface_newton builds these blocks (neumann, robin and monolithic do not). An
-// adaptive run's first mesh is estimated (refinement at the contact makes it grow).
+// The interface problem's memory (estimate_interface_memory, contact/problem.hpp), from the contact edges' nodes,
+// before anything is factorised. Only interface_newton builds these blocks (neumann, robin and monolithic do not).
+// An adaptive run is estimated on its first mesh here; its refinement stops where the next meshes would pass the
+// limit (AdaptivitySettings::max_interface_bytes, set here).
 void JobReader::check_interface_memory() {
   if (limits_.max_interface_bytes <= 0 || errors_.size() > 0 || problem_.contacts.empty() ||
       problem_.solver.method != Method::interface_newton)
     return;
-  std::map<std::pair<int, std::string>, double> nodes_of_edge;  // each contact edge's nodes, counted once
-  const auto nodes_on = [&](int body, const std::string& edge) {
-    auto [it, inserted] = nodes_of_edge.try_emplace({body, edge}, 0.0);
-    if (inserted)
-      it->second = static_cast<double>(inputs_[static_cast<size_t>(body)].body.mesh.edge_set_nodes(edge).size());
-    return it->second;
-  };
-  std::set<std::pair<int, std::string>> counted;  // the edges whose unknowns are in `unknowns`
-  const size_t n = inputs_.size();
-  std::vector<double> unknowns(n, 0.0), rows(n, 0.0);
-  std::vector<char> friction(n, 0);
-  for (const auto& c : problem_.contacts) {
-    const double pair_rows = nodes_on(c.slave_body, c.slave_edge) * (c.friction.active() ? 2.0 : 1.0);
-    for (const auto& [body, edge] :
-         {std::make_pair(c.slave_body, c.slave_edge), std::make_pair(c.master_body, c.master_edge)}) {
-      const auto b = static_cast<size_t>(body);
-      rows[b] += pair_rows;
-      friction[b] = friction[b] || c.friction.active();
-      if (counted.insert({body, edge}).second) unknowns[b] += 2.0 * nodes_on(body, edge);
-    }
-  }
-  double bytes = 0.0, largest = -1.0;
-  size_t top = 0;
-  for (size_t b = 0; b < n; ++b) {
-    const double z = unknowns[b], r = rows[b];
-    const double body_bytes = 8.0 * (z * z + z * r + (friction[b] ? 6.0 : 3.0) * r * r);
-    bytes += body_bytes;
-    if (body_bytes > largest) largest = body_bytes, top = b;
-  }
+  problem_.adaptivity.max_interface_bytes = limits_.max_interface_bytes;
+  const InterfaceMemoryEstimate estimate =
+      estimate_interface_memory(problem_.contacts, inputs_.size(), [&](int body, const std::string& edge) {
+        return static_cast<double>(inputs_[static_cast<size_t>(body)].body.mesh.edge_set_nodes(edge).size());
+      });
+  const double bytes = estimate.bytes, largest = estimate.largest;
+  const size_t top = estimate.body;
   if (bytes <= limits_.max_interface_bytes) return;
   errors_.add("/contacts",
               "the contact interface would take about " + size(bytes) +
                   " of memory (method interface_newton holds dense blocks over each body's contact unknowns: the "
                   "most, " +
                   size(largest) + ", for body '" + inputs_[top].body.name + "' with " +
-                  read::format_number(unknowns[top] / 2.0) + " contact nodes), more than the " +
+                  read::format_number(estimate.contact_nodes) + " contact nodes), more than the " +
                   size(limits_.max_interface_bytes) + " accepted" +
                   (limits_.interface_bytes_hint.empty() ? "" : " (" + limits_.interface_bytes_hint + ")") +
                   "; a limit of " + size(bytes * 1.01) +

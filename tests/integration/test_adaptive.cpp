@@ -82,12 +82,14 @@ TEST(Adaptivity, ConvergeThenRefineWithBothIndicatorsRefinesTowardsTheContactAnd
     json job = example("seed_layers_adaptive.json");
     job["adaptivity"]["strategy"] = "converge_then_refine";
     job["adaptivity"]["indicator"] = indicator;
-    job["solver"] = {{"method", "interface_newton"}, {"enforcement", "penalty"}, {"penalty", {{"c", 0.05}, {"length", 1}}}};
+    job["solver"] = {
+        {"method", "interface_newton"}, {"enforcement", "penalty"}, {"penalty", {{"c", 0.05}, {"length", 1}}}};
     const Result r = run(job);
     ASSERT_TRUE(r.converged) << indicator << ": " << r.message;
     ASSERT_GE(r.steps.size(), 3u) << indicator;
     for (size_t k = 1; k < r.steps.size(); ++k)
-      EXPECT_GT(body(r.steps[k], "lower").mesh.num_cells(), body(r.steps[k - 1], "lower").mesh.num_cells()) << indicator;
+      EXPECT_GT(body(r.steps[k], "lower").mesh.num_cells(), body(r.steps[k - 1], "lower").mesh.num_cells())
+          << indicator;
     // x > 2.5 is never refined; next to x = 2 the neighbourhood of the first steps' zones splits cells once at most.
     EXPECT_EQ(cells_in(body(r.steps.back(), "lower"), 2.5, 4.0).first, 6) << indicator;
     EXPECT_LE(cells_in(body(r.steps.back(), "lower"), 2.0, 4.0).second, 1) << indicator;
@@ -137,7 +139,8 @@ TEST(Adaptivity, CycleTranscriptMatchesTheCheckedInExpectedOutput) {
     ASSERT_NE(rep, nullptr);
     os << "step " << s.index;
     for (size_t a = 0; a < s.bodies.size(); ++a)
-      os << " | " << s.bodies[a].name << ": " << s.bodies[a].mesh.num_cells() << " cells, " << rep->bodies[a].dofs << " dofs";
+      os << " | " << s.bodies[a].name << ": " << s.bodies[a].mesh.num_cells() << " cells, " << rep->bodies[a].dofs
+         << " dofs";
     os << " | iterations " << s.iteration - previous_iteration << "\n";
     previous_iteration = s.iteration;
   }
@@ -170,7 +173,8 @@ class StepRecorder final : public Observer {
 json converge_then_refine_job() {
   json job = example("seed_layers_adaptive.json");
   job["adaptivity"]["strategy"] = "converge_then_refine";
-  job["solver"] = {{"method", "interface_newton"}, {"enforcement", "penalty"}, {"penalty", {{"c", 0.05}, {"length", 1}}}};
+  job["solver"] = {
+      {"method", "interface_newton"}, {"enforcement", "penalty"}, {"penalty", {{"c", 0.05}, {"length", 1}}}};
   return job;
 }
 
@@ -206,8 +210,8 @@ TEST(AdaptiveStop, StopsOnceTheLastStepChangedForcePeakPressureAndEstimateByLess
     }
     // The changes are those of the recorded steps.
     const double peak_before = recorder.reports[recorder.reports.size() - 2].peak_pressure;
-    EXPECT_NEAR(last.peak_change, std::abs(last.peak_pressure - peak_before) / std::max(last.peak_pressure, peak_before),
-                1e-12);
+    EXPECT_NEAR(last.peak_change,
+                std::abs(last.peak_pressure - peak_before) / std::max(last.peak_pressure, peak_before), 1e-12);
   }
 }
 
@@ -348,10 +352,52 @@ TEST(AdaptiveLimits, RefinementStaysWithinTheJobsLimitOnUnknownsOverAllBodies) {
   ASSERT_TRUE(bounded.converged) << bounded.message;
   for (const Step& step : bounded.steps) EXPECT_LE(total_of(step), 2500);
   bool said = false;
-  for (const auto& r : reports) said = said || r.note.find("2500 unknowns over all bodies (--max-dofs) reached") != std::string::npos;
+  for (const auto& r : reports)
+    said = said || r.note.find("2500 unknowns over all bodies (--max-dofs) reached") != std::string::npos;
   EXPECT_TRUE(said) << "no report names the total limit";
 }
 
+TEST(AdaptiveLimits, RefinementStaysWithinTheJobsLimitOnTheInterfacesMemory) {
+  // Issue 51, item 3: the interface problem's memory (method interface_newton: dense blocks over each body's
+  // contact unknowns, estimate_interface_memory) was checked on the first mesh only, and refinement at the contact
+  // makes it grow with the square of the contact edges' nodes. The paper's layers by interface Newton, adaptive:
+  // without a limit they refine past it; under a limit of three times the first mesh's estimate every step stays
+  // within it, and the run says why it stopped refining.
+  nlohmann::json job = contact::testing::example("seed_layers_adaptive.json");
+  job["solver"] = {{"method", "interface_newton"}};
+  job["adaptivity"] = {{"indicator", "fem_bem"}, {"max_level", 6}};
+  const auto estimate_of = [](const Problem& problem, const Step& step) {
+    return estimate_interface_memory(
+               problem.contacts, step.bodies.size(),
+               [&](int body, const std::string& edge) {
+                 return static_cast<double>(step.bodies[static_cast<size_t>(body)].mesh.edge_set_nodes(edge).size());
+               })
+        .bytes;
+  };
+  auto first = job::parse(job);
+  ASSERT_TRUE(first.ok()) << job::format_errors(first.errors);
+  const double start = estimate_interface_memory(
+                           first.problem->contacts, first.problem->bodies.size(),
+                           [&](int body, const std::string& edge) {
+                             return static_cast<double>(
+                                 first.problem->bodies[static_cast<size_t>(body)].mesh.edge_set_nodes(edge).size());
+                           })
+                           .bytes;
+  const double limit = 3.0 * start;
+  const Result free = contact::testing::run(job);
+  ASSERT_TRUE(free.converged) << free.message;
+  EXPECT_GT(estimate_of(*first.problem, free.steps.back()), limit);  // the limit means something
+
+  job::Limits limits;
+  limits.max_interface_bytes = limit;
+  auto parsed = job::parse(job, limits);
+  ASSERT_TRUE(parsed.ok()) << job::format_errors(parsed.errors);
+  const Result bounded = contact::testing::solve_quietly(*parsed.problem);
+  ASSERT_TRUE(bounded.converged) << bounded.message;
+  ASSERT_GE(bounded.steps.size(), 2u) << bounded.message;  // it refined while the limit allowed
+  for (const Step& step : bounded.steps) EXPECT_LE(estimate_of(*parsed.problem, step), limit);
+  EXPECT_NE(bounded.message.find("(--max-interface-bytes): refinement stopped"), std::string::npos) << bounded.message;
+}
 
 TEST(SeedLayersAdaptiveDefaults, TheLastStepIsWithinHalfAPercentWithTwentyTimesFewerUnknownsThanUniform) {
   // Issue 30, item 1: the paper's test with the job's defaults (exact contact, fem_bem, marking "contact", delta

@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -249,6 +250,10 @@ struct AdaptivitySettings {
   // --max-dofs of contact-solve and contactd), so refinement never takes a job past what it could be submitted
   // with (0: no total limit, a Problem built in code).
   long max_total_dofs = 0;
+  // The limit on the interface problem's memory the job was admitted under (job::Limits::max_interface_bytes, for
+  // method interface_newton; 0: none): a refinement whose meshes would take the interface past it is not made
+  // (estimate_interface_memory), and the run stops refining there.
+  double max_interface_bytes = 0;
   // The result's budget in mesh nodes summed over the steps it keeps (the job reader sets it from the limit on
   // the result's size, job::Limits::max_result_bytes; 0: none): a mesh that would take the kept steps past it is
   // not made (refinement is cut back, as by max_total_dofs).
@@ -320,5 +325,24 @@ struct Problem {
     return false;
   }
 };
+
+// The memory of the interface problem that method interface_newton builds (ddm/interface/interface_problem.hpp),
+// from the contact edges' node counts alone, before anything is factorised. Body a holds dense blocks over its
+// contact unknowns (z_a: two per node of its contact edges) and its pairs' rows (r_a: a pair's slave nodes, twice
+// with friction): the trailing block of its factor (z_a x z_a), W_a = L^-1 B^T (z_a x r_a), F_a (r_a x r_a), and a
+// few r_a x r_a more for the preconditioner, the direct solver's assembled copy and factor (3 in all frictionless,
+// 6 with friction: its Newton matrices). Measured on two strips of N cells in contact (N = 1,000 and 2,000):
+// 125 N^2 bytes, 500 N^2 with friction; this estimate gives 144 N^2 and 512 N^2. The job reader refuses a job
+// over --max-interface-bytes with it; an adaptive run stops refining where its next meshes would be
+// (AdaptivitySettings::max_interface_bytes).
+struct InterfaceMemoryEstimate {
+  double bytes = 0.0;          // all bodies together
+  double largest = 0.0;        // the body that takes the most...
+  size_t body = 0;             // ...its index
+  double contact_nodes = 0.0;  // ...and its contact nodes
+};
+// `edge_nodes(body, edge)`: the nodes of that body's edge (or edge set), each pair's edges counted once a body.
+InterfaceMemoryEstimate estimate_interface_memory(const std::vector<ContactPair>& contacts, size_t bodies,
+                                                  const std::function<double(int, const std::string&)>& edge_nodes);
 
 }  // namespace contact
