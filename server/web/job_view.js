@@ -156,6 +156,7 @@ export class JobView {
     const box = $("job-collapse");
     box.hidden = !c;
     this.capacity.show(c);
+    if (!c) drawThrust($("collapse-thrust"), null);
     if (!c) return;
     const num = (x) => (typeof x === "number" ? x.toPrecision(5) : String(x));
     let verdict = `collapse analysis: ${c.verdict}`;
@@ -181,6 +182,7 @@ export class JobView {
     });
     $("collapse-trials").querySelector("tbody").replaceChildren(...rows);
     $("collapse-trials").hidden = rows.length === 0;
+    drawThrust($("collapse-thrust"), c);
   }
 
   log(text) {
@@ -363,4 +365,61 @@ export class JobView {
       this.message(e.message, true);
     }
   }
+}
+
+// The thrust at the last state that held (collapse.thrust, docs/limit-analysis.md): every joint as its slave edge
+// (grey), its centre of pressure (blue dot), joined into the thrust line where consecutive pairs share a body (an
+// arch, a column), and the mechanism's hinges (red rings). The svg's data-joints / data-points / data-hinges say what
+// was drawn (what the browser test reads).
+const SVG = "http://www.w3.org/2000/svg";
+function drawThrust(svg, c) {
+  svg.replaceChildren();
+  const thrust = (c && c.thrust) || [];
+  const hinges = ((c && c.mechanism && c.mechanism.joints) || []).filter((j) => j.kind === "hinge" && j.point);
+  svg.dataset.joints = String(thrust.length);
+  svg.dataset.points = "0";
+  svg.dataset.hinges = "0";
+  svg.parentElement.hidden = thrust.length === 0;  // its box (hidden is not an SVGElement property)
+  if (!thrust.length) return;
+  let x0 = Infinity, x1 = -Infinity, y0 = Infinity, y1 = -Infinity;
+  for (const t of thrust)
+    for (const [x, y] of t.edge) {
+      x0 = Math.min(x0, x); x1 = Math.max(x1, x); y0 = Math.min(y0, y); y1 = Math.max(y1, y);
+    }
+  const span = Math.max(x1 - x0, y1 - y0, 1e-300), pad = 0.05 * span;
+  const width = 480, scale = width / (x1 - x0 + 2 * pad || 1);
+  const height = Math.min(480, Math.max(120, (y1 - y0 + 2 * pad) * scale));
+  const s = Math.min(scale, height / (y1 - y0 + 2 * pad || 1));
+  const X = (x) => (x - x0 + pad) * s, Y = (y) => height - (y - y0 + pad) * s;
+  svg.setAttribute("viewBox", `0 0 ${width} ${height}`);
+  svg.setAttribute("width", String(width));
+  svg.setAttribute("height", String(Math.round(height)));
+  const add = (name, attrs) => {
+    const el = document.createElementNS(SVG, name);
+    for (const [k, v] of Object.entries(attrs)) el.setAttribute(k, String(v));
+    svg.append(el);
+    return el;
+  };
+  for (const t of thrust)
+    add("line", {x1: X(t.edge[0][0]), y1: Y(t.edge[0][1]), x2: X(t.edge[1][0]), y2: Y(t.edge[1][1]),
+                 stroke: "#999", "stroke-width": 2});
+  const shares = (a, b) => [a.slave_body, a.master_body].some((n) => n === b.slave_body || n === b.master_body);
+  for (let i = 1; i < thrust.length; ++i) {
+    const a = thrust[i - 1], b = thrust[i];
+    if (a.point && b.point && shares(a, b))
+      add("line", {x1: X(a.point[0]), y1: Y(a.point[1]), x2: X(b.point[0]), y2: Y(b.point[1]),
+                   stroke: "#1f6fb2", "stroke-width": 1.5});
+  }
+  let points = 0;
+  for (const t of thrust) {
+    if (!t.point) continue;
+    add("circle", {cx: X(t.point[0]), cy: Y(t.point[1]), r: 3, fill: "#1f6fb2"}).append(
+      Object.assign(document.createElementNS(SVG, "title"), {textContent: `${t.pair}: normal force ${t.force.toPrecision(4)}` +
+        (typeof t.eccentricity === "number" ? `, eccentricity ${t.eccentricity.toFixed(3)} of the half-length` : "")}));
+    ++points;
+  }
+  for (const h of hinges)
+    add("circle", {cx: X(h.point[0]), cy: Y(h.point[1]), r: 6, fill: "none", stroke: "#d9480f", "stroke-width": 2});
+  svg.dataset.points = String(points);
+  svg.dataset.hinges = String(hinges.length);
 }

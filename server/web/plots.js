@@ -329,8 +329,10 @@ export class CapacityPlot {
     this.el.dataset.points = String(held.length);
     this.el.hidden = held.length < 2;
     if (held.length < 2) return;
-    const x = [0, ...held.map((t) => t.displacement)];
-    const y = [0, ...held.map((t) => t.multiplier)];
+    // From the loading's end (multiplier 0: the dead loads' state) where the job says where that was.
+    const start = finite(collapse.start_displacement);
+    const x = [...(start === null ? [] : [start]), ...held.map((t) => t.displacement)];
+    const y = [...(start === null ? [] : [0]), ...held.map((t) => t.multiplier)];
     const top = finite(collapse.failed);
     const data = [x, y, x.map(() => top)];
     this.plot = new uPlot({

@@ -46,6 +46,7 @@ void write_collapse(hid_t file, const CollapseResult& c) {
   h5::write_attribute<std::int32_t>(g, "solves", c.solves);
   h5::write_attribute<std::int32_t>(g, "bracket_solves", c.bracket_solves);
   h5::write_attribute<double>(g, "statics_bound", c.statics_bound);
+  h5::write_attribute<double>(g, "start_displacement", c.start_displacement);
   h5::write_attribute(g, "words", c.words);
   Handle m = h5::create_group(g, "mechanism");
   h5::write_attribute(m, "kind", c.mechanism.kind);
@@ -111,6 +112,8 @@ void read_collapse(hid_t file, CollapseResult& c) {
   c.solves = h5::read_attribute<std::int32_t>(g, "solves");
   c.bracket_solves = h5::read_attribute<std::int32_t>(g, "bracket_solves");
   c.statics_bound = h5::read_attribute<double>(g, "statics_bound");
+  if (h5::has_attribute(g, "start_displacement"))  // (files from before the capacity curve: none)
+    c.start_displacement = h5::read_attribute<double>(g, "start_displacement");
   c.words = h5::read_string_attribute(g, "words");
   Handle m = h5::open_group(g, "mechanism");
   c.mechanism.kind = h5::read_string_attribute(m, "kind");

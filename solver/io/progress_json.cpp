@@ -281,6 +281,16 @@ nlohmann::json collapse_json(const CollapseResult& c) {
                       {"slip", j.slip},
                       {"opening", j.opening},
                       {"words", j.words}});
+  nlohmann::json thrust = nlohmann::json::array();
+  for (const auto& t : c.thrust)
+    thrust.push_back(
+        {{"pair", t.pair},
+         {"slave_body", t.slave_body},
+         {"master_body", t.master_body},
+         {"point", t.point.allFinite() ? nlohmann::json{t.point.x(), t.point.y()} : nlohmann::json(nullptr)},
+         {"edge", {{t.first.x(), t.first.y()}, {t.last.x(), t.last.y()}}},
+         {"force", t.force},
+         {"eccentricity", number(t.eccentricity)}});
   return {{"verdict", c.verdict},
           {"held", c.held},
           {"failed", number(c.failed)},
@@ -291,6 +301,8 @@ nlohmann::json collapse_json(const CollapseResult& c) {
           {"statics_bound", number(c.statics_bound)},
           {"words", c.words},
           {"trials", trials},
+          {"start_displacement", number(c.start_displacement)},
+          {"thrust", thrust},
           {"mechanism",
            {{"kind", c.mechanism.kind}, {"words", c.mechanism.words}, {"bodies", bodies}, {"joints", joints}}}};
 }

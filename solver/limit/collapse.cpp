@@ -5,6 +5,7 @@
 
 #include "../ddm/driver.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -63,6 +64,34 @@ std::string joints_that_give(const Step& step) {
   return out;
 }
 
+// Each pair's centre of pressure at `step` (CollapseResult::Thrust): its arc length along the slave edge
+// (JointResults::centre_of_pressure) placed on the edge's polyline.
+std::vector<CollapseResult::Thrust> thrust_of(const Step& step) {
+  std::vector<CollapseResult::Thrust> out;
+  for (const auto& pair : step.pairs) {
+    CollapseResult::Thrust t;
+    t.pair = pair.name;
+    t.slave_body = pair.slave_body;
+    t.master_body = pair.master_body;
+    const Eigen::Index n = pair.position.rows();
+    if (n == 0 || pair.arc_length.size() != n) continue;
+    t.first = pair.position.row(0).transpose();
+    t.last = pair.position.row(n - 1).transpose();
+    t.force = pair.force;
+    t.eccentricity = pair.joint.eccentricity;
+    const double s = pair.joint.centre_of_pressure;
+    if (std::isfinite(s) && pair.force > 0) {
+      Eigen::Index k = 1;
+      while (k < n - 1 && pair.arc_length[k] < s) ++k;
+      const double a = pair.arc_length[std::max<Eigen::Index>(k - 1, 0)], b = pair.arc_length[k];
+      const double w = n > 1 && b > a ? std::clamp((s - a) / (b - a), 0.0, 1.0) : 0.0;
+      t.point = ((1 - w) * pair.position.row(std::max<Eigen::Index>(k - 1, 0)) + w * pair.position.row(k)).transpose();
+    }
+    out.push_back(std::move(t));
+  }
+  return out;
+}
+
 std::string statics_words(const CollapseResult& c) {
   if (std::isinf(c.statics_bound))
     return "the bodies as rigid blocks carry any multiple of the live loads (they press the joints shut)";
@@ -113,6 +142,7 @@ class CollapseRun {
     out_.tolerance = spec_.tolerance;
     bound_by_statics();
     live_loads();
+    out_.start_displacement = live_displacement(frame_.outcome().u);
     held_ = Held::of(frame_.outcome(), frame_.state(), 0.0);
     first_index_ = steps_.held();
     double next = spec_.first > 0 ? spec_.first : bounded() ? 0.5 * out_.statics_bound : 1.0;
@@ -258,6 +288,7 @@ class CollapseRun {
     state.slip_origin = std::move(held_.slip_origin);
     state.load.multiplier = out_.held;
     word_verdict(out_, last_failure_, !steps_.empty() ? joints_that_give(steps_.back()) : std::string());
+    if (!steps_.empty()) out_.thrust = thrust_of(steps_.back());
     total.refused = false;
     const bool answered = out_.verdict != "solver_failed";
     total.converged = answered;

@@ -414,18 +414,32 @@ def test_collapse(server, b):
     curve = b.wait(lambda: b.el("collapse-curve").is_displayed()
                    and b.el("collapse-curve").get_attribute("data-points") == "2"
                    and b.driver.find_elements(By.CSS_SELECTOR, "#collapse-curve canvas"), 30)
+    check("collapse: the capacity curve's start (the dead loads' state) below its held trials",
+          server.get(f"/v1/jobs/{job_id}").json()["collapse"]["start_displacement"] < held[0][1], held)
     check("collapse: the capacity curve is drawn with its 2 held trials", bool(curve),
           b.el("collapse-curve").get_attribute("data-points"))
     cells = [r.find_elements(By.TAG_NAME, "td")[-1].text
              for r in b.driver.find_elements(By.CSS_SELECTOR, "#collapse-trials tbody tr")]
     check("collapse: the trials table gives each held trial's displacement",
           len(cells) == 2 and all(c and float(c) > 0 for c in cells), cells)
+    # The thrust at the last held state: the column's three joints drawn as edges with their centres of pressure,
+    # and the mechanism's hinge (the base's toe) marked.
+    thrust = server.get(f"/v1/jobs/{job_id}").json()["collapse"]["thrust"]
+    check("collapse: the job resource has the thrust, a centre of pressure per joint that carries force",
+          len(thrust) == 3 and all(t["point"] and t["force"] > 0 for t in thrust), thrust)
+    drawn = b.wait(lambda: b.el("collapse-thrust").get_attribute("data-joints") == "3"
+                   and b.el("collapse-thrust").get_attribute("data-points") == "3"
+                   and b.el("collapse-thrust").get_attribute("data-hinges") == "1"
+                   and b.el("collapse-thrust").is_displayed(), 30)
+    check("collapse: the thrust drawn, 3 joints with their centres of pressure and the hinge",
+          bool(drawn), {k: b.el("collapse-thrust").get_attribute(k) for k in ("data-joints", "data-points", "data-hinges")})
     clean = server.submit_id(flat_patch(name="no-collapse"))
     server.wait_done(clean, 60)
     b.driver.execute_script(f"window.location.hash = 'job={clean}';")
     check("collapse: a job without one shows none",
           b.wait(lambda: b.text("job-id") == clean and not b.el("job-collapse").is_displayed()
-                 and b.el("collapse-curve").get_attribute("data-points") == "0", 30),
+                 and b.el("collapse-curve").get_attribute("data-points") == "0"
+                 and b.el("collapse-thrust").get_attribute("data-joints") == "0", 30),
           b.text("job-collapse"))
 
 

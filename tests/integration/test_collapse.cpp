@@ -212,7 +212,34 @@ TEST(Collapse, EveryTrialIsOneIncrementAndTheBisectionHalvesTheBracket) {
   }
   std::sort(curve.begin(), curve.end());
   ASSERT_GE(curve.size(), 2u) << c.words;
+  // From the dead loads' state (multiplier 0) the live loads do positive work on what they add.
+  ASSERT_TRUE(std::isfinite(c.start_displacement)) << c.words;
+  EXPECT_GT(curve.front().second, c.start_displacement);
   for (size_t k = 1; k < curve.size(); ++k) EXPECT_GT(curve[k].second, curve[k - 1].second) << curve[k].first;
+}
+
+// The thrust at the last held state is statics: the joint under k blocks of the column (unit blocks of weight 10
+// each, pushed by lambda 10 per block at their mid-heights) carries N = 10 k, and the push's moment about the
+// joint's middle is 10 lambda (0.5 + 1.5 + ...) = 5 lambda k^2, so its centre of pressure lies at x = 0.5 +
+// lambda k / 2 on it: 0.5 + 1.5 lambda at the base, whatever the blocks' elasticity (any equilibrium's). At the
+// collapse (1/3) the base's reaches the toe: the hinge of the mechanism.
+TEST(Collapse, TheThrustAtTheLastHeldStateIsTheColumnsStatics) {
+  const Result r = contact::testing::run(column(3, 1.0, 1.0, 0.8, "body"));
+  ASSERT_TRUE(r.converged) << r.message;
+  const CollapseResult& c = r.collapse;
+  ASSERT_EQ(c.thrust.size(), 3u);
+  for (int k = 3; k >= 1; --k) {  // the pairs in the job's order: the base (3 blocks above), then up
+    const auto& t = c.thrust[static_cast<size_t>(3 - k)];
+    ASSERT_TRUE(t.point.allFinite()) << t.pair;
+    EXPECT_NEAR(t.force, 10.0 * k, 1e-8 * 10 * k) << t.pair;
+    EXPECT_NEAR(t.point.x(), 0.5 + c.held * k / 2.0, 1e-7) << t.pair;
+    EXPECT_NEAR(t.point.y(), 3.0 - k, 1e-12) << t.pair;
+    EXPECT_NEAR(t.eccentricity, c.held * k, 1e-6) << t.pair;
+  }
+  const JointMotion* hinge = joint(c.mechanism, c.thrust[0].pair);
+  ASSERT_NE(hinge, nullptr);
+  EXPECT_NEAR((hinge->point - Eigen::Vector2d(1.0, 0.0)).norm(), 0.0, 1e-9);
+  EXPECT_NEAR(c.thrust[0].point.x(), 1.0, 1e-3);  // at the toe, to the bracket's width
 }
 
 // A job whose live loads only press the joints shut has no collapse: statics carries any multiple, and the trial
@@ -259,6 +286,7 @@ TEST(Collapse, TheResultFileKeepsTheVerdictTheMechanismAndTheCapacityCurve) {
   EXPECT_EQ(f.step_history.multiplier.back(), r.collapse.held);
   EXPECT_EQ(f.steps.back().multiplier, r.collapse.held);
   ASSERT_EQ(c.trials.size(), r.collapse.trials.size());
+  EXPECT_EQ(c.start_displacement, r.collapse.start_displacement);
   for (size_t k = 0; k < c.trials.size(); ++k) {
     EXPECT_EQ(c.trials[k].held, r.collapse.trials[k].held);
     if (c.trials[k].held)

@@ -264,6 +264,20 @@ struct CollapseResult {
     double displacement = std::numeric_limits<double>::quiet_NaN();
   };
   std::vector<Trial> trials;
+  // The live loads' displacement (Trial::displacement) at the loading's end, multiplier 0: the capacity curve's
+  // first point (the dead loads move the live loads' points too). NaN when not computed.
+  double start_displacement = std::numeric_limits<double>::quiet_NaN();
+  // The thrust at the last state that held: each pair's centre of pressure on its slave edge (where its normal force
+  // acts; NaN where the joint carries none), with the edge's two ends, the normal force and the eccentricity
+  // (JointResults). Joined in the pairs' order where they form a chain (an arch, a column), the thrust line.
+  struct Thrust {
+    std::string pair, slave_body, master_body;
+    Eigen::Vector2d point = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+    Eigen::Vector2d first = Eigen::Vector2d::Zero(), last = Eigen::Vector2d::Zero();
+    double force = 0.0;
+    double eccentricity = std::numeric_limits<double>::quiet_NaN();
+  };
+  std::vector<Thrust> thrust;
 };
 
 struct Result : RunOutcome {
