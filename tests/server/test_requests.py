@@ -175,11 +175,11 @@ with Server(token=TOKEN, args=["--workers", "1"]) as server:
                        ("a chunk size that is not hexadecimal", b"zz\r\nhello\r\n0\r\n\r\n"),
                        ("data longer than its chunk size", b"2\r\nhello\r\n0\r\n\r\n"),
                        ("a chunk size of 17 hex digits", b"1" * 17 + b"\r\nx\r\n0\r\n\r\n")):
-        started = time.monotonic()
+        # (No clock: httplib's own answer, after its read timeout, says "the request body could not be read";
+        # only the framing check, which answers as the bytes arrive, names the framing.)
         raw = server.raw(head + body)
-        seconds = time.monotonic() - started
-        check(f"{name}: 400 at once, naming the chunked framing", raw.startswith(b"HTTP/1.1 400") and
-              b"chunked body is malformed" in raw and seconds < 5, (seconds, raw[:300]))
+        check(f"{name}: 400 naming the chunked framing", raw.startswith(b"HTTP/1.1 400") and
+              b"chunked body is malformed" in raw, raw[:300])
     chunks = b"".join(b"%x;ext=1\r\n%s\r\n" % (len(good[k:k + 100]), good[k:k + 100]) for k in range(0, len(good), 100))
     raw = server.raw(head + chunks + b"0\r\n\r\n")
     check("a well-framed chunked body with chunk extensions: validated (200)", raw.startswith(b"HTTP/1.1 200"),
