@@ -176,11 +176,17 @@ class ProgressPrinter final : public contact::Observer {
     }
     if (!std::isfinite(r.estimate))  // cancelled while estimating
       std::printf("  | estimate cancelled  force %.6g  p_max %.6g", r.force, r.peak_pressure);
-    else if (r.step == 0)
+    else if (r.compared_with < 0)
       std::printf("  | estimate %.3e  force %.6g  p_max %.6g", r.estimate, r.force, r.peak_pressure);
-    else
-      std::printf("  | estimate %.3e (change %.2g %%)  force %.6g (%.2g %%)  p_max %.6g (%.2g %%)", r.estimate,
-                  100 * r.estimate_change, r.force, 100 * r.force_change, r.peak_pressure, 100 * r.peak_change);
+    else {  // the changes the stop test reads, against the last step with at most half the unknowns
+      std::printf(
+          "  | estimate %.3e  force %.6g  p_max %.6g  | against step %d: force %.2g %%, p_max %.2g %%, zone "
+          "%.2g %%",
+          r.estimate, r.force, r.peak_pressure, r.compared_with, 100 * r.force_change, 100 * r.peak_change,
+          100 * r.extent_change);
+      if (r.stick_change > 0.0 || r.tangential_change > 1e-9)  // (a load-controlled T changes by rounding only)
+        std::printf(", stick zone %.2g %%, tangential %.2g %%", 100 * r.stick_change, 100 * r.tangential_change);
+    }
     if (std::isfinite(r.pressure_estimate)) std::printf("  pressure error ~%.3g %%", 100 * r.pressure_estimate);
     std::printf("  | estimating %.2fs  %.2fs\n", r.indicator_seconds, r.elapsed_seconds);
     std::fflush(stdout);

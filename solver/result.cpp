@@ -36,11 +36,7 @@ const char* to_string(Measure m) {
   return "fixed_point";
 }
 
-namespace {
-
-// The length of a pair's slave edge where it is a closed loop (its closing segment, from the last node back to
-// the first, included), else 0.
-double loop_length(const Step& step, const PairField& p) {
+double slave_loop_length(const Step& step, const PairField& p) {
   const auto n = p.arc_length.size();
   if (n < 2 || p.position.rows() != n) return 0.0;
   for (const auto& b : step.bodies)
@@ -48,8 +44,6 @@ double loop_length(const Step& step, const PairField& p) {
       return p.arc_length[n - 1] + (p.position.row(0) - p.position.row(n - 1)).norm();
   return 0.0;
 }
-
-}  // namespace
 
 StepSummary summarize(const Step& step) {
   StepSummary s;
@@ -72,7 +66,7 @@ StepSummary summarize(const Step& step) {
     Eigen::VectorXd carried = p.pressure;
     for (Eigen::Index j = 0; j < carried.size() && j < p.status.size(); ++j)
       if (p.status[j] == 5) carried[j] = 0.0;
-    const ContactExtent extent = contact_extent(p.arc_length, carried, loop_length(step, p));
+    const ContactExtent extent = contact_extent(p.arc_length, carried, slave_loop_length(step, p));
     s.contact_begin.push_back(extent.begin);
     s.contact_end.push_back(extent.end);
   }

@@ -63,9 +63,13 @@ nlohmann::json adaptive_step_json(const AdaptiveStepReport& r) {
           {"pressure_estimate", r.pressure_estimate},
           {"force", r.force},
           {"peak_pressure", r.peak_pressure},
+          {"compared_with", r.compared_with},
           {"estimate_change", r.estimate_change},
           {"force_change", r.force_change},
           {"peak_change", r.peak_change},
+          {"extent_change", r.extent_change},
+          {"stick_change", r.stick_change},
+          {"tangential_change", r.tangential_change},
           {"indicator_seconds", r.indicator_seconds},
           {"elapsed_seconds", r.elapsed_seconds}};
 }

@@ -135,8 +135,8 @@ class JobReader {
   void resolve_method_defaults();
   void read_adaptivity(const json& value, const std::string& pointer);
   void read_adaptive_bodies(const json& value, const std::string& pointer);
-  void read_target_error(const json& value, const std::string& pointer, const json* stop_tolerance,
-                         const json* max_level, json& out);
+  void read_target_error(const json& value, const std::string& pointer, const json* stop_tolerance, json& out);
+  void resolve_marking(const std::string& given, bool delta, bool max_level, bool max_steps, json& out);
   void write_adaptivity_defaults(json& out);
   void read_robin(const json& value, const std::string& pointer);
   void read_augmented_lagrangian(const json& value, const std::string& pointer);

@@ -63,7 +63,8 @@ struct NameTable<Normalization> {
 };
 template <>
 struct NameTable<MarkingRule> {
-  static constexpr Entries<MarkingRule, 2> entries{{{MarkingRule::contact, "contact"}, {MarkingRule::plain, "plain"}}};
+  static constexpr Entries<MarkingRule, 3> entries{
+      {{MarkingRule::contact, "contact"}, {MarkingRule::plain, "plain"}, {MarkingRule::goal, "goal"}}};
 };
 template <>
 struct NameTable<AdaptStrategy> {

@@ -192,21 +192,25 @@ void JobReader::read_adaptivity(const json& value, const std::string& pointer) {
     }
   if (const json* b = f.find("bodies")) read_adaptive_bodies(*b, f.at("bodies"));
   if (const json* t = f.find("target_error"))
-    read_target_error(*t, f.at("target_error"), f.find("stop_tolerance"), f.find("max_level"), out);
+    read_target_error(*t, f.at("target_error"), f.find("stop_tolerance"), out);
+  resolve_marking(f.find("marking") ? f.at("marking") : std::string(), f.find("delta") != nullptr,
+                  f.find("max_level") != nullptr, f.find("max_steps") != nullptr, out);
   write_adaptivity_defaults(out);
 }
 
-// max_level with a target_error and no max_level of the job's (read_target_error).
+// max_level and max_steps with the goal-oriented marking (a target_error, or marking "goal") where the job sets
+// neither (resolve_marking).
 constexpr int kTargetMaxLevel = 12;
+constexpr int kGoalMaxSteps = 30;
 
 // "target_error": the estimated relative error of the contact pressure to reach (adapt/pressure_estimate.hpp).
 // The estimate takes the fem_bem indicator's boundary-element solutions, and the loop it ends is
 // converge_then_refine's; the stop test on the changes is off unless the job sets it (it would end the run at
-// the changes of 0.5 %, before a finer target); max_level is 12 unless the job sets it: the contact edges' share
-// of the pressure error falls like their cells' size, and at level 8 it is ~0.08 % on the two-cylinder example,
-// the floor of any finer target (docs/algorithm.md, "Refinement for the pressure's target").
+// the changes of 0.5 %, before a finer target); max_level is 12 unless the job sets it (resolve_marking): the
+// contact edges' share of the pressure error falls like their cells' size, and at level 8 it is ~0.08 % on the
+// two-cylinder example, the floor of any finer target (docs/algorithm.md, "Refinement for the pressure's target").
 void JobReader::read_target_error(const json& value, const std::string& pointer, const json* stop_tolerance,
-                                  const json* max_level, json& out) {
+                                  json& out) {
   AdaptivitySettings& a = problem_.adaptivity;
   const auto x = read::number(value, pointer, "target_error", errors_);
   if (!x) return;
@@ -240,9 +244,42 @@ void JobReader::read_target_error(const json& value, const std::string& pointer,
     a.stop_tolerance = 0.0;
     out["stop_tolerance"] = 0.0;
   }
-  if (!max_level) {
+}
+
+// The marking: "goal" (the pressure estimate's shares, as a target marks) by default where that estimate can be made
+// (the fem_bem indicator, converge_then_refine, a domain-decomposition method) and the job gives no delta (a delta
+// asks for the indicator's marking: "contact"); max_level is then 12 unless the job sets it (the contact edges'
+// share of the pressure error falls like their cells' size: read_target_error), and max_steps 30 (a step adds a
+// tenth to a half of the unknowns: the three examples of docs/job-format.md settle after 12-17 steps, where the
+// indicator's marking doubles them a step). A "goal" the job names where the
+// estimate cannot be made is an error, never a silent substitute. `given`: the pointer of the job's "marking", or
+// "" without one.
+void JobReader::resolve_marking(const std::string& given, bool delta, bool max_level, bool max_steps, json& out) {
+  AdaptivitySettings& a = problem_.adaptivity;
+  std::string why_not;
+  if (a.indicator != Indicator::fem_bem)
+    why_not = "the fem_bem indicator (the pressure estimate takes its boundary-element solutions)";
+  else if (a.strategy != AdaptStrategy::converge_then_refine)
+    why_not = "the strategy \"converge_then_refine\" (the paper's strategy refines before each solve has converged)";
+  else if (problem_.solver.method == Method::monolithic)
+    why_not =
+        "a domain-decomposition method (the pressure estimate solves each body alone, and the monolithic method "
+        "factorises none)";
+  if (!given.empty()) {
+    if (a.marking == MarkingRule::goal && !why_not.empty())
+      errors_.add(given, "marking \"goal\" needs " + why_not + "; use \"contact\" or \"plain\"");
+  } else if (why_not.empty() && (!delta || a.target_error > 0.0)) {  // (a target marks so whatever the delta)
+    a.marking = MarkingRule::goal;
+    out["marking"] = name_of(a.marking);
+  }
+  const bool goal = a.marking == MarkingRule::goal || a.target_error > 0.0;
+  if (goal && !max_level) {
     a.max_level = kTargetMaxLevel;
     out["max_level"] = kTargetMaxLevel;
+  }
+  if (goal && !max_steps) {
+    a.max_steps = kGoalMaxSteps;
+    out["max_steps"] = kGoalMaxSteps;
   }
 }
 

@@ -51,9 +51,7 @@ TEST(AdaptiveTarget, ThePapersTestReachesATenthOfAPercentWithTenTimesFewerUnknow
   // delta 0.01 and 11 levels, 9 steps: ~195k unknowns, the contact edge at h = 1/4096). Its last step is within
   // ~0.01 % of the solution (measured against a run two steps further: 0.0024 %; uniform 2048 x 512 is 0.027 %
   // off it, the square-root edge's sqrt(1/10) h / a for h = 1/2048 being 0.015 %).
-  json overkill = seed_layers_defaults(8);
-  overkill["adaptivity"] = {{"delta", 0.01}, {"max_level", 11}, {"stop_tolerance", 0}, {"max_steps", 9}};
-  const Result fine = run(overkill);
+  const Result fine = run(seed_layers_overkill());
   ASSERT_TRUE(fine.converged) << fine.message;
   const PressureProfile reference(fine.steps.back().pairs.at(0));
 
@@ -116,13 +114,15 @@ TEST(AdaptiveTarget, TwoCylindersErrorKeepsFallingBelowATenthOfAPercentFasterTha
   const double R = 1.0 / (1.0 / 10 + 1.0 / 25), inv_E = (1 - 0.3 * 0.3) / 2.1e5 + (1 - 0.33 * 0.33) / 7.0e4;
   const double a = std::sqrt(4 * last.force * R * inv_E / M_PI);
   const PressureProfile reference(last);
-  const auto error_of = [&](const Step& step) { return pressure_error(step.pairs.at(0), reference, -1.5 * a, 1.5 * a, 60000); };
+  const auto error_of = [&](const Step& step) {
+    return pressure_error(step.pairs.at(0), reference, -1.5 * a, 1.5 * a, 60000);
+  };
   const auto dofs_of = mesh_unknowns;
   std::vector<double> errors;
   for (size_t k = 0; k < r.steps.size(); ++k) {
     errors.push_back(error_of(r.steps[k]));
-    std::printf("  step %zu: %ld unknowns, estimate %.4f %%, error %.4f %%, effectivity %.2f\n", k,
-                dofs_of(r.steps[k]), 100 * estimates.pressure[k], 100 * errors[k], estimates.pressure[k] / errors[k]);
+    std::printf("  step %zu: %ld unknowns, estimate %.4f %%, error %.4f %%, effectivity %.2f\n", k, dofs_of(r.steps[k]),
+                100 * estimates.pressure[k], 100 * errors[k], estimates.pressure[k] / errors[k]);
   }
   // No plateau: from 2 % down each step lowers the error, to below 0.1 % (read against a reference 0.05 % off,
   // the steps below 0.25 % are not compared).
@@ -148,8 +148,8 @@ TEST(AdaptiveTarget, TwoCylindersErrorKeepsFallingBelowATenthOfAPercentFasterTha
     size_t k = 0;
     while (k < errors.size() && errors[k] > e) ++k;
     ASSERT_LT(k, errors.size()) << "no adaptive step reaches uniform level " << level << "'s " << 100 * e << " %";
-    std::printf("  uniform level %zu: %ld unknowns, error %.4f %%; adaptive step %zu: %ld unknowns (%.1fx)\n", level,
-                n, 100 * e, k, dofs_of(r.steps[k]), static_cast<double>(n) / dofs_of(r.steps[k]));
+    std::printf("  uniform level %zu: %ld unknowns, error %.4f %%; adaptive step %zu: %ld unknowns (%.1fx)\n", level, n,
+                100 * e, k, dofs_of(r.steps[k]), static_cast<double>(n) / dofs_of(r.steps[k]));
     EXPECT_LT(dofs_of(r.steps[k]), n) << "level " << level;
     if (level == 4) EXPECT_LE(10 * dofs_of(r.steps[k]), n);
   }
@@ -209,8 +209,7 @@ TEST(AdaptiveTarget, TheJobNamesATargetOnlyWhereTheEstimateCanBeMade) {
             std::string::npos)
       << validation_errors(job);
   job["adaptivity"] = {{"target_error", 0}};
-  EXPECT_NE(validation_errors(job).find("/adaptivity/target_error: target_error must lie in (0, 1)"),
-            std::string::npos)
+  EXPECT_NE(validation_errors(job).find("/adaptivity/target_error: target_error must lie in (0, 1)"), std::string::npos)
       << validation_errors(job);
   job["adaptivity"] = {{"target_error", "0.1 %"}};
   EXPECT_NE(validation_errors(job).find("/adaptivity/target_error"), std::string::npos) << validation_errors(job);
@@ -223,12 +222,21 @@ TEST(AdaptiveTarget, TheJobNamesATargetOnlyWhereTheEstimateCanBeMade) {
   EXPECT_EQ(parsed.problem->adaptivity.target_error, 0.002);
   job["adaptivity"]["stop_tolerance"] = 0.01;
   EXPECT_EQ(job::parse(job).problem->adaptivity.stop_tolerance, 0.01);
-  // And max_level is 12 (the contact edges' share of the error falls with their cells), unless the job sets it;
-  // without a target it stays 8.
+  // And max_level is 12 (the contact edges' share of the error falls with their cells) and max_steps 30, unless
+  // the job sets them; so without a target under the default marking ("goal", which refines as a target does),
+  // and 8 and 20 under the indicator's marking (a delta given).
   EXPECT_EQ(parsed.problem->adaptivity.max_level, 12);
   EXPECT_EQ(parsed.problem->normalized["adaptivity"]["max_level"], 12);
+  EXPECT_EQ(parsed.problem->adaptivity.max_steps, 30);
   job["adaptivity"]["max_level"] = 6;
+  job["adaptivity"]["max_steps"] = 7;
   EXPECT_EQ(job::parse(job).problem->adaptivity.max_level, 6);
+  EXPECT_EQ(job::parse(job).problem->adaptivity.max_steps, 7);
   job["adaptivity"] = json::object();
+  EXPECT_EQ(job::parse(job).problem->adaptivity.marking, MarkingRule::goal);
+  EXPECT_EQ(job::parse(job).problem->adaptivity.max_level, 12);
+  job["adaptivity"] = {{"delta", 0.1}};
+  EXPECT_EQ(job::parse(job).problem->adaptivity.marking, MarkingRule::contact);
   EXPECT_EQ(job::parse(job).problem->adaptivity.max_level, 8);
+  EXPECT_EQ(job::parse(job).problem->adaptivity.max_steps, 20);
 }

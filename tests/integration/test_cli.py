@@ -308,7 +308,9 @@ with tempfile.TemporaryDirectory() as tmp:
               f"{run['code']} {run['stderr'][-300:]}")
         check(f"{what}: the result so far is written", os.path.exists(out) and os.path.getsize(out) > 0)
 
-    # SIGTERM during a large boundary-element estimate: the run without the stop test goes on to large meshes;
+    # SIGTERM during a large boundary-element estimate: the run without the stop test, under the indicator's marking
+    # (each step doubles the unknowns; the default goal-oriented marking adds a tenth to a half), goes on to large
+    # meshes;
     # once adaptive step 4 is reported, the solve on the refined mesh (~60k + 25k unknowns) follows, and right
     # after its line the estimate of step 5 starts (boundary-element solves and ~130k interior points, a few
     # seconds): the signal lands inside it (0.2 s after that line).
@@ -319,7 +321,8 @@ with tempfile.TemporaryDirectory() as tmp:
         return seen["step 4"] and line.startswith("step ")  # the solve on step 5's mesh is done: its estimate runs
 
     out = os.path.join(tmp, "cancelled.hdf")
-    run_estimate = sigterm_when(two_cylinders_job(tmp, stop_tolerance=0, max_steps=9), out, inside_estimate, delay=0.2)
+    run_estimate = sigterm_when(two_cylinders_job(tmp, marking="contact", stop_tolerance=0, max_steps=9), out,
+                                inside_estimate, delay=0.2)
     check_stopped(run_estimate, out, "inside the estimate of step 5", "cancelled during adaptive step 5")
 
     # SIGTERM right after adaptive step 6 is reported: the refined meshes (~130k + 50k unknowns) are being assembled

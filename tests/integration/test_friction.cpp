@@ -85,18 +85,19 @@ void check_cattaneo_mindlin(const std::string& interface_solver) {
 
 TEST(Friction, CattaneoMindlinStickZoneAndTractionFollowTheTheory) { check_cattaneo_mindlin("direct"); }
 
-
 TEST(Friction, CattaneoMindlinAdaptsFromACoarseMeshAndEndsOnTheTheory) {
   // Issue 30, item 3: friction with adaptivity. The load path (press, then Q = half of what friction holds) is
   // solved on each mesh from rest (friction depends on the path: its history is never moved between meshes), the
   // indicators take the whole contact traction as the bodies' Neumann data. From 20 x 4 uniform cells per body.
   const double Q = 0.5 * 0.3 * 2194.0;  // P is 2194 to 0.1 % on fine meshes (the held top sets it)
   json job = cattaneo_mesh(20, 4, false, Q);
-  // Refinement graded towards the contact: a cell smaller than half its distance from the contact zone is not
-  // refined, so the stress singularities of the cylinder's point loads and the block's held corner, far from
-  // the contact, do not take the unknowns (with the default grading 0 the run meets the theory at 22,121
-  // unknowns, 5.9x fewer than the graded mesh below; docs/algorithm.md, "Adaptivity with friction").
-  job["adaptivity"] = {{"grading", 0.5}};
+  // The adaptivity defaults (issue 50): the goal-oriented marking refines for the pressure's error, the stick-slip
+  // points included, and weighs the stress singularities of the cylinder's point loads and the block's held corner
+  // by how much they move the contact (little); the run stops where the answer settled. (Under the indicator's
+  // marking, the defaults before, a grading of 0.5 kept the refinement from those corners; under the goal marking
+  // it stops the run short: the cylinder's top is held, so the force needs the far field, which the grading keeps
+  // coarse: docs/job-format.md, "Grading".)
+  job["adaptivity"] = json::object();
   job["output"] = {{"steps", "all"}};
   struct Estimates : Observer {
     std::vector<double> of_step;
@@ -116,10 +117,11 @@ TEST(Friction, CattaneoMindlinAdaptsFromACoarseMeshAndEndsOnTheTheory) {
     // The pressure estimate (issue 30, item 2) against the pressure's true error: Hertz's at the step's force
     // (the bodies are 25 half-widths deep: their departure from half-spaces is far below these errors).
     const double truth = hertz_pressure_error(pair), effectivity = estimates.of_step[k] / truth;
-    std::printf("  step %d: %ld unknowns, Q / (mu P) %.3f, c / a %.4f (theory %.4f), traction error %.3f (at the "
-                "nodes %.3f), pressure error %.3f %%, estimate %.3f %% (effectivity %.2f)\n",
-                s.index, dofs, fit.ratio, fit.c_over_a, fit.theory, fit.traction_error, fit.nodal_traction_error,
-                100 * truth, 100 * estimates.of_step[k], effectivity);
+    std::printf(
+        "  step %d: %ld unknowns, Q / (mu P) %.3f, c / a %.4f (theory %.4f), traction error %.3f (at the "
+        "nodes %.3f), pressure error %.3f %%, estimate %.3f %% (effectivity %.2f)\n",
+        s.index, dofs, fit.ratio, fit.c_over_a, fit.theory, fit.traction_error, fit.nodal_traction_error, 100 * truth,
+        100 * estimates.of_step[k], effectivity);
     // Calibrated: within a factor of 3 either way (the paper's test and two cylinders measure 0.9 to 2.1;
     // docs/algorithm.md, "The pressure estimate") wherever the contact has nodes enough to be resolved at all
     // (6 in contact: at 3 the profile is three values and its error mostly the zone it cannot draw).
@@ -127,7 +129,8 @@ TEST(Friction, CattaneoMindlinAdaptsFromACoarseMeshAndEndsOnTheTheory) {
       EXPECT_GT(effectivity, 1.0 / 3) << "step " << k;
       EXPECT_LT(effectivity, 3.0) << "step " << k;
     }
-    if (!first_meeting && std::abs(fit.c_over_a - fit.theory) <= 0.03 && fit.traction_error < 0.05) first_meeting = dofs;
+    if (!first_meeting && std::abs(fit.c_over_a - fit.theory) <= 0.03 && fit.traction_error < 0.05)
+      first_meeting = dofs;
   }
   // The last step, what the user receives: Cattaneo-Mindlin, Coulomb at every node, Q carried.
   const PairField& p = pair_of(r.steps.back(), "block.top-cylinder.bottom");
@@ -154,8 +157,8 @@ TEST(Friction, CattaneoMindlinAdaptsFromACoarseMeshAndEndsOnTheTheory) {
   EXPECT_LE(std::abs(graded_fit.c_over_a - graded_fit.theory), 0.03);
   EXPECT_LT(graded_fit.traction_error, 0.05);
   const long graded_dofs = unknowns(graded, graded.iterations);
-  std::printf("  adaptive meets both at %ld unknowns; graded 1000 x 30: %ld (ratio %.1f)\n", first_meeting,
-              graded_dofs, static_cast<double>(graded_dofs) / static_cast<double>(first_meeting));
+  std::printf("  adaptive meets both at %ld unknowns; graded 1000 x 30: %ld (ratio %.1f)\n", first_meeting, graded_dofs,
+              static_cast<double>(graded_dofs) / static_cast<double>(first_meeting));
   ASSERT_GT(first_meeting, 0);
   EXPECT_LE(10 * first_meeting, graded_dofs);
 }
@@ -183,7 +186,8 @@ TEST(Friction, CattaneoMindlinWithATargetRefinesTheStickSlipPointsAndEndsOnTheTh
   // The slave's segments at the stick-slip points are finer than in the middle of the stick zone, by 4x (by 2x
   // without the stick-slip term, where only the pressure's shares steered the refinement there).
   std::vector<std::pair<double, int>> nodes;  // (x, sticks)
-  for (Eigen::Index j = 0; j < p.position.rows(); ++j) nodes.emplace_back(p.position(j, 0), p.stick[static_cast<size_t>(j)]);
+  for (Eigen::Index j = 0; j < p.position.rows(); ++j)
+    nodes.emplace_back(p.position(j, 0), p.stick[static_cast<size_t>(j)]);
   std::sort(nodes.begin(), nodes.end());
   size_t last_stick = 0, centre = 0;
   for (size_t j = 0; j < nodes.size(); ++j) {
@@ -271,7 +275,8 @@ TEST(Friction, ZeroCoefficientIsTheFrictionlessSolution) {
   const Result zero = run(job);
   ASSERT_TRUE(frictionless.converged && zero.converged) << zero.message;
   for (size_t b = 0; b < 2; ++b)
-    EXPECT_LT(relative(zero.steps.back().bodies[b].displacement, frictionless.steps.back().bodies[b].displacement), 1e-10);
+    EXPECT_LT(relative(zero.steps.back().bodies[b].displacement, frictionless.steps.back().bodies[b].displacement),
+              1e-10);
   const PairField& p = zero.steps.back().pairs[0];
   EXPECT_LT(relative(p.pressure, frictionless.steps.back().pairs[0].pressure), 1e-10);
   EXPECT_LT(p.tangential_traction.cwiseAbs().maxCoeff(), 1e-10 * p.pressure.maxCoeff());

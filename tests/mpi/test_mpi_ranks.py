@@ -61,12 +61,19 @@ with tempfile.TemporaryDirectory() as tmp:
     with open(targeted_path, "w") as f:
         json.dump(targeted, f)
 
+    # With every default (issue 50): the same marking, stopped where the answer settled (each rank must decide alike).
+    defaults = dict(targeted, adaptivity={})
+    defaults_path = os.path.join(tmp, "adaptive_defaults.json")
+    with open(defaults_path, "w") as f:
+        json.dump(defaults, f)
+
     jobs = {
         "stack3": os.path.join(EXAMPLES, "stack3.json"),               # the paper's Neumann DDM, 1477 iterations
         "stack3_floating": os.path.join(EXAMPLES, "stack3_floating.json"),  # interface Newton, a floating body
         "brick_wall": os.path.join(EXAMPLES, "brick_wall.json"),       # 69 bodies, 120 pairs, 68 floating
         "adaptive": adaptive_path,                                      # meshes refined between solves
         "adaptive_target": targeted_path,                               # refined by the estimate's shares
+        "adaptive_defaults": defaults_path,                             # the same, stopped where the answer settled
         "roller_friction": os.path.join(EXAMPLES, "roller_friction.json"),  # friction, load histories, floating
     }
     for name, job in jobs.items():

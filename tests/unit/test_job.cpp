@@ -266,8 +266,9 @@ TEST(JobExplicitMesh, StraightEdgesAndCornersGetNoCurveSoAFlatExplicitMeshIsItsC
   const auto& mesh = r.problem->bodies[0].mesh;
   EXPECT_TRUE(mesh.edge_set_closed("outline"));
   EXPECT_TRUE(mesh.side_curves.empty());
-  EXPECT_EQ(r.problem->normalized["bodies"][0]["mesh"]["curves"],
-            json({{"base", "fitted"}, {"cap", "fitted"}, {"outline", "fitted"}, {"side", "fitted"}, {"wall", "fitted"}}));
+  EXPECT_EQ(
+      r.problem->normalized["bodies"][0]["mesh"]["curves"],
+      json({{"base", "fitted"}, {"cap", "fitted"}, {"outline", "fitted"}, {"side", "fitted"}, {"wall", "fitted"}}));
   // A curve given for an edge is set on each of its sides, b and c from each side's ends: "cap" (nodes 5, 4, 3,
   // all at y = 1) as the parabola of a = 0 is y = 1 on both its sides.
   job["bodies"][0]["mesh"]["curves"] = {{"cap", {{"parabola", {{"a", 0.0}}}}}};
@@ -349,7 +350,9 @@ struct BadJob {
 
 void PrintTo(const BadJob& row, std::ostream* os) { *os << row.name << ": " << json(row.patch).dump(); }
 
-json add(const std::string& pointer, json value) { return {{"op", "add"}, {"path", pointer}, {"value", std::move(value)}}; }
+json add(const std::string& pointer, json value) {
+  return {{"op", "add"}, {"path", pointer}, {"value", std::move(value)}};
+}
 json replace(const std::string& pointer, json value) {
   return {{"op", "replace"}, {"path", pointer}, {"value", std::move(value)}};
 }
@@ -367,144 +370,251 @@ json upper_explicit() {
 std::vector<BadJob> bad_jobs() {
   return {
       // Bodies: materials, block meshes, fields.
-      {"MissingMaterialIsReportedWhereItBelongs", small_job, {remove("/bodies/0/material")},
-       "/bodies/0/material", "required field 'material' is missing"},
-      {"ZeroYoungsModulusIsRejectedAsNotPositive", small_job, {replace("/bodies/1/material/E", 0)},
-       "/bodies/1/material/E", "E = 0 must be positive"},
-      {"NuOfOneHalfIsRejectedAtItsPointer", small_job, {replace("/bodies/1/material/nu", 0.5)},
-       "/bodies/1/material/nu", "nu = 0.5 is outside (-1, 0.5)"},
-      {"NuOfMinusOneIsRejectedAtItsPointer", small_job, {replace("/bodies/0/material/nu", -1)},
-       "/bodies/0/material/nu", "nu = -1 is outside (-1, 0.5)"},
-      {"WrongTypeIsNamed", small_job, {replace("/bodies/0/material/nu", "0.3")},
-       "/bodies/0/material/nu", "nu must be a number, got string"},
-      {"ZeroElementsAcrossABlockAreRejected", small_job, {replace("/bodies/0/mesh/block/nx", 0)},
-       "/bodies/0/mesh/block/nx", "nx = 0 must be at least 1"},
-      {"FractionalElementCountIsNotAnInteger", small_job, {replace("/bodies/0/mesh/block/nx", 2.5)},
-       "/bodies/0/mesh/block/nx", "nx must be an integer, got 2.5"},
-      {"UnknownFieldInsideABlockIsRejected", small_job, {add("/bodies/1/mesh/block/nz", 3)},
-       "/bodies/1/mesh/block/nz", "unknown field 'nz' in block"},
-      {"ArcRadiusInconsistentWithTheCornersIsReportedAtTheArc", small_job,
+      {"MissingMaterialIsReportedWhereItBelongs",
+       small_job,
+       {remove("/bodies/0/material")},
+       "/bodies/0/material",
+       "required field 'material' is missing"},
+      {"ZeroYoungsModulusIsRejectedAsNotPositive",
+       small_job,
+       {replace("/bodies/1/material/E", 0)},
+       "/bodies/1/material/E",
+       "E = 0 must be positive"},
+      {"NuOfOneHalfIsRejectedAtItsPointer",
+       small_job,
+       {replace("/bodies/1/material/nu", 0.5)},
+       "/bodies/1/material/nu",
+       "nu = 0.5 is outside (-1, 0.5)"},
+      {"NuOfMinusOneIsRejectedAtItsPointer",
+       small_job,
+       {replace("/bodies/0/material/nu", -1)},
+       "/bodies/0/material/nu",
+       "nu = -1 is outside (-1, 0.5)"},
+      {"WrongTypeIsNamed",
+       small_job,
+       {replace("/bodies/0/material/nu", "0.3")},
+       "/bodies/0/material/nu",
+       "nu must be a number, got string"},
+      {"ZeroElementsAcrossABlockAreRejected",
+       small_job,
+       {replace("/bodies/0/mesh/block/nx", 0)},
+       "/bodies/0/mesh/block/nx",
+       "nx = 0 must be at least 1"},
+      {"FractionalElementCountIsNotAnInteger",
+       small_job,
+       {replace("/bodies/0/mesh/block/nx", 2.5)},
+       "/bodies/0/mesh/block/nx",
+       "nx must be an integer, got 2.5"},
+      {"UnknownFieldInsideABlockIsRejected",
+       small_job,
+       {add("/bodies/1/mesh/block/nz", 3)},
+       "/bodies/1/mesh/block/nz",
+       "unknown field 'nz' in block"},
+      {"ArcRadiusInconsistentWithTheCornersIsReportedAtTheArc",
+       small_job,
        {add("/bodies/0/mesh/block/edges", {{"bottom", {{"arc", {{"center", {1, 5}}, {"radius", 4}}}}}})},
-       "/bodies/0/mesh/block/edges/bottom/arc", "not at the radius 4"},
-      {"ParabolaWithEqualXEndsIsReportedAtTheParabola", small_job,
+       "/bodies/0/mesh/block/edges/bottom/arc",
+       "not at the radius 4"},
+      {"ParabolaWithEqualXEndsIsReportedAtTheParabola",
+       small_job,
        {add("/bodies/0/mesh/block/edges", {{"left", {{"parabola", {{"a", 0.1}}}}}})},
-       "/bodies/0/mesh/block/edges/left/parabola", "different x"},
-      {"GradingTowardsBothTopAndBottomIsRejected", small_job,
+       "/bodies/0/mesh/block/edges/left/parabola",
+       "different x"},
+      {"GradingTowardsBothTopAndBottomIsRejected",
+       small_job,
        {add("/bodies/0/mesh/block/grading", {{"top", 4}, {"bottom", 4}})},
-       "/bodies/0/mesh/block/grading", "grading towards both bottom and top"},
-      {"ClockwiseCornersAreRejectedBeforeMeshing", small_job,
+       "/bodies/0/mesh/block/grading",
+       "grading towards both bottom and top"},
+      {"ClockwiseCornersAreRejectedBeforeMeshing",
+       small_job,
        {replace("/bodies/0/mesh/block/corners", {{0, 0}, {0, 1}, {2, 1}, {2, 0}})},
-       "/bodies/0/mesh/block/corners", "the corners run clockwise"},
+       "/bodies/0/mesh/block/corners",
+       "the corners run clockwise"},
 
       // Explicit meshes.
-      {"InvertedExplicitQuadIsReportedOnTheMesh", upper_explicit,
+      {"InvertedExplicitQuadIsReportedOnTheMesh",
+       upper_explicit,
        {replace("/bodies/0/mesh/quads/1", {1, 4, 5, 2})},  // clockwise
-       "/bodies/0/mesh", "cell 1 is inverted"},
+       "/bodies/0/mesh",
+       "cell 1 is inverted"},
       // Quad 1 has four distinct node indices, but nodes 5 and 2 coincide: it collapses to a triangle.
-      {"DegenerateExplicitQuadIsReportedOnTheMesh", upper_explicit,
+      {"DegenerateExplicitQuadIsReportedOnTheMesh",
+       upper_explicit,
        {replace("/bodies/0/mesh", json::parse(R"({
           "nodes": [[0, 0], [1, 0], [1, 1], [0, 1], [2, 0], [1, 1]],
           "quads": [[0, 1, 2, 3], [1, 4, 5, 2]],
           "edges": {"base": [[0, 1], [1, 4]], "wall": [[3, 0]]}})"))},
-       "/bodies/0/mesh", "cell 1 is degenerate"},
-      {"EdgePairThatIsNotABoundarySideIsReportedAtTheEdgeSet", upper_explicit,
+       "/bodies/0/mesh",
+       "cell 1 is degenerate"},
+      {"EdgePairThatIsNotABoundarySideIsReportedAtTheEdgeSet",
+       upper_explicit,
        {replace("/bodies/0/mesh/edges/base", {{0, 1}, {1, 4}}),  // 1-4 is shared by both quads
         replace("/contacts/0/slave", "upper.cap")},
-       "/bodies/0/mesh/edges/base", "interior side"},
-      {"ExplicitCurveOfAnUnknownEdgeListsTheMeshsEdges", upper_explicit,
+       "/bodies/0/mesh/edges/base",
+       "interior side"},
+      {"ExplicitCurveOfAnUnknownEdgeListsTheMeshsEdges",
+       upper_explicit,
        {add("/bodies/0/mesh/curves", {{"bse", "chords"}})},
-       "/bodies/0/mesh/curves/bse", "'bse' is not an edge of this mesh; its edges are base, cap, side and wall"},
-      {"ExplicitCurveOfAnUnknownKindNamesTheFourKinds", upper_explicit,
+       "/bodies/0/mesh/curves/bse",
+       "'bse' is not an edge of this mesh; its edges are base, cap, side and wall"},
+      {"ExplicitCurveOfAnUnknownKindNamesTheFourKinds",
+       upper_explicit,
        {add("/bodies/0/mesh/curves", {{"base", "smooth"}})},
-       "/bodies/0/mesh/curves/base", "unknown curve \"smooth\": give \"fitted\""},
-      {"ExplicitArcOffTheEdgesNodesNamesTheSide", upper_explicit,
+       "/bodies/0/mesh/curves/base",
+       "unknown curve \"smooth\": give \"fitted\""},
+      {"ExplicitArcOffTheEdgesNodesNamesTheSide",
+       upper_explicit,
        {add("/bodies/0/mesh/curves", {{"cap", {{"arc", {{"center", {1, -5}}, {"radius", 6}}}}}})},
-       "/bodies/0/mesh/curves/cap/arc", "edge 'cap': side [5, 4]: the edge's end corners are at distances"},
-      {"ExplicitCurvesMustBeAnObject", upper_explicit, {add("/bodies/0/mesh/curves", "fitted")},
-       "/bodies/0/mesh/curves", "curves must be an object"},
+       "/bodies/0/mesh/curves/cap/arc",
+       "edge 'cap': side [5, 4]: the edge's end corners are at distances"},
+      {"ExplicitCurvesMustBeAnObject",
+       upper_explicit,
+       {add("/bodies/0/mesh/curves", "fitted")},
+       "/bodies/0/mesh/curves",
+       "curves must be an object"},
 
       // Boundary conditions.
-      {"UnknownEdgeInBoundaryListsTheEdgesTheBodyHas", small_job, {replace("/bodies/1/boundary/1/edge", "botom")},
-       "/bodies/1/boundary/1/edge", "the body has no edge 'botom'; its edges are bottom, right, top and left"},
-      {"ConditionWithADisplacementAndTwoLoadsIsRejected", small_job,
+      {"UnknownEdgeInBoundaryListsTheEdgesTheBodyHas",
+       small_job,
+       {replace("/bodies/1/boundary/1/edge", "botom")},
+       "/bodies/1/boundary/1/edge",
+       "the body has no edge 'botom'; its edges are bottom, right, top and left"},
+      {"ConditionWithADisplacementAndTwoLoadsIsRejected",
+       small_job,
        {add("/bodies/0/boundary/0/traction", {0, 0}), add("/bodies/0/boundary/0/force", {0, 1})},
-       "/bodies/0/boundary/0", "give a displacement, a load (traction or force)"},
-      {"ConditionWithADisplacementALoadAndFreeIsRejected", small_job,
+       "/bodies/0/boundary/0",
+       "give a displacement, a load (traction or force)"},
+      {"ConditionWithADisplacementALoadAndFreeIsRejected",
+       small_job,
        {add("/bodies/0/boundary/0/force", {0, 1}), add("/bodies/0/boundary/0/free", true)},
-       "/bodies/0/boundary/0", "give a displacement, a load (traction or force)"},
-      {"DisplacementWithoutComponentsIsRejected", small_job,
+       "/bodies/0/boundary/0",
+       "give a displacement, a load (traction or force)"},
+      {"DisplacementWithoutComponentsIsRejected",
+       small_job,
        {add("/bodies/0/boundary/-", {{"edge", "right"}, {"displacement", json::object()}})},
-       "/bodies/0/boundary/2/displacement", "at least one of the components x and y"},
-      {"SecondConditionOnTheSameEdgeIsRejected", small_job,
+       "/bodies/0/boundary/2/displacement",
+       "at least one of the components x and y"},
+      {"SecondConditionOnTheSameEdgeIsRejected",
+       small_job,
        {add("/bodies/0/boundary/-", {{"edge", "left"}, {"displacement", {{"y", 0}}}})},
-       "/bodies/0/boundary/2/edge", "already has a condition at /bodies/0/boundary/0"},
+       "/bodies/0/boundary/2/edge",
+       "already has a condition at /bodies/0/boundary/0"},
 
       // Rigid motions left free.
-      {"BodyWithoutDisplacementConditionsAndWithoutContactHasAllThreeRigidMotionsFree", small_job,
+      {"BodyWithoutDisplacementConditionsAndWithoutContactHasAllThreeRigidMotionsFree",
+       small_job,
        {replace("/bodies/0/boundary", {{{"edge", "top"}, {"traction", {{"normal", 1.0}}}}}), remove("/contacts")},
-       "/bodies/0/boundary", "translation in x, translation in y and rotation are free) and touches no other body"},
+       "/bodies/0/boundary",
+       "translation in x, translation in y and rotation are free) and touches no other body"},
       // u_x = 0 along the (horizontal) bottom and u_y = 0 along the (vertical) left edge leave the rotation about
       // their common corner (0, -1) free.
-      {"BodyHeldOnlyAgainstTranslationsRotatesAboutTheCornerThatNamesIt", small_job,
+      {"BodyHeldOnlyAgainstTranslationsRotatesAboutTheCornerThatNamesIt",
+       small_job,
        {replace("/bodies/1/boundary", json::parse(R"([{"edge": "bottom", "displacement": {"x": 0}},
                                                       {"edge": "left", "displacement": {"y": 0}}])")),
         remove("/contacts")},
-       "/bodies/1/boundary", "rotation about (0, -1) is free"},
-      {"RigidMotionIsNotCheckedForABodyWithOtherErrors", small_job,
+       "/bodies/1/boundary",
+       "rotation about (0, -1) is free"},
+      {"RigidMotionIsNotCheckedForABodyWithOtherErrors",
+       small_job,
        {remove("/bodies/1/boundary/0"), replace("/bodies/1/material/E", -1)},
-       "/bodies/1/material/E", "must be positive"},
+       "/bodies/1/material/E",
+       "must be positive"},
 
       // Contacts.
-      {"UnknownBodyInContactListsTheBodies", small_job, {replace("/contacts/0/slave", "uper.bottom")},
-       "/contacts/0/slave", "there is no body named 'uper'; the bodies are upper and lower"},
-      {"UnknownEdgeInContactIsRejected", small_job, {replace("/contacts/0/master", "lower.tip")},
-       "/contacts/0/master", "body 'lower' has no edge 'tip'"},
-      {"ContactReferenceWithoutADotIsMalformed", small_job, {replace("/contacts/0/slave", "upper")},
-       "/contacts/0/slave", "must be \"body.edge\""},
-      {"BodyCannotBeInContactWithItself", small_job, {replace("/contacts/0/master", "upper.top")},
-       "/contacts/0", "a body cannot be in contact with itself"},
-      {"SamePairTwiceIsRejected", small_job,
+      {"UnknownBodyInContactListsTheBodies",
+       small_job,
+       {replace("/contacts/0/slave", "uper.bottom")},
+       "/contacts/0/slave",
+       "there is no body named 'uper'; the bodies are upper and lower"},
+      {"UnknownEdgeInContactIsRejected",
+       small_job,
+       {replace("/contacts/0/master", "lower.tip")},
+       "/contacts/0/master",
+       "body 'lower' has no edge 'tip'"},
+      {"ContactReferenceWithoutADotIsMalformed",
+       small_job,
+       {replace("/contacts/0/slave", "upper")},
+       "/contacts/0/slave",
+       "must be \"body.edge\""},
+      {"BodyCannotBeInContactWithItself",
+       small_job,
+       {replace("/contacts/0/master", "upper.top")},
+       "/contacts/0",
+       "a body cannot be in contact with itself"},
+      {"SamePairTwiceIsRejected",
+       small_job,
        {add("/contacts/-", {{"slave", "upper.bottom"}, {"master", "lower.top"}, {"name", "again"}})},
-       "/contacts/1", "already given at /contacts/0"},
-      {"SamePairTwiceIsRejectedWithSlaveAndMasterSwapped", small_job,
+       "/contacts/1",
+       "already given at /contacts/0"},
+      {"SamePairTwiceIsRejectedWithSlaveAndMasterSwapped",
+       small_job,
        {add("/contacts/-", {{"slave", "lower.top"}, {"master", "upper.bottom"}})},
-       "/contacts/1", "slave and master swapped"},
+       "/contacts/1",
+       "slave and master swapped"},
 
       // The job's own fields.
       {"UnsupportedVersionIsRejected", small_job, {add("/version", 2)}, "/version", "version 2 is not supported"},
-      {"UnknownTopLevelFieldIsRejectedWithASuggestion", small_job, {add("/solvr", json::object())},
-       "/solvr", "unknown field 'solvr' in the job (did you mean 'solver'?)"},
-      {"UnknownFieldNamesAreEscapedInThePointer", small_job, {add("/a~1b~0c", 1)},  // the field "a/b~c"
-       "/a~1b~0c", "unknown field 'a/b~c'"},
+      {"UnknownTopLevelFieldIsRejectedWithASuggestion",
+       small_job,
+       {add("/solvr", json::object())},
+       "/solvr",
+       "unknown field 'solvr' in the job (did you mean 'solver'?)"},
+      {"UnknownFieldNamesAreEscapedInThePointer",
+       small_job,
+       {add("/a~1b~0c", 1)},  // the field "a/b~c"
+       "/a~1b~0c",
+       "unknown field 'a/b~c'"},
 
       // Solver.
-      {"BothThetaAndCAreRejected", small_job, {add("/solver", {{"penalty", {{"theta", 1e-7}, {"c", 0.05}}}})},
-       "/solver/penalty", "give either theta, or c"},
-      {"GammaOfTwoIsOutsideTheOpenInterval", small_job, {add("/solver", {{"gamma", 2}})},
-       "/solver/gamma", "gamma = 2 is outside (0, 2)"},
-      {"UnknownMethodListsTheChoices", small_job, {add("/solver", {{"method", "uzawa"}})},
+      {"BothThetaAndCAreRejected",
+       small_job,
+       {add("/solver", {{"penalty", {{"theta", 1e-7}, {"c", 0.05}}}})},
+       "/solver/penalty",
+       "give either theta, or c"},
+      {"GammaOfTwoIsOutsideTheOpenInterval",
+       small_job,
+       {add("/solver", {{"gamma", 2}})},
+       "/solver/gamma",
+       "gamma = 2 is outside (0, 2)"},
+      {"UnknownMethodListsTheChoices",
+       small_job,
+       {add("/solver", {{"method", "uzawa"}})},
        "/solver/method",
        "method \"uzawa\" is not one of \"neumann\", \"monolithic\", \"interface_newton\" and \"robin\""},
       // Combinations that cannot run.
-      {"ExactEnforcementWithTheNeumannMethod", small_job,
+      {"ExactEnforcementWithTheNeumannMethod",
+       small_job,
        {add("/solver", {{"method", "neumann"}, {"enforcement", "exact"}})},
-       "/solver/enforcement", "penalty problem"},
-      {"ExactEnforcementWithTheRobinMethod", small_job,
+       "/solver/enforcement",
+       "penalty problem"},
+      {"ExactEnforcementWithTheRobinMethod",
+       small_job,
        {add("/solver", {{"method", "robin"}, {"enforcement", "exact"}})},
-       "/solver/enforcement", "penalty problem"},
-      {"PaperStrategyWithTheInterfaceNewtonMethod", small_job,
+       "/solver/enforcement",
+       "penalty problem"},
+      {"PaperStrategyWithTheInterfaceNewtonMethod",
+       small_job,
        {add("/solver", {{"method", "interface_newton"}}), add("/adaptivity", {{"strategy", "paper"}})},
-       "/solver/method", "needs method \"neumann\""},
-      {"PaperStrategyWithExactEnforcement", small_job,
+       "/solver/method",
+       "needs method \"neumann\""},
+      {"PaperStrategyWithExactEnforcement",
+       small_job,
        {add("/solver", {{"enforcement", "exact"}}), add("/adaptivity", {{"strategy", "paper"}})},
-       "/solver/enforcement", "must be \"penalty\""},
+       "/solver/enforcement",
+       "must be \"penalty\""},
 
       // Adaptivity.
-      {"AdaptivityWithAnUnknownBodyNamesTheBodies", small_job,
+      {"AdaptivityWithAnUnknownBodyNamesTheBodies",
+       small_job,
        {add("/adaptivity", {{"indicator", "fem_bem"}, {"bodies", {"lower", "middle"}}})},
-       "/adaptivity/bodies/1", "unknown body 'middle'; the bodies are upper and lower"},
-      {"AdaptivityWithAnUnknownIndicatorListsTheChoices", small_job, {add("/adaptivity", {{"indicator", "residual"}})},
-       "/adaptivity/indicator", "\"fem_bem\""},
+       "/adaptivity/bodies/1",
+       "unknown body 'middle'; the bodies are upper and lower"},
+      {"AdaptivityWithAnUnknownIndicatorListsTheChoices",
+       small_job,
+       {add("/adaptivity", {{"indicator", "residual"}})},
+       "/adaptivity/indicator",
+       "\"fem_bem\""},
   };
 }
 
@@ -537,8 +647,10 @@ TEST(JobErrors, AWrongChoiceStringIsShownShortened) {
   for (const char* field : {"gamma", "robin"}) {
     json job = small_job();
     const std::string huge(100000, 'x');
-    if (std::string(field) == "gamma") job["solver"]["gamma"] = huge;
-    else job["solver"] = {{"method", "robin"}, {"robin", {{"psi", huge}}}};
+    if (std::string(field) == "gamma")
+      job["solver"]["gamma"] = huge;
+    else
+      job["solver"] = {{"method", "robin"}, {"robin", {{"psi", huge}}}};
     const ParseResult r = parse(job);
     ASSERT_EQ(r.errors.size(), 1u) << listing(r);
     EXPECT_LT(r.errors[0].message.size(), 300u) << field;
@@ -560,18 +672,38 @@ TEST(JobErrors, AdaptivityStopToleranceMustBeARelativeChangeBelowOne) {
   EXPECT_EQ(r.problem->normalized["adaptivity"]["stop_tolerance"], 0.0);
 }
 
-TEST(JobErrors, AdaptivityMarkingIsContactOrPlainAndGradingNonNegative) {
+TEST(JobErrors, AdaptivityMarkingIsGoalContactOrPlainAndGradingNonNegative) {
   json job = small_job();
   job["adaptivity"] = {{"marking", "dorfler"}};
-  expect_only_error(parse(job), "/adaptivity/marking", "\"contact\"");
+  expect_only_error(parse(job), "/adaptivity/marking", "\"goal\"");
   job["adaptivity"] = {{"grading", -0.5}};
   expect_only_error(parse(job), "/adaptivity/grading", "must be >= 0");
+  // The default: "goal" where the pressure estimate can be made (fem_bem, converge_then_refine, a domain
+  // decomposition method) and no delta is given; "contact" otherwise, never an error.
   job["adaptivity"] = json::object();
   ParseResult r = parse(job);
   ASSERT_TRUE(r.ok()) << listing(r);
-  EXPECT_EQ(r.problem->adaptivity.marking, contact::MarkingRule::contact);
+  EXPECT_EQ(r.problem->adaptivity.marking, contact::MarkingRule::goal);
   EXPECT_EQ(r.problem->adaptivity.grading, 0.0);
-  EXPECT_EQ(r.problem->normalized["adaptivity"]["marking"], "contact");
+  EXPECT_EQ(r.problem->normalized["adaptivity"]["marking"], "goal");
+  for (const json& other : {json{{"delta", 0.05}}, json{{"indicator", "zz"}}}) {
+    job["adaptivity"] = other;
+    r = parse(job);
+    ASSERT_TRUE(r.ok()) << listing(r);
+    EXPECT_EQ(r.problem->adaptivity.marking, contact::MarkingRule::contact) << other.dump();
+    EXPECT_EQ(r.problem->normalized["adaptivity"]["marking"], "contact") << other.dump();
+  }
+  job["adaptivity"] = json::object();
+  job["solver"] = {{"method", "monolithic"}};
+  r = parse(job);
+  ASSERT_TRUE(r.ok()) << listing(r);
+  EXPECT_EQ(r.problem->adaptivity.marking, contact::MarkingRule::contact);
+  // Named where the estimate cannot be made: an error saying what it needs.
+  job["adaptivity"] = {{"marking", "goal"}};
+  expect_only_error(parse(job), "/adaptivity/marking", "a domain-decomposition method");
+  job.erase("solver");
+  job["adaptivity"] = {{"marking", "goal"}, {"indicator", "zz"}};
+  expect_only_error(parse(job), "/adaptivity/marking", "the fem_bem indicator");
   job["adaptivity"] = {{"marking", "plain"}, {"grading", 0.25}};
   r = parse(job);
   ASSERT_TRUE(r.ok()) << listing(r);
@@ -624,7 +756,8 @@ TEST(JobErrors, AFloatingBodyThatSlidesAlongItsFlatFrictionlessContactIsRefusedA
   expect_only_error(parse(job), "/bodies/1/boundary",
                     "body 'lower' floats (translation in x is free) and its frictionless contacts "
                     "'upper.bottom-lower.top' cannot hold it");
-  EXPECT_NE(listing(parse(job)).find("translation in x (it slides along them)"), std::string::npos) << listing(parse(job));
+  EXPECT_NE(listing(parse(job)).find("translation in x (it slides along them)"), std::string::npos)
+      << listing(parse(job));
 }
 
 TEST(JobErrors, TheNaiveRollerNamesThePlatesSlidingAndTheRollersSpinNotTheLoads) {
@@ -684,17 +817,21 @@ TEST(JobBoundary, VertexConditionsForcesAndLoadingAreReadAndBadOnesNamed) {
                                   {{"vertex", "bottom_left"}, {"force", {0, 2}}}};
   r = parse(bad);
   const std::string text = listing(r);
-  EXPECT_NE(text.find("/bodies/0/boundary/0/vertex: the body has no vertex 'middle'; its vertices are"), std::string::npos) << text;
+  EXPECT_NE(text.find("/bodies/0/boundary/0/vertex: the body has no vertex 'middle'; its vertices are"),
+            std::string::npos)
+      << text;
   EXPECT_NE(text.find("/bodies/0/boundary/1: a vertex takes a displacement"), std::string::npos) << text;
   EXPECT_NE(text.find("/bodies/0/boundary/2: give exactly one of edge"), std::string::npos) << text;
-  EXPECT_NE(text.find("/bodies/0/boundary/4/vertex: vertex 'bottom_left' already has a condition at /bodies/0/boundary/3"),
-            std::string::npos) << text;
+  EXPECT_NE(
+      text.find("/bodies/0/boundary/4/vertex: vertex 'bottom_left' already has a condition at /bodies/0/boundary/3"),
+      std::string::npos)
+      << text;
   // Loading: both forms, none, a non-positive factor, too many steps, and load steps with adaptivity.
-  for (const auto& [loading, words] : std::vector<std::pair<json, std::string>>{
-           {{{"steps", 2}, {"factors", {1}}}, "give either steps"},
-           {json::object(), "give either steps"},
-           {{{"factors", {0.5, -1}}}, "/loading/factors/1"},
-           {{{"steps", 5000}}, "steps = 5000 is too large"}}) {
+  for (const auto& [loading, words] :
+       std::vector<std::pair<json, std::string>>{{{{"steps", 2}, {"factors", {1}}}, "give either steps"},
+                                                 {json::object(), "give either steps"},
+                                                 {{{"factors", {0.5, -1}}}, "/loading/factors/1"},
+                                                 {{{"steps", 5000}}, "steps = 5000 is too large"}}) {
     json j = small_job();
     j["loading"] = loading;
     EXPECT_NE(listing(parse(j)).find(words), std::string::npos) << loading.dump() << ": " << listing(parse(j));
@@ -730,7 +867,8 @@ TEST(JobBoundary, ExplicitMeshVerticesTakePointLoadsAndBadOnesAreNamed) {
   bad["bodies"][1]["mesh"]["vertices"] = {{"corner", 9}, {"b.d", 1}};
   bad["bodies"][1]["boundary"].erase(2);
   const std::string text = listing(parse(bad));
-  EXPECT_NE(text.find("/bodies/1/mesh/vertices/corner: vertex 'corner' node index = 9 is out of range"), std::string::npos)
+  EXPECT_NE(text.find("/bodies/1/mesh/vertices/corner: vertex 'corner' node index = 9 is out of range"),
+            std::string::npos)
       << text;
   EXPECT_NE(text.find("/bodies/1/mesh/vertices/b.d"), std::string::npos) << text;
   bad = job;
@@ -1109,8 +1247,8 @@ json row_of_blocks(int bodies) {
          {"mesh", {{"block", {{"corners", {{0, y}, {1, y}, {1, y + 1}, {0, y + 1}}}, {"nx", 1}, {"ny", 1}}}}},
          {"boundary", {{{"edge", "bottom"}, {"displacement", {{"x", 0}, {"y", 0}}}}}}});
     if (k > 0)
-      job["contacts"].push_back({{"slave", "b" + std::to_string(k) + ".bottom"},
-                                 {"master", "b" + std::to_string(k - 1) + ".top"}});
+      job["contacts"].push_back(
+          {{"slave", "b" + std::to_string(k) + ".bottom"}, {"master", "b" + std::to_string(k - 1) + ".top"}});
   }
   return job;
 }
@@ -1294,7 +1432,8 @@ TEST(JobHistory, AConditionsHistoryHasOneFactorPerLoadStep) {
   ASSERT_TRUE(r.ok()) << listing(r);
   EXPECT_EQ(r.problem->bodies[0].boundary[1].history, (std::vector<double>{1, 0, 2}));
   job["loading"] = {{"steps", 2}};
-  expect_only_error(parse(job), "/bodies/0/boundary/1/history", "history has 3 load factors but the job has 2 load steps");
+  expect_only_error(parse(job), "/bodies/0/boundary/1/history",
+                    "history has 3 load factors but the job has 2 load steps");
   job["bodies"][0]["boundary"][1]["history"] = json::array();
   expect_only_error(parse(job), "/bodies/0/boundary/1/history", "non-empty array");
   job["bodies"][0]["boundary"][1]["history"] = {1, "two"};
@@ -1304,8 +1443,9 @@ TEST(JobHistory, AConditionsHistoryHasOneFactorPerLoadStep) {
   job["adaptivity"] = {{"indicator", "zz"}};  // converge_then_refine solves the (one-step) path on each mesh
   EXPECT_TRUE(parse(job).ok()) << listing(parse(job));
   job["adaptivity"] = {{"strategy", "paper"}};
-  EXPECT_NE(listing(parse(job)).find("/bodies/0/boundary/1/history: a load history needs load steps, which the "
-                                     "adaptive strategy \"paper\" does not take"),
+  EXPECT_NE(listing(parse(job))
+                .find("/bodies/0/boundary/1/history: a load history needs load steps, which the "
+                      "adaptive strategy \"paper\" does not take"),
             std::string::npos)
       << listing(parse(job));
 }

@@ -205,7 +205,24 @@ TEST(ProgressJson, AnAdaptiveStepCarriesItsEstimatesAndAnEstimateThatCouldNotBeM
   EXPECT_EQ(j["pressure_estimate"], 0.0012);
   EXPECT_EQ(j["estimate"], 0.03);
   EXPECT_FALSE(j.contains("type"));  // the writer names it (contact-solve's line, contactd's event)
+  // The changes the stop test reads, and the step they are read against.
+  r.compared_with = 1;
+  r.force_change = 0.001;
+  r.extent_change = 0.002;
+  r.stick_change = 0.003;
+  r.tangential_change = 0.004;
+  const nlohmann::json changes = contact::io::adaptive_step_json(r);
+  EXPECT_EQ(changes["compared_with"], 1);
+  EXPECT_EQ(changes["force_change"], 0.001);
+  EXPECT_EQ(changes["extent_change"], 0.002);
+  EXPECT_EQ(changes["stick_change"], 0.003);
+  EXPECT_EQ(changes["tangential_change"], 0.004);
   r.pressure_estimate = std::nan("");  // the zz indicator: no estimate
+  r.compared_with = -1;                // no step with half the unknowns yet: no changes
+  r.force_change = r.peak_change = r.extent_change = r.stick_change = r.tangential_change = std::nan("");
   const nlohmann::json line = nlohmann::json::parse(contact::io::adaptive_step_json(r).dump());
   EXPECT_TRUE(line["pressure_estimate"].is_null());
+  EXPECT_EQ(line["compared_with"], -1);
+  EXPECT_TRUE(line["force_change"].is_null());
+  EXPECT_TRUE(line["stick_change"].is_null());
 }

@@ -233,8 +233,12 @@ enum class AdaptStrategy { paper, converge_then_refine };
 enum class Normalization { rms, area };
 // Which cells over delta are refined (docs/algorithm.md, "Marking that serves the contact"): plain = all of them
 // (the paper); contact = the cells along the contact zones held to a tighter delta, and with grading > 0 none
-// already smaller than grading x their distance to the nearest zone.
-enum class MarkingRule { contact, plain };
+// already smaller than grading x their distance to the nearest zone; goal = not by delta: Doerfler's marking of the
+// cells holding half the pressure estimate's correction (adapt/goal_marking.hpp, as with a target_error), where
+// that estimate can be made (else as contact). The job reader's default is goal for the fem_bem indicator with
+// converge_then_refine and a domain-decomposition method when the job gives no delta, contact otherwise; a
+// Problem built in code has contact.
+enum class MarkingRule { contact, plain, goal };
 
 struct AdaptivitySettings {
   bool enabled = false;
@@ -260,8 +264,10 @@ struct AdaptivitySettings {
   double max_kept_nodes = 0;
   AdaptStrategy strategy = AdaptStrategy::converge_then_refine;
   int max_steps = 20;  // refinement steps (converge_then_refine)
-  // converge_then_refine stops once a step changed the total contact force, the peak contact pressure and the
-  // global estimate each by less than this, relatively (0: never stop for that reason).
+  // converge_then_refine stops once the answer has settled to this (adapt/settled.hpp): each pair's force, peak
+  // pressure, contact zone's ends and, with friction, stick zone's ends and tangential force changed by less than
+  // this, relatively, against the last step with at most half the unknowns, at two steps in a row (0: never stop for
+  // that reason).
   double stop_tolerance = 0.005;
   // converge_then_refine stops at the first step whose estimated relative error of the contact pressure
   // (adapt/pressure_estimate.hpp) is at most this; where nothing is marked before, delta is halved (0: no target).

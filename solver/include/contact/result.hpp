@@ -186,6 +186,10 @@ struct StepSummary {
 // The step's scalars; the contact zone interpolated between nodes (solver/contact_extent.hpp; 0, 0 if none).
 StepSummary summarize(const Step& step);
 
+// The length of a pair's slave edge where it is a closed loop (its closing segment, from the last node back to
+// the first, included), else 0.
+double slave_loop_length(const Step& step, const PairField& pair);
+
 // How a run ended and what it cost: what every level of a run builds (ddm::MethodOutcome adds the answer it carries
 // between levels) and the Result reports, so the one is handed to the other whole.
 struct RunOutcome {
@@ -325,7 +329,13 @@ struct AdaptiveStepReport {
   double estimate = 0.0;       // global: sqrt(sum ||sigma_R - sigma_F||^2 / sum ||sigma_R||^2) over the adaptive bodies
   double force = 0.0;          // total normal contact force, all pairs
   double peak_pressure = 0.0;  // largest contact pressure, all pairs
-  double force_change = 0.0, peak_change = 0.0, estimate_change = 0.0;
+  // The changes the stop test reads (adapt/settled.hpp), against step `compared_with` (the last with at most half
+  // the unknowns; -1 and NaN changes before there is one): the largest over the pairs of each pair's force and peak
+  // pressure (relative to the largest pair's), of its contact zone's ends and stick zone's ends (relative to the
+  // zone's width), of its tangential force; and the global estimate's (reported, not tested).
+  int compared_with = -1;
+  double force_change = 0.0, peak_change = 0.0, extent_change = 0.0, stick_change = 0.0, tangential_change = 0.0;
+  double estimate_change = 0.0;
   // The estimated relative L2 error of the contact pressure over all pairs (adapt/pressure_estimate.hpp); NaN
   // where it cannot be made (the zz indicator, a cancel).
   double pressure_estimate = 0.0;
