@@ -120,6 +120,8 @@ class Progress:
             self._line(f"step {num(e.get('step'), 'd')} at iteration {num(e.get('iteration'), 'd')}: {bodies}")
         elif t == "load_step":
             self._line(load_step_words(e))
+        elif t == "adaptive_step":
+            self._line(adaptive_step_words(e))
         elif t == "end":
             if self.bar is not None:
                 self.bar.refresh()
@@ -130,6 +132,22 @@ class Progress:
             msg = f": {word(e['message'], 500)}" if e.get("message") else ""
             self._line(f"end {word(e.get('state'))} ({conv}) after {num(e.get('iterations'), 'd')} "
                        f"iterations, {num(e.get('solve_seconds', 0), '.3g')} s{msg}")
+
+
+def adaptive_step_words(e):
+    """An adaptive_step event in words: the step's unknowns, its estimated pressure error and, once there is a step
+    with at most half its unknowns, the largest change the stop test reads against it (docs/job-format.md, "What
+    the defaults aim at")."""
+    unknowns = sum(b.get("unknowns", 0) for b in dicts(e.get("bodies")) if isinstance(b.get("unknowns"), int))
+    text = f"adaptive step {num(e.get('step'), 'd')}: {unknowns} unknowns"
+    if isinstance(e.get("pressure_estimate"), (int, float)):
+        text += f", pressure error ~{num(100 * e['pressure_estimate'], '.3g')} %"
+    changes = [e.get(k) for k in ("force_change", "peak_change", "extent_change", "stick_change", "tangential_change")]
+    changes = [c for c in changes if isinstance(c, (int, float)) and not isinstance(c, bool)]
+    compared = e.get("compared_with")
+    if isinstance(compared, int) and compared >= 0 and changes:
+        text += f"; against step {compared}: the answer changed by at most {num(100 * max(changes), '.2g')} %"
+    return text
 
 
 def load_step_words(e):

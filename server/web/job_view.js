@@ -230,8 +230,14 @@ export class JobView {
         const unknowns = (Array.isArray(e.bodies) ? e.bodies : []).reduce((n, b) => n + (b.unknowns || 0), 0);
         const pressure = typeof e.pressure_estimate === "number"
           ? `, pressure error ~${(100 * e.pressure_estimate).toPrecision(3)} %` : "";
+        // The largest change the stop test reads, against the last step with at most half the unknowns.
+        const changes = ["force_change", "peak_change", "extent_change", "stick_change", "tangential_change"]
+          .map((k) => e[k]).filter((c) => typeof c === "number");
+        const settled = Number.isInteger(e.compared_with) && e.compared_with >= 0 && changes.length
+          ? `; against step ${e.compared_with}: the answer changed by at most ` +
+            `${(100 * Math.max(...changes)).toPrecision(2)} %` : "";
         this.log(`adaptive step ${e.step}: ${unknowns} unknowns, estimate ${Number(e.estimate).toPrecision(3)}` +
-                 `${pressure}`);
+                 `${pressure}${settled}`);
         break;
       }
       case "load_step": {

@@ -611,7 +611,25 @@ def test_token(tmp):
         check("token: module submit and wait", c.wait(job["id"]).get("state") == "SUCCEEDED")
 
 
+def test_adaptive_step_words():
+    """The progress display's words for an adaptive step (issue 50): the unknowns over the bodies, the estimated
+    pressure error, and the largest change the stop test reads against the step it names; nothing of the changes
+    before there is such a step (null in the event)."""
+    event = {"type": "adaptive_step", "step": 5, "bodies": [{"unknowns": 1200}, {"unknowns": 800}],
+             "pressure_estimate": 0.0042, "compared_with": 2, "force_change": 0.001, "peak_change": 0.0031,
+             "extent_change": 0.0007, "stick_change": None, "tangential_change": None}
+    words = cc.display.adaptive_step_words(event)
+    check("adaptive step words: unknowns summed, pressure error, the largest change and its step",
+          words == "adaptive step 5: 2000 unknowns, pressure error ~0.42 %; against step 2: the answer changed by at "
+                   "most 0.31 %", words)
+    first = cc.display.adaptive_step_words(dict(event, step=0, compared_with=-1, force_change=None, peak_change=None,
+                                                extent_change=None, pressure_estimate=None))
+    check("adaptive step words before a step to compare with: no changes, no estimate",
+          first == "adaptive step 0: 2000 unknowns", first)
+
+
 def main():
+    test_adaptive_step_words()
     if not os.path.exists(harness.CONTACTD):
         check(f"contactd not built: {harness.CONTACTD}", False)
         finish()
