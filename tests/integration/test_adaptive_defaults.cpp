@@ -38,7 +38,13 @@ Result defaults_against_target(json job, const std::function<double(const Step&)
   job["adaptivity"] = json::object();
   const Result d = run(job);
   EXPECT_TRUE(d.converged) << name << ": " << d.message;
-  EXPECT_NE(d.message.find("the answer settled"), std::string::npos) << name << ": " << d.message;
+  // Stopped by itself: the answer settled, or the level limit left nothing of the pressure's error to refine
+  // (Cattaneo-Mindlin from 20 x 4: its contact zone is narrower than one first cell, and its stick-slip points reach
+  // level 8 about when the answer settles, so either stop comes first from run to run; docs/algorithm.md,
+  // "Reproducibility").
+  EXPECT_TRUE(d.message.find("the answer settled") != std::string::npos ||
+              d.message.find("cells at max_level not refined") != std::string::npos)
+      << name << ": " << d.message;
   if (d.steps.empty()) return d;
   const double e = error(d.steps.back());
   const long n = mesh_unknowns(d.steps.back());

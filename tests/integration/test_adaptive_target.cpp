@@ -223,8 +223,9 @@ TEST(AdaptiveTarget, TheJobNamesATargetOnlyWhereTheEstimateCanBeMade) {
   job["adaptivity"]["stop_tolerance"] = 0.01;
   EXPECT_EQ(job::parse(job).problem->adaptivity.stop_tolerance, 0.01);
   // And max_level is 12 (the contact edges' share of the error falls with their cells) and max_steps 30, unless
-  // the job sets them; so without a target under the default marking ("goal", which refines as a target does),
-  // and 8 and 20 under the indicator's marking (a delta given).
+  // the job sets them. Without a target max_level stays 8 (a singular peak, a punch's corner, would take the goal
+  // marking to the limit), max_steps is 30 under the default marking ("goal", which refines as a target does) and 20
+  // under the indicator's marking (a delta given).
   EXPECT_EQ(parsed.problem->adaptivity.max_level, 12);
   EXPECT_EQ(parsed.problem->normalized["adaptivity"]["max_level"], 12);
   EXPECT_EQ(parsed.problem->adaptivity.max_steps, 30);
@@ -234,7 +235,8 @@ TEST(AdaptiveTarget, TheJobNamesATargetOnlyWhereTheEstimateCanBeMade) {
   EXPECT_EQ(job::parse(job).problem->adaptivity.max_steps, 7);
   job["adaptivity"] = json::object();
   EXPECT_EQ(job::parse(job).problem->adaptivity.marking, MarkingRule::goal);
-  EXPECT_EQ(job::parse(job).problem->adaptivity.max_level, 12);
+  EXPECT_EQ(job::parse(job).problem->adaptivity.max_level, 8);
+  EXPECT_EQ(job::parse(job).problem->adaptivity.max_steps, 30);
   job["adaptivity"] = {{"delta", 0.1}};
   EXPECT_EQ(job::parse(job).problem->adaptivity.marking, MarkingRule::contact);
   EXPECT_EQ(job::parse(job).problem->adaptivity.max_level, 8);
