@@ -96,9 +96,11 @@ std::string settled_message(const FrictionData& d, const QpSolution& out, int ou
   os << "FETI (projected MPRGP on the box, SMALBE) with " << (d.coulomb ? "Coulomb" : "Tresca")
      << " friction converged: " << out.inner_iterations << " MPRGP iterations";
   if (d.coulomb) os << " in " << outer << " outer iterations on the slip bounds";
-  os << " (" << smalbe.face_steps() << " of them in CG on settled faces; " << active << " nodes in contact: " << stick
-     << " sticking, " << slip << " slipping; F products " << smalbe.seconds_F() << " s, coarse projections "
-     << smalbe.seconds_coarse() << " s)";
+  const linalg::MprgpResult& steps = smalbe.mprgp_steps();
+  os << " (" << smalbe.face_steps() << " of them in CG on settled faces; MPRGP's own steps " << steps.cg_steps
+     << " CG, " << steps.expansion_steps << " expansion, " << steps.proportioning_steps << " proportioning; " << active
+     << " nodes in contact: " << stick << " sticking, " << slip << " slipping; F products " << smalbe.seconds_F()
+     << " s, coarse projections " << smalbe.seconds_coarse() << " s)";
   return os.str();
 }
 

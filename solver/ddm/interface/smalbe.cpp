@@ -211,6 +211,9 @@ void Smalbe::solve(const Bounds& bounds, const Eigen::VectorXd* z0, const Solve&
     last_inner_ = linalg::solve_mprgp(bound_, x, inner, done);
     const linalg::MprgpResult& r = last_inner_;
     out.inner_iterations += r.report.iterations;
+    steps_.cg_steps += r.cg_steps;
+    steps_.expansion_steps += r.expansion_steps;
+    steps_.proportioning_steps += r.proportioning_steps;
     x = r.x;
     out.report.iterations = outer;
     // A face that the last inner solve kept throughout (CG steps only) after a multiplier update: solved on the

@@ -44,6 +44,9 @@ class Smalbe {
   double seconds_F() const { return seconds_F_; }
   double seconds_coarse() const { return seconds_coarse_; }
   long face_steps() const { return face_steps_; }  // products with F in CG on settled faces (in inner_iterations)
+  // MPRGP's own steps over the object's life, by kind: where the products go when they grow with the mesh (on a
+  // 16 x 16 wall from 4 to 16 cells a brick the face CG stayed flat and these grew 3x; docs/friction-solvers.md).
+  const linalg::MprgpResult& mprgp_steps() const { return steps_; }
   const linalg::MprgpResult& last_inner() const { return last_inner_; }
 
  private:
@@ -71,6 +74,7 @@ class Smalbe {
   Eigen::VectorXd range_;  // Q x of the last x apply_A took
   double rho_ = 1.0, norm_A_ = 1.0, norm_PHP_ = 1.0;
   long face_steps_ = 0;                            // products with H in solve_face, over the object's life
+  linalg::MprgpResult steps_;                      // its cg_steps, expansion_steps, proportioning_steps summed
   double seconds_F_ = 0.0, seconds_coarse_ = 0.0;  // products with F (and their sum over processes), P and Q
   bool ready_ = false;
   linalg::BoundQp bound_;
