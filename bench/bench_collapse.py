@@ -8,7 +8,8 @@ of the bisection), the wall time, and the cost of the last held trial against th
 bound: a step far from the limit), in iterations and seconds. Against each, a plain solve of the same wall (the
 22 x 22 at H/V 0.3: the issue's yardstick), and the ratio.
 
-    bench/bench_collapse.py [BUILD_DIR] [--quick]      # --quick: without the 22 x 22 wall
+    bench/bench_collapse.py [BUILD_DIR] [--quick] [--verbose]
+      --quick: without the 22 x 22 wall; --verbose: each mechanism in words, and its check
 
 Prints a table; ratios from one run (the machine is noisy). Needs h5py (Debian's python3-h5py)."""
 import json
@@ -24,6 +25,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 SRC = os.path.join(HERE, "..")
 args = [a for a in sys.argv[1:] if not a.startswith("--")]
 QUICK = "--quick" in sys.argv
+VERBOSE = "--verbose" in sys.argv
 BUILD = args[0] if args else os.path.join(SRC, "build")
 CLI = os.path.join(BUILD, "contact-solve")
 sys.path.insert(0, os.path.join(SRC, "tests"))
@@ -47,7 +49,12 @@ def solve(job, tmp, name):
         c = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in g.attrs.items()}
         t = g["trials"]
         c["trials"] = list(zip(t["multiplier"][()], t["held"][()], t["iterations"][()], t["seconds"][()]))
-        c["kind"] = g["mechanism"].attrs["kind"]
+        m = g["mechanism"].attrs
+        c["kind"] = m["kind"] + (" (" + m["source"] + ")" if "source" in m else "")
+        c["words"] = m["words"]
+        c["check"] = m.get("check", "")
+        if "statics_mechanism" in g:
+            c["statics_kind"] = g["statics_mechanism"].attrs["kind"]
     os.remove(out)
     return c, seconds, ""
 
@@ -96,7 +103,7 @@ def main():
             cases.append(("22 x 22 wall", wall(22, tmp, "--collapse"), wall(22, tmp, "--shear", "0.3")))
         print(f"{'case':<34} {'verdict':>8} {'lambda_c':>9} {'bracket':>19} {'bound':>7} {'solves':>6} "
               f"{'bisect':>6} {'time s':>7} {'plain s':>7} {'ratio':>6} {'last/first it.':>14} {'last/first s':>12} "
-              f"{'mechanism':>11}", flush=True)
+              f"{'mechanism':>21} {'statics':>11}", flush=True)
         for label, job, plain in cases:
             c, seconds, error = solve(job, tmp, "case")
             if not c:
@@ -109,7 +116,10 @@ def main():
             print(f"{label:<34} {c['verdict']:>8} {mid:>9.4f} [{c['held']:.5f}, {c['failed']:.5f}] "
                   f"{c['statics_bound']:>7.4f} {c['solves']:>6} {c['bracket_solves']:>6} {seconds:>7.2f} "
                   f"{plain_s:>7.2f} {seconds / plain_s if plain else float('nan'):>6.1f} "
-                  f"{last[2]:>6}/{first[2]:<7} {last[3]:>5.2f}/{first[3]:<6.2f} {c['kind']:>11}", flush=True)
+                  f"{last[2]:>6}/{first[2]:<7} {last[3]:>5.2f}/{first[3]:<6.2f} {c['kind']:>21} "
+                  f"{c.get('statics_kind', ''):>11}", flush=True)
+            if VERBOSE:
+                print(f"    mechanism: {c['words']}\n    check: {c['check']}", flush=True)
 
 
 if __name__ == "__main__":

@@ -51,7 +51,9 @@ def print_collapse(collapse, out=None):
         out.write(f"  statics (rigid blocks, associated friction): lambda <= {bound:.6g}\n")
     mechanism = collapse.get("mechanism") or {}
     if mechanism.get("words"):
-        out.write(f"  mechanism: {word(mechanism['words'], 600)}\n")
+        whose = {"elastic": "the elastic solution's", "statics": "the rigid blocks' statics'"}.get(
+            word(mechanism.get("source")), "")
+        out.write(f"  mechanism{' (' + whose + ')' if whose else ''}: {word(mechanism['words'], 600)}\n")
 
 
 def _follow(c, job_id, a, warnings_shown=0):

@@ -140,7 +140,9 @@ def draw_mechanism(fig, ax, f, collapse):
                               label="centres of pressure at the last state that held"
                                     + (" (the thrust line)" if line["chain"] else "")))
     ax.legend(handles=handles, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.05), ncol=len(handles))
-    ax.set_title(f"mechanism ({m.get('kind') or 'none found'}): the statics' motion at its bound", fontsize=10)
+    whose = ("the elastic solution's motion into the last state that held" if m.get("source") == "elastic"
+             else "the rigid blocks' statics' motion at its bound")
+    ax.set_title(f"mechanism ({m.get('kind') or 'none found'}): {whose}", fontsize=10)
 
 
 def plot_collapse(path, png, body=None, point=None, title=None):

@@ -217,16 +217,21 @@ class ResultFile:
     def collapse(self):
         """A collapse analysis's answer, or the statics' verdict on a failed step (/collapse; docs/results-format.md):
         {"verdict", "held", "failed", "statics_bound", "solves", "words", ..., "trials": {"multiplier", "held",
-        "iterations", "seconds", "displacement"}, "mechanism": {"kind", "words",
+        "iterations", "seconds", "displacement"}, "mechanism": {"kind", "words", "source", "check",
         "body_names", "body_velocity", "body_omega", "body_reference", "body_centre", "pair_names", "joint_kind",
         "joint_point", ...}}, or None for a file without one."""
         if "collapse" not in self._f:
             return None
         g = self._f["collapse"]
         out = {k: _attr(v) for k, v in g.attrs.items()}
-        m = g["mechanism"]
-        out["mechanism"] = {k: _attr(v) for k, v in m.attrs.items()}
-        out["mechanism"].update({k: _dataset(item) for k, item in m.items()})
+        # "mechanism": the collapse's (its "source": "elastic", the elastic solution's own, or "statics"; its
+        # "check"); "statics_mechanism": the rigid-block statics' at its bound (files from before it: absent).
+        for name in ("mechanism", "statics_mechanism"):
+            if name not in g:
+                continue
+            m = g[name]
+            out[name] = {k: _attr(v) for k, v in m.attrs.items()}
+            out[name].update({k: _dataset(item) for k, item in m.items()})
         # Every trial: "multiplier", "held", "iterations", "seconds" and, at those that held, the live loads'
         # "displacement" (NaN elsewhere): the capacity curve's points.
         if "trials" in g:

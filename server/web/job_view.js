@@ -169,7 +169,8 @@ export class JobView {
       verdict += `; rigid-block statics: at most ${num(c.statics_bound)}`;
     $("collapse-verdict").textContent = verdict;
     const m = c.mechanism || {};
-    $("collapse-mechanism").textContent = m.words ? `mechanism: ${m.words}` : "";
+    const whose = m.source === "elastic" ? " (the elastic solution's)" : m.source === "statics" ? " (the rigid blocks' statics')" : "";
+    $("collapse-mechanism").textContent = m.words ? `mechanism${whose}: ${m.words}` : "";
     const rows = (c.trials || []).map((t, i) => {
       const tr = document.createElement("tr");
       const shift = typeof t.displacement === "number" ? t.displacement.toPrecision(4) : "";

@@ -255,6 +255,31 @@ std::string load_step_words(const nlohmann::json& e) {
   return text;
 }
 
+namespace {
+
+// A mechanism (limit/mechanism.hpp) as the job resource and the end event show it.
+nlohmann::json mechanism_json(const Mechanism& m) {
+  nlohmann::json bodies = nlohmann::json::array(), joints = nlohmann::json::array();
+  for (const auto& b : m.bodies)
+    bodies.push_back(
+        {{"body", b.body},
+         {"velocity", {b.velocity.x(), b.velocity.y()}},
+         {"omega", b.omega},
+         {"centre", std::isnan(b.centre.x()) ? nlohmann::json(nullptr) : nlohmann::json{b.centre.x(), b.centre.y()}},
+         {"words", b.words}});
+  for (const auto& j : m.joints)
+    joints.push_back({{"pair", j.pair},
+                      {"kind", j.kind},
+                      {"point", {j.point.x(), j.point.y()}},
+                      {"slip", j.slip},
+                      {"opening", j.opening},
+                      {"words", j.words}});
+  return {{"kind", m.kind},   {"words", m.words}, {"source", m.source},
+          {"check", m.check}, {"bodies", bodies}, {"joints", joints}};
+}
+
+}  // namespace
+
 nlohmann::json collapse_json(const CollapseResult& c) {
   if (!c.analysed) return nullptr;
   // JSON has no NaN or infinity: a bound or a failure not known is null, an unbounded statics "inf".
@@ -263,14 +288,6 @@ nlohmann::json collapse_json(const CollapseResult& c) {
     if (std::isinf(x)) return "inf";
     return x;
   };
-  nlohmann::json bodies = nlohmann::json::array(), joints = nlohmann::json::array();
-  for (const auto& b : c.mechanism.bodies)
-    bodies.push_back(
-        {{"body", b.body},
-         {"velocity", {b.velocity.x(), b.velocity.y()}},
-         {"omega", b.omega},
-         {"centre", std::isnan(b.centre.x()) ? nlohmann::json(nullptr) : nlohmann::json{b.centre.x(), b.centre.y()}},
-         {"words", b.words}});
   nlohmann::json trials = nlohmann::json::array();
   for (const auto& t : c.trials)
     trials.push_back({{"multiplier", t.multiplier},
@@ -278,13 +295,6 @@ nlohmann::json collapse_json(const CollapseResult& c) {
                       {"iterations", t.iterations},
                       {"seconds", t.seconds},
                       {"displacement", number(t.displacement)}});
-  for (const auto& j : c.mechanism.joints)
-    joints.push_back({{"pair", j.pair},
-                      {"kind", j.kind},
-                      {"point", {j.point.x(), j.point.y()}},
-                      {"slip", j.slip},
-                      {"opening", j.opening},
-                      {"words", j.words}});
   nlohmann::json thrust = nlohmann::json::array();
   for (const auto& t : c.thrust)
     thrust.push_back(
@@ -307,8 +317,8 @@ nlohmann::json collapse_json(const CollapseResult& c) {
           {"trials", trials},
           {"start_displacement", number(c.start_displacement)},
           {"thrust", thrust},
-          {"mechanism",
-           {{"kind", c.mechanism.kind}, {"words", c.mechanism.words}, {"bodies", bodies}, {"joints", joints}}}};
+          {"mechanism", mechanism_json(c.mechanism)},
+          {"statics_mechanism", mechanism_json(c.statics_mechanism)}};
 }
 
 }  // namespace contact::io

@@ -1,5 +1,6 @@
 #include "collapse.hpp"
 
+#include "elastic_mechanism.hpp"
 #include "mechanism.hpp"
 #include "statics.hpp"
 
@@ -114,7 +115,13 @@ void word_verdict(CollapseResult& c, const std::string& last_failure, const std:
       w += "; lambda_c is " + shown(100 * (1 - c.held / c.statics_bound)) +
            " % below that bound: non-associated friction collapses below it (sliding joints that cannot dilate), "
            "or the solver failed near the limit";
-    if (!c.mechanism.words.empty()) w += "; mechanism (rigid blocks, at the bound): " + c.mechanism.words;
+    if (c.mechanism.source == "elastic") {
+      w += "; mechanism (the elastic solution's, into the last held state): " + c.mechanism.words;
+      if (!c.statics_mechanism.words.empty() && c.statics_mechanism.kind != c.mechanism.kind)
+        w += "; the rigid blocks' at the bound (associated friction) is " + c.statics_mechanism.words;
+    } else if (!c.mechanism.words.empty()) {
+      w += "; mechanism (rigid blocks, at the bound): " + c.mechanism.words;
+    }
   } else if (c.verdict == "holds") {
     w = "no collapse up to max_multiplier = " + shown(c.held) + " (it held, after " + std::to_string(c.solves) +
         " trial solve" + (c.solves == 1 ? "" : "s") + ")";
@@ -160,7 +167,8 @@ class CollapseRun {
     statics_ = largest_multiplier(blocks, loads.dead, loads.live, frame_.stop_check());
     if (statics_.status == StaticsAnswer::Status::bounded) {
       out_.statics_bound = statics_.multiplier;
-      out_.mechanism = describe_mechanism(system_, blocks, statics_.velocity);
+      out_.statics_mechanism = describe_mechanism(system_, blocks, statics_.velocity);
+      out_.statics_mechanism.source = "statics";
       hi_ = statics_.multiplier * (1 + spec_.tolerance / 4);
     } else if (statics_.status == StaticsAnswer::Status::unbounded) {
       out_.statics_bound = std::numeric_limits<double>::infinity();
@@ -265,12 +273,31 @@ class CollapseRun {
     ddm::RunState& state = frame_.state();
     const MethodOutcome& total = frame_.outcome();
     state.slip_origin = system_.tangential_jumps(total.u);
+    before_ = std::move(held_.u);
     held_ = Held::of(total, state, lambda);
     Step step = ddm::step_of(system_, total, state);
     step.index = first_index_ + out_.solves - 1;
     step.load_factor = state.load.value();
     step.multiplier = lambda;
     steps_.push_back(std::move(step));
+  }
+
+  // The collapse's mechanism: the elastic states' own (the increment into the last held state) when it passes its
+  // check and the collapse was bracketed by a solve that failed, else the statics'.
+  void mechanism() {
+    out_.mechanism = out_.statics_mechanism;
+    if (out_.verdict != "collapse" || out_.solves == 0 || before_.empty() || steps_.empty()) return;
+    const RigidBlocks blocks = rigid_blocks(system_);
+    const Loads loads = loads_at(system_, blocks, frame_.state().load);
+    ElasticMechanism elastic = elastic_mechanism(system_, blocks, before_, held_.u, steps_.back(), loads.live);
+    if (elastic.admissible) {
+      out_.mechanism = std::move(elastic.mechanism);
+      out_.mechanism.check += "; the increment into the last held state is " + shown(100 * elastic.rigid_share) +
+                              " % rigid in the bodies that move, and the mechanism is its rigid part to a cosine of " +
+                              shown(elastic.kept);
+    } else if (!out_.mechanism.words.empty()) {
+      out_.mechanism.check = "the elastic states' mechanism was not taken: " + elastic.check;
+    }
   }
 
   // The answer: the last state that held, and the verdict in words.
@@ -281,6 +308,7 @@ class CollapseRun {
     out_.failed = hi_;
     out_.failed_by_statics = !std::isnan(hi_) && !solve_failed_;
     if (!stopped_.empty()) last_failure_ = stopped_;
+    mechanism();
     total.u = std::move(held_.u);
     total.z = std::move(held_.z);
     total.q = std::move(held_.q);
@@ -308,6 +336,7 @@ class CollapseRun {
   std::vector<Eigen::VectorXd> live_;  // the live loads at multiplier 1 of the bodies this process owns
   double live_magnitude_ = 0.0;        // sum of their nodal magnitudes over every body
   Held held_;
+  Displacements before_;  // the state that held before held_ (the increment into held_ shows the mechanism)
   int first_index_ = 0;
   double hi_ = std::numeric_limits<double>::quiet_NaN();  // the smallest multiplier known not to hold
   bool solve_failed_ = false;

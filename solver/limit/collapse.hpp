@@ -13,8 +13,9 @@
 //     the last held state (one increment: about one step's cost), until the bracket is `tolerance` relative.
 //
 // Every state that held is a result step with its multiplier (the capacity curve); the run's answer is the last
-// one. The verdict names the mechanism (mechanism.hpp) at the statics bound and the joints that open or slip at
-// the last held state.
+// one. The verdict names the mechanism: the elastic solution's own near the limit when it passes its check
+// (elastic_mechanism.hpp), else the statics' at its bound (mechanism.hpp), and the joints that open or slip at the
+// last held state.
 #pragma once
 
 #include "../ddm/load_steps.hpp"

@@ -163,8 +163,8 @@ Mechanism describe_mechanism(const ddm::ContactSystem& system, const RigidBlocks
   } else if (opens == joints) {
     m.kind = "lift-off";
     why = " (the loads pull them off their joints: is a load, or gravity, the wrong way?)";
-  } else if (slides == joints) {
-    m.kind = "sliding";
+  } else if (slides > 0 && slides + opens == joints) {
+    m.kind = "sliding";  // (joints that only open besides: head joints parting as the courses slide)
   } else if (hinges == joints) {
     m.kind = hinges == 1 ? "overturning" : "hinging";
   } else if (groups.size() == 1 && !std::isnan(m.bodies.front().centre.x())) {

@@ -96,7 +96,8 @@ RigidBlocks rigid_blocks(const ddm::ContactSystem& system) {
       JointRow row;
       row.pair = k;
       row.row = r;
-      row.point = slave_mesh.nodes[static_cast<size_t>(p.slave_nodes[static_cast<size_t>(p.node_of_row[r])])];
+      row.node = p.slave_nodes[static_cast<size_t>(p.node_of_row[r])];
+      row.point = slave_mesh.nodes[static_cast<size_t>(row.node)];
       row.normal = p.normal[static_cast<size_t>(r)];
       row.tangent =
           p.has_friction() ? p.tangent[static_cast<size_t>(r)] : Eigen::Vector2d(-row.normal.y(), row.normal.x());

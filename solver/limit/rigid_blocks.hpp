@@ -36,6 +36,7 @@ struct RigidBody {
 struct JointRow {
   size_t pair = 0;
   int row = 0;
+  int node = 0;                                      // the row's slave node (its index in the slave's mesh)
   Eigen::Vector2d point = Eigen::Vector2d::Zero();   // the row's slave node
   Eigen::Vector2d normal = Eigen::Vector2d::Zero();  // the slave's outward normal there (mortar/pair.hpp)
   Eigen::Vector2d tangent = Eigen::Vector2d::Zero();

@@ -22,6 +22,8 @@ CollapseResult judge_failed_step(const ddm::ContactSystem& system, const fem::Lo
       if (statics.multiplier < 1 - 1e-9) {
         out.verdict = "no_equilibrium";
         out.mechanism = describe_mechanism(system, blocks, statics.velocity);
+        out.mechanism.source = "statics";
+        out.statics_mechanism = out.mechanism;
         out.words =
             "no equilibrium by statics: the bodies as rigid blocks, with no-tension joints and their "
             "friction, carry at most " +

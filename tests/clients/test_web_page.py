@@ -404,7 +404,7 @@ def test_collapse(server, b):
     text = b.text("job-collapse")
     check("collapse: the view gives the bracket around 1/3, the bound and the overturning mechanism",
           bool(shown) and "held at 0.33325" in text and "did not at 0.33342" in text and "at most 0.33333" in text
-          and "overturning" in text, text)
+          and "overturning" in text and "mechanism (the elastic solution's): overturning" in text, text)
     # The capacity curve: the held trials' multiplier against the live loads' displacement (the job resource's
     # collapse.trials), drawn as a chart with one point per held trial; the table gives each displacement.
     trials = server.get(f"/v1/jobs/{job_id}").json()["collapse"]["trials"]

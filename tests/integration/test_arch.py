@@ -8,6 +8,10 @@ Milankovitch's problem for these voussoirs), and below it names the classical fi
 - 0.3 % thicker than the limit the arch stands (contact-solve exits 0, converged); 0.3 % thinner it fails, and the
   verdict is statics' (no equilibrium), not the solver's: the mechanism is hinging, with four or five hinges, each
   at a springing's or the crown's extrados or at a haunch joint's intrados, where the limit thrust line touches.
+- 1.2 times the limit thickness, pushed sideways by a live horizontal body force (a seismic coefficient lambda): the
+  collapse analysis's mechanism is the elastic solution's own (read off its last increment and contact sets) and
+  is the rigid blocks' statics' one, found independently by the linear program's dual: the same four hinges at the
+  same points (where no joint slides, associated and Coulomb friction give the same mechanism).
 
 Exits 1 on any failure."""
 import json
@@ -75,5 +79,41 @@ with tempfile.TemporaryDirectory() as tmp:
     matched = all(min(math.dist(e, f) for e in expected) < 1e-9 for f in found)
     check("each hinge is where the limit thrust line touches: springings and crown outside, haunches inside",
           matched and len(found) >= 4, (sorted(expected), sorted(found)))
+
+    job = arch.arch_job(N, 1.2 * t_min)
+    for body in job["bodies"]:
+        if body["name"].startswith("v"):
+            body["body_force"] = {"value": [10, 0], "live": True}
+    job["collapse"] = {}
+    path = os.path.join(tmp, "arch_collapse.json")
+    with open(path, "w") as f:
+        json.dump(job, f)
+    r = subprocess.run([CLI, path, "-o", os.path.join(tmp, "collapse.hdf"), "--progress", "ndjson"],
+                       capture_output=True, text=True, timeout=300)
+    results = [json.loads(line) for line in r.stdout.splitlines() if line.startswith('{')]
+    results = [line for line in results if line.get("type") == "result"]
+    c = (results[-1] if results else {}).get("collapse") or {}
+    check("pushed sideways, the arch collapses below the statics bound", r.returncode == 0 and
+          c.get("verdict") == "collapse" and c["failed"] <= c["statics_bound"] * (1 + c["tolerance"]),
+          (r.returncode, c.get("words", r.stderr[-300:])))
+    elastic, statics = c.get("mechanism") or {}, c.get("statics_mechanism") or {}
+
+    def hinges_of(m):
+        return sorted((j["pair"], tuple(round(x, 9) for x in j["point"])) for j in m.get("joints", [])
+                      if j["kind"] == "hinge")
+
+    check("its mechanism is the elastic solution's, checked admissible", elastic.get("source") == "elastic" and
+          elastic.get("check", "").startswith("admissible"), (elastic.get("source"), elastic.get("check")))
+    check("the elastic mechanism's four hinges are the statics' (the same joints, the same points)",
+          elastic.get("kind") == statics.get("kind") == "hinging" and len(hinges_of(elastic)) == 4 and
+          hinges_of(elastic) == hinges_of(statics), (elastic.get("words"), statics.get("words")))
+    same_motion = all(
+        any(b["body"] == s["body"] and abs(b["omega"] / elastic["bodies"][0]["omega"] -
+                                           s["omega"] / statics["bodies"][0]["omega"]) <= 1e-6
+            for s in statics.get("bodies", []))
+        for b in elastic.get("bodies", [])) and len(elastic.get("bodies", [])) == len(statics.get("bodies", []))
+    check("and the same motion: each body turning at the same rate relative to the first", same_motion,
+          ([(b["body"], b["omega"]) for b in elastic.get("bodies", [])],
+           [(b["body"], b["omega"]) for b in statics.get("bodies", [])]))
 
 finish()

@@ -90,6 +90,11 @@ TEST(Collapse, AColumnUnderAHorizontalBodyForceOverturnsAboutItsBaseToe) {
   ASSERT_TRUE(c.analysed);
   expect_bracket(c, 1.0 / 3.0);
   EXPECT_NEAR(c.statics_bound, 1.0 / 3.0, 1e-9);
+  // The mechanism is the elastic solution's own (its contact set at the last held state: the base bears at its toe
+  // only), made exact; here the rigid blocks' statics finds the same one.
+  EXPECT_EQ(c.mechanism.source, "elastic") << c.mechanism.check;
+  EXPECT_EQ(c.statics_mechanism.source, "statics");
+  EXPECT_EQ(c.statics_mechanism.words, c.mechanism.words);
   EXPECT_EQ(c.mechanism.kind, "overturning") << c.mechanism.words;
   ASSERT_EQ(c.mechanism.joints.size(), 1u) << c.mechanism.words;
   const JointMotion* base = joint(c.mechanism, "b1.bottom-ground.top");
@@ -120,6 +125,7 @@ TEST(Collapse, AColumnPushedAtItsTopSlidesAtItsTopJoint) {
   ASSERT_TRUE(r.converged) << r.message;
   const CollapseResult& c = r.collapse;
   expect_bracket(c, 0.6);
+  EXPECT_EQ(c.mechanism.source, "elastic") << c.mechanism.check;
   EXPECT_EQ(c.mechanism.kind, "sliding") << c.mechanism.words;
   ASSERT_EQ(c.mechanism.bodies.size(), 1u) << c.mechanism.words;
   EXPECT_EQ(c.mechanism.bodies[0].body, "b3");
@@ -173,10 +179,21 @@ TEST(Collapse, ABlockOnASlopeSlidesDownItAtTheFrictionLimit) {
   const Result r = contact::testing::run(job);
   ASSERT_TRUE(r.converged) << r.message;
   expect_bracket(r.collapse, (mu - t) / (1 + mu * t));
-  EXPECT_EQ(r.collapse.mechanism.kind, "sliding") << r.collapse.mechanism.words;
-  ASSERT_EQ(r.collapse.mechanism.bodies.size(), 1u);
-  // Down the slope: along d, with the associated flow's dilatancy (an opening of mu times the slip) besides.
-  const Eigen::Vector2d v = r.collapse.mechanism.bodies[0].velocity;
+  // The elastic solution's mechanism: down the slope along d, and no more (Coulomb friction does not dilate).
+  const Mechanism& m = r.collapse.mechanism;
+  EXPECT_EQ(m.source, "elastic") << m.check;
+  EXPECT_EQ(m.kind, "sliding") << m.words;
+  ASSERT_EQ(m.bodies.size(), 1u);
+  EXPECT_NEAR(m.bodies[0].velocity.dot(n), 0.0, 1e-9);
+  EXPECT_GT(m.bodies[0].velocity.dot(d), 0.99);
+  EXPECT_NEAR(m.bodies[0].omega, 0.0, 1e-9);
+  // The statics' one (associated friction) slides the same way with the flow rule's dilatancy besides: an opening
+  // of mu times the slip.
+  const Mechanism& associated = r.collapse.statics_mechanism;
+  EXPECT_EQ(associated.source, "statics");
+  EXPECT_EQ(associated.kind, "sliding") << associated.words;
+  ASSERT_EQ(associated.bodies.size(), 1u);
+  const Eigen::Vector2d v = associated.bodies[0].velocity;
   EXPECT_NEAR(v.dot(n) / v.dot(d), mu, 1e-6);
   EXPECT_GT(v.dot(d), 0.0);
 }
@@ -282,6 +299,11 @@ TEST(Collapse, TheResultFileKeepsTheVerdictTheMechanismAndTheCapacityCurve) {
   EXPECT_EQ(c.mechanism.bodies[2].centre, r.collapse.mechanism.bodies[2].centre);
   ASSERT_EQ(c.mechanism.joints.size(), 1u);
   EXPECT_EQ(c.mechanism.joints[0].kind, "hinge");
+  EXPECT_EQ(c.mechanism.source, "elastic");
+  EXPECT_EQ(c.mechanism.check, r.collapse.mechanism.check);
+  EXPECT_EQ(c.statics_mechanism.source, "statics");
+  EXPECT_EQ(c.statics_mechanism.words, r.collapse.statics_mechanism.words);
+  ASSERT_EQ(c.statics_mechanism.bodies.size(), 3u);
   ASSERT_EQ(f.step_history.multiplier.size(), r.step_history.size());
   EXPECT_EQ(f.step_history.multiplier.back(), r.collapse.held);
   EXPECT_EQ(f.steps.back().multiplier, r.collapse.held);

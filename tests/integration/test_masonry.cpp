@@ -191,6 +191,34 @@ TEST(Masonry, NearItsLimitAWallsCollapseTrialsAreDecidedWithoutRunningOutTheirBu
     return (curve[k].first - curve[k - 1].first) / (curve[k].second - curve[k - 1].second);
   };
   EXPECT_LT(slope(curve.size() - 1), 0.2 * slope(1)) << c.words;
+  // The mechanism the elastic solution shows (the increment into the last held state, on its contact sets): courses
+  // sliding on their bed joints, each moving body translating along the shear with no vertical motion at all
+  // (Coulomb friction does not dilate), every sliding joint one that slips at the last held state (or carries
+  // nothing: open, touching at no pressure). The rigid
+  // blocks' statics (associated friction) slides them the same way but rising: dv_y / dv_x = mu.
+  const Mechanism& m = c.mechanism;
+  EXPECT_EQ(m.source, "elastic") << m.check;
+  EXPECT_EQ(m.kind, "sliding") << m.words;
+  ASSERT_FALSE(m.bodies.empty()) << m.words;
+  for (const auto& b : m.bodies) {
+    EXPECT_GT(b.velocity.x(), 0.0) << b.words;
+    EXPECT_NEAR(b.velocity.y(), 0.0, 1e-9) << b.words;
+    EXPECT_NEAR(b.omega, 0.0, 1e-9) << b.words;
+  }
+  int sliding = 0;
+  for (const auto& j : m.joints) {
+    if (j.kind != "slides") continue;
+    ++sliding;
+    const auto pair = std::find_if(r.steps.back().pairs.begin(), r.steps.back().pairs.end(),
+                                   [&](const PairField& p) { return p.name == j.pair; });
+    ASSERT_NE(pair, r.steps.back().pairs.end()) << j.pair;
+    EXPECT_TRUE(pair->joint.slip_fraction > 0 || pair->joint.open_fraction == 1.0)
+        << j.words << ": slip " << pair->joint.slip_fraction << ", open " << pair->joint.open_fraction;
+  }
+  EXPECT_GT(sliding, 0) << m.words;
+  ASSERT_EQ(c.statics_mechanism.source, "statics");
+  ASSERT_FALSE(c.statics_mechanism.bodies.empty());
+  for (const auto& b : c.statics_mechanism.bodies) EXPECT_NEAR(b.velocity.y() / b.velocity.x(), 0.6, 1e-6) << b.words;
 }
 
 TEST(Masonry, TheIterativeSolverHoldsAFreeEndedWallAtHalfItsLoadInOneIncrement) {

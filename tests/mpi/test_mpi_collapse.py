@@ -37,6 +37,10 @@ def collapse(path):
         t = g["trials"]
         return {"verdict": g.attrs["verdict"], "held": float(g.attrs["held"]), "failed": float(g.attrs["failed"]),
                 "bound": float(g.attrs["statics_bound"]), "kind": g["mechanism"].attrs["kind"],
+                "source": g["mechanism"].attrs.get("source", ""),
+                "moving": sorted(n.decode() for n in g["mechanism"]["body_names"][()]),
+                "joints": sorted(zip((n.decode() for n in g["mechanism"]["pair_names"][()]),
+                                     (k.decode() for k in g["mechanism"]["joint_kind"][()]))),
                 "curve": sorted((float(m), float(d)) for m, h, d in
                                 zip(t["multiplier"][()], t["held"][()], t["displacement"][()]) if h)}
 
@@ -65,6 +69,11 @@ with tempfile.TemporaryDirectory() as tmp:
           and abs(one["failed"] - two["failed"]) <= 1e-3 * one["failed"], (one, two))
     check("1 and 2 ranks: the same statics bound (1e-9) and mechanism",
           abs(one["bound"] - two["bound"]) <= 1e-9 * one["bound"] and one["kind"] == two["kind"] != "", (one, two))
+    # The mechanism is read off the elastic states near the limit (the increment into the last held state, fitted by
+    # rigid motions on the ranks that own the bodies and summed): the same bodies move, the same joints do the same.
+    check("1 and 2 ranks: the elastic solution's own mechanism, the same bodies and joints",
+          one["source"] == two["source"] == "elastic" and one["moving"] == two["moving"] != [] and
+          one["joints"] == two["joints"], (one["source"], two["source"], one["moving"], two["moving"]))
     check("the bracket lies below the statics bound", one["failed"] <= one["bound"] * 1.001, one)
     # The capacity curve's displacement sums the live loads' work over the ranks that own the bodies: at the first
     # held trial (the same multiplier on both) the same to 1e-8.

@@ -234,6 +234,10 @@ struct Mechanism {
   std::vector<BodyMotion> bodies;   // the bodies that move
   std::vector<JointMotion> joints;  // the joints that open or slide
   std::string words;                // one sentence: what moves and how
+  // "elastic" (the rigid part of the elastic solution's last increment before the collapse, made exact and checked:
+  // limit/elastic_mechanism.hpp) or "statics" (the rigid-block statics' dual at its bound: limit/statics.hpp)
+  std::string source;
+  std::string check;  // for an elastic one: its admissibility check in words (what passed, or what failed)
 };
 
 // A collapse analysis's answer (Problem::collapse; limit/collapse.hpp). The result's steps are the states that held
@@ -253,8 +257,11 @@ struct CollapseResult {
   // The rigid-block statics (limit/statics.hpp): the largest multiplier the bodies as rigid blocks carry with
   // associated friction, an upper bound of lambda_c; +inf when any multiple is carried, NaN when not computed.
   double statics_bound = std::numeric_limits<double>::quiet_NaN();
-  Mechanism mechanism;  // the statics' mechanism at its bound
-  std::string words;    // the verdict as one paragraph (also the end of Result::message)
+  // The collapse's mechanism: the elastic solution's own when it passes its check (source "elastic"), else the
+  // statics' (source "statics", its `check` then says why the elastic one was not taken).
+  Mechanism mechanism;
+  Mechanism statics_mechanism;  // the statics' mechanism at its bound (associated friction), whatever `mechanism` is
+  std::string words;            // the verdict as one paragraph (also the end of Result::message)
   // Every trial in order: its multiplier, whether it held, its solver iterations and its wall time (s), and at a
   // trial that held the live loads' displacement: the work of the live loads at multiplier 1 on the answer's
   // displacements over the sum of their nodal magnitudes, (f_live . u) / sum |f_live,i| (for one point load its
