@@ -230,15 +230,16 @@ Result solve(const Problem& problem, Observer& observer, const CancelToken& canc
       frame.state().load = fem::LoadPoint::end_of(problem.loading.factors.size() - 1, problem.loading.factors.back());
       adapt::run_adaptive(working, system, frame, *method, steps);
     } else {
-      ddm::run_load_steps(system, problem.loading.factors, frame, *method, steps);
+      const ddm::HeldPath held = ddm::run_load_steps(system, problem.loading.factors, frame, *method, steps);
       ddm::MethodOutcome& loading = frame.outcome();
       if (problem.collapse.enabled && loading.converged) {
         limit::run_collapse(system, problem.collapse, frame, *method, steps, result.collapse);
       } else if (!loading.converged && !loading.refused && loading.stop_reason != StopReason::cancelled &&
                  !frame.stop_requested()) {
         // Why the step failed, by statics: a collapse (no equilibrium, its mechanism) or the solver.
-        result.collapse = limit::judge_failed_step(
-            system, frame.state().load, problem.collapse.enabled ? "the dead loads" : "the loads", frame.stop_check());
+        result.collapse = limit::judge_failed_step(system, frame.state().load,
+                                                   problem.collapse.enabled ? "the dead loads" : "the loads",
+                                                   frame.stop_check(), &held);
         if (problem.collapse.enabled) result.collapse.verdict = "dead_loads_fail";
         loading.message += "; " + result.collapse.words;
       }

@@ -44,6 +44,8 @@ def print_collapse(collapse, out=None):
     if verdict == "collapse" and isinstance(held, (int, float)) and isinstance(failed, (int, float)):
         out.write(f"collapse: lambda_c between {held:.6g} (held) and {failed:.6g} (did not hold), "
                   f"{collapse.get('solves', 0)} trial solves\n")
+    elif verdict == "collapse":
+        out.write("collapse: where the step failed, the states that held last show a mechanism\n")
     elif verdict:
         out.write(f"collapse analysis: {verdict}\n")
     bound = collapse.get("statics_bound")

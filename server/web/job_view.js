@@ -160,7 +160,9 @@ export class JobView {
     if (!c) return;
     const num = (x) => (typeof x === "number" ? x.toPrecision(5) : String(x));
     let verdict = `collapse analysis: ${c.verdict}`;
-    if (c.verdict === "collapse")
+    if (c.verdict === "collapse" && !(c.trials || []).length)
+      verdict = "collapse: where the step failed, the states that held last show a mechanism (below)";
+    else if (c.verdict === "collapse")
       verdict = `collapse: the multiplier of the live loads held at ${num(c.held)} and did not at ${num(c.failed)}` +
         ` (${c.solves} trial solves)`;
     else if (c.verdict === "holds") verdict = `no collapse: held at ${num(c.held)} (max_multiplier)`;

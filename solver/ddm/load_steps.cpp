@@ -45,11 +45,17 @@ Step step_of(const ContactSystem& system, const MethodOutcome& outcome, const Ru
                                            outcome.q.empty() ? nullptr : &outcome.q);
 }
 
-void run_load_steps(const ContactSystem& system, const std::vector<double>& factors, RunFrame& frame,
-                    ContactMethod& method, StepLog& steps) {
+HeldPath run_load_steps(const ContactSystem& system, const std::vector<double>& factors, RunFrame& frame,
+                        ContactMethod& method, StepLog& steps) {
   MethodOutcome& total = frame.outcome();
   RunState& state = frame.state();
   Displacements warm;
+  HeldPath path;
+  const auto held = [&] {  // (before the slip origins move on to it)
+    path.before = std::move(path.last.u);
+    path.last = total;
+    path.last_state = state;
+  };
   for (size_t k = 0; k < factors.size(); ++k) {
     const double previous = k == 0 ? 0.0 : factors[k - 1];
     double done = 0.0, increment = 1.0;
@@ -74,6 +80,7 @@ void run_load_steps(const ContactSystem& system, const std::vector<double>& fact
       frame.nested(warm.empty() ? nullptr : &warm, InnerMarks{},
                    [&](RunFrame& inner) { run_enforced(system, inner, method); });
       if (total.converged) announce(LoadStepReport::Kind::held, t, 0.0, total.iterations - before);
+      if (total.converged) held();
       if (total.converged && t < 1.0) {  // a sub-step held: its state is the next one's start
         state.slip_origin = system.tangential_jumps(total.u);
         warm = total.u;
@@ -101,16 +108,17 @@ void run_load_steps(const ContactSystem& system, const std::vector<double>& fact
       prefix += std::string(prefix.empty() ? "" : " ") +
                 "(not cut: from rest with every joint closed, a smaller increment is the same problem scaled)";
     if (!prefix.empty()) total.message = prefix + ": " + total.message;
-    if (total.u.empty()) return;
+    if (total.u.empty()) return path;
     Step step = step_of(system, total, state);
     step.index = static_cast<int>(k);
     step.load_factor = state.load.value();  // factors[k], or where a cut step failed the fraction tried
     step.converged = total.converged;
     steps.push_back(std::move(step));
-    if (!total.converged) return;
+    if (!total.converged) return path;
     state.slip_origin = system.tangential_jumps(total.u);  // friction: the next step's slip is measured from here
     warm = total.u;
   }
+  return path;
 }
 
 }  // namespace contact::ddm

@@ -15,7 +15,16 @@ namespace contact::ddm {
 // The fields of a solved state (a load step, a collapse analysis's trial) as a result Step.
 Step step_of(const ContactSystem& system, const MethodOutcome& outcome, const RunState& state);
 
-void run_load_steps(const ContactSystem& system, const std::vector<double>& factors, RunFrame& frame,
-                    ContactMethod& method, StepLog& steps);
+// The last two states that held along the loading (steps or their cut sub-steps): where a step fails, the
+// increment between them shows the collapse's mechanism, if it is one (limit/elastic_mechanism.hpp).
+struct HeldPath {
+  Displacements before;  // the state that held before `last` (empty: none did)
+  MethodOutcome last;    // the last state that held (u empty: none did)
+  RunState last_state;   // its load point and slip origins
+};
+
+// Returns the last two states that held (what the verdict on a failed step reads).
+HeldPath run_load_steps(const ContactSystem& system, const std::vector<double>& factors, RunFrame& frame,
+                        ContactMethod& method, StepLog& steps);
 
 }  // namespace contact::ddm

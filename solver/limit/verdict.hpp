@@ -7,6 +7,8 @@
 
 #include "rigid_blocks.hpp"
 
+#include "../ddm/load_steps.hpp"
+
 #include "contact/result.hpp"
 
 namespace contact::limit {
@@ -14,7 +16,13 @@ namespace contact::limit {
 // The verdict on a step that stopped at `at`, in a CollapseResult (verdict, statics_bound: the fraction of the
 // loads carried, mechanism, words). `what` names the loads in the words ("the loads", "the dead loads"); a cancel
 // (`cancelled`) returns at once, the verdict then without statics.
+//
+// Where statics carries the loads and friction is Coulomb's, the elastic states that held last (`path`, the loading's
+// last two) may still show a mechanism (elastic_mechanism.hpp) on which the loads' increment to `at` does work:
+// non-associated friction gives way below the associated bound. Then the verdict is "collapse" with that mechanism
+// (the statics' kept as statics_mechanism; `held`, `failed` unset: the words say where on the load path); else
+// "solver_failed", saying that either may be the cause.
 CollapseResult judge_failed_step(const ddm::ContactSystem& system, const fem::LoadPoint& at, const std::string& what,
-                                 const std::function<bool()>& cancelled = {});
+                                 const std::function<bool()>& cancelled = {}, const ddm::HeldPath* path = nullptr);
 
 }  // namespace contact::limit

@@ -443,6 +443,43 @@ TEST(Masonry, AShearAboveTheFrictionCoefficientStopsAtOnceNamingTheSlidingCourse
   }
 }
 
+TEST(Masonry, AWallThatStaticsHoldsButCoulombFrictionDoesNotFailsAsACollapseWithItsMechanism) {
+  // A 4 x 4 running-bond panel of 2:1 stones, mu = 0.6: its collapse analysis brackets H/V = 0.500, below the
+  // rigid blocks' associated bound 0.524 (a wedge of end stones slides over a stepped crack without dilating, which
+  // associated friction forbids). A plain job sheared to H/V = 0.51 between the two fails; statics carries its
+  // loads (any multiple: they press the joints shut), so the verdict is read off the elastic states that held last:
+  // a collapse, with the wedge sliding flat (no vertical motion, no turning) on the joints that slip, the same
+  // wedge the collapse analysis names. At H/V = 0.45 the same panel holds (no verdict at all).
+  const Result holds = run(wall(4, 4, "--head-joints --friction 0.6 --brick-height 0.12 --shear 0.45"));
+  EXPECT_TRUE(holds.converged) << holds.message;
+  EXPECT_FALSE(holds.collapse.analysed);
+  const Result r = run(wall(4, 4, "--head-joints --friction 0.6 --brick-height 0.12 --shear 0.51"));
+  ASSERT_FALSE(r.converged);
+  const CollapseResult& c = r.collapse;
+  ASSERT_TRUE(c.analysed) << r.message;
+  EXPECT_TRUE(std::isinf(c.statics_bound)) << c.words;
+  EXPECT_EQ(c.verdict, "collapse") << c.words;
+  EXPECT_NE(r.message.find("a collapse: the states that held last"), std::string::npos) << r.message;
+  EXPECT_EQ(r.message.find("so either the solver failed"), std::string::npos) << r.message;
+  const Mechanism& m = c.mechanism;
+  EXPECT_EQ(m.source, "elastic") << m.check;
+  EXPECT_EQ(m.kind, "sliding") << m.words;
+  std::vector<std::string> moving;
+  for (const auto& b : m.bodies) {
+    moving.push_back(b.body);
+    EXPECT_GT(b.velocity.x(), 0.0) << b.words;
+    EXPECT_NEAR(b.velocity.y(), 0.0, 1e-9) << b.words;
+    EXPECT_NEAR(b.omega, 0.0, 1e-9) << b.words;
+  }
+  EXPECT_TRUE(c.statics_mechanism.bodies.empty()) << "statics carries any multiple: it has no mechanism";
+  const Result analysis = run(wall(4, 4, "--head-joints --friction 0.6 --brick-height 0.12 --collapse"));
+  ASSERT_EQ(analysis.collapse.verdict, "collapse") << analysis.message;
+  EXPECT_LT(analysis.collapse.failed, 0.51) << analysis.collapse.words;
+  std::vector<std::string> wedge;
+  for (const auto& b : analysis.collapse.mechanism.bodies) wedge.push_back(b.body);
+  EXPECT_EQ(moving, wedge) << m.words << "\n" << analysis.collapse.mechanism.words;
+}
+
 TEST(Masonry, AStepThatDidNotConvergeIsCutAndIfThatFailsKeptOnlyAsTheLastAndFlagged) {
   // Three Newton steps per solve are enough for the precompression of this wall (it takes three), too few for the
   // shear of 0.3 in one increment (four): the step is cut, its halves converge, and the answer is statics' (the
