@@ -192,7 +192,7 @@ TEST(Masonry, NearItsLimitAWallsCollapseTrialsAreDecidedWithoutRunningOutTheirBu
   };
   EXPECT_LT(slope(curve.size() - 1), 0.2 * slope(1)) << c.words;
   // The mechanism the elastic solution shows (the increment into the last held state, on its contact sets): courses
-  // sliding on their bed joints, each moving body translating along the shear with no vertical motion at all
+  // sliding on their bed joints, each moving body translating horizontally with no vertical motion at all
   // (Coulomb friction does not dilate), every sliding joint one that slips at the last held state (or carries
   // nothing: open, touching at no pressure). The rigid
   // blocks' statics (associated friction) slides them the same way but rising: dv_y / dv_x = mu.
@@ -200,11 +200,13 @@ TEST(Masonry, NearItsLimitAWallsCollapseTrialsAreDecidedWithoutRunningOutTheirBu
   EXPECT_EQ(m.source, "elastic") << m.check;
   EXPECT_EQ(m.kind, "sliding") << m.words;
   ASSERT_FALSE(m.bodies.empty()) << m.words;
+  double fastest = 0.0;
   for (const auto& b : m.bodies) {
-    EXPECT_GT(b.velocity.x(), 0.0) << b.words;
     EXPECT_NEAR(b.velocity.y(), 0.0, 1e-9) << b.words;
     EXPECT_NEAR(b.omega, 0.0, 1e-9) << b.words;
+    if (std::abs(b.velocity.x()) > std::abs(fastest)) fastest = b.velocity.x();
   }
+  EXPECT_NEAR(fastest, 1.0, 1e-12) << m.words;  // along the shear (a heel brick may be squeezed out the other way, slower)
   int sliding = 0;
   for (const auto& j : m.joints) {
     if (j.kind != "slides") continue;
