@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_map>
 
 namespace contact::limit {
 
@@ -107,13 +108,16 @@ std::vector<Joint> joints_of(const ddm::ContactSystem& system, const RigidBlocks
     double N = 0.0, slipping = 0.0;
     Eigen::Vector2d moment = Eigen::Vector2d::Zero();
     std::vector<std::pair<const JointRow*, Eigen::Index>> carrying;
-    for (const auto* r : j.rows)
-      for (Eigen::Index i = 0; i < pair->node.size(); ++i)
-        if (pair->node[i] == r->node && pair->weight[i] > 0 && pair->pressure[i] > 0) {
-          carrying.emplace_back(r, i);
-          N += pair->weight[i] * pair->pressure[i];
-          break;
-        }
+    std::unordered_map<int, Eigen::Index> entry;  // slave node -> its entry in the pair's fields
+    for (Eigen::Index i = 0; i < pair->node.size(); ++i) entry.emplace(pair->node[i], i);
+    for (const auto* r : j.rows) {
+      const auto found = entry.find(r->node);
+      if (found == entry.end()) continue;
+      const Eigen::Index i = found->second;
+      if (!(pair->weight[i] > 0) || !(pair->pressure[i] > 0)) continue;
+      carrying.emplace_back(r, i);
+      N += pair->weight[i] * pair->pressure[i];
+    }
     double carried = 0.0;
     for (const auto& [r, i] : carrying) {
       const double f = pair->weight[i] * pair->pressure[i];
@@ -261,7 +265,8 @@ bool normalise(const RigidBlocks& blocks, std::vector<Velocity>& v, double at_le
   return true;
 }
 
-// The check: no joint overlaps, sliding joints slide against their friction, the live loads do positive work.
+// The check: no joint overlaps, sliding joints slide against their friction, the loads being raised (`live`: a
+// collapse analysis's live loads at multiplier 1, or a failed step's increment) do positive work.
 std::string check(const ddm::ContactSystem& system, const RigidBlocks& blocks, const std::vector<Velocity>& v,
                   const Mechanism& m, const Step& held, const std::vector<Resultant>& live, bool& admissible) {
   admissible = false;
@@ -282,11 +287,11 @@ std::string check(const ddm::ContactSystem& system, const RigidBlocks& blocks, c
   }
   double work = 0.0;
   for (size_t a = 0; a < v.size() && a < live.size(); ++a) work += live[a].dot(v[a]);
-  if (!(work > 0)) return "the live loads would do no positive work on it (" + shown(work) + ")";
+  if (!(work > 0)) return "the loads being raised would do no positive work on it (" + shown(work) + ")";
   admissible = true;
-  return "admissible: no joint overlaps, the sliding joints slide against their friction, the live loads do positive "
-         "work on it (" +
-         shown(work) + " at multiplier 1)";
+  return "admissible: no joint overlaps, the sliding joints slide against their friction, the loads being raised do "
+         "positive work on it (" +
+         shown(work) + ")";
 }
 
 // The cosine between two motions of the bodies, each body's (vx, vy, size omega) one block of the vectors.
