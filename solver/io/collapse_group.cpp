@@ -121,6 +121,7 @@ void write_collapse(hid_t file, const CollapseResult& c) {
   h5::write_attribute<double>(g, "held", c.held);
   h5::write_attribute<double>(g, "failed", c.failed);
   h5::write_attribute<std::int32_t>(g, "failed_by_statics", c.failed_by_statics ? 1 : 0);
+  h5::write_attribute<std::int32_t>(g, "failed_by_budget", c.failed_by_budget ? 1 : 0);
   h5::write_attribute<double>(g, "tolerance", c.tolerance);
   h5::write_attribute<std::int32_t>(g, "solves", c.solves);
   h5::write_attribute<std::int32_t>(g, "bracket_solves", c.bracket_solves);
@@ -156,6 +157,8 @@ void read_collapse(hid_t file, CollapseResult& c) {
   c.held = h5::read_attribute<double>(g, "held");
   c.failed = h5::read_attribute<double>(g, "failed");
   c.failed_by_statics = h5::read_attribute<std::int32_t>(g, "failed_by_statics") != 0;
+  if (h5::has_attribute(g, "failed_by_budget"))  // (files from before it: none)
+    c.failed_by_budget = h5::read_attribute<std::int32_t>(g, "failed_by_budget") != 0;
   c.tolerance = h5::read_attribute<double>(g, "tolerance");
   c.solves = h5::read_attribute<std::int32_t>(g, "solves");
   c.bracket_solves = h5::read_attribute<std::int32_t>(g, "bracket_solves");

@@ -309,6 +309,7 @@ nlohmann::json collapse_json(const CollapseResult& c) {
           {"held", c.held},
           {"failed", number(c.failed)},
           {"failed_by_statics", c.failed_by_statics},
+          {"failed_by_budget", c.failed_by_budget},
           {"tolerance", c.tolerance},
           {"solves", c.solves},
           {"bracket_solves", c.bracket_solves},

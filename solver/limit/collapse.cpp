@@ -126,6 +126,13 @@ void word_verdict(CollapseResult& c, const std::string& last_failure, const std:
     w = "no collapse up to max_multiplier = " + shown(c.held) + " (it held, after " + std::to_string(c.solves) +
         " trial solve" + (c.solves == 1 ? "" : "s") + ")";
     if (!statics.empty()) w += "; " + statics;
+  } else if (c.failed_by_budget) {
+    w = "the collapse analysis could not decide above lambda = " + shown(c.held) +
+        " (it held): lambda = " + shown(c.failed) + " ran out of the iterative interface solver's budget (" +
+        last_failure +
+        "), which is the solver's limit, not a proof that nothing holds, so lambda_c >= " + shown(c.held) +
+        " and a larger interface.max_iterations may bracket it; after " + std::to_string(c.solves) + " trial solves";
+    if (!statics.empty()) w += "; " + statics;
   } else {
     w = "the collapse analysis stopped before it bracketed lambda_c: lambda = " + shown(c.held) + " held" +
         (std::isnan(c.failed) ? std::string() : " and lambda = " + shown(c.failed) + " did not") + ", after " +
@@ -230,6 +237,7 @@ class CollapseRun {
     marks.multiplier = lambda;
     const double started = frame_.elapsed();
     const int iterations_before = total.iterations;
+    const long interface_before = total.interface_iterations;
     frame_.nested(&held_.u, marks, [&](ddm::RunFrame& inner) { ddm::run_enforced(system_, inner, method_); });
     out_.trials.push_back({lambda, total.converged, total.iterations - iterations_before, frame_.elapsed() - started,
                            total.converged ? live_displacement(total.u) : std::numeric_limits<double>::quiet_NaN()});
@@ -245,6 +253,9 @@ class CollapseRun {
       hi_ = lambda;
       solve_failed_ = true;
       last_failure_ = total.message;
+      // Out of the iterative interface solver's budget: the solver's limit, not a proof that nothing holds (near
+      // the limit its Coulomb iteration crawls; above it, it has no fixed point to reach).
+      top_by_budget_ = total.interface_iterations - interface_before >= frame_.settings().interface.max_iterations;
       return 0.5 * (held_.multiplier + hi_);
     }
     const double previous = held_.multiplier;
@@ -307,6 +318,8 @@ class CollapseRun {
     out_.held = held_.multiplier;
     out_.failed = hi_;
     out_.failed_by_statics = !std::isnan(hi_) && !solve_failed_;
+    out_.failed_by_budget = solve_failed_ && top_by_budget_;
+    if (out_.verdict == "collapse" && out_.failed_by_budget) out_.verdict = "solver_failed";
     if (!stopped_.empty()) last_failure_ = stopped_;
     mechanism();
     total.u = std::move(held_.u);
@@ -340,6 +353,7 @@ class CollapseRun {
   int first_index_ = 0;
   double hi_ = std::numeric_limits<double>::quiet_NaN();  // the smallest multiplier known not to hold
   bool solve_failed_ = false;
+  bool top_by_budget_ = false;  // the bracket's top is a trial that ran out of interface.max_iterations
   std::string last_failure_, stopped_;
 };
 

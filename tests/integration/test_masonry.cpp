@@ -174,6 +174,7 @@ TEST(Masonry, NearItsLimitAWallsCollapseTrialsAreDecidedWithoutRunningOutTheirBu
   const Result r = run(job);
   const CollapseResult& c = r.collapse;
   ASSERT_EQ(c.verdict, "collapse") << r.message;
+  EXPECT_FALSE(c.failed_by_budget) << c.words;
   EXPECT_LE(c.held, c.statics_bound) << c.words;
   EXPECT_LE(c.failed - c.held, c.tolerance * c.held * (1 + 1e-9)) << c.words;
   EXPECT_GT(c.held, 0.9 * c.statics_bound) << c.words;  // sliding governs these free-ended courses: near the bound
@@ -221,6 +222,25 @@ TEST(Masonry, NearItsLimitAWallsCollapseTrialsAreDecidedWithoutRunningOutTheirBu
   ASSERT_EQ(c.statics_mechanism.source, "statics");
   ASSERT_FALSE(c.statics_mechanism.bodies.empty());
   for (const auto& b : c.statics_mechanism.bodies) EXPECT_NEAR(b.velocity.y() / b.velocity.x(), 0.6, 1e-6) << b.words;
+}
+
+TEST(Masonry, ACollapseTrialThatRunsOutOfTheSolversBudgetDecidesNothing) {
+  // The same wall with the iterative solver's budget cut to 3,000 MPRGP iterations: near the limit a trial's Coulomb
+  // iteration runs out of it (where 60,000 decide the bracket at 0.5996 above). That is the solver's limit, not a
+  // collapse: the verdict says so (solver_failed, failed_by_budget) and keeps only what is known, lambda_c >= held.
+  json job = wall(8, 8, "--head-joints --friction 0.6 --collapse");
+  job["solver"]["interface"] = {{"solver", "iterative"}, {"max_iterations", 3000}};
+  const Result r = run(job);
+  const CollapseResult& c = r.collapse;
+  EXPECT_FALSE(r.converged);
+  EXPECT_EQ(c.verdict, "solver_failed") << c.words;
+  EXPECT_TRUE(c.failed_by_budget) << c.words;
+  EXPECT_GT(c.held, 0.0) << c.words;
+  EXPECT_LT(c.held, c.failed) << c.words;
+  EXPECT_LE(c.held, c.statics_bound) << c.words;
+  EXPECT_NE(c.words.find("ran out of the iterative interface solver's budget"), std::string::npos) << c.words;
+  EXPECT_NE(c.words.find("lambda_c >= "), std::string::npos) << c.words;
+  EXPECT_EQ(c.words.find("collapse at"), std::string::npos) << c.words;
 }
 
 TEST(Masonry, TheIterativeSolverHoldsAFreeEndedWallAtHalfItsLoadInOneIncrement) {

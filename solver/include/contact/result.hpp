@@ -251,6 +251,9 @@ struct CollapseResult {
   double held = 0.0;                                         // the largest multiplier that held (lambda_c from below)
   double failed = std::numeric_limits<double>::quiet_NaN();  // the smallest that did not (lambda_c from above)
   bool failed_by_statics = false;  // `failed` exceeds the statics bound: refused without a solve
+  // `failed` ran out of the iterative interface solver's budget (interface.max_iterations): the solver's limit, not a
+  // proof of collapse; the verdict is then "solver_failed" and lambda_c >= held is all that is known.
+  bool failed_by_budget = false;
   double tolerance = 0.0;
   int solves = 0;          // trial solves, each one load increment from the last state that held
   int bracket_solves = 0;  // of those, after the first failure (the bisection)
