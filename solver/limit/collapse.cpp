@@ -303,9 +303,6 @@ class CollapseRun {
     ElasticMechanism elastic = elastic_mechanism(system_, blocks, before_, held_.u, steps_.back(), loads.live);
     if (elastic.admissible) {
       out_.mechanism = std::move(elastic.mechanism);
-      out_.mechanism.check += "; the increment into the last held state is " + shown(100 * elastic.rigid_share) +
-                              " % rigid in the bodies that move, and the mechanism is its rigid part to a cosine of " +
-                              shown(elastic.kept);
     } else if (!out_.mechanism.words.empty()) {
       out_.mechanism.check = "the elastic states' mechanism was not taken: " + elastic.check;
     }

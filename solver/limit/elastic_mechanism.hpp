@@ -34,7 +34,8 @@ struct ElasticMechanism {
   bool admissible = false;   // the check passed
   double rigid_share = 0.0;  // of the moving bodies' increment, the share (by norm) its rigid fit explains
   double kept = 0.0;         // the cosine between the mechanism and the fitted rigid motion it was projected from
-  std::string check;         // the check in words: what passed, or what failed and where
+  std::string check;         // the check in words: what passed, or what failed and where (mechanism.check adds,
+                             // when it passed, how rigid the increment was and the cosine `kept`)
 };
 
 // From the held states `before` and `after` (displacements of the bodies this process owns; a collective call on

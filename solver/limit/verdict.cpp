@@ -38,9 +38,6 @@ bool judge_by_the_elastic_states(const ddm::ContactSystem& system, const RigidBl
   if (!elastic.admissible) return false;
   out.verdict = "collapse";  // (held and failed stay unset: a plain job has no multiplier; the words say where)
   out.mechanism = std::move(elastic.mechanism);
-  out.mechanism.check += "; the increment into the last held state is " + shown(100 * elastic.rigid_share) +
-                         " % rigid in the bodies that move, and the mechanism is its rigid part to a cosine of " +
-                         shown(elastic.kept);
   out.words = "a collapse: the states that held last (the last at " + position(path.last_state.load) +
               ", the solve failed at " + position(at) +
               ") show a mechanism on which the loads' increment does work, checked admissible (no joint overlaps, "
