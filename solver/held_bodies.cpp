@@ -35,8 +35,12 @@ std::vector<Eigen::RowVector3d> held_rows(const Problem& problem, const Step& st
       if (pair.active[i] == 0 || !(pair.normal.row(i).squaredNorm() > 0)) continue;
       rows.push_back(
           held_row(pair.position.row(i).transpose(), pair.normal.row(i).transpose(), body.rigid_center, radius));
-      // A node that sticks holds along its tangent too.
-      if (pair.stick.size() == pair.active.size() && pair.stick[i] != 0)
+      // A node whose friction carries a force holds along its tangent too: one that sticks, and one that slips
+      // pressed (its friction force balances the loads though its slip is free: a brick that slides at both its
+      // bed joints is in equilibrium at any slip, and the monolithic reference takes the least motion).
+      const bool sticks = pair.stick.size() == pair.active.size() && pair.stick[i] != 0;
+      const bool rubs = pair.tangential_traction.size() == pair.active.size() && pair.tangential_traction[i] != 0.0;
+      if (sticks || rubs)
         rows.push_back(
             held_row(pair.position.row(i).transpose(), pair.tangent.row(i).transpose(), body.rigid_center, radius));
     }

@@ -58,6 +58,7 @@ void run_robin(const ContactSystem& system, RunFrame& frame);
 // converged answer, the next load step's (sub-step's, collapse trial's) first sets.
 struct MonolithicMemory {
   linalg::FrictionSets sets;
+  Eigen::VectorXd x, lambda;  // its stacked unknowns and multipliers: the augmented Lagrangian's start
 };
 
 // The same discrete problem (exact or penalty, per the settings' enforcement) solved in one system: the

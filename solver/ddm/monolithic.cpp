@@ -10,12 +10,18 @@
 //    rows of B include each friction pair's tangential rows (-Ts, +Tm; the slip of the step g0 - w_origin), and
 //    the same stick and slip sets as the interface solver's (linalg/friction_sets.hpp) give lambda = P y +
 //    lambda0: [K  -B^T P; R B  0] [x; y] = [b + B^T lambda0; -R g0]. Slow for large problems (an unsymmetric
-//    factorisation per step): a reference, not a production method.
+//    factorisation per step): a reference, not a production method. Near the limit that Newton cycles (sets whose
+//    systems are singular: a brick that slips at every contact node); a step it does not settle is solved again
+//    by an augmented Lagrangian on the same stacked system (monolithic_friction.hpp) and its answer's sets
+//    confirmed by the Newton.
 // Both are independent of the interface machinery (Schur complements, dense active-set solves) that
 // interface Newton uses, which is what makes them a check on it.
 #include "method.hpp"
+#include "monolithic_friction.hpp"
+#include "monolithic_system.hpp"
 
 #include "../linalg/friction_newton.hpp"
+#include "friction_policy.hpp"
 #include "friction_rows.hpp"
 #include "friction_statics.hpp"
 #include "../linalg/friction_sets.hpp"
@@ -32,123 +38,7 @@ namespace contact::ddm {
 namespace {
 
 using SpMat = Eigen::SparseMatrix<double>;
-
-// All bodies stacked: block-diagonal K, right-hand side b, and the contact rows in x.
-struct Stacked {
-  std::vector<Eigen::Index> offset;  // per body, into x
-  SpMat K;
-  Eigen::VectorXd b;
-  std::vector<Eigen::Index> row_offset;  // per pair, into the stacked rows
-  SpMat B;                               // rows x n
-  Eigen::VectorXd g0, D, c;              // per row: weighted gap at x = 0, D, and the active-set scaling
-  std::vector<int> row_pair, row_index;  // per row: its pair and its row in the pair
-  // Friction: the tangential rows follow the normal ones (tangential_offset per pair, -1 if frictionless).
-  std::vector<Eigen::Index> tangential_offset;
-  std::vector<linalg::FrictionRow> friction;
-  fem::LoadPoint at;  // the load point the loads (b) and prescribed values (g0, to_bodies) are taken at
-};
-
-Stacked stack(const ContactSystem& system, const RunState& state, bool shift_by_multipliers) {
-  Stacked s;
-  s.at = state.load;
-  const size_t n_bodies = system.n_bodies();
-  s.offset.assign(n_bodies + 1, 0);
-  for (size_t a = 0; a < n_bodies; ++a) s.offset[a + 1] = s.offset[a] + system.body(a).n_free();
-  const Eigen::Index n = s.offset[n_bodies];
-  std::vector<Eigen::Triplet<double>> tk;
-  s.b.resize(n);
-  for (size_t a = 0; a < n_bodies; ++a) {
-    const auto& K = system.body(a).reduced_stiffness();
-    for (int col = 0; col < K.outerSize(); ++col)
-      for (SpMat::InnerIterator it(K, col); it; ++it)
-        tk.emplace_back(s.offset[a] + it.row(), s.offset[a] + it.col(), it.value());
-    s.b.segment(s.offset[a], system.body(a).n_free()) = system.body(a).reduced_rhs(s.at);
-  }
-  s.K.resize(n, n);
-  s.K.setFromTriplets(tk.begin(), tk.end());
-
-  const auto& pairs = system.pairs();
-  s.row_offset.assign(pairs.size() + 1, 0);
-  for (size_t k = 0; k < pairs.size(); ++k) s.row_offset[k + 1] = s.row_offset[k] + pairs[k].n_rows();
-  Eigen::Index m = s.row_offset.back();
-  s.tangential_offset.assign(pairs.size(), -1);
-  for (size_t k = 0; k < pairs.size(); ++k)
-    if (pairs[k].has_friction()) {
-      s.tangential_offset[k] = m;
-      m += pairs[k].n_rows();
-    }
-  s.g0.resize(m);
-  s.D.resize(m);
-  s.c.resize(m);
-  s.row_pair.resize(static_cast<size_t>(m));
-  s.row_index.resize(static_cast<size_t>(m));
-  std::vector<Eigen::Triplet<double>> tb;
-  const Problem& problem = system.problem();
-  const double thickness = problem.model.plane == Plane::stress ? problem.model.thickness : 1.0;
-  // Rows [first, first + rows) of B from a pair's slave and master operators (B = [-slave, +master]).
-  auto add_rows = [&](size_t k, Eigen::Index first, const mortar::SparseRows& Gs, const mortar::SparseRows& Gm) {
-    const auto& pair = pairs[k];
-    const size_t sb = static_cast<size_t>(pair.slave_body), mb = static_cast<size_t>(pair.master_body);
-    const SpMat Bs = SpMat(Gs) * system.body(sb).constraints().T(), Bm = SpMat(Gm) * system.body(mb).constraints().T();
-    for (int col = 0; col < Bs.outerSize(); ++col)
-      for (SpMat::InnerIterator it(Bs, col); it; ++it)
-        tb.emplace_back(first + it.row(), s.offset[sb] + it.col(), -it.value());
-    for (int col = 0; col < Bm.outerSize(); ++col)
-      for (SpMat::InnerIterator it(Bm, col); it; ++it)
-        tb.emplace_back(first + it.row(), s.offset[mb] + it.col(), it.value());
-    const Eigen::VectorXd g = Gm * system.body(mb).prescribed(s.at) - Gs * system.body(sb).prescribed(s.at);
-    s.g0.segment(first, pair.n_rows()) = g;
-    s.D.segment(first, pair.n_rows()) = pair.area;
-    // c = E' / h: a contact node's own stiffness scale (h its support length), for the active-set prediction.
-    const double E = system.penalties()[k].E_pair;
-    for (Eigen::Index r = 0; r < pair.n_rows(); ++r) {
-      s.c[first + r] = E / (pair.area[r] / thickness);
-      s.row_pair[static_cast<size_t>(first + r)] = static_cast<int>(k);
-      s.row_index[static_cast<size_t>(first + r)] = static_cast<int>(r);
-    }
-  };
-  for (size_t k = 0; k < pairs.size(); ++k) {
-    const auto& pair = pairs[k];
-    add_rows(k, s.row_offset[k], pair.Gs, pair.Gm);
-    s.g0.segment(s.row_offset[k], pair.n_rows()) += pair.gap0;
-    const Eigen::VectorXd* lambda = state.multipliers_of(k, pair.n_rows());
-    if (shift_by_multipliers && lambda)  // the augmented Lagrangian's shifted gap
-      s.g0.segment(s.row_offset[k], pair.n_rows()) -= pair.theta * pair.area.cwiseProduct(*lambda);
-    if (s.tangential_offset[k] < 0) continue;
-    add_rows(k, s.tangential_offset[k], pair.Ts, pair.Tm);
-    if (const Eigen::VectorXd* origin = state.slip_origin_of(k, pair.n_rows()))
-      s.g0.segment(s.tangential_offset[k], pair.n_rows()) -= *origin;
-  }
-  s.B.resize(m, n);
-  s.B.setFromTriplets(tb.begin(), tb.end());
-  // Friction rows (friction_rows.hpp), but not where both sides' tangential motion is prescribed (a symmetry line):
-  // the row of B is zero there and the node cannot slip (q = 0; its traction goes into the supports).
-  const Eigen::SparseMatrix<double, Eigen::RowMajor> rows_of_B = s.B;
-  s.friction = friction_rows(
-      system, [&](size_t k) { return s.row_offset[k]; }, [&](size_t k) { return s.tangential_offset[k]; },
-      [&](Eigen::Index t) { return rows_of_B.row(t).norm() > 0; });
-  return s;
-}
-
-Displacements to_bodies(const ContactSystem& system, const Stacked& s, const Eigen::VectorXd& x) {
-  Displacements u(system.n_bodies());
-  for (size_t a = 0; a < u.size(); ++a)
-    u[a] = system.body(a).expand(x.segment(s.offset[a], system.body(a).n_free()), s.at);
-  return u;
-}
-
-Pressures split_rows(const ContactSystem& system, const Stacked& s, const Eigen::VectorXd& rows) {
-  Pressures z(system.pairs().size());
-  for (size_t k = 0; k < z.size(); ++k) z[k] = rows.segment(s.row_offset[k], s.row_offset[k + 1] - s.row_offset[k]);
-  return z;
-}
-
-Pressures split_tangential(const ContactSystem& system, const Stacked& s, const Eigen::VectorXd& rows) {
-  Pressures q(system.pairs().size());
-  for (size_t k = 0; k < q.size(); ++k)
-    if (s.tangential_offset[k] >= 0) q[k] = rows.segment(s.tangential_offset[k], s.row_offset[k + 1] - s.row_offset[k]);
-  return q;
-}
+using namespace monolithic;
 
 // Solves `kkt` by sparse LU with two steps of iterative refinement (linalg/refined_solve.hpp); false when it is
 // singular, and with `strict` also when it is so nearly singular that the refined solution does not solve it.
@@ -210,6 +100,56 @@ double zone_change(const ContactSystem& system, const Displacements& u, std::vec
   return paper;
 }
 
+// The step the friction Newton did not settle (it stalled, or cycled through singular sets), solved again by the
+// augmented Lagrangian (monolithic_friction.hpp) from the last converged answer, and its answer polished by a few
+// Newton steps from the sets it predicts (exact on them, where the augmented Lagrangian's tolerance is its own). On
+// success `result` becomes that answer (converged); else it keeps its stop. Returns what was done, in words for the
+// outcome's message. `steps_before` counts the reported steps and is moved past those taken here.
+template <class Report>
+std::string by_augmented_lagrangian(const Stacked& s, const linalg::FrictionNewtonProblem& problem,
+                                    const MonolithicMemory& memory, int& steps_before, const Report& report,
+                                    linalg::FrictionNewtonResult& result) {
+  const int newton_steps = static_cast<int>(result.report.iterations);
+  const std::string why = result.report.stop == SolveStop::singular ? "reached only singular sets" : "did not settle";
+  const AlmOutcome alm = solve_by_augmented_lagrangian(
+      s, problem.mask, problem.c, memory.x, memory.lambda, AlmSettings{},
+      [&](int k, const Eigen::VectorXd& x, const Eigen::VectorXd& lambda, const Eigen::VectorXd& h, double comp) {
+        return report(k, linalg::FrictionIterate{lambda, h, x}, comp, 0);
+      });
+  steps_before += alm.updates;
+  std::ostringstream os;
+  os << "the active-set Newton " << why << " in " << newton_steps << " steps; the augmented Lagrangian ";
+  if (alm.cancelled) {
+    result.report.stop = SolveStop::cancelled;
+    return os.str() + "was cancelled";
+  }
+  if (!alm.converged) {
+    os << "did not converge either (" << alm.failure << "; complementarity " << alm.complementarity << " after "
+       << alm.updates << " updates)";
+    return os.str();
+  }
+  os << "settled in " << alm.updates << " updates (" << alm.newton_steps << " Newton steps on the whole system)";
+  const linalg::FrictionSets predicted =
+      linalg::predict_friction_sets(alm.lambda, alm.h, problem.c, problem.rows, problem.mask);
+  linalg::FrictionNewtonSettings polish;
+  polish.max_steps = 10;
+  polish.tolerance = 1e-12;
+  const auto on_step = [&](const linalg::FrictionIterate& it, const linalg::ActiveSetStep& step) {
+    return report(step.step, it, step.complementarity, step.changes);
+  };
+  linalg::FrictionNewtonResult polished = linalg::friction_newton(problem, predicted, polish, on_step);
+  if (polished.report.stop == SolveStop::converged) {
+    result = std::move(polished);
+    return os.str() + ", its sets confirmed by the Newton";
+  }
+  steps_before += static_cast<int>(polished.report.iterations);
+  result = linalg::FrictionNewtonResult{};
+  result.report.stop = SolveStop::converged;
+  result.iterate = linalg::FrictionIterate{alm.lambda, alm.h, alm.x};
+  result.sets = predicted;
+  return os.str();
+}
+
 void run_exact(const ContactSystem& system, RunFrame& frame, MonolithicMemory& memory) {
   MethodOutcome& out = frame.outcome();
   if (std::string sliding = friction_cannot_hold(system, frame.state().load);
@@ -241,29 +181,49 @@ void run_exact(const ContactSystem& system, RunFrame& frame, MonolithicMemory& m
   linalg::FrictionNewtonSettings newton;
   newton.max_steps = std::max(1, frame.settings().max_iterations);
   newton.tolerance = 1e-12;
-  const auto on_step = [&](const linalg::FrictionIterate& it, const linalg::ActiveSetStep& step) {
+  if (!s.friction.empty()) {  // a stalling Newton hands the step to the augmented Lagrangian (below) at once
+    newton.stall_steps = policy::kFrictionPolicy.direct.stall_steps;
+    newton.stall_fall = policy::kFrictionPolicy.direct.stall_fall;
+  }
+  int steps_before = 0;  // of the runs before the current one (each numbers its steps from 1)
+  const auto report = [&](int step, const linalg::FrictionIterate& it, double complementarity, int changes) {
     const Displacements u = to_bodies(system, s, it.other);
     const double paper = zone_change(system, u, zone, !first);
     first = false;
     const Pressures z = split_rows(system, s, it.lambda);
-    IterationReport r = system.report(step.step, u, z, report_active);
+    IterationReport r = system.report(steps_before + step, u, z, report_active);
     if (!s.friction.empty()) system.report_friction(z, split_tangential(system, s, it.lambda), r);
     r.paper_criterion = paper;
     r.measure = Measure::complementarity;
-    r.complementarity = step.complementarity;
-    r.active_set_changes = step.changes;
+    r.complementarity = complementarity;
+    r.active_set_changes = changes;
     frame.report(std::move(r));
     return frame.stop_requested();
+  };
+  const auto on_step = [&](const linalg::FrictionIterate& it, const linalg::ActiveSetStep& step) {
+    return report(step.step, it, step.complementarity, step.changes);
   };
   // From the last converged answer's sets where there is one (a load step, a cut's sub-step, a collapse trial: each
   // a small increment from it), else from the start above; where those leave a body held by nothing at once, from
   // the start above after all.
   const bool warm = memory.sets.active.size() == sets.active.size() && memory.sets.state.size() == sets.state.size();
   linalg::FrictionNewtonResult result = linalg::friction_newton(problem, warm ? memory.sets : sets, newton, on_step);
-  if (warm && result.report.stop == SolveStop::singular && result.iterate.lambda.size() == 0)
+  if (warm && result.report.stop == SolveStop::singular && result.iterate.lambda.size() == 0) {
+    steps_before += static_cast<int>(result.report.iterations);
     result = linalg::friction_newton(problem, std::move(sets), newton, on_step);
-  if (result.report.stop == SolveStop::converged) memory.sets = result.sets;
-  out.iterations = static_cast<int>(result.report.iterations);
+  }
+  std::string handed_over;
+  if (!s.friction.empty() &&
+      (result.report.stop == SolveStop::max_iterations || result.report.stop == SolveStop::singular)) {
+    steps_before += static_cast<int>(result.report.iterations);
+    handed_over = by_augmented_lagrangian(s, problem, memory, steps_before, report, result);
+  }
+  if (result.report.stop == SolveStop::converged) {
+    memory.sets = result.sets;
+    memory.x = result.iterate.other;
+    memory.lambda = result.iterate.lambda;
+  }
+  out.iterations = steps_before + static_cast<int>(result.report.iterations);
   switch (result.report.stop) {
     case SolveStop::converged: {
       out.converged = true;
@@ -274,6 +234,7 @@ void run_exact(const ContactSystem& system, RunFrame& frame, MonolithicMemory& m
       std::ostringstream os;
       os << "monolithic active set settled (" << na << " of " << s.row_offset.back() << " contact nodes in contact)";
       if (result.damped_steps > 0) os << "; " << result.damped_steps << " steps damped by the line search";
+      if (!handed_over.empty()) os << "; " << handed_over;
       out.message = os.str();
       break;
     }
@@ -291,6 +252,7 @@ void run_exact(const ContactSystem& system, RunFrame& frame, MonolithicMemory& m
     case SolveStop::max_iterations:
       out.stop_reason = StopReason::max_iterations;
       out.message = "monolithic: the active set did not settle within max_iterations";
+      if (!handed_over.empty()) out.message += "; " + handed_over;
       break;
   }
   const Eigen::VectorXd x = result.iterate.other.size() == s.b.size()

@@ -326,6 +326,48 @@ TEST(Masonry, TheInterfaceSolverEqualsTheMonolithicReferenceOnFrictionalWalls) {
   }
 }
 
+TEST(Masonry, TheMonolithicReferenceAnswersNearTheLimitWhereItsNewtonCycles) {
+  // The 8 x 8 wall with free course ends at H/V = 0.5 (its collapse multiplier is 0.600): the monolithic Newton on the
+  // stick and slip sets cycles there (it ran 880 steps and failed in cut sub-steps, or 527 steps on 16 elements a
+  // brick), through sets whose systems are singular (a brick slipping at every contact node). The augmented
+  // Lagrangian (ddm/monolithic_friction.hpp) then takes the step, its sets confirmed by the Newton, and the answer
+  // is the iterative interface solver's: a method that shares nothing with it but the discrete problem.
+  json job = wall(8, 8, "--head-joints --friction 0.6 --shear 0.5");
+  job["solver"]["interface"] = {{"solver", "iterative"}, {"tolerance", 1e-13}};
+  const Result interface = run(job);
+  const Result reference = run(monolithic(job));
+  ASSERT_TRUE(interface.converged) << interface.message;
+  ASSERT_TRUE(reference.converged) << reference.message;
+  EXPECT_NE(reference.message.find("the augmented Lagrangian settled"), std::string::npos) << reference.message;
+  EXPECT_NE(reference.message.find("its sets confirmed by the Newton"), std::string::npos) << reference.message;
+  EXPECT_EQ(reference.message.find("cut"), std::string::npos) << reference.message;
+  // Both carry the applied loads into the base (1e-8), and every traction is the same to 1e-8 of the largest
+  // pressure. The displacements agree only to the slips that no force decides: a brick held by slipping nodes
+  // alone (b1_0, the half brick at the left end of the second course, at mu times its three nodes' pressure) is in
+  // equilibrium at any slip, and each method's is the end of its own iteration (2.8e-7 of its displacement apart,
+  // where two tolerances of the iterative solver itself give 9e-8).
+  const Eigen::Vector2d load = applied_load(job, 1);
+  for (const Result* r : {&interface, &reference}) {
+    const Eigen::Vector2d reaction = support_reactions(r->steps[1]);
+    EXPECT_NEAR(reaction.x(), -load.x(), 1e-8 * load.norm());
+    EXPECT_NEAR(reaction.y(), -load.y(), 1e-8 * load.norm());
+  }
+  double largest = 0.0, worst = 0.0;
+  for (const auto& pair : reference.steps[1].pairs) largest = std::max(largest, pair.pressure.cwiseAbs().maxCoeff());
+  for (size_t k = 0; k < reference.steps[1].pairs.size(); ++k) {
+    const auto& p = interface.steps[1].pairs[k];
+    const auto& q = reference.steps[1].pairs[k];
+    worst = std::max(worst, (p.pressure - q.pressure).cwiseAbs().maxCoeff());
+    worst = std::max(worst, (p.tangential_traction - q.tangential_traction).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LT(worst, 1e-8 * largest);
+  for (size_t i = 0; i < reference.steps[1].bodies.size(); ++i) {
+    const auto& u = interface.steps[1].bodies[i].displacement;
+    const auto& v = reference.steps[1].bodies[i].displacement;
+    EXPECT_LT((u - v).cwiseAbs().maxCoeff(), 1e-5 * v.cwiseAbs().maxCoeff()) << reference.steps[1].bodies[i].name;
+  }
+}
+
 TEST(Masonry, AHeadJointLeavesTheBedJointsTheirWholeFriction) {
   // Two half bricks side by side on a brick: the top course's point shears S V are carried by its two bed joints
   // alone (the head joint is inside the course), so statics holds it for every S < mu = 0.6, with the bed joints'
