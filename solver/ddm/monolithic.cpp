@@ -111,11 +111,24 @@ std::string by_augmented_lagrangian(const Stacked& s, const linalg::FrictionNewt
                                     linalg::FrictionNewtonResult& result) {
   const int newton_steps = static_cast<int>(result.report.iterations);
   const std::string why = result.report.stop == SolveStop::singular ? "reached only singular sets" : "did not settle";
+  // The Newton on the sets an answer predicts: it confirms them where they are the solution's (exact on them).
+  int attempts = 0;
+  linalg::FrictionNewtonResult polished;
+  const auto confirm = [&](const AlmOutcome& answer, int max_steps) {
+    ++attempts;
+    linalg::FrictionNewtonSettings polish;
+    polish.max_steps = max_steps;
+    polish.tolerance = 1e-12;
+    polished = linalg::friction_newton(
+        problem, linalg::predict_friction_sets(answer.lambda, answer.h, problem.c, problem.rows, problem.mask), polish);
+    return polished.report.stop == SolveStop::converged;
+  };
   const AlmOutcome alm = solve_by_augmented_lagrangian(
       s, problem.mask, problem.c, memory.x, memory.lambda, AlmSettings{},
       [&](int k, const Eigen::VectorXd& x, const Eigen::VectorXd& lambda, const Eigen::VectorXd& h, double comp) {
         return report(k, linalg::FrictionIterate{lambda, h, x}, comp, 0);
-      });
+      },
+      [&](const AlmOutcome& answer) { return confirm(answer, 3); });
   steps_before += alm.updates;
   std::ostringstream os;
   os << "the active-set Newton " << why << " in " << newton_steps << " steps; the augmented Lagrangian ";
@@ -129,24 +142,19 @@ std::string by_augmented_lagrangian(const Stacked& s, const linalg::FrictionNewt
     return os.str();
   }
   os << "settled in " << alm.updates << " updates (" << alm.newton_steps << " Newton steps on the whole system)";
-  const linalg::FrictionSets predicted =
-      linalg::predict_friction_sets(alm.lambda, alm.h, problem.c, problem.rows, problem.mask);
-  linalg::FrictionNewtonSettings polish;
-  polish.max_steps = 10;
-  polish.tolerance = 1e-12;
-  const auto on_step = [&](const linalg::FrictionIterate& it, const linalg::ActiveSetStep& step) {
-    return report(step.step, it, step.complementarity, step.changes);
-  };
-  linalg::FrictionNewtonResult polished = linalg::friction_newton(problem, predicted, polish, on_step);
-  if (polished.report.stop == SolveStop::converged) {
+  if (alm.confirmed || confirm(alm, 10)) {
+    os << ", its sets confirmed by the Newton (" << attempts << (attempts == 1 ? " try" : " tries") << ")";
     result = std::move(polished);
-    return os.str() + ", its sets confirmed by the Newton";
+    const double complementarity = linalg::friction_complementarity(result.iterate.lambda, result.iterate.h, problem.c,
+                                                                    problem.rows, problem.mask);
+    report(1, result.iterate, complementarity, 0);  // the confirmed answer, as one more step
+    result.report.iterations = 1;
+    return os.str();
   }
-  steps_before += static_cast<int>(polished.report.iterations);
   result = linalg::FrictionNewtonResult{};
   result.report.stop = SolveStop::converged;
   result.iterate = linalg::FrictionIterate{alm.lambda, alm.h, alm.x};
-  result.sets = predicted;
+  result.sets = linalg::predict_friction_sets(alm.lambda, alm.h, problem.c, problem.rows, problem.mask);
   return os.str();
 }
 

@@ -149,7 +149,8 @@ bool minimise(const Lagrangian& L, const Eigen::VectorXd& proximal, Eigen::Vecto
 
 AlmOutcome solve_by_augmented_lagrangian(const Stacked& s, const std::vector<char>& mask, const Eigen::VectorXd& c,
                                          const Eigen::VectorXd& x0, const Eigen::VectorXd& lambda0,
-                                         const AlmSettings& settings, const AlmCallback& after_update) {
+                                         const AlmSettings& settings, const AlmCallback& after_update,
+                                         const AlmConfirm& confirm) {
   const Eigen::Index n = s.b.size(), m = s.g0.size(), nf = static_cast<Eigen::Index>(s.friction.size());
   const RowKinds kinds(m, mask, s.friction);
   const Eigen::VectorXd rho = settings.boost * c;
@@ -201,6 +202,10 @@ AlmOutcome solve_by_augmented_lagrangian(const Stacked& s, const std::vector<cha
     if (!settled) break;
     if (out.complementarity <= settings.tolerance) {
       out.converged = true;
+      return out;
+    }
+    if (confirm && out.complementarity <= settings.confirm_below && confirm(out)) {
+      out.converged = out.confirmed = true;
       return out;
     }
     // Coulomb: the bounds from the normal multipliers, and the next Tresca solve to a hundredth of their change.

@@ -32,6 +32,9 @@ struct AlmSettings {
   // which the Newton's step (ddm/monolithic.cpp) is exact.
   double tolerance = 1e-9;
   double boost = 1e3;  // rho = boost c
+  // Below this complementarity each Coulomb iteration's answer is offered to `confirm` (the caller's Newton on the
+  // sets it predicts): the sets are usually right long before the multipliers reach the tolerance.
+  double confirm_below = 1e-6;
 };
 
 struct AlmOutcome {
@@ -41,7 +44,8 @@ struct AlmOutcome {
   int newton_steps = 0;  // factorisations
   Eigen::VectorXd x, lambda, h;
   double complementarity = 0.0;
-  std::string failure;  // why it stopped unconverged
+  bool confirmed = false;  // converged because `confirm` accepted the answer's sets
+  std::string failure;     // why it stopped unconverged
 };
 
 // After each update: its number, the iterate and its complementarity; true stops the solve (cancelled).
@@ -51,8 +55,12 @@ using AlmCallback = std::function<bool(int update, const Eigen::VectorXd& x, con
 // From x0 and lambda0 (either may be empty: zero; without lambda0 the first update holds every contact node by
 // unbounded friction, the tied problem, which is well posed where Coulomb bounds of zero would let every floating
 // body slide). `mask` marks the tangential rows, `c` each row's scale (prediction and rho).
+// Whether the caller takes an answer as converged (it solved the sets the answer predicts exactly).
+using AlmConfirm = std::function<bool(const AlmOutcome& answer)>;
+
 AlmOutcome solve_by_augmented_lagrangian(const Stacked& s, const std::vector<char>& mask, const Eigen::VectorXd& c,
                                          const Eigen::VectorXd& x0, const Eigen::VectorXd& lambda0,
-                                         const AlmSettings& settings, const AlmCallback& after_update);
+                                         const AlmSettings& settings, const AlmCallback& after_update,
+                                         const AlmConfirm& confirm = {});
 
 }  // namespace contact::ddm::monolithic

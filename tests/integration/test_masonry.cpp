@@ -207,7 +207,8 @@ TEST(Masonry, NearItsLimitAWallsCollapseTrialsAreDecidedWithoutRunningOutTheirBu
     EXPECT_NEAR(b.omega, 0.0, 1e-9) << b.words;
     if (std::abs(b.velocity.x()) > std::abs(fastest)) fastest = b.velocity.x();
   }
-  EXPECT_NEAR(fastest, 1.0, 1e-12) << m.words;  // along the shear (a heel brick may be squeezed out the other way, slower)
+  EXPECT_NEAR(fastest, 1.0, 1e-12)
+      << m.words;  // along the shear (a heel brick may be squeezed out the other way, slower)
   int sliding = 0;
   for (const auto& j : m.joints) {
     if (j.kind != "slides") continue;
@@ -342,10 +343,10 @@ TEST(Masonry, TheMonolithicReferenceAnswersNearTheLimitWhereItsNewtonCycles) {
   EXPECT_NE(reference.message.find("its sets confirmed by the Newton"), std::string::npos) << reference.message;
   EXPECT_EQ(reference.message.find("cut"), std::string::npos) << reference.message;
   // Both carry the applied loads into the base (1e-8), and every traction is the same to 1e-8 of the largest
-  // pressure. The displacements agree only to the slips that no force decides: a brick held by slipping nodes
-  // alone (b1_0, the half brick at the left end of the second course, at mu times its three nodes' pressure) is in
-  // equilibrium at any slip, and each method's is the end of its own iteration (2.8e-7 of its displacement apart,
-  // where two tolerances of the iterative solver itself give 9e-8).
+  // pressure. So is every body's displacement, but for a brick held by slipping nodes alone (b1_0, the half brick
+  // at the left end of the second course, at mu times its three nodes' pressure): it is in equilibrium at any slip,
+  // no force decides it, and each method's is its own (the reference's from the factorisation of the singular system
+  // its sets give).
   const Eigen::Vector2d load = applied_load(job, 1);
   for (const Result* r : {&interface, &reference}) {
     const Eigen::Vector2d reaction = support_reactions(r->steps[1]);
@@ -361,11 +362,22 @@ TEST(Masonry, TheMonolithicReferenceAnswersNearTheLimitWhereItsNewtonCycles) {
     worst = std::max(worst, (p.tangential_traction - q.tangential_traction).cwiseAbs().maxCoeff());
   }
   EXPECT_LT(worst, 1e-8 * largest);
+  int undecided = 0;
   for (size_t i = 0; i < reference.steps[1].bodies.size(); ++i) {
+    const std::string& name = reference.steps[1].bodies[i].name;
+    bool sticks = name == "base";
+    for (const auto& pair : reference.steps[1].pairs)
+      if (pair.slave_body == name || pair.master_body == name)
+        for (Eigen::Index j = 0; j < pair.active.size(); ++j) sticks = sticks || (pair.active[j] && pair.stick[j]);
+    if (!sticks) {
+      ++undecided;
+      continue;
+    }
     const auto& u = interface.steps[1].bodies[i].displacement;
     const auto& v = reference.steps[1].bodies[i].displacement;
-    EXPECT_LT((u - v).cwiseAbs().maxCoeff(), 1e-5 * v.cwiseAbs().maxCoeff()) << reference.steps[1].bodies[i].name;
+    EXPECT_LT((u - v).cwiseAbs().maxCoeff(), 1e-8 * v.cwiseAbs().maxCoeff()) << name;
   }
+  EXPECT_LE(undecided, 2);
 }
 
 TEST(Masonry, AHeadJointLeavesTheBedJointsTheirWholeFriction) {
