@@ -112,15 +112,22 @@ std::string by_augmented_lagrangian(const Stacked& s, const linalg::FrictionNewt
   const int newton_steps = static_cast<int>(result.report.iterations);
   const std::string why = result.report.stop == SolveStop::singular ? "reached only singular sets" : "did not settle";
   // The Newton on the sets an answer predicts: it confirms them where they are the solution's (exact on them).
+  // Sets that failed once are not tried again (the answers between two Coulomb iterations often predict the same).
   int attempts = 0;
   linalg::FrictionNewtonResult polished;
+  linalg::FrictionSets tried;
+  int tried_steps = 0;
   const auto confirm = [&](const AlmOutcome& answer, int max_steps) {
+    linalg::FrictionSets sets =
+        linalg::predict_friction_sets(answer.lambda, answer.h, problem.c, problem.rows, problem.mask);
+    if (attempts > 0 && sets == tried && max_steps <= tried_steps) return false;
     ++attempts;
+    tried = sets;
+    tried_steps = max_steps;
     linalg::FrictionNewtonSettings polish;
     polish.max_steps = max_steps;
     polish.tolerance = 1e-12;
-    polished = linalg::friction_newton(
-        problem, linalg::predict_friction_sets(answer.lambda, answer.h, problem.c, problem.rows, problem.mask), polish);
+    polished = linalg::friction_newton(problem, std::move(sets), polish);
     return polished.report.stop == SolveStop::converged;
   };
   const AlmOutcome alm = solve_by_augmented_lagrangian(

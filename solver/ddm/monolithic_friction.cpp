@@ -91,15 +91,39 @@ class Lagrangian {
   const Eigen::VectorXd &rho_, &lambda_, &bound_;
 };
 
+// The Newton matrices' Cholesky factor. Their pattern is K's and B^T B's whichever rows are inside C (the rows
+// outside enter with weight 0, kept as stored zeros), so CHOLMOD's ordering and symbolic analysis are made once per
+// solve and each step only factorises numerically.
+class NewtonFactor {
+ public:
+  NewtonFactor() { factor_.cholmod().print = 0; }
+  // H^-1 g (empty when H could not be factorised). H compressed.
+  Eigen::VectorXd solve(const SpMat& H, const Eigen::VectorXd& g) {
+    const std::vector<int> outer(H.outerIndexPtr(), H.outerIndexPtr() + H.outerSize() + 1);
+    const std::vector<int> inner(H.innerIndexPtr(), H.innerIndexPtr() + H.nonZeros());
+    if (outer != outer_ || inner != inner_) {  // a new pattern (Eigen may drop a zero): analysed again
+      factor_.analyzePattern(H);
+      outer_ = outer;
+      inner_ = inner;
+    }
+    factor_.factorize(H);
+    if (factor_.info() != Eigen::Success) return {};
+    return factor_.solve(g);
+  }
+
+ private:
+  Eigen::CholmodDecomposition<SpMat, Eigen::Lower> factor_;
+  std::vector<int> outer_, inner_;
+};
+
 // x <- argmin L(x) + 1/2 (x - x_k)^T T (x - x_k), x_k the update's start, by Newton steps with the Armijo line
 // search. The proximal term T (kProximal of each unknown's own stiffness) keeps every Newton matrix positive
 // definite: along a brick that slides at both its joints L has no curvature (and, until the joints around it
 // engage, a slope), and the step there is the slope over T, a finite move per update, where a bare Newton step would
 // be unbounded. At the multipliers' fixed point x = x_k, so the answer is L's own (the proximal method of
 // multipliers, Rockafellar 1976). False when a Newton matrix cannot be factorised.
-bool minimise(const Lagrangian& L, const Eigen::VectorXd& proximal, Eigen::VectorXd& x, int& steps) {
-  Eigen::CholmodDecomposition<SpMat, Eigen::Lower> factor;
-  factor.cholmod().print = 0;
+bool minimise(const Lagrangian& L, const Eigen::VectorXd& proximal, NewtonFactor& factor, Eigen::VectorXd& x,
+              int& steps) {
   const Eigen::VectorXd centre = x;
   const auto value = [&](const Lagrangian::Point& p, const Eigen::VectorXd& y) {
     const Eigen::VectorXd d = y - centre;
@@ -109,11 +133,11 @@ bool minimise(const Lagrangian& L, const Eigen::VectorXd& proximal, Eigen::Vecto
   for (int k = 0; k < kMaxNewton; ++k) {
     const Eigen::VectorXd g = L.gradient(x, p) + proximal.cwiseProduct(x - centre);
     if (g.norm() <= 1e-15 * L.force_scale(p)) return true;  // at the minimum to rounding
-    factor.compute(SpMat(L.newton_matrix(p) + SpMat(proximal.asDiagonal())));
+    SpMat H = L.newton_matrix(p) + SpMat(proximal.asDiagonal());
+    H.makeCompressed();
+    const Eigen::VectorXd d = -factor.solve(H, g);
     ++steps;
-    if (factor.info() != Eigen::Success) return false;
-    const Eigen::VectorXd d = -factor.solve(g);
-    if (!d.allFinite()) return false;
+    if (d.size() != g.size() || !d.allFinite()) return false;
     const double slope = g.dot(d);
     if (slope >= 0) return true;  // no descent left: at the minimum to rounding
     const double v0 = value(p, x);
@@ -170,6 +194,7 @@ AlmOutcome solve_by_augmented_lagrangian(const Stacked& s, const std::vector<cha
   bool tied = lambda0.size() != m;
   Eigen::VectorXd bound = bounds_of(lambda, tied);
   linalg::NonnegativeAnderson mixing(5);
+  NewtonFactor factor;
   double inner_tolerance = 1e-3;  // the first bounds are wrong by far more than any finer Tresca answer would fix
   while (out.updates < settings.max_updates) {
     // Tresca at `bound`: multiplier updates until they settle to the inner tolerance (a convex problem: they do).
@@ -178,7 +203,7 @@ AlmOutcome solve_by_augmented_lagrangian(const Stacked& s, const std::vector<cha
     while (!settled && out.updates < settings.max_updates) {
       Eigen::VectorXd x = out.x;
       const Lagrangian L(s, kinds, rho, lambda, bound);
-      if (!minimise(L, proximal, x, out.newton_steps)) {
+      if (!minimise(L, proximal, factor, x, out.newton_steps)) {
         out.failure = "its Newton matrix could not be factorised";
         return out;
       }
