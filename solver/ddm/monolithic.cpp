@@ -112,20 +112,19 @@ std::string by_augmented_lagrangian(const Stacked& s, const linalg::FrictionNewt
   const int newton_steps = static_cast<int>(result.report.iterations);
   const std::string why = result.report.stop == SolveStop::singular ? "reached only singular sets" : "did not settle";
   // The Newton on the sets an answer predicts: it confirms them where they are the solution's (exact on them).
-  // Sets that failed once are not tried again (the answers between two Coulomb iterations often predict the same).
+  // Ten Newton steps from the sets an answer predicts; sets that failed once are not tried again (the answers of two
+  // Coulomb iterations often predict the same).
   int attempts = 0;
   linalg::FrictionNewtonResult polished;
   linalg::FrictionSets tried;
-  int tried_steps = 0;
-  const auto confirm = [&](const AlmOutcome& answer, int max_steps) {
+  const auto confirm = [&](const AlmOutcome& answer) {
     linalg::FrictionSets sets =
         linalg::predict_friction_sets(answer.lambda, answer.h, problem.c, problem.rows, problem.mask);
-    if (attempts > 0 && sets == tried && max_steps <= tried_steps) return false;
+    if (attempts > 0 && sets == tried) return false;
     ++attempts;
     tried = sets;
-    tried_steps = max_steps;
     linalg::FrictionNewtonSettings polish;
-    polish.max_steps = max_steps;
+    polish.max_steps = 10;
     polish.tolerance = 1e-12;
     polished = linalg::friction_newton(problem, std::move(sets), polish);
     return polished.report.stop == SolveStop::converged;
@@ -135,7 +134,7 @@ std::string by_augmented_lagrangian(const Stacked& s, const linalg::FrictionNewt
       [&](int k, const Eigen::VectorXd& x, const Eigen::VectorXd& lambda, const Eigen::VectorXd& h, double comp) {
         return report(k, linalg::FrictionIterate{lambda, h, x}, comp, 0);
       },
-      [&](const AlmOutcome& answer) { return confirm(answer, 3); });
+      confirm);
   steps_before += alm.updates;
   std::ostringstream os;
   os << "the active-set Newton " << why << " in " << newton_steps << " steps; the augmented Lagrangian ";
@@ -149,7 +148,7 @@ std::string by_augmented_lagrangian(const Stacked& s, const linalg::FrictionNewt
     return os.str();
   }
   os << "settled in " << alm.updates << " updates (" << alm.newton_steps << " Newton steps on the whole system)";
-  if (alm.confirmed || confirm(alm, 10)) {
+  if (alm.confirmed || confirm(alm)) {
     os << ", its sets confirmed by the Newton (" << attempts << (attempts == 1 ? " try" : " tries") << ")";
     result = std::move(polished);
     const double complementarity = linalg::friction_complementarity(result.iterate.lambda, result.iterate.h, problem.c,
