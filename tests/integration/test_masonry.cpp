@@ -380,6 +380,37 @@ TEST(Masonry, TheMonolithicReferenceAnswersNearTheLimitWhereItsNewtonCycles) {
   EXPECT_LE(undecided, 2);
 }
 
+TEST(Masonry, TheMonolithicReferenceChecksAWallWithinTwoPercentOfItsCollapse) {
+  // The 4 x 4 wall with free course ends: the interface solvers' collapse analysis brackets lambda_c = 0.600 (its
+  // courses slide, at the associated bound). The monolithic reference's own analysis brackets the same limit to the
+  // analysis' tolerance (1e-3; it stopped at 0.588 when its Newton alone took the trials), and at H/V = 0.59, within
+  // 2 % of the limit, the two give the same tractions to 1e-8 of the largest pressure.
+  const json analysis = wall(4, 4, "--head-joints --friction 0.6 --collapse");
+  const Result by_interface = run(analysis);
+  const Result by_reference = run(monolithic(analysis));
+  ASSERT_EQ(by_interface.collapse.verdict, "collapse") << by_interface.message;
+  ASSERT_EQ(by_reference.collapse.verdict, "collapse") << by_reference.message;
+  const double limit = by_interface.collapse.held;
+  EXPECT_NEAR(by_reference.collapse.held, limit, 1e-3 * limit) << by_reference.collapse.words;
+  EXPECT_NEAR(by_reference.collapse.failed, limit, 1e-3 * limit) << by_reference.collapse.words;
+
+  json job = wall(4, 4, "--head-joints --friction 0.6 --shear 0.59");
+  job["solver"]["interface"] = {{"solver", "iterative"}, {"tolerance", 1e-13}};
+  const Result interface = run(job);
+  const Result reference = run(monolithic(job));
+  ASSERT_TRUE(interface.converged) << interface.message;
+  ASSERT_TRUE(reference.converged) << reference.message;
+  double largest = 0.0, worst = 0.0;
+  for (const auto& pair : reference.steps[1].pairs) largest = std::max(largest, pair.pressure.cwiseAbs().maxCoeff());
+  for (size_t k = 0; k < reference.steps[1].pairs.size(); ++k) {
+    const auto& p = interface.steps[1].pairs[k];
+    const auto& q = reference.steps[1].pairs[k];
+    worst = std::max(worst, (p.pressure - q.pressure).cwiseAbs().maxCoeff());
+    worst = std::max(worst, (p.tangential_traction - q.tangential_traction).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LT(worst, 1e-8 * largest);
+}
+
 TEST(Masonry, AHeadJointLeavesTheBedJointsTheirWholeFriction) {
   // Two half bricks side by side on a brick: the top course's point shears S V are carried by its two bed joints
   // alone (the head joint is inside the course), so statics holds it for every S < mu = 0.6, with the bed joints'
