@@ -164,6 +164,53 @@ std::string by_augmented_lagrangian(const Stacked& s, const linalg::FrictionNewt
   return os.str();
 }
 
+// The method's outcome from the Newton's (or the augmented Lagrangian's) result: its stop in words, and the
+// displacements and multipliers of its last iterate.
+void record_outcome(const ContactSystem& system, const Stacked& s, const std::vector<char>& mask, bool floating,
+                    const linalg::FrictionNewtonResult& result, const std::string& handed_over, MethodOutcome& out) {
+  const Eigen::Index m = s.g0.size();
+  switch (result.report.stop) {
+    case SolveStop::converged: {
+      out.converged = true;
+      out.stop_reason = StopReason::converged;
+      int na = 0;
+      for (Eigen::Index j = 0; j < m; ++j)
+        na += result.sets.active[static_cast<size_t>(j)] && !mask[static_cast<size_t>(j)];
+      std::ostringstream os;
+      os << "monolithic active set settled (" << na << " of " << s.row_offset.back() << " contact nodes in contact)";
+      if (result.damped_steps > 0) os << "; " << result.damped_steps << " steps damped by the line search";
+      if (!handed_over.empty()) os << "; " << handed_over;
+      out.message = os.str();
+      break;
+    }
+    case SolveStop::cancelled:
+      out.stop_reason = StopReason::cancelled;
+      out.message = "cancelled";
+      break;
+    case SolveStop::singular:
+      out.stop_reason = StopReason::error;
+      out.message = std::string("monolithic: the saddle-point system of the ") +
+                    (s.friction.empty() ? "active set" : "stick and slip sets") + " is singular at step " +
+                    std::to_string(result.report.iterations) +
+                    (floating ? ": a floating body is held by none of the contact nodes in contact" : "") +
+                    (handed_over.empty() ? "" : "; " + handed_over);
+      return;
+    case SolveStop::max_iterations:
+      out.stop_reason = StopReason::max_iterations;
+      out.message = "monolithic: the active set did not settle within max_iterations";
+      if (!handed_over.empty()) out.message += "; " + handed_over;
+      break;
+  }
+  const Eigen::VectorXd x = result.iterate.other.size() == s.b.size()
+                                ? result.iterate.other
+                                : Eigen::VectorXd(Eigen::VectorXd::Zero(s.b.size()));
+  const Eigen::VectorXd lambda =
+      result.iterate.lambda.size() == m ? result.iterate.lambda : Eigen::VectorXd(Eigen::VectorXd::Zero(m));
+  out.u = to_bodies(system, s, x);
+  out.z = split_rows(system, s, lambda);
+  if (!s.friction.empty()) out.q = split_tangential(system, s, lambda);
+}
+
 void run_exact(const ContactSystem& system, RunFrame& frame, MonolithicMemory& memory) {
   MethodOutcome& out = frame.outcome();
   if (std::string sliding = friction_cannot_hold(system, frame.state().load);
@@ -238,45 +285,7 @@ void run_exact(const ContactSystem& system, RunFrame& frame, MonolithicMemory& m
     memory.lambda = result.iterate.lambda;
   }
   out.iterations = steps_before + static_cast<int>(result.report.iterations);
-  switch (result.report.stop) {
-    case SolveStop::converged: {
-      out.converged = true;
-      out.stop_reason = StopReason::converged;
-      int na = 0;
-      for (Eigen::Index j = 0; j < m; ++j)
-        na += result.sets.active[static_cast<size_t>(j)] && !mask[static_cast<size_t>(j)];
-      std::ostringstream os;
-      os << "monolithic active set settled (" << na << " of " << s.row_offset.back() << " contact nodes in contact)";
-      if (result.damped_steps > 0) os << "; " << result.damped_steps << " steps damped by the line search";
-      if (!handed_over.empty()) os << "; " << handed_over;
-      out.message = os.str();
-      break;
-    }
-    case SolveStop::cancelled:
-      out.stop_reason = StopReason::cancelled;
-      out.message = "cancelled";
-      break;
-    case SolveStop::singular:
-      out.stop_reason = StopReason::error;
-      out.message = std::string("monolithic: the saddle-point system of the ") +
-                    (s.friction.empty() ? "active set" : "stick and slip sets") + " is singular at step " +
-                    std::to_string(result.report.iterations) +
-                    (floating ? ": a floating body is held by none of the contact nodes in contact" : "");
-      return;
-    case SolveStop::max_iterations:
-      out.stop_reason = StopReason::max_iterations;
-      out.message = "monolithic: the active set did not settle within max_iterations";
-      if (!handed_over.empty()) out.message += "; " + handed_over;
-      break;
-  }
-  const Eigen::VectorXd x = result.iterate.other.size() == s.b.size()
-                                ? result.iterate.other
-                                : Eigen::VectorXd(Eigen::VectorXd::Zero(s.b.size()));
-  const Eigen::VectorXd lambda =
-      result.iterate.lambda.size() == m ? result.iterate.lambda : Eigen::VectorXd(Eigen::VectorXd::Zero(m));
-  out.u = to_bodies(system, s, x);
-  out.z = split_rows(system, s, lambda);
-  if (!s.friction.empty()) out.q = split_tangential(system, s, lambda);
+  record_outcome(system, s, mask, floating, result, handed_over, out);
 }
 
 // The penalty problem on the stacked system: the convex energy
