@@ -134,7 +134,7 @@ std::string by_augmented_lagrangian(const Stacked& s, const linalg::FrictionNewt
       [&](int k, const Eigen::VectorXd& x, const Eigen::VectorXd& lambda, const Eigen::VectorXd& h, double comp) {
         return report(k, linalg::FrictionIterate{lambda, h, x}, comp, 0);
       },
-      confirm);
+      confirm, problem.cancelled);
   steps_before += alm.updates;
   std::ostringstream os;
   os << "the active-set Newton " << why << " in " << newton_steps << " steps; the augmented Lagrangian ";

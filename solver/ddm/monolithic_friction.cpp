@@ -121,9 +121,10 @@ class NewtonFactor {
 // definite: along a brick that slides at both its joints L has no curvature (and, until the joints around it
 // engage, a slope), and the step there is the slope over T, a finite move per update, where a bare Newton step would
 // be unbounded. At the multipliers' fixed point x = x_k, so the answer is L's own (the proximal method of
-// multipliers, Rockafellar 1976). False when a Newton matrix cannot be factorised.
-bool minimise(const Lagrangian& L, const Eigen::VectorXd& proximal, NewtonFactor& factor, Eigen::VectorXd& x,
-              int& steps) {
+// multipliers, Rockafellar 1976).
+enum class Minimised { yes, singular, cancelled };
+Minimised minimise(const Lagrangian& L, const Eigen::VectorXd& proximal, NewtonFactor& factor,
+                   const std::function<bool()>& cancelled, Eigen::VectorXd& x, int& steps) {
   const Eigen::VectorXd centre = x;
   const auto value = [&](const Lagrangian::Point& p, const Eigen::VectorXd& y) {
     const Eigen::VectorXd d = y - centre;
@@ -132,14 +133,15 @@ bool minimise(const Lagrangian& L, const Eigen::VectorXd& proximal, NewtonFactor
   Lagrangian::Point p = L.at(x);
   for (int k = 0; k < kMaxNewton; ++k) {
     const Eigen::VectorXd g = L.gradient(x, p) + proximal.cwiseProduct(x - centre);
-    if (g.norm() <= 1e-15 * L.force_scale(p)) return true;  // at the minimum to rounding
+    if (g.norm() <= 1e-15 * L.force_scale(p)) return Minimised::yes;  // at the minimum to rounding
+    if (cancelled && cancelled()) return Minimised::cancelled;
     SpMat H = L.newton_matrix(p) + SpMat(proximal.asDiagonal());
     H.makeCompressed();
     const Eigen::VectorXd d = -factor.solve(H, g);
     ++steps;
-    if (d.size() != g.size() || !d.allFinite()) return false;
+    if (d.size() != g.size() || !d.allFinite()) return Minimised::singular;
     const double slope = g.dot(d);
-    if (slope >= 0) return true;  // no descent left: at the minimum to rounding
+    if (slope >= 0) return Minimised::yes;  // no descent left: at the minimum to rounding
     const double v0 = value(p, x);
     double alpha = 1.0;
     Eigen::VectorXd y = x + d;
@@ -155,7 +157,7 @@ bool minimise(const Lagrangian& L, const Eigen::VectorXd& proximal, NewtonFactor
       // No step verifies a decrease: near the minimum L's changes are below its rounding. The full step if it
       // lowers the gradient, else x is the minimum to rounding.
       const Eigen::VectorXd g_full = L.gradient(x + d, full) + proximal.cwiseProduct(x + d - centre);
-      if (g_full.norm() >= g.norm()) return true;
+      if (g_full.norm() >= g.norm()) return Minimised::yes;
       alpha = 1.0;
       y = x + d;
       q = full;
@@ -164,9 +166,9 @@ bool minimise(const Lagrangian& L, const Eigen::VectorXd& proximal, NewtonFactor
     const bool same_piece = alpha == 1.0 && q.interior == p.interior;
     x = std::move(y);
     p = std::move(q);
-    if (same_piece) return true;
+    if (same_piece) return Minimised::yes;
   }
-  return true;  // still descending after kMaxNewton steps: the update makes progress all the same
+  return Minimised::yes;  // still descending after kMaxNewton steps: the update makes progress all the same
 }
 
 }  // namespace
@@ -174,7 +176,7 @@ bool minimise(const Lagrangian& L, const Eigen::VectorXd& proximal, NewtonFactor
 AlmOutcome solve_by_augmented_lagrangian(const Stacked& s, const std::vector<char>& mask, const Eigen::VectorXd& c,
                                          const Eigen::VectorXd& x0, const Eigen::VectorXd& lambda0,
                                          const AlmSettings& settings, const AlmCallback& after_update,
-                                         const AlmConfirm& confirm) {
+                                         const AlmConfirm& confirm, const std::function<bool()>& cancelled) {
   const Eigen::Index n = s.b.size(), m = s.g0.size(), nf = static_cast<Eigen::Index>(s.friction.size());
   const RowKinds kinds(m, mask, s.friction);
   const Eigen::VectorXd rho = settings.boost * c;
@@ -203,7 +205,12 @@ AlmOutcome solve_by_augmented_lagrangian(const Stacked& s, const std::vector<cha
     while (!settled && out.updates < settings.max_updates) {
       Eigen::VectorXd x = out.x;
       const Lagrangian L(s, kinds, rho, lambda, bound);
-      if (!minimise(L, proximal, factor, x, out.newton_steps)) {
+      const Minimised minimised = minimise(L, proximal, factor, cancelled, x, out.newton_steps);
+      if (minimised == Minimised::cancelled) {
+        out.cancelled = true;
+        return out;
+      }
+      if (minimised == Minimised::singular) {
         out.failure = "its Newton matrix could not be factorised";
         return out;
       }

@@ -55,15 +55,16 @@ struct AlmOutcome {
 using AlmCallback = std::function<bool(int update, const Eigen::VectorXd& x, const Eigen::VectorXd& lambda,
                                        const Eigen::VectorXd& h, double complementarity)>;
 
-// From x0 and lambda0 (either may be empty: zero; without lambda0 the first update holds every contact node by
-// unbounded friction, the tied problem, which is well posed where Coulomb bounds of zero would let every floating
-// body slide). `mask` marks the tangential rows, `c` each row's scale (prediction and rho).
 // Whether the caller takes an answer as converged (it solved the sets the answer predicts exactly).
 using AlmConfirm = std::function<bool(const AlmOutcome& answer)>;
 
+// From x0 and lambda0 (either may be empty: zero; without lambda0 the first update holds every contact node by
+// unbounded friction, the tied problem, which is well posed where Coulomb bounds of zero would let every floating
+// body slide). `mask` marks the tangential rows, `c` each row's scale (prediction and rho). `cancelled` is asked
+// before every Newton step (one factorisation: a cancel stops the solve within one).
 AlmOutcome solve_by_augmented_lagrangian(const Stacked& s, const std::vector<char>& mask, const Eigen::VectorXd& c,
                                          const Eigen::VectorXd& x0, const Eigen::VectorXd& lambda0,
                                          const AlmSettings& settings, const AlmCallback& after_update,
-                                         const AlmConfirm& confirm = {});
+                                         const AlmConfirm& confirm, const std::function<bool()>& cancelled);
 
 }  // namespace contact::ddm::monolithic
